@@ -1,0 +1,62 @@
+/* core.h — engine-internal helpers shared by every module: diagnostics text built
+ * without stdio, vector and matrix math, and deterministic trigonometry.
+ * Private names carry the om__ prefix; nothing here is part of the public API. */
+#ifndef OM_CORE_H
+#define OM_CORE_H
+
+#include "ombra.h"
+
+/* ---- diagnostics: a bounded string builder (no stdio in the engine) */
+typedef struct om__str { char *buf; size_t cap, len; } om__str;
+
+void om__str_init(om__str *s, char *buf, size_t cap);
+void om__str_s(om__str *s, const char *text);
+void om__str_u(om__str *s, uint64_t v);
+void om__str_i(om__str *s, int64_t v);
+void om__str_f(om__str *s, double v, int decimals);
+
+/* Sets d->status and d->msg (if d) and returns `st`, so callers write
+ * `return om__fail(d, OM_E_INVALID, "width must be 1..8192");`. */
+om_status om__fail(om_diag *d, om_status st, const char *msg);
+/* Starts a message in d->msg and returns a builder over it (a dummy one if d is NULL). */
+om__str om__diag_begin(om_diag *d, om_status st, char *scratch, size_t scratch_cap);
+
+/* OM_OK when `a` has `need` bytes left; otherwise OM_E_BUDGET with a message naming
+ * `who` and the minimum. Inits call it with their bytes query's figure. */
+om_status om__need(om_arena *a, size_t need, const char *who, om_diag *d);
+
+/* ---- vectors */
+static inline om_vec3 om__v3(float x, float y, float z) { om_vec3 v; v.x = x; v.y = y; v.z = z; return v; }
+static inline om_vec3 om__add(om_vec3 a, om_vec3 b) { return om__v3(a.x + b.x, a.y + b.y, a.z + b.z); }
+static inline om_vec3 om__sub(om_vec3 a, om_vec3 b) { return om__v3(a.x - b.x, a.y - b.y, a.z - b.z); }
+static inline om_vec3 om__scale(om_vec3 a, float s) { return om__v3(a.x * s, a.y * s, a.z * s); }
+static inline float om__dot(om_vec3 a, om_vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+static inline om_vec3 om__cross(om_vec3 a, om_vec3 b)
+{
+    return om__v3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
+}
+om_vec3 om__normalize(om_vec3 a);          /* zero vector stays zero */
+bool om__finite3(om_vec3 a);
+static inline bool om__finite(float f) { return f == f && f - f == 0.0f; }
+
+/* ---- matrices (row-major, v' = M v) */
+om_mat4 om__mat_identity(void);
+om_mat4 om__mat_mul(const om_mat4 *a, const om_mat4 *b);
+om_vec4 om__mat_apply(const om_mat4 *m, om_vec3 p);        /* w = 1 */
+om_vec3 om__mat_apply_dir(const om_mat4 *m, om_vec3 d);    /* w = 0 */
+/* View matrix looking from eye to target; fails (false) when degenerate. */
+bool om__mat_look_at(om_mat4 *out, om_vec3 eye, om_vec3 target, om_vec3 up);
+/* Perspective projection onto clip space with depth z/w in [0, 1] (0 at znear). */
+om_mat4 om__mat_perspective(float fovy_deg, float aspect, float znear, float zfar);
+/* Orthographic projection of the view-space box to x, y in [-1,1], z in [0,1]. */
+om_mat4 om__mat_ortho(float l, float r, float b, float t, float znear, float zfar);
+
+/* ---- deterministic trigonometry: our own polynomials in IEEE double, so that every
+ * C library and CPU gives the same bits (libm's sin/cos/tan/atan need not). */
+double om__sin(double x);
+double om__cos(double x);
+double om__tan(double x);
+double om__atan(double x);
+#define OM_PI 3.14159265358979323846
+
+#endif

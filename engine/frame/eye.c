@@ -1,0 +1,103 @@
+/* eye.c — the eye pass: rasterize the scene from the camera (depth + triangle id),
+ * then give every covered pixel its exact visible point. The point comes from
+ * perspective-correct barycentrics of the pixel centre in homogeneous clip space
+ * (no division by w, so triangles crossing the camera plane are handled), which
+ * places it exactly on the triangle's plane whatever the depth buffer's precision. */
+#include "frame.h"
+
+static void clip_tri(const om_scene *s, const om_mat4 *vp, uint32_t t, om_vec4 c[3])
+{
+    const uint32_t *ix = s->idx + (size_t)t * 3;
+    for (int k = 0; k < 3; k++) c[k] = om__mat_apply(vp, s->verts[ix[k]]);
+}
+
+/* Per-triangle data reused while neighbouring pixels see the same triangle. */
+typedef struct tri_cache {
+    uint32_t tri;
+    double adj[9];         /* adjugate of the 3x3 matrix of (x, y, w) columns */
+    om_vec3 v[3], n;
+} tri_cache;
+
+static void cache_tri(const om_scene *s, const om_view *v, uint32_t t, tri_cache *c)
+{
+    om_vec4 q[3];
+    clip_tri(s, &v->cam_vp, t, q);
+    /* M has columns (x_i, y_i, w_i); we need M^-1 up to scale: the adjugate. */
+    double m[9] = {q[0].x, q[1].x, q[2].x, q[0].y, q[1].y, q[2].y, q[0].w, q[1].w, q[2].w};
+    c->adj[0] = m[4] * m[8] - m[5] * m[7];
+    c->adj[1] = m[2] * m[7] - m[1] * m[8];
+    c->adj[2] = m[1] * m[5] - m[2] * m[4];
+    c->adj[3] = m[5] * m[6] - m[3] * m[8];
+    c->adj[4] = m[0] * m[8] - m[2] * m[6];
+    c->adj[5] = m[2] * m[3] - m[0] * m[5];
+    c->adj[6] = m[3] * m[7] - m[4] * m[6];
+    c->adj[7] = m[1] * m[6] - m[0] * m[7];
+    c->adj[8] = m[0] * m[4] - m[1] * m[3];
+    const uint32_t *ix = s->idx + (size_t)t * 3;
+    for (int k = 0; k < 3; k++) c->v[k] = s->verts[ix[k]];
+    c->n = om__normalize(om__cross(om__sub(c->v[1], c->v[0]), om__sub(c->v[2], c->v[0])));
+    c->tri = t;
+}
+
+static void resolve_pixel(const tri_cache *c, double sx, double sy, om_sample *out)
+{
+    double b[3], sum = 0.0;
+    for (int k = 0; k < 3; k++) {
+        b[k] = c->adj[k * 3] * sx + c->adj[k * 3 + 1] * sy + c->adj[k * 3 + 2];
+        sum += b[k];
+    }
+    double inv = sum != 0.0 ? 1.0 / sum : 0.0;
+    double px = 0, py = 0, pz = 0;
+    for (int k = 0; k < 3; k++) {
+        double w = b[k] * inv;
+        px += w * c->v[k].x;
+        py += w * c->v[k].y;
+        pz += w * c->v[k].z;
+    }
+    out->p[0] = (float)px;
+    out->p[1] = (float)py;
+    out->p[2] = (float)pz;
+    out->n[0] = c->n.x;
+    out->n[1] = c->n.y;
+    out->n[2] = c->n.z;
+    out->tri = c->tri;
+}
+
+void om__scene_raster(const om_scene *s, const om_mat4 *vp, const om_target *tg,
+                      om_raster_mode mode)
+{
+    om_raster r;
+    r.target = tg;
+    r.mode = mode;
+    r.frag = NULL;
+    r.user = NULL;
+    om__target_clear(tg);
+    for (uint32_t t = 0; t < s->ntris; t++) {
+        om_vec4 c[3];
+        clip_tri(s, vp, t, c);
+        om__raster_tri(&r, c, t);
+    }
+}
+
+void om__eye_pass(const om_scene *s, const om_view *v, const om_target *tg, om_strip *st)
+{
+    om__scene_raster(s, &v->cam_vp, tg, OM_RASTER_DEPTH_ID);
+    tri_cache cache;
+    cache.tri = OM_NO_TRI;
+    for (uint32_t y = 0; y < st->rows; y++) {
+        double sy = 1.0 - ((double)(st->y0 + y) + 0.5) * 2.0 / (double)st->height;
+        for (uint32_t x = 0; x < st->width; x++) {
+            size_t i = (size_t)y * st->width + x;
+            uint32_t t = tg->id[i];
+            om_sample *smp = &st->samples[i];
+            if (t == OM_NO_TRI) {
+                memset(smp, 0, sizeof *smp);
+                smp->tri = OM_NO_TRI;
+                continue;
+            }
+            if (cache.tri != t) cache_tri(s, v, t, &cache);
+            double sx = ((double)x + 0.5) * 2.0 / (double)st->width - 1.0;
+            resolve_pixel(&cache, sx, sy, smp);
+        }
+    }
+}

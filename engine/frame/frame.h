@@ -1,0 +1,34 @@
+/* frame.h — engine-internal pieces of a frame: the eye pass that turns a strip of the
+ * image into visible samples, the geometric part of the lit rule, and shading. */
+#ifndef OM_FRAME_H
+#define OM_FRAME_H
+
+#include "../core/core.h"
+#include "../raster/raster.h"
+
+#include <string.h>
+#include <math.h>
+
+/* Clears `tg` and rasterizes every triangle of the scene through `vp` into it: the
+ * eye pass (OM_RASTER_DEPTH_ID) and every light depth pass (OM_RASTER_DEPTH). */
+void om__scene_raster(const om_scene *s, const om_mat4 *vp, const om_target *tg,
+                      om_raster_mode mode);
+
+/* Renders rows [st->y0, st->y0 + st->rows) of the camera view into `tg` (depth and
+ * triangle id, strip-sized) and resolves st->samples: the exact point of the visible
+ * triangle under each pixel centre, by perspective-correct barycentrics. */
+void om__eye_pass(const om_scene *s, const om_view *v, const om_target *tg, om_strip *st);
+
+/* The parts of the lit rule that no occluder decides, the same for every method:
+ * the normal turned towards the camera faces the light, and the point lies inside
+ * the light's frustum. */
+bool om__exposed(const om_view *v, const om_sample *smp);
+
+/* Direction from a point towards the light (unit). */
+om_vec3 om__to_light(const om_view *v, om_vec3 p);
+
+/* Shades a strip into fb rows 0..st->rows-1. */
+void om__shade_strip(const om_scene *s, const om_view *v, const om_shade_cfg *c,
+                     const om_strip *st, om_framebuffer *fb);
+
+#endif

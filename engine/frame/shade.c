@@ -1,0 +1,82 @@
+/* shade.c — the geometric half of the lit rule, Lambert + ambient shading, and the
+ * pixel formats of small devices. Shading is float arithmetic with no contraction and
+ * one rounding to 8 bits, so it is bit-identical on every CPU. */
+#include "frame.h"
+
+om_vec3 om__to_light(const om_view *v, om_vec3 p)
+{
+    if (v->light.kind == OM_LIGHT_DIRECTIONAL) return om__scale(v->light_axis, -1.0f);
+    return om__normalize(om__sub(v->light.pos, p));
+}
+
+bool om__exposed(const om_view *v, const om_sample *smp)
+{
+    om_vec3 p = om__v3(smp->p[0], smp->p[1], smp->p[2]);
+    om_vec3 n = om__v3(smp->n[0], smp->n[1], smp->n[2]);
+    if (om__dot(n, om__sub(v->cam.eye, p)) < 0.0f) n = om__scale(n, -1.0f);
+    if (!(om__dot(n, om__to_light(v, p)) > 0.0f)) return false;
+    om_vec4 q = om__mat_apply(&v->light_vp, p);
+    return q.w > 0.0f && q.x >= -q.w && q.x <= q.w && q.y >= -q.w && q.y <= q.w &&
+           q.z >= 0.0f && q.z <= q.w;
+}
+
+void om_shade_cfg_default(om_shade_cfg *c)
+{
+    c->ambient = 0.25f;
+    c->bg_r = 36;
+    c->bg_g = 44;
+    c->bg_b = 60;
+}
+
+uint32_t om_format_bpp(om_format f)
+{
+    return f == OM_RGB888 ? 3u : f == OM_RGB565 ? 2u : 1u;
+}
+
+static uint8_t to8(float v)
+{
+    v = v * 255.0f + 0.5f;
+    return v <= 0.0f ? 0 : v >= 255.0f ? 255 : (uint8_t)v;
+}
+
+static void put(om_framebuffer *fb, uint8_t *px, uint8_t r, uint8_t g, uint8_t b)
+{
+    switch (fb->format) {
+    case OM_RGB888: px[0] = r; px[1] = g; px[2] = b; break;
+    case OM_RGB565: {   /* little-endian 16-bit word: r in the top 5 bits */
+        uint16_t w = (uint16_t)(((r >> 3) << 11) | ((g >> 2) << 5) | (b >> 3));
+        px[0] = (uint8_t)(w & 0xFF);
+        px[1] = (uint8_t)(w >> 8);
+        break;
+    }
+    default: px[0] = (uint8_t)((77u * r + 150u * g + 29u * b + 128u) >> 8); break;
+    }
+}
+
+void om__shade_strip(const om_scene *s, const om_view *v, const om_shade_cfg *c,
+                     const om_strip *st, om_framebuffer *fb)
+{
+    uint32_t bpp = om_format_bpp(fb->format);
+    for (uint32_t y = 0; y < st->rows; y++) {
+        uint8_t *row = fb->pixels + (size_t)y * fb->stride;
+        for (uint32_t x = 0; x < st->width; x++) {
+            size_t i = (size_t)y * st->width + x;
+            const om_sample *smp = &st->samples[i];
+            uint8_t *px = row + (size_t)x * bpp;
+            if (smp->tri == OM_NO_TRI) { put(fb, px, c->bg_r, c->bg_g, c->bg_b); continue; }
+            const om_material *m = &s->mats[s->tri_mat[smp->tri]];
+            const om_term *t = &st->terms[i];
+            float lr = c->ambient, lg = c->ambient, lb = c->ambient;
+            if (t->flags & OM_TERM_EXPOSED) {
+                om_vec3 p = om__v3(smp->p[0], smp->p[1], smp->p[2]);
+                om_vec3 n = om__v3(smp->n[0], smp->n[1], smp->n[2]);
+                if (om__dot(n, om__sub(v->cam.eye, p)) < 0.0f) n = om__scale(n, -1.0f);
+                float k = om__dot(n, om__to_light(v, p)) * (1.0f - c->ambient) * (1.0f / 255.0f);
+                lr += k * (float)t->r;
+                lg += k * (float)t->g;
+                lb += k * (float)t->b;
+            }
+            put(fb, px, to8(m->r * lr), to8(m->g * lg), to8(m->b * lb));
+        }
+    }
+}

@@ -1,0 +1,120 @@
+/* view.c — camera and light matrices for one frame. A spot light projects through a
+ * square perspective frustum; a directional light through an orthographic box whose
+ * depth covers the whole scene (every caster) and whose x/y are fitted to the scene,
+ * or narrowed by om_view_fit_light to what the camera sees. */
+#include "frame.h"
+
+static om_status check_vec(om_vec3 v, om_diag *d, const char *what)
+{
+    if (!om__finite3(v) || v.x > 1e7f || v.x < -1e7f || v.y > 1e7f || v.y < -1e7f ||
+        v.z > 1e7f || v.z < -1e7f) {
+        char tmp[8];
+        om__str s = om__diag_begin(d, OM_E_RANGE, tmp, sizeof tmp);
+        om__str_s(&s, what);
+        om__str_s(&s, " must be finite and within 1e7");
+        return OM_E_RANGE;
+    }
+    return OM_OK;
+}
+
+static om_status check_range(float v, float lo, float hi, om_diag *d, const char *what)
+{
+    if (!(v > lo && v < hi)) {
+        char tmp[8];
+        om__str s = om__diag_begin(d, OM_E_INVALID, tmp, sizeof tmp);
+        om__str_s(&s, what);
+        om__str_s(&s, " must be in (");
+        om__str_f(&s, lo, 3);
+        om__str_s(&s, ", ");
+        om__str_f(&s, hi, 1);
+        om__str_s(&s, ")");
+        return OM_E_INVALID;
+    }
+    return OM_OK;
+}
+
+/* Light-space bounds of the scene's box: x/y extent and depth range along the view. */
+static void light_box(const om_mat4 *view, const om_scene *s, om_vec3 *lo, om_vec3 *hi)
+{
+    for (int i = 0; i < 8; i++) {
+        om_vec3 c = om__v3(i & 1 ? s->hi.x : s->lo.x, i & 2 ? s->hi.y : s->lo.y,
+                           i & 4 ? s->hi.z : s->lo.z);
+        om_vec4 q = om__mat_apply(view, c);
+        if (i == 0 || q.x < lo->x) lo->x = q.x;
+        if (i == 0 || q.y < lo->y) lo->y = q.y;
+        if (i == 0 || q.z < lo->z) lo->z = q.z;
+        if (i == 0 || q.x > hi->x) hi->x = q.x;
+        if (i == 0 || q.y > hi->y) hi->y = q.y;
+        if (i == 0 || q.z > hi->z) hi->z = q.z;
+    }
+}
+
+static void ortho_from(om_view *v, float x0, float x1, float y0, float y1, float zn, float zf)
+{
+    /* A little margin keeps samples on the box's faces strictly inside. */
+    float mx = (x1 - x0) * 1e-3f + 1e-4f, my = (y1 - y0) * 1e-3f + 1e-4f;
+    v->light_proj = om__mat_ortho(x0 - mx, x1 + mx, y0 - my, y1 + my, zn, zf);
+    v->light_vp = om__mat_mul(&v->light_proj, &v->light_view);
+}
+
+om_status om_view_init(om_view *v, const om_camera *cam, const om_light *light,
+                       const om_scene *s, om_diag *d)
+{
+    om_status st;
+    memset(v, 0, sizeof *v);
+    if (cam->width < 1 || cam->width > OM_MAX_DIM || cam->height < 1 || cam->height > OM_MAX_DIM)
+        return om__fail(d, OM_E_INVALID, "image size must be 1..8192 in each direction");
+    if ((st = check_vec(cam->eye, d, "camera eye")) || (st = check_vec(cam->target, d, "camera target")) ||
+        (st = check_vec(cam->up, d, "camera up")) ||
+        (st = check_range(cam->fovy_deg, 0.0f, 180.0f, d, "camera fov")) ||
+        (st = check_range(cam->znear, 0.0f, 1e7f, d, "camera near")) ||
+        (st = check_range(cam->zfar, cam->znear, 1e8f, d, "camera far")))
+        return st;
+    v->cam = *cam;
+    v->light = *light;
+    if (!om__mat_look_at(&v->cam_view, cam->eye, cam->target, cam->up))
+        return om__fail(d, OM_E_INVALID, "camera eye and target must differ");
+    v->cam_proj = om__mat_perspective(cam->fovy_deg, (float)cam->width / (float)cam->height,
+                                      cam->znear, cam->zfar);
+    v->cam_vp = om__mat_mul(&v->cam_proj, &v->cam_view);
+
+    if (light->kind == OM_LIGHT_SPOT) {
+        if ((st = check_vec(light->pos, d, "light pos")) ||
+            (st = check_vec(light->target, d, "light target")) ||
+            (st = check_range(light->fov_deg, 0.0f, 180.0f, d, "light fov")) ||
+            (st = check_range(light->znear, 0.0f, 1e7f, d, "light near")) ||
+            (st = check_range(light->zfar, light->znear, 1e8f, d, "light far")))
+            return st;
+        if (!om__mat_look_at(&v->light_view, light->pos, light->target, om__v3(0, 1, 0)))
+            return om__fail(d, OM_E_INVALID, "light pos and target must differ");
+        v->light_axis = om__normalize(om__sub(light->target, light->pos));
+        v->light_proj = om__mat_perspective(light->fov_deg, 1.0f, light->znear, light->zfar);
+        v->light_vp = om__mat_mul(&v->light_proj, &v->light_view);
+        return OM_OK;
+    }
+    if (light->kind != OM_LIGHT_DIRECTIONAL)
+        return om__fail(d, OM_E_INVALID, "light kind must be spot or directional");
+    if ((st = check_vec(light->dir, d, "light dir"))) return st;
+    om_vec3 dir = om__normalize(light->dir);
+    if (om__dot(dir, dir) == 0.0f) return om__fail(d, OM_E_INVALID, "light dir must not be zero");
+    v->light_axis = dir;
+    /* Stand the light outside the scene's bounding sphere, looking along dir. */
+    om_vec3 c = om__scale(om__add(s->lo, s->hi), 0.5f);
+    om_vec3 h = om__sub(s->hi, c);
+    float r = sqrtf(om__dot(h, h)) + 1.0f;
+    om__mat_look_at(&v->light_view, om__sub(c, om__scale(dir, 2.0f * r)), c, om__v3(0, 1, 0));
+    om_vec3 lo, hi;
+    light_box(&v->light_view, s, &lo, &hi);
+    v->light.znear = -hi.z;
+    v->light.zfar = -lo.z;
+    ortho_from(v, lo.x, hi.x, lo.y, hi.y, -hi.z * 0.999f, -lo.z * 1.001f + 1e-3f);
+    return OM_OK;
+}
+
+void om_view_fit_light(om_view *v, const om_scene *s, om_vec3 lo, om_vec3 hi)
+{
+    if (v->light.kind != OM_LIGHT_DIRECTIONAL || !(lo.x <= hi.x && lo.y <= hi.y)) return;
+    om_vec3 slo, shi;
+    light_box(&v->light_view, s, &slo, &shi);
+    ortho_from(v, lo.x, hi.x, lo.y, hi.y, -shi.z * 0.999f, -slo.z * 1.001f + 1e-3f);
+}

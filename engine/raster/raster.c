@@ -1,0 +1,278 @@
+/* raster.c — clipping, snapping and filling of triangles; the rule is written at the
+ * top of raster.h. Everything after the snap is integer except the depth plane, which
+ * is evaluated in double from one fixed origin per triangle (so strips agree). */
+#include "raster.h"
+#include "../core/core.h"
+
+#include <math.h>
+
+static int64_t floordiv(int64_t a, int64_t b)   /* b > 0 */
+{
+    int64_t q = a / b;
+    return (a % b != 0 && a < 0) ? q - 1 : q;
+}
+
+bool om__tri2_setup(om__tri2 *t, const int64_t x[3], const int64_t y[3], bool biased)
+{
+    int p[3] = {0, 1, 2};
+    t->area2 = 0;
+    for (int i = 0; i < 3; i++)
+        if (x[i] > OM_TRI2_MAX_COORD || x[i] < -OM_TRI2_MAX_COORD ||
+            y[i] > OM_TRI2_MAX_COORD || y[i] < -OM_TRI2_MAX_COORD)
+            return false;
+    int64_t area2 = (x[1] - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[1] - y[0]);
+    if (area2 < 0) { p[1] = 2; p[2] = 1; area2 = -area2; }
+    if (area2 == 0 && biased) return false;
+    for (int i = 0; i < 3; i++) {
+        t->perm[i] = p[i];
+        t->x[i] = x[p[i]];
+        t->y[i] = y[p[i]];
+    }
+    for (int i = 0; i < 3; i++) {
+        int j = i == 2 ? 0 : i + 1;
+        int64_t dx = t->x[j] - t->x[i], dy = t->y[j] - t->y[i];
+        /* E(p) = dx * (py - yi) - dy * (px - xi): positive on the interior side. */
+        t->a[i] = -dy;
+        t->b[i] = dx;
+        t->c[i] = dy * t->x[i] - dx * t->y[i];
+        /* With area2 > 0 in a y-down image, a top edge runs in +x and a left edge runs
+         * upwards; points exactly on any other edge are outside. */
+        bool top_left = (dy == 0 && dx > 0) || dy < 0;
+        if (biased && !top_left) t->c[i] -= 1;
+    }
+    t->area2 = area2;
+    return true;
+}
+
+void om__target_clear(const om_target *t)
+{
+    size_t n = (size_t)t->rows * t->width;
+    for (size_t i = 0; i < n; i++) t->depth[i] = 0xFFFFFFFFu;
+    if (t->id)
+        for (size_t i = 0; i < n; i++) t->id[i] = OM_NO_TRI;
+}
+
+/* ---- clipping */
+
+typedef struct cvert { float x, y, z, w; } cvert;
+
+static float plane_dist(int plane, const cvert *v, float gx, float gy)
+{
+    switch (plane) {
+    case 0: return v->z;               /* near: z >= 0 */
+    case 1: return v->w - v->z;        /* far: z <= w */
+    case 2: return v->x + gx * v->w;   /* guard band, left */
+    case 3: return gx * v->w - v->x;   /* right */
+    case 4: return v->y + gy * v->w;   /* bottom */
+    default: return gy * v->w - v->y;  /* top */
+    }
+}
+
+static float guard(uint32_t size) { return 1.0f + 2.0f * (float)OM_GUARD_PX / (float)size; }
+
+unsigned om__outcode(const om_vec4 *v, uint32_t width, uint32_t height)
+{
+    cvert c = {v->x, v->y, v->z, v->w};
+    float gx = guard(width), gy = guard(height);
+    unsigned mask = 0;
+    for (int p = 0; p < 6; p++)
+        if (!(plane_dist(p, &c, gx, gy) >= 0.0f)) mask |= 1u << p;
+    return mask;
+}
+
+bool om__project(const om_vec4 *v, uint32_t width, uint32_t height, int64_t *gx, int64_t *gy,
+                 double *gz)
+{
+    const double sx = (double)width * (OM_SUBPIX / 2), sy = (double)height * (OM_SUBPIX / 2);
+    const double lim = (double)(1ll << 26);
+    if (!(v->w > 0.0f)) return false;
+    double iw = 1.0 / (double)v->w;
+    double X = floor(((double)v->x * iw + 1.0) * sx + 0.5);
+    double Y = floor((1.0 - (double)v->y * iw) * sy + 0.5);
+    double Z = (double)v->z * iw * 4294967296.0;
+    if (!(X > -lim && X < lim && Y > -lim && Y < lim)) return false;
+    *gx = (int64_t)X;
+    *gy = (int64_t)Y;
+    *gz = Z < 0.0 ? 0.0 : Z > 4294967295.0 ? 4294967295.0 : Z;
+    return true;
+}
+
+/* The intersection is always computed from the inside vertex towards the outside one,
+ * so an edge shared by two triangles is cut at the same point in both: no cracks. */
+static cvert cut(const cvert *in, const cvert *out, float din, float dout)
+{
+    float t = din / (din - dout);
+    cvert r;
+    r.x = in->x + t * (out->x - in->x);
+    r.y = in->y + t * (out->y - in->y);
+    r.z = in->z + t * (out->z - in->z);
+    r.w = in->w + t * (out->w - in->w);
+    return r;
+}
+
+int om__clip_project(const om_vec4 clip[3], uint32_t width, uint32_t height,
+                     int64_t *gx_out, int64_t *gy_out, double *gz_out)
+{
+    cvert buf[2][10];
+    int n = 3;
+    float gx = guard(width), gy = guard(height);
+    unsigned outside_all = 0x3F, outside_any = 0;
+    for (int i = 0; i < 3; i++) {
+        unsigned mask = om__outcode(&clip[i], width, height);
+        buf[0][i].x = clip[i].x;
+        buf[0][i].y = clip[i].y;
+        buf[0][i].z = clip[i].z;
+        buf[0][i].w = clip[i].w;
+        outside_all &= mask;
+        outside_any |= mask;
+    }
+    if (outside_all) return 0;    /* wholly beyond one plane */
+    int cur = 0;
+    for (int p = 0; p < 6 && n > 0; p++) {
+        if (!(outside_any & (1u << p))) continue;
+        cvert *src = buf[cur], *dst = buf[cur ^ 1];
+        int m = 0;
+        for (int i = 0; i < n; i++) {
+            const cvert *a = &src[i], *b = &src[i + 1 == n ? 0 : i + 1];
+            float da = plane_dist(p, a, gx, gy), db = plane_dist(p, b, gx, gy);
+            bool ina = da >= 0.0f, inb = db >= 0.0f;
+            if (ina) dst[m++] = *a;
+            if (ina && !inb) dst[m++] = cut(a, b, da, db);
+            else if (!ina && inb) dst[m++] = cut(b, a, db, da);
+        }
+        n = m;
+        cur ^= 1;
+    }
+    if (n < 3) return 0;
+    for (int i = 0; i < n; i++) {
+        const cvert *c = &buf[cur][i];
+        om_vec4 v = {c->x, c->y, c->z, c->w};
+        if (!om__project(&v, width, height, &gx_out[i], &gy_out[i], &gz_out[i])) return 0;
+    }
+    return n;
+}
+
+/* ---- filling */
+
+void om__rtri_plane(om__rtri *t, const double z[3])
+{
+    const om__tri2 *e = &t->e;
+    double z0 = z[e->perm[0]], z1 = z[e->perm[1]], z2 = z[e->perm[2]];
+    double x1 = (double)(e->x[1] - e->x[0]), y1 = (double)(e->y[1] - e->y[0]);
+    double x2 = (double)(e->x[2] - e->x[0]), y2 = (double)(e->y[2] - e->y[0]);
+    t->z0 = z0;
+    if (e->area2 > 0) {
+        double inv = 1.0 / (double)e->area2;
+        t->zx = ((z1 - z0) * y2 - (z2 - z0) * y1) * inv;
+        t->zy = ((z2 - z0) * x1 - (z1 - z0) * x2) * inv;
+    } else {
+        t->zx = t->zy = 0.0;
+    }
+    t->zmin = fmin(z0, fmin(z1, z2));
+    t->zmax = fmax(z0, fmax(z1, z2));
+}
+
+static bool bounds(om__rtri *t, const om_target *tg, bool conservative)
+{
+    const om__tri2 *e = &t->e;
+    int64_t minX = e->x[0], maxX = e->x[0], minY = e->y[0], maxY = e->y[0];
+    for (int i = 1; i < 3; i++) {
+        if (e->x[i] < minX) minX = e->x[i];
+        if (e->x[i] > maxX) maxX = e->x[i];
+        if (e->y[i] < minY) minY = e->y[i];
+        if (e->y[i] > maxY) maxY = e->y[i];
+    }
+    int64_t x0, x1, y0, y1;
+    if (conservative) {       /* pixels whose closed square meets the bounding box */
+        x0 = floordiv(minX - 1, OM_SUBPIX); x1 = floordiv(maxX, OM_SUBPIX);
+        y0 = floordiv(minY - 1, OM_SUBPIX); y1 = floordiv(maxY, OM_SUBPIX);
+    } else {                  /* pixels whose centre lies in the bounding box */
+        const int64_t h = OM_SUBPIX / 2;
+        x0 = floordiv(minX - h + OM_SUBPIX - 1, OM_SUBPIX); x1 = floordiv(maxX - h, OM_SUBPIX);
+        y0 = floordiv(minY - h + OM_SUBPIX - 1, OM_SUBPIX); y1 = floordiv(maxY - h, OM_SUBPIX);
+    }
+    if (x0 < 0) x0 = 0;
+    if (y0 < (int64_t)tg->y0) y0 = tg->y0;
+    if (x1 > (int64_t)tg->width - 1) x1 = (int64_t)tg->width - 1;
+    if (y1 > (int64_t)(tg->y0 + tg->rows) - 1) y1 = (int64_t)(tg->y0 + tg->rows) - 1;
+    if (x0 > x1 || y0 > y1) return false;
+    t->minx = (int32_t)x0; t->maxx = (int32_t)x1;
+    t->miny = (int32_t)y0; t->maxy = (int32_t)y1;
+    return true;
+}
+
+static void fill(const om_raster *r, const om__rtri *t, uint32_t id)
+{
+    const om_target *tg = r->target;
+    const om__tri2 *e = &t->e;
+    const int64_t S = OM_SUBPIX, H = OM_SUBPIX / 2;
+    const int64_t sa0 = e->a[0] * S, sa1 = e->a[1] * S, sa2 = e->a[2] * S;
+    const bool with_id = r->mode == OM_RASTER_DEPTH_ID;
+    for (int32_t y = t->miny; y <= t->maxy; y++) {
+        int64_t py = (int64_t)y * S + H, px = (int64_t)t->minx * S + H;
+        int64_t e0 = om__tri2_edge(e, 0, px, py);
+        int64_t e1 = om__tri2_edge(e, 1, px, py);
+        int64_t e2 = om__tri2_edge(e, 2, px, py);
+        double ztail = t->zy * (double)(py - e->y[0]);
+        size_t row = (size_t)(y - (int32_t)tg->y0) * tg->width;
+        uint32_t *dep = tg->depth + row;
+        for (int32_t x = t->minx; x <= t->maxx; x++, px += S) {
+            if ((e0 | e1 | e2) >= 0) {
+                double z = (t->z0 + t->zx * (double)(px - e->x[0])) + ztail;
+                z = z < t->zmin ? t->zmin : z > t->zmax ? t->zmax : z;
+                uint32_t d = (uint32_t)z;
+                if (d < dep[x]) {
+                    dep[x] = d;
+                    if (with_id) tg->id[row + (size_t)x] = id;
+                }
+            }
+            e0 += sa0; e1 += sa1; e2 += sa2;
+        }
+    }
+}
+
+static void fill_conservative(const om_raster *r, const om__rtri *t)
+{
+    const om__tri2 *e = &t->e;
+    const int64_t S = OM_SUBPIX, H = OM_SUBPIX / 2;
+    /* Largest value of each edge function over a pixel square, relative to its centre. */
+    int64_t reach[3];
+    for (int i = 0; i < 3; i++)
+        reach[i] = ((e->a[i] < 0 ? -e->a[i] : e->a[i]) + (e->b[i] < 0 ? -e->b[i] : e->b[i])) * H;
+    for (int32_t y = t->miny; y <= t->maxy; y++) {
+        int64_t py = (int64_t)y * S + H;
+        for (int32_t x = t->minx; x <= t->maxx; x++) {
+            int64_t px = (int64_t)x * S + H;
+            if (om__tri2_edge(e, 0, px, py) + reach[0] >= 0 &&
+                om__tri2_edge(e, 1, px, py) + reach[1] >= 0 &&
+                om__tri2_edge(e, 2, px, py) + reach[2] >= 0)
+                r->frag(r->user, x, y, t);
+        }
+    }
+}
+
+int om__raster_tri(const om_raster *r, const om_vec4 clip[3], uint32_t id)
+{
+    const om_target *tg = r->target;
+    int64_t gx[9], gy[9];
+    double gz[9];
+    for (int i = 0; i < 3; i++)
+        if (!om__finite(clip[i].x) || !om__finite(clip[i].y) || !om__finite(clip[i].z) ||
+            !om__finite(clip[i].w))
+            return 0;
+    int n = om__clip_project(clip, tg->width, tg->height, gx, gy, gz);
+    const bool cons = r->mode == OM_RASTER_CONSERVATIVE;
+    int filled = 0;
+    for (int k = 1; k + 1 < n; k++) {
+        int64_t tx[3] = {gx[0], gx[k], gx[k + 1]}, ty[3] = {gy[0], gy[k], gy[k + 1]};
+        double tz[3] = {gz[0], gz[k], gz[k + 1]};
+        om__rtri t;
+        if (!om__tri2_setup(&t.e, tx, ty, !cons)) continue;
+        if (!bounds(&t, tg, cons)) continue;
+        om__rtri_plane(&t, tz);
+        if (cons) fill_conservative(r, &t);
+        else fill(r, &t, id);
+        filled++;
+    }
+    return filled;
+}

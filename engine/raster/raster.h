@@ -1,0 +1,129 @@
+/* raster.h — the fixed-point triangle rasterizer shared by the eye pass, every
+ * shadow map and the occlusion predicate.
+ *
+ * The rule, in plain words:
+ *  - Clip space is D3D-style: visible when -w <= x, y <= w and 0 <= z <= w. Triangles are
+ *    clipped in homogeneous space against the near (z >= 0) and far (z <= w) planes and
+ *    against a guard band OM_GUARD_PX pixels beyond each image side, so that every
+ *    snapped coordinate stays below 2^23 and edge functions fit in int64 with room.
+ *  - Vertices snap to 1/256 pixel (OM_SUBPIX_BITS = 8), rounding half up. Pixel (x, y)
+ *    is sampled at its centre ((x + 0.5) * 256, (y + 0.5) * 256); row 0 is the top.
+ *  - Edge functions are exact integers. A point is inside when it is strictly inside
+ *    every edge, or exactly on an edge that is a top edge (horizontal, other vertex
+ *    below) or a left edge (the interior lies to its right when going up): the top-left
+ *    rule, so a point on an edge shared by two triangles belongs to exactly one.
+ *    Both windings are accepted (they are put in one order first); zero-area triangles
+ *    after snapping cover nothing.
+ *  - Depth is z/w, affine in screen space, stored as uint32: 0 at the near plane,
+ *    0xFFFFFFFF at the far plane (z/w * 2^32, clamped to the triangle's own vertex
+ *    depths). The plane is evaluated per pixel in double directly from one origin, so
+ *    a pixel's depth does not depend on the strip it is rendered in. The depth test is
+ *    strict (<): among equal depths the first triangle drawn wins.
+ *  - Conservative mode reports every pixel whose closed square the snapped triangle
+ *    touches at all (an exact separating-axis test: bounding boxes and three edges).
+ */
+#ifndef OM_RASTER_H
+#define OM_RASTER_H
+
+#include "ombra.h"
+
+#define OM_SUBPIX_BITS 8
+#define OM_SUBPIX (1 << OM_SUBPIX_BITS)
+#define OM_GUARD_PX 8192
+/* om__tri2 accepts coordinates of magnitude up to 2^29 so that a*x + b*y + c stays far
+ * from int64 overflow (|a|, |b| < 2^30, products < 2^60). */
+#define OM_TRI2_MAX_COORD (1ll << 29)
+
+/* A 2-D triangle on an integer grid with its three edge functions
+ * E_i(x, y) = a[i] * x + b[i] * y + c[i]; inside when all E_i >= 0 (top-left bias
+ * folded into c when built with `biased`). Vertices are stored in the order that makes
+ * area2 > 0. */
+typedef struct om__tri2 {
+    int64_t x[3], y[3];
+    int64_t a[3], b[3], c[3];
+    int64_t area2;         /* twice the signed area, > 0 after setup (0: degenerate) */
+    int perm[3];           /* perm[i]: which input vertex is stored at i */
+} om__tri2;
+
+/* Sets up a triangle; returns false (and leaves area2 = 0) when the coordinates are
+ * out of range or the triangle has zero area. `biased` applies the top-left rule;
+ * unbiased edges accept points on every edge (used for conservative coverage). */
+bool om__tri2_setup(om__tri2 *t, const int64_t x[3], const int64_t y[3], bool biased);
+
+static inline int64_t om__tri2_edge(const om__tri2 *t, int i, int64_t px, int64_t py)
+{
+    return t->a[i] * px + t->b[i] * py + t->c[i];
+}
+
+/* The point-in-triangle test at any grid position, with the fill rule's ties. */
+static inline bool om__tri2_covers(const om__tri2 *t, int64_t px, int64_t py)
+{
+    return (om__tri2_edge(t, 0, px, py) | om__tri2_edge(t, 1, px, py) |
+            om__tri2_edge(t, 2, px, py)) >= 0;
+}
+
+/* Where fragments go: a strip of rows [y0, y0 + rows) of a width x height image.
+ * depth (and id, when not NULL) hold rows * width entries, row-major, strip-relative. */
+typedef struct om_target {
+    uint32_t width, height, y0, rows;
+    uint32_t *depth;
+    uint32_t *id;
+} om_target;
+
+void om__target_clear(const om_target *t);
+
+/* A triangle ready to fill: snapped screen coordinates, edges, depth plane, bounds. */
+typedef struct om__rtri {
+    om__tri2 e;
+    double z0, zx, zy;     /* depth (0..2^32) at stored vertex 0, and per sub-pixel unit */
+    double zmin, zmax;
+    int32_t minx, maxx, miny, maxy;   /* pixel bounds (inclusive), clamped to the image */
+} om__rtri;
+
+/* Sets the depth plane from the depths of the vertices as given to om__tri2_setup
+ * (input order; the setup's permutation is applied). */
+void om__rtri_plane(om__rtri *t, const double z[3]);
+
+/* Depth of the triangle's plane at a grid position (sub-pixel units), clamped to the
+ * triangle's vertex depth range. */
+static inline double om__rtri_depth(const om__rtri *t, int64_t px, int64_t py)
+{
+    double z = t->z0 + t->zx * (double)(px - t->e.x[0]) + t->zy * (double)(py - t->e.y[0]);
+    return z < t->zmin ? t->zmin : z > t->zmax ? t->zmax : z;
+}
+
+typedef enum om_raster_mode {
+    OM_RASTER_DEPTH,       /* depth test and write (shadow maps) */
+    OM_RASTER_DEPTH_ID,    /* depth test, write depth and triangle id (eye pass) */
+    OM_RASTER_CONSERVATIVE /* call `frag` for every touched pixel; no buffers written */
+} om_raster_mode;
+
+typedef void (*om__frag_fn)(void *user, int32_t x, int32_t y, const om__rtri *t);
+
+typedef struct om_raster {
+    const om_target *target;
+    om_raster_mode mode;
+    om__frag_fn frag;      /* conservative mode */
+    void *user;
+} om_raster;
+
+/* Rasterizes one triangle given in clip space (clipping it first). Non-finite vertices
+ * are rejected: they cover nothing. Returns the number of sub-triangles filled. */
+int om__raster_tri(const om_raster *r, const om_vec4 clip[3], uint32_t id);
+
+/* Which of the six clip planes (near, far, four guard-band sides) a vertex is outside
+ * of, as a bit mask; 0 means it needs no clipping. */
+unsigned om__outcode(const om_vec4 *v, uint32_t width, uint32_t height);
+/* Projects one clip-space vertex to the sub-pixel grid of a width x height image, with
+ * depth z/w * 2^32 (clamped to [0, 2^32 - 1]); false when w <= 0 or it lands beyond
+ * 2^26 grid units. Clipping uses exactly this, so a vertex projects the same alone. */
+bool om__project(const om_vec4 *v, uint32_t width, uint32_t height, int64_t *gx, int64_t *gy,
+                 double *gz);
+
+/* Clips a triangle against the near, far and guard-band planes of a width x height
+ * viewport and projects it: up to 9 vertices of a convex polygon in sub-pixel grid
+ * coordinates with depth z/w * 2^32. Returns the vertex count (0: nothing left). */
+int om__clip_project(const om_vec4 clip[3], uint32_t width, uint32_t height,
+                     int64_t *gx, int64_t *gy, double *gz);
+
+#endif

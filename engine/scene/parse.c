@@ -1,0 +1,1370 @@
+/* parse.c — the scene text format (see om_scene_parse in ombra.h and the grammar in the
+ * README): line and token scanning, decimal numbers, parameters with their ranges, and
+ * the two passes over the text. The first pass validates every line and counts what
+ * it will produce (om_scene_bytes stops there), so every error comes with a line and
+ * column before any memory is carved; the second pass runs the very same code with a
+ * sink that writes into arrays carved once, at their exact sizes. Also om_scene_at. */
+#include "scene.h"
+
+#include <math.h>
+#include <string.h>
+
+/* ================================================================ lines and tokens */
+
+void om__line_init(om__line *l, const char *text, size_t len, bool strict)
+{
+    memset(l, 0, sizeof *l);
+    l->text = text;
+    l->len = text ? len : 0;
+    l->strict = strict;
+    /* Editors on some systems start UTF-8 files with a byte-order mark: skip it. */
+    if (l->len >= 3 && memcmp(text, "\xEF\xBB\xBF", 3) == 0) l->next = 3;
+}
+
+bool om__line_next(om__line *l)
+{
+    if (l->next >= l->len) return false;
+    size_t i = l->next, end = l->len;
+    bool comment = false;
+    l->start = i;
+    for (; i < l->len && l->text[i] != '\n'; i++)
+        if (!comment && l->text[i] == '#') {
+            comment = true;
+            end = i;
+        }
+    l->end = comment ? end : i;
+    l->next = i < l->len ? i + 1 : i;
+    l->p = l->start;
+    if (l->no < UINT32_MAX) l->no++;
+    return true;
+}
+
+static bool is_sep(char c) { return c == ' ' || c == '\t' || c == '\r'; }
+static bool is_ctrl(unsigned char c) { return (c < 0x20 && c != '\t' && c != '\r') || c == 0x7F; }
+
+uint32_t om__col(const om__line *l, size_t at)
+{
+    size_t c = at - l->start + 1;
+    return c > UINT32_MAX ? UINT32_MAX : (uint32_t)c;
+}
+
+int om__tok_next(om__line *l, om__tok *t)
+{
+    const char *s = l->text;
+    size_t i = l->p;
+    while (i < l->end && is_sep(s[i])) i++;
+    t->at = i;
+    t->len = 0;
+    t->col = om__col(l, i);
+    if (i >= l->end) {
+        l->p = i;
+        return 0;
+    }
+    size_t b = i;
+    for (; i < l->end && !is_sep(s[i]); i++)
+        if (l->strict && is_ctrl((unsigned char)s[i])) {
+            t->at = i;
+            t->len = 1;
+            t->col = om__col(l, i);
+            l->p = i;
+            return -1;
+        }
+    t->len = i - b;
+    l->p = i;
+    return 1;
+}
+
+int om__tok_peek(const om__line *l, om__tok *t)
+{
+    om__line copy = *l;
+    return om__tok_next(&copy, t);
+}
+
+uint32_t om__line_end_col(const om__line *l)
+{
+    size_t e = l->end;
+    while (e > l->start && is_sep(l->text[e - 1])) e--;
+    return om__col(l, e);
+}
+
+/* Our own strlen: the engine links against nothing but mem* and a few libm names. */
+static size_t cstr_len(const char *s)
+{
+    size_t n = 0;
+    while (s[n]) n++;
+    return n;
+}
+
+bool om__tok_is(const char *text, const om__tok *t, const char *word)
+{
+    size_t i = 0;
+    for (; i < t->len; i++)
+        if (word[i] == '\0' || text[t->at + i] != word[i]) return false;
+    return word[i] == '\0';
+}
+
+static bool is_digit(char c) { return c >= '0' && c <= '9'; }
+
+bool om__numlike(const char *s, size_t n)
+{
+    return n > 0 && (is_digit(s[0]) || s[0] == '+' || s[0] == '-' || s[0] == '.');
+}
+
+/* ================================================================ numbers */
+
+bool om__num(const char *s, size_t n, double *out)
+{
+    static const double p10[23] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
+                                   1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
+                                   1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+    const int64_t sat = 1000000000;   /* exponents saturate here; the result is 0 or inf */
+    size_t i = 0;
+    bool neg = false, any = false;
+    uint64_t m = 0;
+    int nd = 0;            /* significant digits kept in m (at most 19: < 2^64) */
+    int64_t e10 = 0;
+    if (i < n && (s[i] == '+' || s[i] == '-')) neg = s[i++] == '-';
+    for (; i < n && is_digit(s[i]); i++) {
+        any = true;
+        if (nd < 19) {
+            if (m || s[i] != '0') { m = m * 10 + (uint64_t)(s[i] - '0'); nd++; }
+        } else if (e10 < sat) {
+            e10++;         /* a digit beyond the 19 we keep still scales the value */
+        }
+    }
+    if (i < n && s[i] == '.') {
+        for (i++; i < n && is_digit(s[i]); i++) {
+            any = true;
+            if (nd < 19) {
+                if (m || s[i] != '0') { m = m * 10 + (uint64_t)(s[i] - '0'); nd++; }
+                if (e10 > -sat) e10--;
+            }
+        }
+    }
+    if (!any) return false;
+    if (i < n && (s[i] == 'e' || s[i] == 'E')) {
+        bool eneg = false;
+        int64_t e = 0;
+        i++;
+        if (i < n && (s[i] == '+' || s[i] == '-')) eneg = s[i++] == '-';
+        if (i >= n || !is_digit(s[i])) return false;
+        for (; i < n && is_digit(s[i]); i++)
+            if (e < sat) e = e * 10 + (s[i] - '0');
+        e10 += eneg ? -e : e;
+    }
+    if (i != n) return false;
+    double v = (double)m;
+    if (m != 0) {
+        /* 19 digits are below 1e19, so beyond +-400 the result is inf or 0 anyway. */
+        if (e10 > 400) e10 = 400;
+        if (e10 < -400) e10 = -400;
+        for (; e10 > 22; e10 -= 22) v *= 1e22;
+        for (; e10 < -22; e10 += 22) v /= 1e22;
+        v = e10 >= 0 ? v * p10[e10] : v / p10[-e10];
+    }
+    *out = neg ? -v : v;
+    return true;
+}
+
+/* ================================================================ messages */
+
+om__str om__perr(om_diag *d, om_status st, const char *file, uint32_t line, uint32_t col,
+                 char *scratch, size_t cap)
+{
+    om__str s = om__diag_begin(d, st, scratch, cap);
+    if (d) {
+        d->line = line;
+        d->col = col;
+    }
+    if (file) {
+        om__str_s(&s, file);
+        om__str_s(&s, ": ");
+    }
+    om__str_s(&s, "line ");
+    om__str_u(&s, line);
+    om__str_s(&s, ", col ");
+    om__str_u(&s, col);
+    om__str_s(&s, ": ");
+    return s;
+}
+
+void om__str_tok(om__str *s, const char *p, size_t n)
+{
+    char buf[40];
+    size_t k = 0;
+    for (size_t i = 0; i < n && i < 32; i++) {
+        unsigned char c = (unsigned char)p[i];
+        buf[k++] = c < 0x20 || c >= 0x7F || c == '\'' ? '?' : (char)c;
+    }
+    if (n > 32) { buf[k++] = '.'; buf[k++] = '.'; buf[k++] = '.'; }
+    buf[k] = '\0';
+    om__str_s(s, "'");
+    om__str_s(s, buf);
+    om__str_s(s, "'");
+}
+
+/* ================================================================ parameters */
+
+enum {
+    C_CAMERA, C_LIGHT, C_MATERIAL, C_PLANE, C_BOX, C_SPHERE, C_CYLINDER, C_MESH,
+    C_TRIANGLES, C_KEY, C_N_
+};
+static const char *const cmd_names[C_N_] = {
+    "camera", "light", "material", "plane", "box", "sphere", "cylinder", "mesh",
+    "triangles", "key",
+};
+
+enum {
+    P_EYE, P_TARGET, P_UP, P_FOV, P_SIZE, P_NEAR, P_FAR, P_POS, P_DIR, P_ALBEDO, P_OPACITY,
+    P_SIZE2, P_DIVISIONS, P_SIZE3, P_RADIUS, P_SEGMENTS, P_RINGS, P_HEIGHT, P_COUNT, P_SEED,
+    P_AREA, P_IN, P_SCALE, P_ROTATE, P_TRANSLATE, P_MATERIAL, P_N_
+};
+enum { K_NUM, K_INT, K_SCALE, K_WORD };
+enum {
+    R_COORD, R_LEN, R_FOV, R_UNIT, R_DIM, R_DIV, R_SEG, R_RING, R_COUNT, R_SEED, R_NEAR,
+    R_FAR, R_AREA, R_SCALE, R_N_
+};
+
+typedef struct pdef { const char *name; uint8_t n, kind, rng; } pdef;
+static const pdef pdefs[P_N_] = {
+    [P_EYE] = {"eye", 3, K_NUM, R_COORD},        [P_TARGET] = {"target", 3, K_NUM, R_COORD},
+    [P_UP] = {"up", 3, K_NUM, R_COORD},          [P_FOV] = {"fov", 1, K_NUM, R_FOV},
+    [P_SIZE] = {"size", 2, K_INT, R_DIM},        [P_NEAR] = {"near", 1, K_NUM, R_NEAR},
+    [P_FAR] = {"far", 1, K_NUM, R_FAR},          [P_POS] = {"pos", 3, K_NUM, R_COORD},
+    [P_DIR] = {"dir", 3, K_NUM, R_COORD},        [P_ALBEDO] = {"albedo", 3, K_NUM, R_UNIT},
+    [P_OPACITY] = {"opacity", 1, K_NUM, R_UNIT}, [P_SIZE2] = {"size", 2, K_NUM, R_LEN},
+    [P_DIVISIONS] = {"divisions", 1, K_INT, R_DIV},
+    [P_SIZE3] = {"size", 3, K_NUM, R_LEN},       [P_RADIUS] = {"radius", 1, K_NUM, R_LEN},
+    [P_SEGMENTS] = {"segments", 1, K_INT, R_SEG}, [P_RINGS] = {"rings", 1, K_INT, R_RING},
+    [P_HEIGHT] = {"height", 1, K_NUM, R_LEN},    [P_COUNT] = {"count", 1, K_INT, R_COUNT},
+    [P_SEED] = {"seed", 1, K_INT, R_SEED},       [P_AREA] = {"area", 1, K_NUM, R_AREA},
+    [P_IN] = {"in", 6, K_NUM, R_COORD},          [P_SCALE] = {"scale", 3, K_SCALE, R_SCALE},
+    [P_ROTATE] = {"rotate", 3, K_NUM, R_COORD},  [P_TRANSLATE] = {"translate", 3, K_NUM, R_COORD},
+    [P_MATERIAL] = {"material", 1, K_WORD, 0},
+};
+
+/* Every number has a range; `mag` ranges bound the magnitude (scale may be negative:
+ * a mirror) and `open` ones exclude their ends. */
+typedef struct rdef { double lo, hi; bool open, mag; const char *text; } rdef;
+static const rdef rdefs[R_N_] = {
+    [R_COORD] = {-1e7, 1e7, false, false, "-1e7..1e7"},
+    [R_LEN] = {1e-6, 1e7, false, false, "1e-6..1e7"},
+    [R_FOV] = {0.0, 180.0, true, false, "above 0 and below 180"},
+    [R_UNIT] = {0.0, 1.0, false, false, "0..1"},
+    [R_DIM] = {1.0, 8192.0, false, false, "1..8192"},
+    [R_DIV] = {1.0, 4096.0, false, false, "1..4096"},
+    [R_SEG] = {3.0, 4096.0, false, false, "3..4096"},
+    [R_RING] = {2.0, 4096.0, false, false, "2..4096"},
+    [R_COUNT] = {1.0, 1e7, false, false, "1..10000000"},
+    [R_SEED] = {0.0, 4294967295.0, false, false, "0..4294967295"},
+    [R_NEAR] = {1e-6, 1e7, false, false, "1e-6..1e7"},
+    [R_FAR] = {1e-6, 1e8, false, false, "1e-6..1e8"},
+    [R_AREA] = {1e-6, 1e12, false, false, "1e-6..1e12"},
+    [R_SCALE] = {1e-6, 1e6, false, true, "1e-6..1e6 in magnitude"},
+};
+
+#define COMMON_PARAMS P_SCALE, P_ROTATE, P_TRANSLATE, P_ALBEDO, P_OPACITY, P_MATERIAL
+static const uint8_t cam_params[] = {P_EYE, P_TARGET, P_UP, P_FOV, P_SIZE, P_NEAR, P_FAR};
+static const uint8_t spot_params[] = {P_POS, P_TARGET, P_FOV, P_NEAR, P_FAR};
+static const uint8_t dir_params[] = {P_DIR};
+static const uint8_t mat_params[] = {P_ALBEDO, P_OPACITY};
+static const uint8_t plane_params[] = {P_SIZE2, P_DIVISIONS, COMMON_PARAMS};
+static const uint8_t box_params[] = {P_SIZE3, COMMON_PARAMS};
+static const uint8_t sphere_params[] = {P_RADIUS, P_SEGMENTS, P_RINGS, COMMON_PARAMS};
+static const uint8_t cyl_params[] = {P_RADIUS, P_HEIGHT, P_SEGMENTS, COMMON_PARAMS};
+static const uint8_t mesh_params[] = {COMMON_PARAMS};
+static const uint8_t tris_params[] = {P_COUNT, P_SEED, P_AREA, P_IN, COMMON_PARAMS};
+static const uint8_t keycam_params[] = {P_EYE, P_TARGET};
+static const uint8_t keylight_params[] = {P_POS, P_TARGET, P_DIR};
+#define NP(a) (sizeof(a) / sizeof((a)[0]))
+
+/* One parameter as read from a line. */
+typedef struct pv {
+    bool has;
+    uint8_t n;             /* values read (scale: 1 or 3) */
+    uint32_t col;          /* column of the parameter's name */
+    uint32_t vcol[6];      /* column of each value */
+    double v[6];
+    om__tok w;             /* K_WORD: the word */
+} pv;
+
+/* ================================================================ the parser */
+
+#define MCACHE 64          /* material names remembered; a miss rescans earlier lines */
+
+typedef struct mslot { size_t at, len; uint32_t ord; bool used; } mslot;
+
+typedef struct parser {
+    const char *text;
+    size_t len;
+    const om_loader *ld;
+    om_diag *d;
+    om__line l;
+    om__tok cmd;           /* the current line's command */
+    bool fill;             /* second pass: write into the scene */
+    uint64_t nv, nt;       /* vertices and triangles so far */
+    uint32_t nnamed, ninline, ncam, nlight;
+    uint32_t nnamed_total; /* second pass: named materials in the whole text */
+    bool have_cam, have_light;
+    uint32_t cam_line, light_line;
+    float cam_t, light_t;  /* time of the last key of each kind */
+    uint32_t cam_t_line, light_t_line;
+    int lkey_form;         /* 0 none yet, 1 spot (pos/target), 2 directional (dir) */
+    uint32_t lkey_line, lkey_col;
+    om_camera cam;
+    om_light light;
+    om_scene *s;           /* second pass */
+    om__sink out;          /* second pass: the whole scene's sink */
+    mslot cache[MCACHE];
+} parser;
+
+static om__str fail_begin(parser *p, om_status st, uint32_t col, char *tmp, size_t cap)
+{
+    return om__perr(p->d, st, NULL, p->l.no, col, tmp, cap);
+}
+
+/* "line L, col C: <a>'<q>'<b>" — most messages have this shape. */
+static om_status fail(parser *p, om_status st, uint32_t col, const char *a, const char *q,
+                      size_t qn, const char *b)
+{
+    char tmp[4];
+    om__str s = fail_begin(p, st, col, tmp, sizeof tmp);
+    om__str_s(&s, a);
+    if (q) om__str_tok(&s, q, qn);
+    if (b) om__str_s(&s, b);
+    return st;
+}
+
+static om_status fail_tok(parser *p, om_status st, const om__tok *t, const char *a,
+                          const char *b)
+{
+    return fail(p, st, t->col, a, p->text + t->at, t->len, b);
+}
+
+static om_status bad_byte(parser *p, const om__tok *t)
+{
+    static const char hex[] = "0123456789abcdef";
+    unsigned char c = (unsigned char)p->text[t->at];
+    char code[5] = {'0', 'x', hex[c >> 4], hex[c & 15], '\0'};
+    char tmp[4];
+    om__str s = fail_begin(p, OM_E_PARSE, t->col, tmp, sizeof tmp);
+    om__str_s(&s, "unexpected byte ");
+    om__str_s(&s, code);
+    om__str_s(&s, " (scene files are text)");
+    return OM_E_PARSE;
+}
+
+static void list_names(om__str *s, const uint8_t *ids, size_t n)
+{
+    for (size_t i = 0; i < n; i++) {
+        if (i) om__str_s(s, ", ");
+        om__str_s(s, pdefs[ids[i]].name);
+    }
+}
+
+static void expected_numbers(om__str *s, unsigned want, bool integer)
+{
+    om__str_s(s, "expected ");
+    if (want == 0) om__str_s(s, "1 or 3 numbers");
+    else if (want == 1) om__str_s(s, integer ? "a whole number" : "a number");
+    else {
+        om__str_u(s, want);
+        om__str_s(s, integer ? " whole numbers" : " numbers");
+    }
+}
+
+/* Reads one value of parameter `what`; want (0: "1 or 3") only shapes messages. */
+static om_status read_value(parser *p, const char *what, uint8_t kind, uint8_t rng,
+                            unsigned want, double *v, uint32_t *col)
+{
+    om__tok t;
+    int r = om__tok_next(&p->l, &t);
+    if (r < 0) return bad_byte(p, &t);
+    if (r == 0 || !om__numlike(p->text + t.at, t.len)) {
+        char tmp[4];
+        om__str s = fail_begin(p, OM_E_PARSE, r == 0 ? om__line_end_col(&p->l) : t.col, tmp,
+                               sizeof tmp);
+        expected_numbers(&s, want, kind == K_INT);
+        om__str_s(&s, " after '");
+        om__str_s(&s, what);
+        om__str_s(&s, "'");
+        if (r != 0) {
+            om__str_s(&s, ", found ");
+            om__str_tok(&s, p->text + t.at, t.len);
+        }
+        return OM_E_PARSE;
+    }
+    *col = t.col;
+    if (!om__num(p->text + t.at, t.len, v))
+        return fail_tok(p, OM_E_PARSE, &t, "malformed number ", NULL);
+    if (!(*v - *v == 0.0))
+        return fail_tok(p, OM_E_PARSE, &t, "number ", " is not finite");
+    if (kind == K_INT && *v != floor(*v)) {
+        char tmp[4];
+        om__str s = fail_begin(p, OM_E_PARSE, t.col, tmp, sizeof tmp);
+        om__str_s(&s, "expected a whole number after '");
+        om__str_s(&s, what);
+        om__str_s(&s, "', found ");
+        om__str_tok(&s, p->text + t.at, t.len);
+        return OM_E_PARSE;
+    }
+    const rdef *rd = &rdefs[rng];
+    double x = rd->mag ? fabs(*v) : *v;
+    bool ok = rd->open ? x > rd->lo && x < rd->hi : x >= rd->lo && x <= rd->hi;
+    if (!ok) {
+        char tmp[4];
+        om__str s = fail_begin(p, OM_E_RANGE, t.col, tmp, sizeof tmp);
+        om__str_s(&s, what);
+        om__str_s(&s, " ");
+        om__str_tok(&s, p->text + t.at, t.len);
+        om__str_s(&s, " is out of range (");
+        om__str_s(&s, rd->text);
+        om__str_s(&s, ")");
+        return OM_E_RANGE;
+    }
+    return OM_OK;
+}
+
+static bool peek_number(parser *p, om__tok *t)
+{
+    return om__tok_peek(&p->l, t) == 1 && om__numlike(p->text + t->at, t->len);
+}
+
+/* Reads `name value...` pairs to the end of the line, any order, each at most once. */
+static om_status read_params(parser *p, const char *what, const uint8_t *ids, size_t nids,
+                             pv *pl)
+{
+    memset(pl, 0, sizeof(pv) * P_N_);
+    om__tok t;
+    int r;
+    while ((r = om__tok_next(&p->l, &t)) != 0) {
+        if (r < 0) return bad_byte(p, &t);
+        int id = -1;
+        for (size_t i = 0; i < nids && id < 0; i++)
+            if (om__tok_is(p->text, &t, pdefs[ids[i]].name)) id = ids[i];
+        if (id < 0) {
+            char tmp[4];
+            bool num = om__numlike(p->text + t.at, t.len);
+            om__str s = fail_begin(p, OM_E_PARSE, t.col, tmp, sizeof tmp);
+            om__str_s(&s, num ? "unexpected value " : "unknown parameter ");
+            om__str_tok(&s, p->text + t.at, t.len);
+            om__str_s(&s, " for '");
+            om__str_s(&s, what);
+            om__str_s(&s, "' (expected ");
+            list_names(&s, ids, nids);
+            om__str_s(&s, ")");
+            return OM_E_PARSE;
+        }
+        const pdef *pd = &pdefs[id];
+        pv *v = &pl[id];
+        if (v->has) return fail_tok(p, OM_E_PARSE, &t, "parameter ", " is given twice");
+        v->has = true;
+        v->col = t.col;
+        om_status st;
+        if (pd->kind == K_WORD) {
+            r = om__tok_next(&p->l, &v->w);
+            if (r < 0) return bad_byte(p, &v->w);
+            if (r == 0)
+                return fail(p, OM_E_PARSE, om__line_end_col(&p->l), "expected a name after ",
+                            pd->name, cstr_len(pd->name), NULL);
+            continue;
+        }
+        if (pd->kind == K_SCALE) {
+            om__tok nx;
+            while (v->n < 4 && peek_number(p, &nx)) {
+                if (v->n == 3)
+                    return fail(p, OM_E_PARSE, nx.col, "too many values after ", pd->name,
+                                cstr_len(pd->name), " (it takes 1 or 3)");
+                if ((st = read_value(p, pd->name, K_NUM, pd->rng, 0, &v->v[v->n],
+                                     &v->vcol[v->n])) != OM_OK)
+                    return st;
+                v->n++;
+            }
+            if (v->n != 1 && v->n != 3) {
+                /* reads the offending token (or the end of the line) for the message */
+                double dummy;
+                uint32_t dcol;
+                return read_value(p, pd->name, K_NUM, pd->rng, 0, &dummy, &dcol);
+            }
+            if (v->n == 1) v->v[1] = v->v[2] = v->v[0];
+            continue;
+        }
+        for (unsigned i = 0; i < pd->n; i++)
+            if ((st = read_value(p, pd->name, pd->kind, pd->rng, pd->n, &v->v[i],
+                                 &v->vcol[i])) != OM_OK)
+                return st;
+        v->n = pd->n;
+        om__tok nx;
+        if (peek_number(p, &nx)) {
+            char tmp[4];
+            om__str s = fail_begin(p, OM_E_PARSE, nx.col, tmp, sizeof tmp);
+            om__str_s(&s, "too many values after '");
+            om__str_s(&s, pd->name);
+            om__str_s(&s, "' (it takes ");
+            om__str_u(&s, pd->n);
+            om__str_s(&s, ")");
+            return OM_E_PARSE;
+        }
+    }
+    return OM_OK;
+}
+
+static om_vec3 pv3(const pv *v, int i) { return om__v3((float)v->v[i], (float)v->v[i + 1], (float)v->v[i + 2]); }
+static double val(const pv *pl, int id, int i, double def) { return pl[id].has ? pl[id].v[i] : def; }
+static bool v3_eq(om_vec3 a, om_vec3 b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
+static bool v3_zero(om_vec3 a) { return a.x == 0.0f && a.y == 0.0f && a.z == 0.0f; }
+
+static om_status missing(parser *p, const char *what, const char *need)
+{
+    char tmp[4];
+    om__str s = fail_begin(p, OM_E_PARSE, p->cmd.col, tmp, sizeof tmp);
+    om__str_s(&s, "'");
+    om__str_s(&s, what);
+    om__str_s(&s, "' needs ");
+    om__str_s(&s, need);
+    return OM_E_PARSE;
+}
+
+static om_status check_near_far(parser *p, const pv *pl, float zn, float zf)
+{
+    if (zf > zn) return OM_OK;
+    uint32_t col = pl[P_FAR].has ? pl[P_FAR].vcol[0] : pl[P_NEAR].vcol[0];
+    return fail(p, OM_E_RANGE, col, "'far' must be greater than 'near'", NULL, 0, NULL);
+}
+
+static om_status second_line(parser *p, const char *what, uint32_t first)
+{
+    char tmp[4];
+    om__str s = fail_begin(p, OM_E_PARSE, p->cmd.col, tmp, sizeof tmp);
+    om__str_s(&s, "a second '");
+    om__str_s(&s, what);
+    om__str_s(&s, "' line (a scene has one; the first is on line ");
+    om__str_u(&s, first);
+    om__str_s(&s, ")");
+    return OM_E_PARSE;
+}
+
+/* ---------------------------------------------------------------- camera and light */
+
+static void default_camera(om_camera *c)
+{
+    memset(c, 0, sizeof *c);
+    c->eye = om__v3(0, 5, 15);
+    c->target = om__v3(0, 0, 0);
+    c->up = om__v3(0, 1, 0);
+    c->fovy_deg = 50.0f;
+    c->width = 640;
+    c->height = 480;
+    c->znear = 0.1f;
+    c->zfar = 1000.0f;
+}
+
+static void default_light(om_light *l)
+{
+    memset(l, 0, sizeof *l);
+    l->kind = OM_LIGHT_SPOT;
+    l->pos = om__v3(10, 20, 10);
+    l->target = om__v3(0, 0, 0);
+    l->dir = om__normalize(om__sub(l->target, l->pos));
+    l->fov_deg = 60.0f;
+    l->znear = 0.5f;
+    l->zfar = 1000.0f;
+}
+
+static om_status do_camera(parser *p)
+{
+    pv pl[P_N_];
+    om_status st;
+    if (p->have_cam) return second_line(p, "camera", p->cam_line);
+    if ((st = read_params(p, "camera", cam_params, NP(cam_params), pl)) != OM_OK) return st;
+    if (!pl[P_EYE].has || !pl[P_TARGET].has) return missing(p, "camera", "eye X Y Z and target X Y Z");
+    om_camera c;
+    default_camera(&c);
+    c.eye = pv3(&pl[P_EYE], 0);
+    c.target = pv3(&pl[P_TARGET], 0);
+    if (pl[P_UP].has) c.up = pv3(&pl[P_UP], 0);
+    c.fovy_deg = (float)val(pl, P_FOV, 0, 50.0);
+    c.width = (uint32_t)val(pl, P_SIZE, 0, 640.0);
+    c.height = (uint32_t)val(pl, P_SIZE, 1, 480.0);
+    c.znear = (float)val(pl, P_NEAR, 0, 0.1);
+    c.zfar = (float)val(pl, P_FAR, 0, 1000.0);
+    if (v3_eq(c.eye, c.target))
+        return fail(p, OM_E_RANGE, pl[P_TARGET].vcol[0], "camera eye and target must differ",
+                    NULL, 0, NULL);
+    if (v3_zero(c.up))
+        return fail(p, OM_E_RANGE, pl[P_UP].vcol[0], "'up' must not be zero", NULL, 0, NULL);
+    if ((st = check_near_far(p, pl, c.znear, c.zfar)) != OM_OK) return st;
+    p->cam = c;
+    p->have_cam = true;
+    p->cam_line = p->l.no;
+    return OM_OK;
+}
+
+static om_status do_light(parser *p)
+{
+    pv pl[P_N_];
+    om_status st;
+    om__tok t;
+    if (p->have_light) return second_line(p, "light", p->light_line);
+    int r = om__tok_next(&p->l, &t);
+    if (r < 0) return bad_byte(p, &t);
+    bool spot = r > 0 && om__tok_is(p->text, &t, "spot");
+    if (!spot && !(r > 0 && om__tok_is(p->text, &t, "directional"))) {
+        if (r == 0)
+            return fail(p, OM_E_PARSE, om__line_end_col(&p->l),
+                        "expected 'spot' or 'directional' after 'light'", NULL, 0, NULL);
+        return fail_tok(p, OM_E_PARSE, &t, "expected 'spot' or 'directional' after 'light', found ",
+                        NULL);
+    }
+    om_light l;
+    default_light(&l);
+    if (spot) {
+        if ((st = read_params(p, "light spot", spot_params, NP(spot_params), pl)) != OM_OK) return st;
+        if (!pl[P_POS].has || !pl[P_TARGET].has)
+            return missing(p, "light spot", "pos X Y Z and target X Y Z");
+        l.pos = pv3(&pl[P_POS], 0);
+        l.target = pv3(&pl[P_TARGET], 0);
+        l.fov_deg = (float)val(pl, P_FOV, 0, 60.0);
+        l.znear = (float)val(pl, P_NEAR, 0, 0.5);
+        l.zfar = (float)val(pl, P_FAR, 0, 1000.0);
+        if (v3_eq(l.pos, l.target))
+            return fail(p, OM_E_RANGE, pl[P_TARGET].vcol[0], "light pos and target must differ",
+                        NULL, 0, NULL);
+        if ((st = check_near_far(p, pl, l.znear, l.zfar)) != OM_OK) return st;
+        l.dir = om__normalize(om__sub(l.target, l.pos));
+    } else {
+        if ((st = read_params(p, "light directional", dir_params, NP(dir_params), pl)) != OM_OK)
+            return st;
+        if (!pl[P_DIR].has) return missing(p, "light directional", "dir X Y Z");
+        l.kind = OM_LIGHT_DIRECTIONAL;
+        l.pos = l.target = om__v3(0, 0, 0);
+        l.dir = pv3(&pl[P_DIR], 0);
+        if (v3_zero(l.dir))
+            return fail(p, OM_E_RANGE, pl[P_DIR].vcol[0], "'dir' must not be zero", NULL, 0, NULL);
+    }
+    p->light = l;
+    p->have_light = true;
+    p->light_line = p->l.no;
+    return OM_OK;
+}
+
+/* ---------------------------------------------------------------- materials */
+
+static uint32_t name_hash(const char *s, size_t n)
+{
+    uint32_t h = 2166136261u;
+    for (size_t i = 0; i < n; i++) h = (h ^ (unsigned char)s[i]) * 16777619u;
+    return h;
+}
+
+static void cache_put(parser *p, const om__tok *name, uint32_t ord)
+{
+    mslot *m = &p->cache[name_hash(p->text + name->at, name->len) % MCACHE];
+    m->at = name->at;
+    m->len = name->len;
+    m->ord = ord;
+    m->used = true;
+}
+
+/* The ordinal of the latest `material NAME` line before this one. The cache answers
+ * most look-ups; a miss reads the earlier lines again (they are known to be valid),
+ * which keeps the parser free of any name table it would have to allocate. */
+static bool mat_find(parser *p, const om__tok *name, uint32_t *ord)
+{
+    const char *nm = p->text + name->at;
+    const mslot *m = &p->cache[name_hash(nm, name->len) % MCACHE];
+    if (m->used && m->len == name->len && memcmp(p->text + m->at, nm, m->len) == 0) {
+        *ord = m->ord;
+        return true;
+    }
+    om__line l;
+    om__line_init(&l, p->text, p->l.start, false);
+    uint32_t n = 0;
+    bool found = false;
+    while (om__line_next(&l)) {
+        om__tok t, w;
+        if (om__tok_next(&l, &t) != 1 || !om__tok_is(p->text, &t, "material")) continue;
+        if (om__tok_next(&l, &w) == 1 && w.len == name->len && memcmp(p->text + w.at, nm, w.len) == 0) {
+            *ord = n;
+            found = true;
+        }
+        n++;
+    }
+    if (found) cache_put(p, name, *ord);
+    return found;
+}
+
+static bool valid_name(const char *s, size_t n)
+{
+    for (size_t i = 0; i < n; i++) {
+        char c = s[i];
+        bool alpha = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '_';
+        if (!alpha && (i == 0 || !(is_digit(c) || c == '.' || c == '-'))) return false;
+    }
+    return n > 0;
+}
+
+static om_status add_material(parser *p)
+{
+    if (1u + p->nnamed + p->ninline >= 65535u)
+        return fail(p, OM_E_RANGE, p->cmd.col, "too many materials (a scene has at most 65535)",
+                    NULL, 0, NULL);
+    return OM_OK;
+}
+
+static om_status do_material(parser *p)
+{
+    pv pl[P_N_];
+    om_status st;
+    om__tok name;
+    int r = om__tok_next(&p->l, &name);
+    if (r < 0) return bad_byte(p, &name);
+    if (r == 0)
+        return fail(p, OM_E_PARSE, om__line_end_col(&p->l), "expected a name after 'material'",
+                    NULL, 0, NULL);
+    if (!valid_name(p->text + name.at, name.len))
+        return fail_tok(p, OM_E_PARSE, &name, "bad material name ",
+                        " (a letter or _, then letters, digits, _ . -)");
+    if ((st = read_params(p, "material", mat_params, NP(mat_params), pl)) != OM_OK) return st;
+    if ((st = add_material(p)) != OM_OK) return st;
+    if (p->fill) {
+        om_material *m = &p->s->mats[1 + p->nnamed];
+        m->r = (float)val(pl, P_ALBEDO, 0, 0.8);
+        m->g = (float)val(pl, P_ALBEDO, 1, 0.8);
+        m->b = (float)val(pl, P_ALBEDO, 2, 0.8);
+        m->opacity = (float)val(pl, P_OPACITY, 0, 1.0);
+    }
+    cache_put(p, &name, p->nnamed);
+    p->nnamed++;
+    return OM_OK;
+}
+
+/* ---------------------------------------------------------------- objects */
+
+/* Transform and material of an object from its COMMON parameters. Materials are laid
+ * out as [default, named in order of definition, inline in order of appearance]. */
+static om_status object_common(parser *p, const pv *pl, om__xform *xf, uint16_t *mat)
+{
+    double one[3] = {1.0, 1.0, 1.0}, zero[3] = {0.0, 0.0, 0.0};
+    om__xform_make(xf, pl[P_SCALE].has ? pl[P_SCALE].v : one,
+                   pl[P_ROTATE].has ? pl[P_ROTATE].v : zero,
+                   pl[P_TRANSLATE].has ? pl[P_TRANSLATE].v : zero);
+    uint32_t m = 0;
+    if (pl[P_MATERIAL].has) {
+        uint32_t ord;
+        const om__tok *w = &pl[P_MATERIAL].w;
+        if (!mat_find(p, w, &ord))
+            return fail_tok(p, OM_E_PARSE, w, "unknown material ",
+                            " (define it on a 'material' line above)");
+        m = 1 + ord;
+    }
+    if (pl[P_ALBEDO].has || pl[P_OPACITY].has) {
+        om_status st = add_material(p);
+        if (st != OM_OK) return st;
+        uint32_t own = 1 + p->nnamed_total + p->ninline;
+        if (p->fill) {
+            om_material *dst = &p->s->mats[own];
+            *dst = p->s->mats[m];
+            if (pl[P_ALBEDO].has) {
+                dst->r = (float)pl[P_ALBEDO].v[0];
+                dst->g = (float)pl[P_ALBEDO].v[1];
+                dst->b = (float)pl[P_ALBEDO].v[2];
+            }
+            if (pl[P_OPACITY].has) dst->opacity = (float)pl[P_OPACITY].v[0];
+        }
+        p->ninline++;
+        m = own;
+    }
+    *mat = (uint16_t)m;
+    return OM_OK;
+}
+
+static om_status check_totals(parser *p, uint64_t nv, uint64_t nt)
+{
+    if (p->nv + nv > OM__MAX_ELEMS || p->nt + nt > OM__MAX_ELEMS)
+        return fail(p, OM_E_RANGE, p->cmd.col,
+                    "the scene would have more than 2147483647 vertices or triangles", NULL, 0,
+                    NULL);
+    return OM_OK;
+}
+
+static void shape_counts(int cmd, const pv *pl, uint64_t *nv, uint64_t *nt)
+{
+    switch (cmd) {
+    case C_PLANE: om__plane_counts((uint32_t)val(pl, P_DIVISIONS, 0, 1), nv, nt); break;
+    case C_BOX: *nv = 8; *nt = 12; break;
+    case C_SPHERE:
+        om__sphere_counts((uint32_t)val(pl, P_SEGMENTS, 0, 32), (uint32_t)val(pl, P_RINGS, 0, 16),
+                          nv, nt);
+        break;
+    case C_CYLINDER: om__cylinder_counts((uint32_t)val(pl, P_SEGMENTS, 0, 32), nv, nt); break;
+    default: /* C_TRIANGLES */
+        *nt = (uint64_t)val(pl, P_COUNT, 0, 0);
+        *nv = 3 * *nt;
+        break;
+    }
+}
+
+static void shape_gen(om__sink *k, int cmd, const pv *pl)
+{
+    static const double in_default[6] = {-5, 0.5, -5, 5, 3, 5};
+    switch (cmd) {
+    case C_PLANE:
+        om__gen_plane(k, val(pl, P_SIZE2, 0, 10), val(pl, P_SIZE2, 1, 10),
+                      (uint32_t)val(pl, P_DIVISIONS, 0, 1));
+        break;
+    case C_BOX:
+        om__gen_box(k, val(pl, P_SIZE3, 0, 1), val(pl, P_SIZE3, 1, 1), val(pl, P_SIZE3, 2, 1));
+        break;
+    case C_SPHERE:
+        om__gen_sphere(k, val(pl, P_RADIUS, 0, 1), (uint32_t)val(pl, P_SEGMENTS, 0, 32),
+                       (uint32_t)val(pl, P_RINGS, 0, 16));
+        break;
+    case C_CYLINDER:
+        om__gen_cylinder(k, val(pl, P_RADIUS, 0, 0.5), val(pl, P_HEIGHT, 0, 1),
+                         (uint32_t)val(pl, P_SEGMENTS, 0, 32));
+        break;
+    default: /* C_TRIANGLES */
+        om__gen_triangles(k, (uint32_t)val(pl, P_COUNT, 0, 0), (uint32_t)val(pl, P_SEED, 0, 1),
+                          val(pl, P_AREA, 0, 1), pl[P_IN].has ? pl[P_IN].v : in_default);
+        break;
+    }
+}
+
+/* A box in the shape's own space that holds all its vertices: the transformed corners
+ * of it bound the object, so most objects pass the range check without generating. */
+static void shape_box(int cmd, const pv *pl, double lo[3], double hi[3])
+{
+    double r = val(pl, P_RADIUS, 0, cmd == C_SPHERE ? 1.0 : 0.5);
+    switch (cmd) {
+    case C_PLANE:
+        hi[0] = 0.5 * val(pl, P_SIZE2, 0, 10); hi[1] = 0.0; hi[2] = 0.5 * val(pl, P_SIZE2, 1, 10);
+        break;
+    case C_BOX:
+        for (int i = 0; i < 3; i++) hi[i] = 0.5 * val(pl, P_SIZE3, i, 1);
+        break;
+    case C_SPHERE: hi[0] = hi[1] = hi[2] = r; break;
+    case C_CYLINDER: hi[0] = hi[2] = r; hi[1] = val(pl, P_HEIGHT, 0, 1); break;
+    default: { /* C_TRIANGLES: the `in` box widened by a triangle's circumradius */
+        static const double in_default[6] = {-5, 0.5, -5, 5, 3, 5};
+        const double *in = pl[P_IN].has ? pl[P_IN].v : in_default;
+        double R = sqrt(4.0 * val(pl, P_AREA, 0, 1) / val(pl, P_COUNT, 0, 1) / (3.0 * 1.7320508075688772));
+        for (int i = 0; i < 3; i++) { lo[i] = in[i] - R; hi[i] = in[i + 3] + R; }
+        return;
+    }
+    }
+    for (int i = 0; i < 3; i++) lo[i] = cmd == C_CYLINDER && i == 1 ? 0.0 : -hi[i];
+}
+
+static bool box_inside(const om__xform *xf, const double lo[3], const double hi[3])
+{
+    /* A margin far above rounding keeps the shortcut on the safe side. */
+    const double lim = OM__COORD_MAX * (1.0 - 1e-9);
+    for (int c = 0; c < 8; c++) {
+        double q[3] = {c & 1 ? hi[0] : lo[0], c & 2 ? hi[1] : lo[1], c & 4 ? hi[2] : lo[2]};
+        for (int r = 0; r < 3; r++) {
+            const double *m = xf->m + 4 * r;
+            double v = m[0] * q[0] + m[1] * q[1] + m[2] * q[2] + m[3];
+            if (!(fabs(v) <= lim)) return false;
+        }
+    }
+    return true;
+}
+
+static om_status out_of_range(parser *p, const char *what)
+{
+    char tmp[4];
+    om__str s = fail_begin(p, OM_E_RANGE, p->cmd.col, tmp, sizeof tmp);
+    om__str_s(&s, what);
+    om__str_s(&s, " reaches beyond 1e7 in some coordinate after its scale, rotate and translate");
+    return OM_E_RANGE;
+}
+
+/* A mesh's file: loaded through the host's loader in both passes (the engine keeps no
+ * pointer between calls), read by obj.c into a counting or the writing sink. */
+static om_status do_mesh(parser *p, const om__tok *file, const char *name, const om__xform *xf,
+                         uint16_t mat)
+{
+    om_diag *d = p->d;
+    if (!p->ld || !p->ld->load)
+        return fail(p, OM_E_NOTFOUND, file->col, "mesh ", name, file->len,
+                    ": no file loader was given to read it");
+    const char *data = NULL;
+    size_t dlen = 0;
+    if (d) d->msg[0] = '\0';
+    om_status st = p->ld->load(p->ld->user, name, &data, &dlen);
+    if (st == OM_OK && !data && dlen) st = OM_E_INVALID;
+    if (st != OM_OK) {
+        /* Keep the loader's own words (it may name the path and the system's reason). */
+        char why[sizeof d->msg];
+        why[0] = '\0';
+        if (d) memcpy(why, d->msg, sizeof why);
+        why[sizeof why - 1] = '\0';
+        char tmp[4];
+        om__str s = fail_begin(p, st, file->col, tmp, sizeof tmp);
+        om__str_s(&s, "cannot load mesh ");
+        om__str_tok(&s, name, file->len);
+        om__str_s(&s, ": ");
+        om__str_s(&s, why[0] ? why : om_status_str(st));
+        return st;
+    }
+    if (p->fill) {
+        uint64_t nv0 = p->out.nv, nt0 = p->out.nt;
+        om__sink_begin(&p->out, xf, mat);
+        if ((st = om__obj_run(data, dlen, name, p->l.no, &p->out, d)) != OM_OK) return st;
+        if (p->out.out_of_range)   /* passed the first pass: the file has changed since */
+            return fail(p, OM_E_INVALID, file->col, "mesh ", name, file->len,
+                        " changed between the counting and filling passes");
+        p->nv += p->out.nv - nv0;
+        p->nt += p->out.nt - nt0;
+        return OM_OK;
+    }
+    om__sink k;
+    om__sink_init(&k, false);
+    om__sink_begin(&k, xf, mat);
+    if ((st = om__obj_run(data, dlen, name, p->l.no, &k, d)) != OM_OK) return st;
+    if (k.out_of_range) {
+        char tmp[4];
+        om__str s = fail_begin(p, OM_E_RANGE, p->cmd.col, tmp, sizeof tmp);
+        om__str_s(&s, "mesh ");
+        om__str_tok(&s, name, file->len);
+        om__str_s(&s, " reaches beyond 1e7 after its transform (vertex on OBJ line ");
+        om__str_u(&s, k.where);
+        om__str_s(&s, ")");
+        return OM_E_RANGE;
+    }
+    if ((st = check_totals(p, k.nv, k.nt)) != OM_OK) return st;
+    p->nv += k.nv;
+    p->nt += k.nt;
+    return OM_OK;
+}
+
+static om_status do_object(parser *p, int cmd)
+{
+    static const struct { const uint8_t *ids; size_t n; } sets[C_N_] = {
+        [C_PLANE] = {plane_params, NP(plane_params)},
+        [C_BOX] = {box_params, NP(box_params)},
+        [C_SPHERE] = {sphere_params, NP(sphere_params)},
+        [C_CYLINDER] = {cyl_params, NP(cyl_params)},
+        [C_MESH] = {mesh_params, NP(mesh_params)},
+        [C_TRIANGLES] = {tris_params, NP(tris_params)},
+    };
+    pv pl[P_N_];
+    om_status st;
+    om__tok file;
+    char name[256];
+    if (cmd == C_MESH) {
+        int r = om__tok_next(&p->l, &file);
+        if (r < 0) return bad_byte(p, &file);
+        if (r == 0)
+            return fail(p, OM_E_PARSE, om__line_end_col(&p->l), "expected a file name after 'mesh'",
+                        NULL, 0, NULL);
+        if (file.len >= sizeof name)
+            return fail(p, OM_E_PARSE, file.col, "file name longer than 255 bytes", NULL, 0, NULL);
+        memcpy(name, p->text + file.at, file.len);
+        name[file.len] = '\0';
+    }
+    if ((st = read_params(p, cmd_names[cmd], sets[cmd].ids, sets[cmd].n, pl)) != OM_OK) return st;
+    if (cmd == C_TRIANGLES) {
+        if (!pl[P_COUNT].has) return missing(p, "triangles", "count N");
+        for (int i = 0; i < 3 && pl[P_IN].has; i++)
+            if (pl[P_IN].v[i] > pl[P_IN].v[i + 3])
+                return fail(p, OM_E_RANGE, pl[P_IN].vcol[i + 3],
+                            "'in' needs X0 <= X1, Y0 <= Y1 and Z0 <= Z1", NULL, 0, NULL);
+    }
+    om__xform xf;
+    uint16_t mat;
+    if ((st = object_common(p, pl, &xf, &mat)) != OM_OK) return st;
+    if (cmd == C_MESH) return do_mesh(p, &file, name, &xf, mat);
+
+    uint64_t nv, nt;
+    shape_counts(cmd, pl, &nv, &nt);
+    if ((st = check_totals(p, nv, nt)) != OM_OK) return st;
+    if (p->fill) {
+        om__sink_begin(&p->out, &xf, mat);
+        shape_gen(&p->out, cmd, pl);
+    } else {
+        double lo[3], hi[3];
+        shape_box(cmd, pl, lo, hi);
+        if (!box_inside(&xf, lo, hi)) {
+            /* Near the limit: generate without storing, so the check is exact per vertex. */
+            om__sink k;
+            om__sink_init(&k, false);
+            om__sink_begin(&k, &xf, mat);
+            shape_gen(&k, cmd, pl);
+            if (k.out_of_range) return out_of_range(p, cmd_names[cmd]);
+        }
+    }
+    p->nv += nv;
+    p->nt += nt;
+    return OM_OK;
+}
+
+/* ---------------------------------------------------------------- keys */
+
+static om_status key_order(parser *p, const char *what, uint32_t col, float last, uint32_t line)
+{
+    char tmp[4];
+    om__str s = fail_begin(p, OM_E_PARSE, col, tmp, sizeof tmp);
+    om__str_s(&s, what);
+    om__str_s(&s, " times must increase (the key before, on line ");
+    om__str_u(&s, line);
+    om__str_s(&s, ", is at t = ");
+    om__str_f(&s, last, 3);
+    om__str_s(&s, ")");
+    return OM_E_PARSE;
+}
+
+static om_status do_key(parser *p)
+{
+    pv pl[P_N_];
+    om_status st;
+    om__tok t;
+    int r = om__tok_next(&p->l, &t);
+    if (r < 0) return bad_byte(p, &t);
+    bool cam = r > 0 && om__tok_is(p->text, &t, "camera");
+    if (!cam && !(r > 0 && om__tok_is(p->text, &t, "light"))) {
+        if (r == 0)
+            return fail(p, OM_E_PARSE, om__line_end_col(&p->l),
+                        "expected 'camera' or 'light' after 'key'", NULL, 0, NULL);
+        return fail_tok(p, OM_E_PARSE, &t, "expected 'camera' or 'light' after 'key', found ", NULL);
+    }
+    const char *what = cam ? "key camera" : "key light";
+    double T;
+    uint32_t tcol;
+    if ((st = read_value(p, what, K_NUM, R_COORD, 1, &T, &tcol)) != OM_OK) return st;
+    float tf = (float)T;
+    if (cam) {
+        if ((st = read_params(p, what, keycam_params, NP(keycam_params), pl)) != OM_OK) return st;
+        if (!pl[P_EYE].has || !pl[P_TARGET].has) return missing(p, what, "eye X Y Z and target X Y Z");
+        om_camera_key k;
+        k.t = tf;
+        k.eye = pv3(&pl[P_EYE], 0);
+        k.target = pv3(&pl[P_TARGET], 0);
+        if (v3_eq(k.eye, k.target))
+            return fail(p, OM_E_RANGE, pl[P_TARGET].vcol[0], "camera eye and target must differ",
+                        NULL, 0, NULL);
+        if (p->ncam && !(tf > p->cam_t)) return key_order(p, what, tcol, p->cam_t, p->cam_t_line);
+        if (p->fill) p->s->cam_keys[p->ncam] = k;
+        p->ncam++;
+        p->cam_t = tf;
+        p->cam_t_line = p->l.no;
+        return OM_OK;
+    }
+    if ((st = read_params(p, what, keylight_params, NP(keylight_params), pl)) != OM_OK) return st;
+    int form;
+    om_light_key k;
+    memset(&k, 0, sizeof k);
+    k.t = tf;
+    if (pl[P_DIR].has) {
+        if (pl[P_POS].has || pl[P_TARGET].has)
+            return fail(p, OM_E_PARSE, pl[P_DIR].col,
+                        "a light key has either pos and target (spot) or dir (directional)", NULL,
+                        0, NULL);
+        form = 2;
+        k.dir = pv3(&pl[P_DIR], 0);
+        if (v3_zero(k.dir))
+            return fail(p, OM_E_RANGE, pl[P_DIR].vcol[0], "'dir' must not be zero", NULL, 0, NULL);
+    } else {
+        if (!pl[P_POS].has || !pl[P_TARGET].has)
+            return missing(p, what, "pos X Y Z and target X Y Z, or dir X Y Z");
+        form = 1;
+        k.pos = pv3(&pl[P_POS], 0);
+        k.target = pv3(&pl[P_TARGET], 0);
+        if (v3_eq(k.pos, k.target))
+            return fail(p, OM_E_RANGE, pl[P_TARGET].vcol[0], "light pos and target must differ",
+                        NULL, 0, NULL);
+        k.dir = om__normalize(om__sub(k.target, k.pos));
+    }
+    if (p->lkey_form && form != p->lkey_form) {
+        char tmp[4];
+        om__str s = fail_begin(p, OM_E_PARSE, p->cmd.col, tmp, sizeof tmp);
+        om__str_s(&s, "light keys mix pos/target and dir (the first key, on line ");
+        om__str_u(&s, p->lkey_line);
+        om__str_s(&s, form == 1 ? ", uses dir)" : ", uses pos/target)");
+        return OM_E_PARSE;
+    }
+    if (p->nlight && !(tf > p->light_t)) return key_order(p, what, tcol, p->light_t, p->light_t_line);
+    if (!p->lkey_form) {
+        p->lkey_form = form;
+        p->lkey_line = p->l.no;
+        p->lkey_col = p->cmd.col;
+    }
+    if (p->fill) p->s->light_keys[p->nlight] = k;
+    p->nlight++;
+    p->light_t = tf;
+    p->light_t_line = p->l.no;
+    return OM_OK;
+}
+
+/* ---------------------------------------------------------------- one pass */
+
+static om_status run(parser *p)
+{
+    om_status st = OM_OK;
+    default_camera(&p->cam);
+    default_light(&p->light);
+    om__line_init(&p->l, p->text, p->len, true);
+    while (om__line_next(&p->l)) {
+        om__tok t;
+        int r = om__tok_next(&p->l, &t);
+        if (r < 0) return bad_byte(p, &t);
+        if (r == 0) continue;
+        p->cmd = t;
+        int cmd = -1;
+        for (int i = 0; i < C_N_ && cmd < 0; i++)
+            if (om__tok_is(p->text, &t, cmd_names[i])) cmd = i;
+        switch (cmd) {
+        case C_CAMERA: st = do_camera(p); break;
+        case C_LIGHT: st = do_light(p); break;
+        case C_MATERIAL: st = do_material(p); break;
+        case C_KEY: st = do_key(p); break;
+        case -1: {
+            char tmp[4];
+            om__str s = fail_begin(p, OM_E_PARSE, t.col, tmp, sizeof tmp);
+            om__str_s(&s, "unknown command ");
+            om__str_tok(&s, p->text + t.at, t.len);
+            om__str_s(&s, " (expected ");
+            for (int i = 0; i < C_N_; i++) {
+                if (i) om__str_s(&s, ", ");
+                om__str_s(&s, cmd_names[i]);
+            }
+            om__str_s(&s, ")");
+            return OM_E_PARSE;
+        }
+        default: st = do_object(p, cmd); break;
+        }
+        if (st != OM_OK) return st;
+    }
+    /* Light keys must match the light's kind, whichever line came first. */
+    if (p->lkey_form && (p->lkey_form == 1) != (p->light.kind == OM_LIGHT_SPOT)) {
+        char tmp[4];
+        om__str s = om__perr(p->d, OM_E_PARSE, NULL, p->lkey_line, p->lkey_col, tmp, sizeof tmp);
+        om__str_s(&s, p->lkey_form == 1 ? "light keys give pos/target but the light is directional"
+                                        : "light keys give dir but the light is a spot light");
+        return OM_E_PARSE;
+    }
+    return OM_OK;
+}
+
+/* ================================================================ public entry points */
+
+typedef struct al_vec3 { char c; om_vec3 x; } al_vec3;
+typedef struct al_u32 { char c; uint32_t x; } al_u32;
+typedef struct al_u16 { char c; uint16_t x; } al_u16;
+typedef struct al_mat { char c; om_material x; } al_mat;
+typedef struct al_ck { char c; om_camera_key x; } al_ck;
+typedef struct al_lk { char c; om_light_key x; } al_lk;
+
+enum { A_VERTS, A_IDX, A_TRIMAT, A_MATS, A_CKEYS, A_LKEYS, A_N_ };
+
+/* Each array's size and alignment, from the first pass's counts. */
+static void layout(const parser *p, uint64_t size[A_N_], size_t align[A_N_])
+{
+    size[A_VERTS] = p->nv * sizeof(om_vec3);          align[A_VERTS] = offsetof(al_vec3, x);
+    size[A_IDX] = p->nt * 3 * sizeof(uint32_t);       align[A_IDX] = offsetof(al_u32, x);
+    size[A_TRIMAT] = p->nt * sizeof(uint16_t);        align[A_TRIMAT] = offsetof(al_u16, x);
+    size[A_MATS] = (1 + (uint64_t)p->nnamed + p->ninline) * sizeof(om_material);
+    align[A_MATS] = offsetof(al_mat, x);
+    size[A_CKEYS] = (uint64_t)p->ncam * sizeof(om_camera_key);   align[A_CKEYS] = offsetof(al_ck, x);
+    size[A_LKEYS] = (uint64_t)p->nlight * sizeof(om_light_key);  align[A_LKEYS] = offsetof(al_lk, x);
+}
+
+/* Bytes of one array: om_arena_need's worst case, or nothing for an empty array. */
+static uint64_t array_need(uint64_t size, size_t align)
+{
+    return size ? size + (align > 1 ? align - 1 : 0) : 0;
+}
+
+static void diag_clear(om_diag *d)
+{
+    if (!d) return;
+    d->status = OM_OK;
+    d->asked = d->left = 0;
+    d->line = d->col = 0;
+    d->msg[0] = '\0';
+}
+
+static void parser_init(parser *p, const char *text, size_t len, const om_loader *ld, om_diag *d)
+{
+    memset(p, 0, sizeof *p);
+    p->text = text;
+    p->len = text ? len : 0;
+    p->ld = ld;
+    p->d = d;
+}
+
+static om_status total_bytes(const parser *p, uint64_t *total, om_diag *d)
+{
+    uint64_t size[A_N_];
+    size_t align[A_N_];
+    layout(p, size, align);
+    *total = 0;
+    for (int i = 0; i < A_N_; i++) *total += array_need(size[i], align[i]);
+    if (*total > (uint64_t)SIZE_MAX) {
+        if (d) {
+            d->asked = SIZE_MAX;
+            d->left = 0;
+        }
+        return om__fail(d, OM_E_BUDGET, "the scene needs more bytes than this machine can address");
+    }
+    return OM_OK;
+}
+
+om_status om_scene_bytes(const char *text, size_t len, const om_loader *ld, size_t *bytes,
+                         om_diag *d)
+{
+    diag_clear(d);
+    if (bytes) *bytes = 0;
+    if (!bytes) return om__fail(d, OM_E_INVALID, "om_scene_bytes needs somewhere to put the bytes");
+    if (!text && len) return om__fail(d, OM_E_INVALID, "scene text is NULL");
+    parser p;
+    parser_init(&p, text, len, ld, d);
+    om_status st = run(&p);
+    if (st != OM_OK) return st;
+    uint64_t total;
+    if ((st = total_bytes(&p, &total, d)) != OM_OK) return st;
+    *bytes = (size_t)total;
+    return OM_OK;
+}
+
+om_status om_scene_parse(const char *text, size_t len, const om_loader *ld, om_arena *a,
+                         om_scene *out, om_diag *d)
+{
+    diag_clear(d);
+    if (!a || !out) return om__fail(d, OM_E_INVALID, "om_scene_parse needs an arena and a scene");
+    memset(out, 0, sizeof *out);
+    if (!text && len) return om__fail(d, OM_E_INVALID, "scene text is NULL");
+    parser p;
+    parser_init(&p, text, len, ld, d);
+    om_status st = run(&p);
+    if (st != OM_OK) return st;
+    uint64_t total, size[A_N_];
+    size_t align[A_N_];
+    if ((st = total_bytes(&p, &total, d)) != OM_OK) return st;
+    layout(&p, size, align);
+
+    /* Each array is one carve of exactly what om_scene_bytes counted for it (its size
+     * plus the worst-case alignment padding), aligned inside the carve: the arena use
+     * is then exactly the bytes query wherever the host's buffer starts, so a budget of
+     * one byte less fails rather than depending on where the buffer happens to lie. */
+    void *arr[A_N_] = {NULL};
+    size_t mark = om_arena_mark(a);
+    for (int i = 0; i < A_N_; i++) {
+        if (!size[i]) continue;
+        void *raw;
+        if ((st = om_arena_alloc(a, (size_t)array_need(size[i], align[i]), 1, &raw, d)) != OM_OK) {
+            om_arena_rewind(a, mark);
+            return st;
+        }
+        uintptr_t at = (uintptr_t)raw;
+        arr[i] = (unsigned char *)raw + ((align[i] - (at & (align[i] - 1))) & (align[i] - 1));
+    }
+    om_scene *s = out;
+    s->nverts = (uint32_t)p.nv;
+    s->ntris = (uint32_t)p.nt;
+    s->nmats = 1 + p.nnamed + p.ninline;
+    s->ncam_keys = p.ncam;
+    s->nlight_keys = p.nlight;
+    s->verts = (om_vec3 *)arr[A_VERTS];
+    s->idx = (uint32_t *)arr[A_IDX];
+    s->tri_mat = (uint16_t *)arr[A_TRIMAT];
+    s->mats = (om_material *)arr[A_MATS];
+    s->cam_keys = (om_camera_key *)arr[A_CKEYS];
+    s->light_keys = (om_light_key *)arr[A_LKEYS];
+    s->mats[0].r = s->mats[0].g = s->mats[0].b = 0.8f;
+    s->mats[0].opacity = 1.0f;
+
+    /* The second pass reuses the parser: one on the stack is enough for small targets. */
+    uint32_t named = p.nnamed, inline_ = p.ninline;
+    parser_init(&p, text, len, ld, d);
+    p.fill = true;
+    p.nnamed_total = named;
+    p.s = s;
+    om__sink_init(&p.out, true);
+    p.out.verts = s->verts;
+    p.out.idx = s->idx;
+    p.out.tri_mat = s->tri_mat;
+    p.out.vcap = s->nverts;
+    p.out.tcap = s->ntris;
+    st = run(&p);
+    /* Only a mesh file that changed between the two loads can make the passes differ. */
+    if (st == OM_OK && (p.out.overflow || p.out.nv != s->nverts || p.out.nt != s->ntris ||
+                        p.nv != s->nverts || p.nt != s->ntris || p.nnamed != named ||
+                        p.ninline != inline_ || p.ncam != s->ncam_keys || p.nlight != s->nlight_keys))
+        st = om__fail(d, OM_E_INVALID, "a mesh file changed between the counting and filling passes");
+    if (st != OM_OK) {
+        om_arena_rewind(a, mark);
+        memset(out, 0, sizeof *out);
+        return st;
+    }
+    s->camera = p.cam;
+    s->light = p.light;
+    if (s->nverts) {
+        s->lo = s->hi = s->verts[0];
+        for (uint32_t i = 1; i < s->nverts; i++) {
+            om_vec3 v = s->verts[i];
+            s->lo = om__v3(fminf(s->lo.x, v.x), fminf(s->lo.y, v.y), fminf(s->lo.z, v.z));
+            s->hi = om__v3(fmaxf(s->hi.x, v.x), fmaxf(s->hi.y, v.y), fmaxf(s->hi.z, v.z));
+        }
+    }
+    return OM_OK;
+}
+
+/* ================================================================ paths */
+
+static om_vec3 lerp3(om_vec3 a, om_vec3 b, float u)
+{
+    /* (1-u) a + u b gives a exactly at u = 0 and b exactly at u = 1. */
+    float w = 1.0f - u;
+    return om__v3(w * a.x + u * b.x, w * a.y + u * b.y, w * a.z + u * b.z);
+}
+
+/* Keys are sorted by strictly increasing t. Returns the key at or before t (clamped to
+ * the first and the last) and in *u the weight of the key after it. */
+#define FIND_SEGMENT(keys, n, t, u, out)                                                 \
+    do {                                                                                 \
+        uint32_t lo_ = 0, hi_ = (n) - 1;                                                 \
+        *(u) = 0.0f;                                                                     \
+        if (!((t) > (keys)[0].t)) { (out) = 0; break; }      /* before, or NaN */        \
+        if ((t) >= (keys)[hi_].t) { (out) = hi_; break; }                                \
+        while (hi_ - lo_ > 1) {                              /* keys[lo].t < t < keys[hi].t */ \
+            uint32_t mid_ = lo_ + (hi_ - lo_) / 2;                                       \
+            if ((keys)[mid_].t <= (t)) lo_ = mid_; else hi_ = mid_;                      \
+        }                                                                                \
+        *(u) = ((t) - (keys)[lo_].t) / ((keys)[hi_].t - (keys)[lo_].t);                  \
+        (out) = lo_;                                                                     \
+    } while (0)
+
+void om_scene_at(const om_scene *s, float t, om_camera *cam, om_light *light)
+{
+    if (cam) {
+        *cam = s->camera;
+        if (s->ncam_keys && s->cam_keys) {
+            float u;
+            uint32_t i;
+            FIND_SEGMENT(s->cam_keys, s->ncam_keys, t, &u, i);
+            const om_camera_key *a = &s->cam_keys[i];
+            const om_camera_key *b = i + 1 < s->ncam_keys ? a + 1 : a;
+            cam->eye = lerp3(a->eye, b->eye, u);
+            cam->target = lerp3(a->target, b->target, u);
+        }
+    }
+    if (light) {
+        *light = s->light;
+        if (s->nlight_keys && s->light_keys) {
+            float u;
+            uint32_t i;
+            FIND_SEGMENT(s->light_keys, s->nlight_keys, t, &u, i);
+            const om_light_key *a = &s->light_keys[i];
+            const om_light_key *b = i + 1 < s->nlight_keys ? a + 1 : a;
+            if (light->kind == OM_LIGHT_SPOT) {
+                light->pos = lerp3(a->pos, b->pos, u);
+                light->target = lerp3(a->target, b->target, u);
+                light->dir = om__normalize(om__sub(light->target, light->pos));
+            } else {
+                light->dir = lerp3(a->dir, b->dir, u);
+            }
+        }
+    }
+}

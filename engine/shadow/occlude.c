@@ -1,0 +1,148 @@
+/* occlude.c — projection onto the light's grid, triangle setup for the occlusion
+ * predicate (see occlude.h for the rule), and optical-depth transmittance. */
+#include "occlude.h"
+
+size_t om__lspace_bytes(const om_scene *s)
+{
+    return om_arena_need((size_t)s->nverts * sizeof(om__lvert), 8);
+}
+
+om_status om__lspace_init(om__lspace *ls, om_arena *a, const om_scene *s, om_diag *d)
+{
+    void *p;
+    memset(ls, 0, sizeof *ls);
+    ls->scene = s;
+    om_status st = om_arena_alloc(a, (size_t)s->nverts * sizeof(om__lvert), 8, &p, d);
+    ls->verts = (om__lvert *)p;
+    return st;
+}
+
+void om__lspace_begin(om__lspace *ls, const om_view *v)
+{
+    const om_scene *s = ls->scene;
+    ls->vp = v->light_vp;
+    for (uint32_t i = 0; i < s->nverts; i++) {
+        om_vec4 c = om__mat_apply(&ls->vp, s->verts[i]);
+        om__lvert *o = &ls->verts[i];
+        int64_t X, Y;
+        double Z;
+        /* A vertex inside every plane projects exactly as clipping would project it. */
+        if (om__outcode(&c, OM_LIGHT_GRID, OM_LIGHT_GRID) == 0 &&
+            om__project(&c, OM_LIGHT_GRID, OM_LIGHT_GRID, &X, &Y, &Z)) {
+            o->x = (int32_t)X;
+            o->y = (int32_t)Y;
+            o->z = Z;
+        } else {
+            o->x = INT32_MIN;
+            o->y = 0;
+            o->z = 0.0;
+        }
+    }
+}
+
+bool om__lspace_point(const om__lspace *ls, const om_sample *smp, om__lpoint *out)
+{
+    om_vec4 c = om__mat_apply(&ls->vp, om__v3(smp->p[0], smp->p[1], smp->p[2]));
+    out->tri = smp->tri;
+    return om__project(&c, OM_LIGHT_GRID, OM_LIGHT_GRID, &out->x, &out->y, &out->z);
+}
+
+static void add_sub(om__ltri *lt, const int64_t x[3], const int64_t y[3], const double z[3])
+{
+    om__rtri *r = &lt->sub[lt->n];
+    if (!om__tri2_setup(&r->e, x, y, true)) return;
+    om__rtri_plane(r, z);
+    for (int i = 0; i < 3; i++) {
+        if (x[i] < lt->lox) lt->lox = x[i];
+        if (x[i] > lt->hix) lt->hix = x[i];
+        if (y[i] < lt->loy) lt->loy = y[i];
+        if (y[i] > lt->hiy) lt->hiy = y[i];
+    }
+    if (r->zmin < lt->zmin) lt->zmin = r->zmin;
+    lt->n++;
+}
+
+bool om__lspace_tri(const om__lspace *ls, uint32_t t, om__ltri *lt)
+{
+    const uint32_t *ix = ls->scene->idx + (size_t)t * 3;
+    const om__lvert *a = &ls->verts[ix[0]], *b = &ls->verts[ix[1]], *c = &ls->verts[ix[2]];
+    lt->n = 0;
+    lt->tri = t;
+    lt->lox = lt->loy = INT64_MAX;
+    lt->hix = lt->hiy = INT64_MIN;
+    lt->zmin = 4294967296.0;
+    if (a->x != INT32_MIN && b->x != INT32_MIN && c->x != INT32_MIN) {
+        int64_t x[3] = {a->x, b->x, c->x}, y[3] = {a->y, b->y, c->y};
+        double z[3] = {a->z, b->z, c->z};
+        add_sub(lt, x, y, z);
+        return lt->n > 0;
+    }
+    om_vec4 clip[3];
+    for (int k = 0; k < 3; k++) clip[k] = om__mat_apply(&ls->vp, ls->scene->verts[ix[k]]);
+    for (int k = 0; k < 3; k++)
+        if (!om__finite(clip[k].x) || !om__finite(clip[k].y) || !om__finite(clip[k].z) ||
+            !om__finite(clip[k].w))
+            return false;
+    int64_t gx[9], gy[9];
+    double gz[9];
+    int n = om__clip_project(clip, OM_LIGHT_GRID, OM_LIGHT_GRID, gx, gy, gz);
+    for (int k = 1; k + 1 < n; k++) {
+        int64_t x[3] = {gx[0], gx[k], gx[k + 1]}, y[3] = {gy[0], gy[k], gy[k + 1]};
+        double z[3] = {gz[0], gz[k], gz[k + 1]};
+        add_sub(lt, x, y, z);
+    }
+    return lt->n > 0;
+}
+
+/* ---- transmittance */
+
+double om__log2(double x)
+{
+    /* x = m * 2^e with m in [0.5, 1); ln m = 2 atanh(u), u = (m - 1) / (m + 1). */
+    int e;
+    double m = frexp(x, &e);
+    double u = (m - 1.0) / (m + 1.0), u2 = u * u, sum = 0.0;
+    for (int k = 20; k >= 0; k--) sum = 1.0 / (2 * k + 1) + u2 * sum;
+    return (double)e + 2.0 * u * sum * 1.44269504088896340736;
+}
+
+double om__exp2(double x)
+{
+    double n = floor(x), f = (x - n) * 0.69314718055994530942;   /* e^f, f in [0, ln 2) */
+    double sum = 1.0, term = 1.0;
+    for (int k = 1; k < 20; k++) {
+        term = term * f / k;
+        sum += term;
+    }
+    return ldexp(sum, (int)n);
+}
+
+om__odepth om__material_odepth(const om_material *m)
+{
+    om__odepth o;
+    const float ch[3] = {m->r, m->g, m->b};
+    for (int i = 0; i < 3; i++) {
+        float t = (1.0f - m->opacity) * ch[i];
+        int q = (int)(t * 255.0f + 0.5f);
+        if (q <= 0) o.c[i] = OM_OPAQUE_DEPTH;
+        else if (q >= 255) o.c[i] = 0;
+        else o.c[i] = (uint32_t)(-om__log2(q / 255.0) * 4096.0 + 0.5);
+    }
+    return o;
+}
+
+void om__odepth_term(const om__odepth *o, om_term *t)
+{
+    uint8_t v[3];
+    if ((o->c[0] | o->c[1] | o->c[2]) == 0) {   /* unblocked: the common case */
+        t->r = t->g = t->b = 255;
+        return;
+    }
+    for (int i = 0; i < 3; i++) {
+        if (o->c[i] == OM_OPAQUE_DEPTH || o->c[i] >= 4096u * 12u) v[i] = 0;   /* below 1/4096: 0 */
+        else v[i] = (uint8_t)(255.0 * om__exp2(-(double)o->c[i] / 4096.0) + 0.5);
+    }
+    t->r = v[0];
+    t->g = v[1];
+    t->b = v[2];
+}

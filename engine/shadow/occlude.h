@@ -1,0 +1,113 @@
+/* occlude.h — the one occlusion predicate, shared by the reference and the irregular
+ * z-buffer, and the transmittance of semi-transparent casters.
+ *
+ * The light's image plane is treated as a virtual OM_LIGHT_GRID x OM_LIGHT_GRID raster
+ * of the engine's rasterizer: samples and triangles are projected with the same code,
+ * snapped to the same 1/256 sub-pixel grid (2^21 steps across the light's frustum), and
+ * clipped to the same planes (the light's near and far depth and a guard band). A
+ * triangle blocks a sample when
+ *   - it is not the sample's own triangle,
+ *   - the sample's grid point is inside it by the rasterizer's edge functions and
+ *     top-left tie rule (a point on an edge shared by two occluders is inside exactly
+ *     one of them), and
+ *   - the triangle's light depth (z/w, the plane through its snapped vertices) at that
+ *     point is strictly nearer the light than the sample's own light depth.
+ * No epsilon or bias enters; only the light's frustum depth range bounds which
+ * geometry casts, as it does for every shadow map. */
+#ifndef OM_OCCLUDE_H
+#define OM_OCCLUDE_H
+
+#include "../frame/frame.h"
+
+#define OM_LIGHT_GRID 8192u
+
+/* A sample on the light's grid: position in sub-pixel units and light depth (0..2^32). */
+typedef struct om__lpoint {
+    int64_t x, y;
+    double z;
+    uint32_t tri;          /* the sample's own triangle */
+} om__lpoint;
+
+/* A vertex projected once per frame; x == INT32_MIN marks one that needs clipping. */
+typedef struct om__lvert { int32_t x, y; double z; } om__lvert;
+
+typedef struct om__lspace {
+    const om_scene *scene;
+    om_mat4 vp;            /* the light's world -> clip */
+    om__lvert *verts;      /* scene->nverts, from the caller's arena */
+} om__lspace;
+
+size_t om__lspace_bytes(const om_scene *s);
+om_status om__lspace_init(om__lspace *ls, om_arena *a, const om_scene *s, om_diag *d);
+/* Projects every vertex for this frame's light. */
+void om__lspace_begin(om__lspace *ls, const om_view *v);
+/* Projects a sample; false when it is not in front of the light. */
+bool om__lspace_point(const om__lspace *ls, const om_sample *smp, om__lpoint *out);
+
+/* A triangle on the light's grid: up to 7 sub-triangles after clipping. */
+typedef struct om__ltri {
+    om__rtri sub[7];
+    int n;
+    uint32_t tri;
+    int64_t lox, loy, hix, hiy;   /* grid bounds of all sub-triangles */
+    double zmin;                  /* nearest light depth of the triangle */
+} om__ltri;
+
+/* Sets up triangle t; returns false when nothing of it is inside the light's frustum. */
+bool om__lspace_tri(const om__lspace *ls, uint32_t t, om__ltri *out);
+
+/* A cheap early answer for the predicate: false when triangle t certainly does not
+ * block p because p lies outside the grid bounds of its three projected vertices (for
+ * a triangle that needs no clipping); true when the full test is needed. */
+static inline bool om__lspace_maybe(const om__lspace *ls, uint32_t t, const om__lpoint *p)
+{
+    const uint32_t *ix = ls->scene->idx + (size_t)t * 3;
+    const om__lvert *a = &ls->verts[ix[0]], *b = &ls->verts[ix[1]], *c = &ls->verts[ix[2]];
+    if (a->x == INT32_MIN || b->x == INT32_MIN || c->x == INT32_MIN) return true;
+    if ((p->x < a->x && p->x < b->x && p->x < c->x) || (p->x > a->x && p->x > b->x && p->x > c->x) ||
+        (p->y < a->y && p->y < b->y && p->y < c->y) || (p->y > a->y && p->y > b->y && p->y > c->y))
+        return false;
+    /* nearer than the sample somewhere? the plane's depth lies within its vertices' */
+    return a->z < p->z || b->z < p->z || c->z < p->z;
+}
+
+/* The predicate. */
+static inline bool om__blocks(const om__ltri *lt, const om__lpoint *p)
+{
+    if (lt->tri == p->tri) return false;
+    for (int k = 0; k < lt->n; k++) {
+        const om__rtri *r = &lt->sub[k];
+        if (om__tri2_covers(&r->e, p->x, p->y)) return om__rtri_depth(r, p->x, p->y) < p->z;
+    }
+    return false;
+}
+
+/* ---- transmittance: casters multiply it, in any order with the same result. Each
+ * channel is kept as an optical depth, -log2(t) in 1/4096 units, summed with
+ * saturation (integer sums do not depend on order, float products would). */
+#define OM_OPAQUE_DEPTH 0xFFFFFFFFu
+
+typedef struct om__odepth { uint32_t c[3]; } om__odepth;
+
+/* The optical depth of one caster: transmittance (1 - opacity) * albedo per channel,
+ * quantized to 8 bits first; opacity 1 (or a zero channel) is opaque. */
+om__odepth om__material_odepth(const om_material *m);
+static inline void om__odepth_add(om__odepth *acc, const om__odepth *o)
+{
+    for (int i = 0; i < 3; i++) {
+        uint32_t s = acc->c[i] + o->c[i];
+        acc->c[i] = s < acc->c[i] ? OM_OPAQUE_DEPTH : s;
+    }
+}
+static inline bool om__odepth_opaque(const om__odepth *o)
+{
+    return o->c[0] == OM_OPAQUE_DEPTH && o->c[1] == OM_OPAQUE_DEPTH && o->c[2] == OM_OPAQUE_DEPTH;
+}
+/* Back to an 8-bit term, rounded: 255 * 2^(-depth / 4096). */
+void om__odepth_term(const om__odepth *o, om_term *t);
+
+/* Deterministic log2 and exp2 (libm's may differ in the last bit between systems). */
+double om__log2(double x);
+double om__exp2(double x);
+
+#endif

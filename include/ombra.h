@@ -1,0 +1,396 @@
+/* ombra.h — the public API of ombra, a freestanding, allocation-free C99 engine
+ * for hard shadows.
+ *
+ * Usage: the host hands in memory as arenas (om_arena_init over its own buffers),
+ * parses or builds a scene into one, picks a shadow method by name, asks every piece
+ * how many bytes it needs, and renders frames strip by strip into a framebuffer.
+ * The engine never allocates, never does I/O and keeps no global state: everything a
+ * call needs is in the structs it is given, so two engines can run in one process.
+ *
+ * Conventions: every fallible function returns an om_status; results go through
+ * out-parameters; an optional om_diag* receives the details (bytes asked and left
+ * for a budget error, line and column for a parse error) and may be NULL.
+ *
+ * Coordinates: right-handed world space. Cameras look down -z of their view space.
+ * Pixel (x, y) has its centre at (x + 0.5, y + 0.5); row 0 is the top row.
+ */
+#ifndef OMBRA_H
+#define OMBRA_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include <stdbool.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ---------------------------------------------------------------- status */
+
+typedef enum om_status {
+    OM_OK = 0,
+    OM_E_BUDGET,      /* an arena is too small: om_diag says bytes asked and left */
+    OM_E_INVALID,     /* an argument is out of its documented range */
+    OM_E_PARSE,       /* malformed text: om_diag says line, column, what was expected */
+    OM_E_RANGE,       /* a value is outside what the engine represents (NaN, 1e30, ...) */
+    OM_E_NOTFOUND,    /* a name (method, file) is unknown */
+    OM_E_IO,          /* the host could not read or write a file (platform/ only) */
+    OM_E_COUNT_
+} om_status;
+
+/* A static English name for a status, never NULL. */
+const char *om_status_str(om_status s);
+
+/* Details of the last failure. Filled by functions that take one; may be NULL. */
+typedef struct om_diag {
+    om_status status;
+    size_t asked, left;    /* OM_E_BUDGET: bytes asked for, bytes that were left */
+    uint32_t line, col;    /* OM_E_PARSE: 1-based position in the text */
+    char msg[160];         /* one line, NUL-terminated, no trailing newline */
+} om_diag;
+
+/* ---------------------------------------------------------------- memory */
+
+/* An arena is a bump allocator over a buffer the host owns. It never writes outside
+ * [base, base + cap). `peak` is the high-water mark of `used`. A failing carve leaves
+ * the arena unchanged and records the request in fail_asked / fail_left. */
+typedef struct om_arena {
+    unsigned char *base;
+    size_t cap, used, peak;
+    size_t fail_asked, fail_left;
+    uint32_t carves;       /* successful carves so far */
+    uint32_t fail_at;      /* fault injection: if non-zero, carve number fail_at fails */
+    const char *name;      /* subsystem name for messages ("scene", "frame", ...) */
+} om_arena;
+
+void om_arena_init(om_arena *a, void *buf, size_t size, const char *name);
+/* Carves `size` bytes aligned to `align` (a power of two, at most 64). The memory is
+ * zeroed. On OM_E_BUDGET, *out is set to NULL and `d` (if given) gets the numbers. */
+om_status om_arena_alloc(om_arena *a, size_t size, size_t align, void **out, om_diag *d);
+/* Carves a whole child arena of `size` bytes (aligned to 16) out of `a`. */
+om_status om_arena_sub(om_arena *a, size_t size, const char *name, om_arena *child,
+                       om_diag *d);
+size_t om_arena_mark(const om_arena *a);
+void om_arena_rewind(om_arena *a, size_t mark);
+size_t om_arena_left(const om_arena *a);
+/* Bytes an arena must have to satisfy a carve of `size` at `align` from any state:
+ * the size plus the worst-case alignment padding. Bytes-needed queries add these up. */
+size_t om_arena_need(size_t size, size_t align);
+
+/* A pool of `count` fixed-size items carved from an arena, recycled through a free
+ * list. Items are `item_size` bytes rounded up to 8. */
+typedef struct om_pool {
+    unsigned char *items;
+    size_t item_size;
+    uint32_t count, in_use, peak;
+    uint32_t free_head;    /* index of first free item, or count if none */
+    uint32_t *next;        /* free-list links, one per item */
+} om_pool;
+
+size_t om_pool_bytes(size_t item_size, uint32_t count);
+om_status om_pool_init(om_pool *p, om_arena *a, size_t item_size, uint32_t count,
+                       om_diag *d);
+/* Takes a zeroed item; returns NULL when all `count` are in use. */
+void *om_pool_get(om_pool *p);
+void om_pool_put(om_pool *p, void *item);
+uint32_t om_pool_index(const om_pool *p, const void *item);
+void *om_pool_item(const om_pool *p, uint32_t index);
+
+/* ---------------------------------------------------------------- math */
+
+typedef struct om_vec3 { float x, y, z; } om_vec3;
+typedef struct om_vec4 { float x, y, z, w; } om_vec4;
+/* Row-major 4x4: v' = M v with v a column vector; m[r * 4 + c]. */
+typedef struct om_mat4 { float m[16]; } om_mat4;
+
+/* ---------------------------------------------------------------- scene */
+
+#define OM_NO_TRI 0xFFFFFFFFu
+#define OM_MAX_DIM 8192u           /* largest image or shadow-map side */
+
+typedef struct om_material {
+    float r, g, b;         /* albedo, 0..1 */
+    float opacity;         /* 1 = opaque; below 1 the caster tints light by its albedo */
+} om_material;
+
+typedef struct om_camera {
+    om_vec3 eye, target, up;
+    float fovy_deg;        /* vertical field of view in degrees, (0, 180) */
+    uint32_t width, height;
+    float znear, zfar;     /* 0 < znear < zfar */
+} om_camera;
+
+typedef enum om_light_kind { OM_LIGHT_SPOT = 0, OM_LIGHT_DIRECTIONAL = 1 } om_light_kind;
+
+typedef struct om_light {
+    om_light_kind kind;
+    om_vec3 pos, target;   /* spot: position and aim point */
+    om_vec3 dir;           /* directional: direction the light travels (from the light) */
+    float fov_deg;         /* spot: full angle of its square frustum, (0, 180) */
+    float znear, zfar;     /* spot: depth range */
+} om_light;
+
+typedef struct om_camera_key { float t; om_vec3 eye, target; } om_camera_key;
+typedef struct om_light_key { float t; om_vec3 pos, target, dir; } om_light_key;
+
+/* A scene: indexed triangles with a material per triangle, one camera, one light and
+ * optional keyframed paths. All arrays live in the arena the scene was parsed into. */
+typedef struct om_scene {
+    uint32_t nverts, ntris, nmats, ncam_keys, nlight_keys;
+    om_vec3 *verts;
+    uint32_t *idx;         /* 3 * ntris vertex indices */
+    uint16_t *tri_mat;     /* ntris material indices */
+    om_material *mats;
+    om_camera camera;
+    om_light light;
+    om_camera_key *cam_keys;   /* sorted by t */
+    om_light_key *light_keys;  /* sorted by t */
+    om_vec3 lo, hi;        /* bounds of all vertices */
+} om_scene;
+
+/* The host reads files named in a scene (`mesh FILE.obj`); the engine never does.
+ * Return OM_OK with the bytes (which must stay valid during the parse), or an error. */
+typedef om_status (*om_file_fn)(void *user, const char *name, const char **data,
+                                size_t *len);
+
+typedef struct om_loader {
+    om_file_fn load;       /* may be NULL: `mesh` lines then fail with OM_E_NOTFOUND */
+    void *user;
+} om_loader;
+
+/* Bytes the arena needs to hold the scene that `text` describes (a first pass that
+ * counts, including the OBJ files it names). */
+om_status om_scene_bytes(const char *text, size_t len, const om_loader *ld,
+                         size_t *bytes, om_diag *d);
+/* Parses scene text into `a`. Malformed text gives OM_E_PARSE with line and column. */
+om_status om_scene_parse(const char *text, size_t len, const om_loader *ld,
+                         om_arena *a, om_scene *out, om_diag *d);
+/* The built-in default scene, as text in the scene format. */
+const char *om_scene_default_text(void);
+/* Camera and light at time t along the scene's paths (the scene's own when it has
+ * none). Linear interpolation between keys, clamped at the ends. */
+void om_scene_at(const om_scene *s, float t, om_camera *cam, om_light *light);
+/* Counts of an OBJ file: vertices and triangles after fan triangulation. */
+om_status om_obj_count(const char *text, size_t len, uint32_t *nverts, uint32_t *ntris,
+                       om_diag *d);
+
+/* ---------------------------------------------------------------- view */
+
+/* Everything a frame needs to know about where the camera and the light are.
+ * light_vp maps world space to the light's clip space; its image plane is the
+ * light's shadow-map plane: x, y in [-1, 1] after division by w, depth z/w in [0, 1]. */
+typedef struct om_view {
+    om_camera cam;
+    om_light light;
+    om_mat4 cam_view, cam_proj, cam_vp;
+    om_mat4 light_view, light_proj, light_vp;
+    om_vec3 light_axis;    /* unit direction light travels along its frustum's axis */
+} om_view;
+
+/* Builds the camera and light matrices. A directional light's bounds are fitted to the
+ * scene's bounds; om_view_fit_light narrows them to what the camera sees. */
+om_status om_view_init(om_view *v, const om_camera *cam, const om_light *light,
+                       const om_scene *s, om_diag *d);
+/* Narrows a directional light's x/y bounds to the light-space box [lo, hi] (from the
+ * visible samples) while keeping its depth range over the whole scene. No-op for spot. */
+void om_view_fit_light(om_view *v, const om_scene *s, om_vec3 lo, om_vec3 hi);
+
+/* ---------------------------------------------------------------- samples */
+
+/* One visible sample per pixel: the exact point of the nearest triangle under the
+ * pixel centre, its geometric normal (unit, as wound; not turned to the camera) and
+ * the triangle. tri == OM_NO_TRI is background. */
+typedef struct om_sample {
+    float p[3];
+    float n[3];
+    uint32_t tri;
+} om_sample;
+
+/* The shadow term of a sample: RGB transmittance from the sample to the light,
+ * 0 = blocked, 255 = unblocked. Every method writes the same kind of term (r, g, b);
+ * the frame sets `flags` before a method runs and methods leave it alone. */
+typedef struct om_term { uint8_t r, g, b, flags; } om_term;
+
+/* flags: the sample faces the light (its normal turned to the camera) and lies inside
+ * the light's frustum — the parts of the lit rule that no occluder decides. Samples
+ * without it are unlit whatever a method says. */
+#define OM_TERM_EXPOSED 1u
+
+/* The binary state every metric and mask uses: lit means exposed and unblocked in
+ * every channel; anything else, a semi-transparent caster included, is shadowed. */
+static inline bool om_term_lit(const om_term *t)
+{
+    return (t->flags & OM_TERM_EXPOSED) && t->r == 255 && t->g == 255 && t->b == 255;
+}
+
+/* A horizontal band of rows [y0, y0 + rows) of a width x height image. */
+typedef struct om_strip {
+    uint32_t width, height, y0, rows;
+    om_sample *samples;    /* rows * width, row-major */
+    om_term *terms;        /* rows * width */
+} om_strip;
+
+/* ---------------------------------------------------------------- framebuffers */
+
+typedef enum om_format { OM_RGB888 = 0, OM_RGB565, OM_L8 } om_format;
+
+typedef struct om_framebuffer {
+    om_format format;
+    uint32_t width, rows;  /* rows: the buffer's height (a strip or a whole frame) */
+    size_t stride;         /* bytes per row */
+    uint8_t *pixels;
+} om_framebuffer;
+
+uint32_t om_format_bpp(om_format f);   /* bytes per pixel */
+
+/* ---------------------------------------------------------------- methods */
+
+/* Every method's settings in one struct; each method reads its own fields. */
+typedef struct om_method_cfg {
+    uint32_t map_size;     /* shadow-map side in texels (sm, rtw, spsm) */
+    float bias_const;      /* sm: constant depth bias, in light depth units */
+    float bias_slope;      /* sm: slope-scaled bias factor */
+    float normal_offset;   /* sm: world offset along the normal, in texels */
+    uint32_t pcf;          /* sm: k for k x k PCF, 1 = none */
+} om_method_cfg;
+
+void om_method_cfg_default(om_method_cfg *c);
+
+typedef struct om_method_stats {
+    size_t bytes_used;     /* arena bytes held by the method this frame (peak) */
+    uint32_t counters[8];  /* method-specific counts; names in counter_names */
+    const char *counter_names[8];
+    uint32_t ncounters;
+} om_method_stats;
+
+enum {
+    OM_METHOD_OBSERVES = 1u   /* wants every visible sample (observe) before build */
+};
+
+/* A shadow method: a small table of functions behind one interface. A frame runs
+ *   begin -> [observe for every strip, if OBSERVES] -> build -> resolve for every strip
+ * and state persists across frames (progressive methods refine it). */
+typedef struct om_method {
+    const char *name;
+    const char *summary;
+    unsigned flags;
+    /* Bytes the method's arena needs for this configuration, scene and image size:
+     * the least it can work with and what it needs to work in one pass. */
+    om_status (*bytes)(const om_method_cfg *c, const om_scene *s, uint32_t width,
+                       uint32_t height, size_t *min, size_t *full);
+    /* Creates the state in `a`; the method keeps `a` for per-frame scratch. */
+    om_status (*init)(void **state, om_arena *a, const om_method_cfg *c,
+                      const om_scene *s, uint32_t width, uint32_t height, om_diag *d);
+    om_status (*begin)(void *state, const om_view *v, om_diag *d);
+    om_status (*observe)(void *state, const om_strip *st, om_diag *d);
+    om_status (*build)(void *state, om_diag *d);
+    /* Writes st->terms for every sample of the strip (background samples get 255). */
+    om_status (*resolve)(void *state, om_strip *st, om_diag *d);
+    void (*stats)(const void *state, om_method_stats *out);
+} om_method;
+
+size_t om_method_count(void);
+const om_method *om_method_at(size_t i);
+const om_method *om_method_find(const char *name);
+
+/* ---------------------------------------------------------------- rendering */
+
+typedef struct om_shade_cfg {
+    float ambient;         /* 0..1, the share of light that reaches shadowed surfaces */
+    uint8_t bg_r, bg_g, bg_b;
+} om_shade_cfg;
+
+void om_shade_cfg_default(om_shade_cfg *c);
+
+/* Called after each strip is shaded, with the strip's samples, terms and pixels
+ * (fb->pixels holds the strip's rows). Return non-OK to stop the frame. */
+typedef om_status (*om_strip_fn)(void *user, const om_strip *st,
+                                 const om_framebuffer *fb);
+
+typedef struct om_frame_stats {
+    uint64_t ns_eye, ns_observe, ns_build, ns_resolve, ns_shade;  /* 0 without a clock */
+    uint32_t strips, eye_passes;
+    size_t frame_peak;
+} om_frame_stats;
+
+/* A monotonic clock the host may provide for per-stage timings; NULL for none. */
+typedef uint64_t (*om_clock_fn)(void *user);
+
+typedef struct om_frame_desc {
+    const om_scene *scene;
+    const om_view *view;
+    const om_method *method;
+    void *method_state;
+    const om_shade_cfg *shade;
+    uint32_t strip_rows;   /* rows per strip; 0 = the whole frame at once */
+    om_framebuffer *fb;    /* fb->rows >= strip rows; receives each strip in turn */
+    om_strip_fn on_strip;  /* may be NULL */
+    void *user;
+    om_clock_fn clock;     /* may be NULL */
+    void *clock_user;
+} om_frame_desc;
+
+/* Bytes the frame arena needs for width x strip_rows (samples, terms and the eye
+ * pass's depth and triangle-ID buffers). */
+size_t om_frame_bytes(uint32_t width, uint32_t strip_rows);
+/* Renders one frame. The frame arena is rewound on return; the method's arena keeps
+ * what the method keeps. */
+om_status om_render_frame(const om_frame_desc *fd, om_arena *frame_arena,
+                          om_frame_stats *stats, om_diag *d);
+
+/* ---------------------------------------------------------------- measuring */
+
+/* Masks are one byte per pixel: 255 lit, 0 shadowed, 128 background (om_mask_of). */
+#define OM_MASK_LIT 255u
+#define OM_MASK_SHADOW 0u
+#define OM_MASK_BG 128u
+
+static inline uint8_t om_mask_of(const om_sample *s, const om_term *t)
+{
+    return s->tri == OM_NO_TRI ? (uint8_t)OM_MASK_BG : om_term_lit(t) ? (uint8_t)OM_MASK_LIT
+                                                                       : (uint8_t)OM_MASK_SHADOW;
+}
+
+/* A method's mask against the reference's on the same visible samples. */
+typedef struct om_metrics {
+    uint64_t samples;          /* foreground samples compared */
+    uint64_t false_lit;        /* lit where the reference is shadowed */
+    uint64_t false_shadowed;   /* shadowed where the reference is lit */
+    uint64_t edge_samples;     /* samples within OM_EDGE_BAND pixels of a reference edge */
+    uint64_t edge_false_lit, edge_false_shadowed;
+    uint64_t mismatched_bg;    /* pixels background in one mask only (must be 0) */
+} om_metrics;
+
+#define OM_EDGE_BAND 2
+
+/* Compares two whole-frame masks. The edge band: foreground pixels within
+ * OM_EDGE_BAND pixels (Chebyshev) of a pixel whose reference state differs. */
+void om_compare_masks(const uint8_t *ref, const uint8_t *m, uint32_t width, uint32_t height,
+                      om_metrics *out);
+/* Share of compared samples that match, 0..1 (1 when nothing was compared). */
+double om_metrics_match(const om_metrics *m);
+/* Difference image, RGB888: false lit red, false shadowed blue, matches grey (lit
+ * light, shadowed dark), background black. */
+void om_diff_image(const uint8_t *ref, const uint8_t *m, uint32_t width, uint32_t height,
+                   uint8_t *rgb);
+
+/* Flicker along a path: between consecutive frames, samples whose binary state changes
+ * in the method's mask while the reference's does not. Feed frames in order. */
+typedef struct om_flicker {
+    uint64_t samples;          /* foreground samples in both frames */
+    uint64_t flicker;          /* changes the reference does not have */
+    uint32_t frames;
+} om_flicker;
+
+void om_flicker_add(om_flicker *f, const uint8_t *ref_prev, const uint8_t *m_prev,
+                    const uint8_t *ref, const uint8_t *m, size_t n);
+double om_flicker_share(const om_flicker *f);
+
+/* 64-bit FNV-1a over bytes, chained from `h` (start with OM_HASH_INIT). */
+#define OM_HASH_INIT 0xcbf29ce484222325ull
+uint64_t om_hash(uint64_t h, const void *data, size_t len);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

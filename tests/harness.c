@@ -1,0 +1,91 @@
+/* harness.c — see harness.h. */
+#include "harness.h"
+#include "test.h"
+
+#include <stdlib.h>
+
+bool h_scene_parse(h_scene *hs, const char *text)
+{
+    om_diag d;
+    size_t bytes;
+    memset(hs, 0, sizeof *hs);
+    if (om_scene_bytes(text, strlen(text), NULL, &bytes, &d) != OM_OK) {
+        CHECK_MSG(0, "scene bytes: %s", d.msg);
+        return false;
+    }
+    hs->mem = malloc(bytes ? bytes : 1);
+    om_arena a;
+    om_arena_init(&a, hs->mem, bytes, "scene");
+    if (om_scene_parse(text, strlen(text), NULL, &a, &hs->s, &d) != OM_OK) {
+        CHECK_MSG(0, "scene parse: %s", d.msg);
+        return false;
+    }
+    return true;
+}
+
+void h_scene_free(h_scene *hs)
+{
+    free(hs->mem);
+    hs->mem = NULL;
+}
+
+typedef struct grab { uint8_t *mask; om_term *terms; om_sample *samples; } grab;
+
+static om_status on_strip(void *user, const om_strip *st, const om_framebuffer *fb)
+{
+    grab *g = (grab *)user;
+    (void)fb;
+    for (uint32_t y = 0; y < st->rows; y++)
+        for (uint32_t x = 0; x < st->width; x++) {
+            size_t i = (size_t)y * st->width + x, o = (size_t)(st->y0 + y) * st->width + x;
+            if (g->mask) g->mask[o] = om_mask_of(&st->samples[i], &st->terms[i]);
+            if (g->terms) g->terms[o] = st->terms[i];
+            if (g->samples) g->samples[o] = st->samples[i];
+        }
+    return OM_OK;
+}
+
+om_status h_render(const om_scene *s, const char *name, const om_method_cfg *cfg, uint32_t w,
+                   uint32_t h, float t, uint32_t strip_rows, uint8_t *mask, om_term *terms,
+                   om_sample *samples)
+{
+    om_camera cam;
+    om_light light;
+    om_view v;
+    om_diag d;
+    om_scene_at(s, t, &cam, &light);
+    if (w) { cam.width = w; cam.height = h; }
+    om_status st = om_view_init(&v, &cam, &light, s, &d);
+    if (st) return st;
+    const om_method *m = om_method_find(name);
+    if (!m) return OM_E_NOTFOUND;
+    om_method_cfg c;
+    if (cfg) c = *cfg;
+    else om_method_cfg_default(&c);
+    size_t mn, full;
+    if ((st = m->bytes(&c, s, cam.width, cam.height, &mn, &full))) return st;
+    uint32_t rows = strip_rows ? strip_rows : cam.height;
+    size_t fbytes = om_frame_bytes(cam.width, rows);
+    void *mm = malloc(full), *fm = malloc(fbytes), *px = malloc((size_t)cam.width * rows * 3);
+    om_arena ma, fa;
+    om_arena_init(&ma, mm, full, "method");
+    om_arena_init(&fa, fm, fbytes, "frame");
+    void *state;
+    st = m->init(&state, &ma, &c, s, cam.width, cam.height, &d);
+    if (st == OM_OK) {
+        om_framebuffer fb = {OM_RGB888, cam.width, rows, (size_t)cam.width * 3, (uint8_t *)px};
+        om_shade_cfg shade;
+        om_shade_cfg_default(&shade);
+        grab g = {mask, terms, samples};
+        om_frame_desc fd;
+        memset(&fd, 0, sizeof fd);
+        fd.scene = s; fd.view = &v; fd.method = m; fd.method_state = state; fd.shade = &shade;
+        fd.strip_rows = strip_rows; fd.fb = &fb; fd.on_strip = on_strip; fd.user = &g;
+        st = om_render_frame(&fd, &fa, NULL, &d);
+    }
+    if (st) fprintf(stderr, "  (h_render %s: %s)\n", name, d.msg);
+    free(mm);
+    free(fm);
+    free(px);
+    return st;
+}

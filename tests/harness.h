@@ -1,0 +1,24 @@
+/* harness.h — helpers the suites share: parse scene text into a heap arena, and render
+ * one method's frame into a whole-frame mask (and the terms) through the public API. */
+#ifndef OM_HARNESS_H
+#define OM_HARNESS_H
+
+#include "ombra.h"
+
+typedef struct h_scene {
+    void *mem;
+    om_scene s;
+} h_scene;
+
+/* Parses `text`; fails the current test (and returns false) on error. */
+bool h_scene_parse(h_scene *hs, const char *text);
+void h_scene_free(h_scene *hs);
+
+/* Renders with method `name` and configuration `cfg` (NULL: defaults) at the scene's
+ * camera (w x h when non-zero) and time t; fills mask[w*h] and, if given, terms and
+ * samples. strip_rows 0 = whole frame. Returns the frame's status. */
+om_status h_render(const om_scene *s, const char *name, const om_method_cfg *cfg, uint32_t w,
+                   uint32_t h, float t, uint32_t strip_rows, uint8_t *mask, om_term *terms,
+                   om_sample *samples);
+
+#endif

@@ -1,0 +1,17 @@
+/* suites.h — the list of test suites; each tests/test_*.c defines one. */
+#ifndef OM_SUITES_H
+#define OM_SUITES_H
+#ifndef OM_SUITES
+#define OM_SUITES \
+    X(suite_core) \
+    X(suite_scene) \
+    X(suite_raster) \
+    X(suite_frame) \
+    X(suite_platform) \
+    X(suite_shadow) \
+    X(suite_measure)
+#endif
+#define X(suite) void suite(void);
+OM_SUITES
+#undef X
+#endif

@@ -1,0 +1,458 @@
+/* test_raster.c — the fixed-point rasterizer: hand-checked masks, both windings, the
+ * top-left rule, watertightness of shared edges (fans, grids, random triangulations,
+ * sub-pixel vertices), clipping at the near and far planes, coordinates that would
+ * overflow 32-bit setup, conservative coverage, and the point-in-triangle test. */
+#include "test.h"
+#include "../engine/raster/raster.h"
+#include "../engine/core/core.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+#define TW 32
+#define TH 32
+
+static uint32_t depth_buf[256 * 256], id_buf[256 * 256];
+static int count_buf[256 * 256];
+
+static om_target target(uint32_t w, uint32_t h)
+{
+    om_target t;
+    t.width = w; t.height = h; t.y0 = 0; t.rows = h;
+    t.depth = depth_buf;
+    t.id = id_buf;
+    return t;
+}
+
+/* A vertex at sub-pixel grid position (X, Y) of a w x h image, on the plane z/w = z. */
+static om_vec4 at(double X, double Y, uint32_t w, uint32_t h, float z)
+{
+    om_vec4 v;
+    v.x = (float)(X / (w * 128.0) - 1.0);
+    v.y = (float)(1.0 - Y / (h * 128.0));
+    v.z = z;
+    v.w = 1.0f;
+    return v;
+}
+
+/* Rasterizes one triangle alone and adds its coverage to count_buf. */
+static void add_coverage(const om_vec4 c[3], uint32_t w, uint32_t h)
+{
+    om_target t = target(w, h);
+    om__target_clear(&t);
+    om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL};
+    om__raster_tri(&r, c, 7);
+    for (uint32_t i = 0; i < w * h; i++) count_buf[i] += id_buf[i] == 7;
+}
+
+static void mask_of(const om_vec4 c[3], char *out)
+{
+    memset(count_buf, 0, sizeof count_buf);
+    add_coverage(c, 8, 8);
+    for (int i = 0; i < 64; i++) out[i] = count_buf[i] ? '#' : '.';
+    out[64] = 0;
+}
+
+static void hand_checked_masks(void)
+{
+    char m[65];
+    /* Right triangle with corners on pixel corners (0,0), (4,0), (0,4): pixel centres
+     * (x + 0.5, y + 0.5) with x + y < 3 are inside; x + y == 3 lie on the hypotenuse,
+     * a right edge, so they are excluded. */
+    om_vec4 a[3] = {at(0, 0, 8, 8, 0.5f), at(4 * 256, 0, 8, 8, 0.5f), at(0, 4 * 256, 8, 8, 0.5f)};
+    mask_of(a, m);
+    CHECK_MSG(!strcmp(m, "###.....##......#..............................................."), "%s", m);
+    /* Same triangle, other winding: same pixels. */
+    om_vec4 b[3] = {a[0], a[2], a[1]};
+    char m2[65];
+    mask_of(b, m2);
+    CHECK(!strcmp(m, m2));
+    /* A triangle whose edges pass exactly through pixel centres: the left edge x = 1.5
+     * (pixel centres of column 1) owns them, the top edge y = 1.5 owns row 1. */
+    om_vec4 c[3] = {at(1.5 * 256, 1.5 * 256, 8, 8, 0.5f), at(5.5 * 256, 1.5 * 256, 8, 8, 0.5f),
+                    at(1.5 * 256, 5.5 * 256, 8, 8, 0.5f)};
+    mask_of(c, m);
+    CHECK_MSG(!strcmp(m, ".........####....###.....##......#.............................."), "%s", m);
+    /* A triangle smaller than a pixel that holds no centre covers nothing; one that
+     * holds a centre covers exactly that pixel. */
+    om_vec4 d[3] = {at(300, 300, 8, 8, 0.5f), at(360, 300, 8, 8, 0.5f), at(300, 360, 8, 8, 0.5f)};
+    mask_of(d, m);
+    CHECK(!strchr(m, '#'));
+    om_vec4 e[3] = {at(370, 370, 8, 8, 0.5f), at(420, 370, 8, 8, 0.5f), at(370, 420, 8, 8, 0.5f)};
+    mask_of(e, m);
+    CHECK_EQ_U(strchr(m, '#') - m, 9);
+    CHECK(strchr(m + 10, '#') == NULL);
+    /* Zero-area after snapping: nothing. */
+    om_vec4 z[3] = {at(0, 0, 8, 8, 0.5f), at(1024, 1024, 8, 8, 0.5f), at(2048, 2048, 8, 8, 0.5f)};
+    mask_of(z, m);
+    CHECK(!strchr(m, '#'));
+}
+
+/* Every pixel of a square region covered exactly once by a mesh with shared edges. */
+static void check_square(double X0, double Y0, double X1, double Y1, const char *what)
+{
+    int bad = 0;
+    for (int y = 0; y < TH; y++)
+        for (int x = 0; x < TW; x++) {
+            double cx = x * 256.0 + 128, cy = y * 256.0 + 128;
+            int n = count_buf[y * TW + x];
+            bool strict_in = cx > X0 && cx < X1 && cy > Y0 && cy < Y1;
+            bool strict_out = cx < X0 || cx > X1 || cy < Y0 || cy > Y1;
+            if (n > 1 || (strict_in && n != 1) || (strict_out && n != 0)) bad++;
+        }
+    CHECK_MSG(bad == 0, "%s: %d pixels covered wrongly", what, bad);
+}
+
+static uint64_t rng_state;
+static uint32_t rnd(void)
+{
+    rng_state = rng_state * 6364136223846793005ull + 1442695040888963407ull;
+    return (uint32_t)(rng_state >> 33);
+}
+
+static void push(const om_vec4 *a, const om_vec4 *b, const om_vec4 *c, bool flip)
+{
+    om_vec4 t[3] = {*a, flip ? *c : *b, flip ? *b : *c};
+    add_coverage(t, TW, TH);
+}
+
+static void watertight_grids(void)
+{
+    for (int trial = 0; trial < 40; trial++) {
+        rng_state = 1000 + (uint64_t)trial;
+        int n = 2 + (int)(rnd() % 6);
+        /* The square's corners lie on arbitrary sub-pixel positions; interior vertices
+         * are jittered by up to a third of a cell so the grid stays valid. */
+        double X0 = 100 + rnd() % 700, Y0 = 100 + rnd() % 700;
+        double X1 = TW * 256 - 100 - rnd() % 700, Y1 = TH * 256 - 100 - rnd() % 700;
+        double gx[9][9], gy[9][9];
+        for (int j = 0; j <= n; j++)
+            for (int i = 0; i <= n; i++) {
+                double cw = (X1 - X0) / n, ch = (Y1 - Y0) / n;
+                gx[j][i] = floor(X0 + cw * i + ((i > 0 && i < n) ? ((int)(rnd() % 200) - 100) / 300.0 * cw : 0));
+                gy[j][i] = floor(Y0 + ch * j + ((j > 0 && j < n) ? ((int)(rnd() % 200) - 100) / 300.0 * ch : 0));
+            }
+        memset(count_buf, 0, sizeof count_buf);
+        for (int j = 0; j < n; j++)
+            for (int i = 0; i < n; i++) {
+                om_vec4 p00 = at(gx[j][i], gy[j][i], TW, TH, 0.5f);
+                om_vec4 p10 = at(gx[j][i + 1], gy[j][i + 1], TW, TH, 0.5f);
+                om_vec4 p01 = at(gx[j + 1][i], gy[j + 1][i], TW, TH, 0.5f);
+                om_vec4 p11 = at(gx[j + 1][i + 1], gy[j + 1][i + 1], TW, TH, 0.5f);
+                if (rnd() & 1) {
+                    push(&p00, &p10, &p11, rnd() & 1);
+                    push(&p00, &p11, &p01, rnd() & 1);
+                } else {
+                    push(&p00, &p10, &p01, rnd() & 1);
+                    push(&p10, &p11, &p01, rnd() & 1);
+                }
+            }
+        /* The outer boundary is the unjittered square, so its pixels are checkable. */
+        check_square(X0, Y0, X1, Y1, "grid");
+    }
+}
+
+static void watertight_fans(void)
+{
+    for (int trial = 0; trial < 30; trial++) {
+        rng_state = 77 + (uint64_t)trial;
+        int n = 3 + (int)(rnd() % 40);
+        double cx = 16 * 256 + (double)(rnd() % 512) - 256, cy = 16 * 256 + (double)(rnd() % 512) - 256;
+        double r = 2000 + rnd() % 1500;
+        memset(count_buf, 0, sizeof count_buf);
+        om_vec4 c = at(cx, cy, TW, TH, 0.5f);
+        double px[64], py[64];
+        for (int i = 0; i < n; i++) {
+            double a = 2 * OM_PI * i / n;
+            px[i] = floor(cx + r * om__cos(a));
+            py[i] = floor(cy + r * om__sin(a));
+        }
+        for (int i = 0; i < n; i++) {
+            int j = (i + 1) % n;
+            om_vec4 a = at(px[i], py[i], TW, TH, 0.5f), b = at(px[j], py[j], TW, TH, 0.5f);
+            push(&c, &a, &b, rnd() & 1);
+        }
+        /* Inside the fan's polygon every pixel is covered exactly once; check against
+         * the polygon with the same integer edge rule (no pixel twice anywhere). */
+        int bad = 0, covered = 0;
+        for (int i = 0; i < TW * TH; i++) {
+            if (count_buf[i] > 1) bad++;
+            covered += count_buf[i];
+        }
+        int inside = 0;
+        for (int y = 0; y < TH; y++)
+            for (int x = 0; x < TW; x++) {
+                int64_t X = x * 256 + 128, Y = y * 256 + 128;
+                bool in = true;
+                for (int i = 0; i < n && in; i++) {
+                    int j = (i + 1) % n;
+                    /* the polygon is convex and wound with angle: interior on one side */
+                    int64_t e = (int64_t)(px[j] - px[i]) * (Y - (int64_t)py[i]) -
+                                (int64_t)(py[j] - py[i]) * (X - (int64_t)px[i]);
+                    if (e <= 0) in = false;
+                }
+                if (in) {
+                    inside++;
+                    if (count_buf[y * TW + x] != 1) bad++;
+                }
+            }
+        CHECK_MSG(bad == 0, "fan %d: %d pixels wrong (%d covered, %d strictly inside)", trial, bad,
+                  covered, inside);
+    }
+}
+
+static void watertight_random_triangulation(void)
+{
+    /* Random points in a square, triangulated by inserting each into the triangle that
+     * holds it (split into three): a random triangulation with shared edges. */
+    for (int trial = 0; trial < 20; trial++) {
+        rng_state = 5 + (uint64_t)trial;
+        double X0 = 300, Y0 = 200, X1 = TW * 256 - 257, Y1 = TH * 256 - 300;
+        int tri[200][3], nt = 2, np = 4;
+        double px[110], py[110];
+        px[0] = X0; py[0] = Y0; px[1] = X1; py[1] = Y0; px[2] = X1; py[2] = Y1; px[3] = X0; py[3] = Y1;
+        tri[0][0] = 0; tri[0][1] = 1; tri[0][2] = 2;
+        tri[1][0] = 0; tri[1][1] = 2; tri[1][2] = 3;
+        for (int k = 0; k < 60; k++) {
+            double x = X0 + 1 + rnd() % (unsigned)(X1 - X0 - 2), y = Y0 + 1 + rnd() % (unsigned)(Y1 - Y0 - 2);
+            for (int t = 0; t < nt; t++) {
+                double ax = px[tri[t][0]], ay = py[tri[t][0]], bx = px[tri[t][1]], by = py[tri[t][1]];
+                double cx = px[tri[t][2]], cy = py[tri[t][2]];
+                double d1 = (bx - ax) * (y - ay) - (by - ay) * (x - ax);
+                double d2 = (cx - bx) * (y - by) - (cy - by) * (x - bx);
+                double d3 = (ax - cx) * (y - cy) - (ay - cy) * (x - cx);
+                if (d1 > 0 && d2 > 0 && d3 > 0) {
+                    px[np] = x; py[np] = y;
+                    int a = tri[t][0], b = tri[t][1], c = tri[t][2];
+                    tri[t][2] = np;
+                    tri[nt][0] = b; tri[nt][1] = c; tri[nt][2] = np; nt++;
+                    tri[nt][0] = c; tri[nt][1] = a; tri[nt][2] = np; nt++;
+                    np++;
+                    break;
+                }
+            }
+        }
+        memset(count_buf, 0, sizeof count_buf);
+        for (int t = 0; t < nt; t++) {
+            om_vec4 a = at(px[tri[t][0]], py[tri[t][0]], TW, TH, 0.5f);
+            om_vec4 b = at(px[tri[t][1]], py[tri[t][1]], TW, TH, 0.5f);
+            om_vec4 c = at(px[tri[t][2]], py[tri[t][2]], TW, TH, 0.5f);
+            push(&a, &b, &c, rnd() & 1);
+        }
+        check_square(X0, Y0, X1, Y1, "random triangulation");
+    }
+}
+
+/* A quad in 3-D crossing the near plane, seen through a perspective camera: after
+ * clipping, the two halves still cover every pixel of the quad exactly once. */
+static void clipping_near_far(void)
+{
+    om_mat4 view, proj;
+    om__mat_look_at(&view, om__v3(0, 1, 0), om__v3(0, 0.5f, -10), om__v3(0, 1, 0));
+    proj = om__mat_perspective(90.0f, 1.0f, 0.5f, 20.0f);
+    om_mat4 vp = om__mat_mul(&proj, &view);
+    /* A ground quad from behind the camera to beyond the far plane. */
+    om_vec3 q[4] = {om__v3(-3, 0, 5), om__v3(3, 0, 5), om__v3(3, 0, -40), om__v3(-3, 0, -40)};
+    om_vec4 c[4];
+    for (int i = 0; i < 4; i++) c[i] = om__mat_apply(&vp, q[i]);
+    memset(count_buf, 0, sizeof count_buf);
+    om_vec4 t1[3] = {c[0], c[1], c[2]}, t2[3] = {c[0], c[2], c[3]};
+    add_coverage(t1, TW, TH);
+    add_coverage(t2, TW, TH);
+    int twice = 0, covered = 0;
+    for (int i = 0; i < TW * TH; i++) {
+        twice += count_buf[i] > 1;
+        covered += count_buf[i] > 0;
+    }
+    CHECK_EQ_U(twice, 0);
+    CHECK(covered > 100);
+    /* Every covered pixel lies below the horizon; the bottom row (near the camera's
+     * feet, where the near plane cuts) is fully covered in the quad's middle columns. */
+    for (int x = 12; x < 20; x++) CHECK(count_buf[(TH - 1) * TW + x] == 1);
+    for (int x = 0; x < TW; x++) CHECK(count_buf[0 * TW + x] == 0);
+    /* The far plane cuts the quad: pixels just below the horizon, beyond 20 m, stay empty. */
+    int horizon_row = -1;
+    for (int y = 0; y < TH && horizon_row < 0; y++)
+        if (count_buf[y * TW + 16]) horizon_row = y;
+    CHECK(horizon_row > TH / 2 - 4);   /* looking 2.9 degrees down: horizon just above centre */
+    /* A triangle entirely behind the camera covers nothing. */
+    om_vec3 b[3] = {om__v3(-1, 0, 3), om__v3(1, 0, 3), om__v3(0, 2, 3)};
+    om_vec4 bc[3];
+    for (int i = 0; i < 3; i++) bc[i] = om__mat_apply(&vp, b[i]);
+    memset(count_buf, 0, sizeof count_buf);
+    add_coverage(bc, TW, TH);
+    int any = 0;
+    for (int i = 0; i < TW * TH; i++) any += count_buf[i];
+    CHECK_EQ_U(any, 0);
+    /* NaN vertices are rejected. */
+    om_vec4 nan3[3] = {c[0], c[1], c[2]};
+    nan3[1].x = nan3[1].x * 0.0f / 0.0f;
+    memset(count_buf, 0, sizeof count_buf);
+    add_coverage(nan3, TW, TH);
+    any = 0;
+    for (int i = 0; i < TW * TH; i++) any += count_buf[i];
+    CHECK_EQ_U(any, 0);
+}
+
+/* A 2 km ground plane seen from 1 m above, and one with vertices at 1e6: every pixel
+ * below the horizon is ground, none above; depths grow towards the horizon. */
+static void huge_ground(float half)
+{
+    const uint32_t W = 64, H = 48;
+    om_mat4 view, proj;
+    om__mat_look_at(&view, om__v3(0, 1, 0), om__v3(0, 1, -100), om__v3(0, 1, 0));
+    proj = om__mat_perspective(60.0f, (float)W / H, 0.1f, 1e7f);
+    om_mat4 vp = om__mat_mul(&proj, &view);
+    om_vec3 q[4] = {om__v3(-half, 0, half), om__v3(half, 0, half), om__v3(half, 0, -half),
+                    om__v3(-half, 0, -half)};
+    om_vec4 c[4];
+    for (int i = 0; i < 4; i++) c[i] = om__mat_apply(&vp, q[i]);
+    om_target t = target(W, H);
+    om__target_clear(&t);
+    om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL};
+    om_vec4 t1[3] = {c[0], c[1], c[2]}, t2[3] = {c[0], c[2], c[3]};
+    om__raster_tri(&r, t1, 1);
+    om__raster_tri(&r, t2, 2);
+    int wrong = 0;
+    for (uint32_t y = 0; y < H; y++)
+        for (uint32_t x = 0; x < W; x++) {
+            bool below = y >= H / 2;   /* horizon at the centre line (at most 1 m / half) */
+            bool ground = id_buf[y * W + x] != OM_NO_TRI;
+            if (below != ground) wrong++;
+        }
+    CHECK_MSG(wrong == 0, "half-size %g: %d pixels wrong", half, wrong);
+    for (uint32_t y = H / 2 + 1; y < H; y++)
+        CHECK(depth_buf[y * W + 5] < depth_buf[(y - 1) * W + 5]);
+}
+
+static void overflow_cases(void)
+{
+    huge_ground(1000.0f);
+    huge_ground(1e6f);
+    /* Screen-space coordinates far beyond int32 sub-pixel range before clipping. */
+    om_vec4 c[3] = {{-1e9f, -1e9f, 0.5f, 1}, {1e9f, -1e9f, 0.5f, 1}, {0, 1e9f, 0.5f, 1}};
+    memset(count_buf, 0, sizeof count_buf);
+    add_coverage(c, TW, TH);
+    for (int i = 0; i < TW * TH; i++) CHECK(count_buf[i] == 1);
+}
+
+static void covers_matches_fill(void)
+{
+    rng_state = 99;
+    int bad = 0;
+    for (int k = 0; k < 200; k++) {
+        int64_t x[3], y[3];
+        for (int i = 0; i < 3; i++) {
+            x[i] = rnd() % (TW * 256);
+            y[i] = rnd() % (TH * 256);
+        }
+        om_vec4 c[3];
+        for (int i = 0; i < 3; i++) c[i] = at((double)x[i], (double)y[i], TW, TH, 0.5f);
+        memset(count_buf, 0, sizeof count_buf);
+        add_coverage(c, TW, TH);
+        om__tri2 t;
+        bool ok = om__tri2_setup(&t, x, y, true);
+        for (int py = 0; py < TH; py++)
+            for (int px = 0; px < TW; px++) {
+                bool in = ok && om__tri2_covers(&t, px * 256 + 128, py * 256 + 128);
+                if (in != (count_buf[py * TW + px] == 1)) bad++;
+            }
+    }
+    CHECK_EQ_U(bad, 0);
+    /* A point on an edge shared by two triangles belongs to exactly one of them. */
+    int64_t ax[3] = {0, 1000, 0}, ay[3] = {0, 0, 1000}, bx[3] = {1000, 1000, 0}, by[3] = {0, 1000, 1000};
+    om__tri2 ta, tb;
+    CHECK(om__tri2_setup(&ta, ax, ay, true) && om__tri2_setup(&tb, bx, by, true));
+    for (int64_t s = 0; s <= 1000; s += 50) {
+        int n = om__tri2_covers(&ta, s, 1000 - s) + om__tri2_covers(&tb, s, 1000 - s);
+        if (s > 0 && s < 1000) CHECK_MSG(n == 1, "point %lld on the shared edge owned %d times", (long long)s, n);
+    }
+    /* Coordinates beyond the documented range are refused, not overflowed. */
+    int64_t big[3] = {0, OM_TRI2_MAX_COORD + 1, 0};
+    CHECK(!om__tri2_setup(&ta, big, ay, true));
+}
+
+typedef struct cons_ctx { int *count; uint32_t w; } cons_ctx;
+static void cons_frag(void *user, int32_t x, int32_t y, const om__rtri *t)
+{
+    cons_ctx *c = (cons_ctx *)user;
+    (void)t;
+    c->count[y * (int32_t)c->w + x]++;
+}
+
+static void conservative_superset(void)
+{
+    rng_state = 4242;
+    static int cons[TW * TH];
+    int missing = 0, dup = 0;
+    for (int k = 0; k < 200; k++) {
+        om_vec4 c[3];
+        double X[3], Y[3];
+        for (int i = 0; i < 3; i++) {
+            X[i] = rnd() % (TW * 256);
+            Y[i] = rnd() % (TH * 256);
+            if (k % 4 == 0) { X[i] = 4000 + rnd() % 300; Y[i] = 4000 + rnd() % 300; }   /* tiny */
+            c[i] = at(X[i], Y[i], TW, TH, 0.5f);
+        }
+        memset(count_buf, 0, sizeof count_buf);
+        add_coverage(c, TW, TH);
+        memset(cons, 0, sizeof cons);
+        om_target t = target(TW, TH);
+        cons_ctx ctx = {cons, TW};
+        om_raster r = {&t, OM_RASTER_CONSERVATIVE, cons_frag, &ctx};
+        om__raster_tri(&r, c, 1);
+        for (int i = 0; i < TW * TH; i++) {
+            if (count_buf[i] && !cons[i]) missing++;
+            if (cons[i] > 1) dup++;
+        }
+        /* Every pixel holding a vertex is touched. */
+        for (int i = 0; i < 3; i++) {
+            int px = (int)(X[i] / 256), py = (int)(Y[i] / 256);
+            if (!cons[py * TW + px]) missing++;
+        }
+    }
+    CHECK_EQ_U(missing, 0);
+    CHECK_EQ_U(dup, 0);
+}
+
+static void strips_match_whole(void)
+{
+    /* The same triangles rendered whole and through strips of 5 rows agree exactly,
+     * depth included. */
+    static uint32_t whole_d[TW * TH], whole_i[TW * TH];
+    rng_state = 31337;
+    om_vec4 tris[40][3];
+    for (int k = 0; k < 40; k++)
+        for (int i = 0; i < 3; i++)
+            tris[k][i] = at(rnd() % (TW * 256 + 2000) - 1000.0, rnd() % (TH * 256 + 2000) - 1000.0,
+                            TW, TH, (float)(rnd() % 1000) / 1000.0f);
+    om_target t = target(TW, TH);
+    om__target_clear(&t);
+    om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL};
+    for (int k = 0; k < 40; k++) om__raster_tri(&r, tris[k], (uint32_t)k);
+    memcpy(whole_d, depth_buf, sizeof whole_d);
+    memcpy(whole_i, id_buf, sizeof whole_i);
+    int diff = 0;
+    for (uint32_t y0 = 0; y0 < TH; y0 += 5) {
+        t.y0 = y0;
+        t.rows = y0 + 5 > TH ? TH - y0 : 5;
+        om__target_clear(&t);
+        for (int k = 0; k < 40; k++) om__raster_tri(&r, tris[k], (uint32_t)k);
+        for (uint32_t i = 0; i < t.rows * TW; i++)
+            if (depth_buf[i] != whole_d[y0 * TW + i] || id_buf[i] != whole_i[y0 * TW + i]) diff++;
+    }
+    CHECK_EQ_U(diff, 0);
+}
+
+void suite_raster(void)
+{
+    RUN(hand_checked_masks);
+    RUN(watertight_grids);
+    RUN(watertight_fans);
+    RUN(watertight_random_triangulation);
+    RUN(clipping_near_far);
+    RUN(overflow_cases);
+    RUN(covers_matches_fill);
+    RUN(conservative_superset);
+    RUN(strips_match_whole);
+}

@@ -1,0 +1,1104 @@
+/* test_scene.c — the scene text format, procedural shapes, OBJ meshes and paths:
+ * values and defaults as parsed, exact byte queries, closed outward-wound shapes,
+ * errors with the right status, line and column, meshes through a loader, om_scene_at,
+ * the default scene, and random mutations of it that must never crash. */
+#include "test.h"
+#include "../engine/scene/scene.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+/* ---------------------------------------------------------------- helpers */
+
+typedef struct parsed {
+    om_scene s;
+    void *mem;
+    size_t bytes;
+    om_diag d;
+    om_status st;
+} parsed;
+
+/* The text in a heap block of exactly its length, no NUL after it: under ASan any read
+ * past `len` is caught. */
+static char *exact_copy(const char *text, size_t len)
+{
+    char *c = (char *)malloc(len ? len : 1);
+    if (len) memcpy(c, text, len);
+    return c;
+}
+
+/* Bytes query, then a parse into a heap buffer of exactly that many bytes (so ASan
+ * sees any write past it); checks that the arena ends exactly full. */
+static om_status parse_ld(const char *text, size_t len, const om_loader *ld, parsed *p)
+{
+    memset(p, 0, sizeof *p);
+    char *t = text ? exact_copy(text, len) : NULL;
+    p->st = om_scene_bytes(t, len, ld, &p->bytes, &p->d);
+    if (p->st == OM_OK) {
+        p->mem = malloc(p->bytes ? p->bytes : 1);
+        om_arena a;
+        om_arena_init(&a, p->mem, p->bytes, "scene");
+        p->st = om_scene_parse(t, len, ld, &a, &p->s, &p->d);
+        if (p->st == OM_OK) CHECK_EQ_U(a.used, p->bytes);
+    }
+    free(t);
+    return p->st;
+}
+
+static om_status parse(const char *text, parsed *p) { return parse_ld(text, strlen(text), NULL, p); }
+static void done(parsed *p) { free(p->mem); p->mem = NULL; }
+
+static bool feq(float a, float b, float tol) { return fabsf(a - b) <= tol; }
+static bool veq(om_vec3 a, float x, float y, float z) { return a.x == x && a.y == y && a.z == z; }
+
+static om_vec3 tri_normal(const om_scene *s, uint32_t t)
+{
+    const uint32_t *i = s->idx + 3 * t;
+    om_vec3 a = s->verts[i[0]], b = s->verts[i[1]], c = s->verts[i[2]];
+    return om__cross(om__sub(b, a), om__sub(c, a));
+}
+
+static om_vec3 tri_centroid(const om_scene *s, uint32_t t)
+{
+    const uint32_t *i = s->idx + 3 * t;
+    om_vec3 c = om__add(om__add(s->verts[i[0]], s->verts[i[1]]), s->verts[i[2]]);
+    return om__scale(c, 1.0f / 3.0f);
+}
+
+typedef struct edge { uint32_t a, b; } edge;
+
+static int edge_cmp(const void *x, const void *y)
+{
+    const edge *e = (const edge *)x, *f = (const edge *)y;
+    if (e->a != f->a) return e->a < f->a ? -1 : 1;
+    if (e->b != f->b) return e->b < f->b ? -1 : 1;
+    return 0;
+}
+
+static bool has_edge(const edge *es, size_t n, uint32_t a, uint32_t b)
+{
+    edge k = {a, b};
+    return bsearch(&k, es, n, sizeof k, edge_cmp) != NULL;
+}
+
+/* Every directed edge appears once; in a closed mesh its reverse appears too (so each
+ * undirected edge has exactly two triangles, wound in opposite directions). Returns the
+ * number of boundary edges (those without a reverse). */
+static size_t check_edges(const om_scene *s, const char *what)
+{
+    size_t n = (size_t)s->ntris * 3, dup = 0, open = 0;
+    edge *es = (edge *)malloc(n * sizeof *es);
+    for (uint32_t t = 0; t < s->ntris; t++)
+        for (int k = 0; k < 3; k++) {
+            es[3 * t + k].a = s->idx[3 * t + k];
+            es[3 * t + k].b = s->idx[3 * t + (k + 1) % 3];
+        }
+    qsort(es, n, sizeof *es, edge_cmp);
+    for (size_t i = 0; i < n; i++) {
+        if (i && edge_cmp(&es[i], &es[i - 1]) == 0) dup++;
+        if (!has_edge(es, n, es[i].b, es[i].a)) open++;
+    }
+    CHECK_MSG(dup == 0, "%s: %zu directed edges repeat (inconsistent winding)", what, dup);
+    free(es);
+    return open;
+}
+
+/* Closed, consistently wound, non-degenerate, normals pointing away from `centre`. */
+static void check_closed_convex(const char *text, om_vec3 centre)
+{
+    parsed p;
+    CHECK_MSG(parse(text, &p) == OM_OK, "%s: %s", text, p.d.msg);
+    if (p.st != OM_OK) return;
+    CHECK_MSG(p.s.ntris > 0, "%s: no triangles", text);
+    CHECK_MSG(check_edges(&p.s, text) == 0, "%s: not closed", text);
+    uint32_t inward = 0, degenerate = 0;
+    for (uint32_t t = 0; t < p.s.ntris; t++) {
+        om_vec3 n = tri_normal(&p.s, t);
+        if (!(om__dot(n, n) > 0.0f)) degenerate++;
+        if (!(om__dot(n, om__sub(tri_centroid(&p.s, t), centre)) > 0.0f)) inward++;
+    }
+    CHECK_MSG(inward == 0 && degenerate == 0, "%s: %u inward, %u degenerate of %u", text, inward,
+              degenerate, p.s.ntris);
+    for (uint32_t i = 0; i < p.s.nverts; i++) {
+        om_vec3 v = p.s.verts[i];
+        CHECK(v.x >= p.s.lo.x && v.y >= p.s.lo.y && v.z >= p.s.lo.z);
+        CHECK(v.x <= p.s.hi.x && v.y <= p.s.hi.y && v.z <= p.s.hi.z);
+    }
+    done(&p);
+}
+
+/* An error with its status, line and column, the same from both passes' entry points. */
+static void expect_err_n(const char *orig, size_t len, om_status st, uint32_t line, uint32_t col,
+                         const char *msg_part)
+{
+    char *text = exact_copy(orig, len);
+    size_t bytes = 123;
+    om_diag d, d2;
+    memset(&d, 0x5A, sizeof d);
+    om_status got = om_scene_bytes(text, len, NULL, &bytes, &d);
+    CHECK_MSG(got == st && d.line == line && d.col == col && d.status == st,
+              "[%.60s]: got %s %u:%u, wanted %s %u:%u (%s)", orig, om_status_str(got), d.line,
+              d.col, om_status_str(st), line, col, d.msg);
+    CHECK_EQ_U(bytes, 0);
+    CHECK_MSG(strstr(d.msg, msg_part) != NULL, "[%.60s]: message '%s' lacks '%s'", orig, d.msg,
+              msg_part);
+    char where[48];
+    snprintf(where, sizeof where, "line %u, col %u: ", line, col);
+    CHECK_MSG(strncmp(d.msg, where, strlen(where)) == 0, "message '%s' should start '%s'", d.msg,
+              where);
+    /* om_scene_parse fails the same way, before carving anything */
+    static unsigned char buf[1 << 16];
+    om_arena a;
+    om_scene s;
+    om_arena_init(&a, buf, sizeof buf, "scene");
+    got = om_scene_parse(text, len, NULL, &a, &s, &d2);
+    CHECK(got == st && d2.line == line && d2.col == col && strcmp(d.msg, d2.msg) == 0);
+    CHECK_EQ_U(a.used, 0);
+    CHECK(s.ntris == 0 && s.verts == NULL);
+    free(text);
+}
+
+static void expect_err(const char *text, om_status st, uint32_t line, uint32_t col,
+                       const char *msg_part)
+{
+    expect_err_n(text, strlen(text), st, line, col, msg_part);
+}
+
+/* ---------------------------------------------------------------- numbers */
+
+static void numbers(void)
+{
+    static const char *exact[] = {
+        "0", "-0", "1", "+5", "0.1", ".5", "5.", "123.456", "3.14159265358979", "1e22",
+        "1e-22", "1E3", "00012", "-2.5e-3", "9007199254740993", "0.000001", "1234567890123456789",
+        "4294967295", "1e23", "0.30000000000000004", "8192", "179.999",
+    };
+    for (size_t i = 0; i < sizeof exact / sizeof exact[0]; i++) {
+        double v = -1;
+        CHECK_MSG(om__num(exact[i], strlen(exact[i]), &v), "%s rejected", exact[i]);
+        CHECK_MSG(v == strtod(exact[i], NULL), "%s: %.17g vs %.17g", exact[i], v,
+                  strtod(exact[i], NULL));
+    }
+    static const char *close[] = {
+        "1e300", "1.7976931348623157e308", "2.2250738585072014e-308", "123456789012345678901234567890",
+        "0.00000000000000000000000001234", "6.02214076e23", "1e-300", "4.9e-320",
+    };
+    for (size_t i = 0; i < sizeof close / sizeof close[0]; i++) {
+        double v = -1, want = strtod(close[i], NULL);
+        CHECK_MSG(om__num(close[i], strlen(close[i]), &v), "%s rejected", close[i]);
+        CHECK_MSG(fabs(v - want) <= fabs(want) * 1e-14 || (want < 1e-307 && fabs(v - want) < 1e-320),
+                  "%s: %.17g vs %.17g", close[i], v, want);
+    }
+    static const char *bad[] = {"", "-", "+", ".", "1e", "1e+", "1.2.3", "0x10", "nan", "inf",
+                                "1 ", "+-1", "1e5x", "e5", "--1", "1..", "1e5.5", "."};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        double v;
+        CHECK_MSG(!om__num(bad[i], strlen(bad[i]), &v), "'%s' accepted", bad[i]);
+    }
+    double v;
+    CHECK(om__num("1e400", 5, &v) && isinf(v));
+    CHECK(om__num("-1e99999999999999999999", 23, &v) && isinf(v) && v < 0);
+    CHECK(om__num("1e-99999999999999999999", 23, &v) && v == 0.0);
+    /* a long run of zeros before and after the point */
+    static char longnum[20010];
+    memset(longnum, '0', sizeof longnum);
+    longnum[10000] = '.';
+    longnum[20005] = '7';
+    CHECK(om__num(longnum, 20006, &v) && v == 0.0);   /* 7e-10005 underflows to 0 */
+    longnum[9999] = '3';
+    CHECK(om__num(longnum, 20006, &v) && v == 3.0);
+    longnum[0] = '1';
+    CHECK(om__num(longnum, 10000, &v) && isinf(v));
+    /* only the given length is read: "12" of "123" */
+    CHECK(om__num("123", 2, &v) && v == 12.0);
+}
+
+/* ---------------------------------------------------------------- values */
+
+static void camera_light_values(void)
+{
+    parsed p;
+    const char *text =
+        "# a comment line\n"
+        "camera eye 1 2 3 target 4 5 6 up 0 0 1 fov 40 size 320 200 near 0.5 far 50 # trailing\n"
+        "\n"
+        "light spot target 0 0 0 pos 0 10 0 fov 70.5 near 1 far 99\n";
+    CHECK_OK(parse(text, &p));
+    const om_camera *c = &p.s.camera;
+    CHECK(veq(c->eye, 1, 2, 3) && veq(c->target, 4, 5, 6) && veq(c->up, 0, 0, 1));
+    CHECK(c->fovy_deg == 40.0f && c->width == 320 && c->height == 200);
+    CHECK(c->znear == 0.5f && c->zfar == 50.0f);
+    const om_light *l = &p.s.light;
+    CHECK(l->kind == OM_LIGHT_SPOT && veq(l->pos, 0, 10, 0) && veq(l->target, 0, 0, 0));
+    CHECK(l->fov_deg == 70.5f && l->znear == 1.0f && l->zfar == 99.0f);
+    CHECK(veq(l->dir, 0, -1, 0));
+    CHECK(p.s.ntris == 0 && p.s.nverts == 0 && p.s.nmats == 1);
+    CHECK(veq(p.s.lo, 0, 0, 0) && veq(p.s.hi, 0, 0, 0));
+    done(&p);
+
+    /* defaults: camera eye 0 5 15, light spot 10 20 10, default material */
+    CHECK_OK(parse("", &p));
+    c = &p.s.camera;
+    CHECK(veq(c->eye, 0, 5, 15) && veq(c->target, 0, 0, 0) && veq(c->up, 0, 1, 0));
+    CHECK(c->fovy_deg == 50.0f && c->width == 640 && c->height == 480);
+    CHECK(c->znear == 0.1f && c->zfar == 1000.0f);
+    l = &p.s.light;
+    CHECK(l->kind == OM_LIGHT_SPOT && veq(l->pos, 10, 20, 10) && veq(l->target, 0, 0, 0));
+    CHECK(l->fov_deg == 60.0f && l->znear == 0.5f && l->zfar == 1000.0f);
+    CHECK(p.s.nmats == 1 && p.s.mats[0].r == 0.8f && p.s.mats[0].opacity == 1.0f);
+    CHECK(p.s.ncam_keys == 0 && p.s.nlight_keys == 0 && p.s.cam_keys == NULL);
+    done(&p);
+
+    /* camera defaults for what a line leaves out; a directional light */
+    CHECK_OK(parse("camera target 0 0 -1 eye 0 0 0\r\nlight directional dir 1 -2 0\r\n", &p));
+    CHECK(p.s.camera.fovy_deg == 50.0f && p.s.camera.width == 640 && p.s.camera.zfar == 1000.0f);
+    CHECK(p.s.light.kind == OM_LIGHT_DIRECTIONAL && veq(p.s.light.dir, 1, -2, 0));
+    done(&p);
+
+    /* anything goes in a comment, NUL bytes included; a UTF-8 byte-order mark is skipped */
+    static const char odd[] = "\xEF\xBB\xBF" "material m # \0\x01\xff\n\nbox material m#\0\n";
+    CHECK_OK(parse_ld(odd, sizeof odd - 1, NULL, &p));
+    CHECK(p.s.ntris == 12 && p.s.nmats == 2 && p.s.tri_mat[0] == 1);
+    done(&p);
+    expect_err("\xEF\xBB\xBF" "camera fov 10", OM_E_PARSE, 1, 1, "'camera' needs eye");
+
+    /* whitespace only, and NULL text of length 0, are empty scenes */
+    CHECK_OK(parse(" \t\r\n\n   \n\t", &p));
+    CHECK(p.s.ntris == 0 && p.s.nmats == 1);
+    done(&p);
+    CHECK_OK(parse_ld(NULL, 0, NULL, &p));
+    done(&p);
+    size_t bytes;
+    CHECK(om_scene_bytes(NULL, 5, NULL, &bytes, NULL) == OM_E_INVALID);
+}
+
+static void primitive_counts(void)
+{
+    static const struct { const char *text; uint32_t nv, nt; } cases[] = {
+        {"plane", 4, 2},
+        {"plane divisions 5", 36, 50},
+        {"box", 8, 12},
+        {"sphere", 32 * 15 + 2, 2 * 32 * 15},
+        {"sphere segments 3 rings 2", 3 + 2, 6},
+        {"sphere segments 96 rings 48", 96 * 47 + 2, 2 * 96 * 47},
+        {"cylinder", 66, 128},
+        {"cylinder segments 3", 8, 12},
+        {"triangles count 7", 21, 7},
+        {"triangles count 1e3", 3000, 1000},
+        {"box\nsphere segments 4 rings 3\nplane divisions 2", 8 + 10 + 9, 12 + 16 + 8},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        parsed p;
+        CHECK_MSG(parse(cases[i].text, &p) == OM_OK, "%s: %s", cases[i].text, p.d.msg);
+        CHECK_MSG(p.s.nverts == cases[i].nv && p.s.ntris == cases[i].nt, "%s: %u verts %u tris",
+                  cases[i].text, p.s.nverts, p.s.ntris);
+        for (uint32_t t = 0; t < 3 * p.s.ntris; t++) CHECK(p.s.idx[t] < p.s.nverts);
+        done(&p);
+    }
+}
+
+static void transforms_and_bounds(void)
+{
+    parsed p;
+    /* scale, then rotate, then translate */
+    CHECK_OK(parse("box size 2 4 6 scale 0.5 translate 10 20 30", &p));
+    CHECK(veq(p.s.lo, 9.5f, 19, 28.5f) && veq(p.s.hi, 10.5f, 21, 31.5f));
+    done(&p);
+    CHECK_OK(parse("box size 2 4 6 scale 1 2 3", &p));
+    CHECK(veq(p.s.lo, -1, -4, -9) && veq(p.s.hi, 1, 4, 9));
+    done(&p);
+    /* quarter turns are exact: about y, x goes to -z */
+    CHECK_OK(parse("box size 2 4 6 rotate 0 90 0", &p));
+    CHECK(veq(p.s.lo, -3, -2, -1) && veq(p.s.hi, 3, 2, 1));
+    done(&p);
+    CHECK_OK(parse("plane size 2 2 rotate 90 0 0", &p));   /* +y normal turns to +z */
+    {
+        om_vec3 n = om__normalize(tri_normal(&p.s, 0));
+        CHECK(feq(n.x, 0, 1e-6f) && feq(n.y, 0, 1e-6f) && feq(n.z, 1, 1e-6f));
+        CHECK(veq(p.s.lo, -1, -1, 0) && veq(p.s.hi, 1, 1, 0));   /* z -> -y: now in xy */
+    }
+    done(&p);
+    /* x first, then y: the +y normal goes to +z (x), then to +x (y) */
+    CHECK_OK(parse("plane rotate 90 90 0", &p));
+    {
+        om_vec3 n = om__normalize(tri_normal(&p.s, 1));
+        CHECK(feq(n.x, 1, 1e-6f) && feq(n.y, 0, 1e-6f) && feq(n.z, 0, 1e-6f));
+    }
+    done(&p);
+    /* ...and about z last: +y -> (z 90) -> -x */
+    CHECK_OK(parse("plane rotate 0 0 90", &p));
+    {
+        om_vec3 n = om__normalize(tri_normal(&p.s, 0));
+        CHECK(feq(n.x, -1, 1e-6f) && feq(n.y, 0, 1e-6f));
+    }
+    done(&p);
+    /* a mirrored plane keeps its normal consistent with the mirror: +y -> -y */
+    CHECK_OK(parse("plane scale 1 -1 1 translate 0 2 0", &p));
+    CHECK(tri_normal(&p.s, 0).y < 0);   /* the mirror image of an up-facing plane faces down */
+    done(&p);
+    CHECK_OK(parse("plane scale -1 1 1", &p));
+    CHECK(tri_normal(&p.s, 0).y > 0);   /* mirroring x keeps a y-facing plane facing +y */
+    done(&p);
+    /* sphere and cylinder extents; several objects add up */
+    CHECK_OK(parse("sphere radius 2 translate 0 5 0\ncylinder radius 1 height 3 translate 10 0 0", &p));
+    CHECK(veq(p.s.lo, -2, 0, -2) && veq(p.s.hi, 11, 7, 2));
+    CHECK_EQ_U(p.s.ntris, 2 * 32 * 15 + 128);
+    done(&p);
+}
+
+static void materials(void)
+{
+    parsed p;
+    const char *text =
+        "material red albedo 1 0 0\n"
+        "material glass albedo 0.5 0.5 1 opacity 0.25\n"
+        "box material red\n"                           /* tris 0..11 -> named 1 */
+        "box\n"                                        /* 12..23 -> default 0 */
+        "box albedo 0 1 0\n"                           /* 24..35 -> inline, opacity 1 */
+        "box material glass albedo 0 0 1\n"            /* 36..47 -> inline over glass */
+        "material red albedo 0.9 0.1 0.1\n"            /* redefinition: later lines see it */
+        "box material red opacity 0.5\n";              /* 48..59 -> inline over the new red */
+    CHECK_OK(parse(text, &p));
+    CHECK_EQ_U(p.s.nmats, 1 + 3 + 3);
+    CHECK_EQ_U(p.s.ntris, 60);
+    const om_material *m = p.s.mats;
+    CHECK(m[0].r == 0.8f && m[0].g == 0.8f && m[0].b == 0.8f && m[0].opacity == 1.0f);
+    CHECK(m[1].r == 1.0f && m[1].g == 0.0f && m[1].opacity == 1.0f);
+    CHECK(m[2].b == 1.0f && m[2].opacity == 0.25f);
+    CHECK(m[3].r == 0.9f && m[3].g == 0.1f);
+    CHECK(m[4].r == 0.0f && m[4].g == 1.0f && m[4].opacity == 1.0f);
+    CHECK(m[5].b == 1.0f && m[5].r == 0.0f && m[5].opacity == 0.25f);
+    CHECK(m[6].r == 0.9f && m[6].opacity == 0.5f);
+    static const uint16_t want[5] = {1, 0, 4, 5, 6};
+    for (uint32_t t = 0; t < 60; t++) CHECK_EQ_U(p.s.tri_mat[t], want[t / 12]);
+    done(&p);
+
+    /* more names than the look-up cache holds: every one still resolves */
+    char *big = (char *)malloc(200 * 64);
+    size_t n = 0;
+    for (int i = 0; i < 200; i++) n += (size_t)sprintf(big + n, "material m%d albedo 0 0 %g\n", i, i / 200.0);
+    for (int i = 0; i < 200; i += 7) n += (size_t)sprintf(big + n, "box material m%d\n", i);
+    CHECK_OK(parse_ld(big, n, NULL, &p));
+    for (uint32_t t = 0; t < p.s.ntris; t++) {
+        uint16_t mi = p.s.tri_mat[t];
+        CHECK(mi == 1 + (t / 12) * 7 && p.s.mats[mi].b == (float)((mi - 1) / 200.0));
+    }
+    done(&p);
+    free(big);
+
+    /* at most 65535 materials */
+    const char line[] = "material m\n";
+    size_t ll = sizeof line - 1;
+    big = (char *)malloc(65535 * ll + 32);
+    for (size_t i = 0; i < 65535; i++) memcpy(big + i * ll, line, ll);
+    CHECK_OK(parse_ld(big, 65534 * ll, NULL, &p));
+    CHECK_EQ_U(p.s.nmats, 65535);
+    done(&p);
+    expect_err_n(big, 65535 * ll, OM_E_RANGE, 65535, 1, "too many materials");
+    memcpy(big + 65534 * ll, "box opacity 1\n", 14);
+    expect_err_n(big, 65534 * ll + 14, OM_E_RANGE, 65535, 1, "too many materials");
+    free(big);
+}
+
+static void keys_parse(void)
+{
+    parsed p;
+    const char *text =
+        "key camera 0 eye 0 1 10 target 0 0 0\n"
+        "key light -1 pos 5 5 5 target 0 0 0\n"
+        "key camera 2.5 target 1 1 1 eye 0 2 10\n"
+        "key light 3 pos 6 5 5 target 0 0 1\n";
+    CHECK_OK(parse(text, &p));
+    CHECK_EQ_U(p.s.ncam_keys, 2);
+    CHECK_EQ_U(p.s.nlight_keys, 2);
+    CHECK(p.s.cam_keys[0].t == 0.0f && veq(p.s.cam_keys[0].eye, 0, 1, 10));
+    CHECK(p.s.cam_keys[1].t == 2.5f && veq(p.s.cam_keys[1].target, 1, 1, 1));
+    CHECK(p.s.light_keys[0].t == -1.0f && veq(p.s.light_keys[1].pos, 6, 5, 5));
+    CHECK(veq(p.s.light_keys[1].target, 0, 0, 1));
+    done(&p);
+    CHECK_OK(parse("light directional dir 0 -1 0\nkey light 0 dir 1 -1 0\nkey light 1 dir -1 -1 0\n", &p));
+    CHECK_EQ_U(p.s.nlight_keys, 2);
+    CHECK(veq(p.s.light_keys[1].dir, -1, -1, 0));
+    done(&p);
+    /* keys may come before the light line they must match */
+    CHECK_OK(parse("key light 0 dir 1 -1 0\nlight directional dir 0 -1 0\n", &p));
+    done(&p);
+}
+
+/* ---------------------------------------------------------------- bytes */
+
+static void bytes_exact(void)
+{
+    const char *texts[] = {
+        "",
+        "box",
+        "sphere segments 5 rings 3\nmaterial a\nbox material a albedo 1 1 1\nkey camera 0 eye 0 0 1 target 0 0 0\n",
+        "key light 0 pos 1 1 1 target 0 0 0\nkey light 1 pos 1 2 1 target 0 0 0\nplane divisions 3\n",
+    };
+    for (size_t i = 0; i < sizeof texts / sizeof texts[0]; i++) {
+        const char *text = texts[i];
+        size_t bytes;
+        CHECK_OK(om_scene_bytes(text, strlen(text), NULL, &bytes, NULL));
+        unsigned char *buf = (unsigned char *)malloc(bytes + 64);
+        /* wherever the buffer starts, exactly `bytes` works and one byte less does not */
+        for (size_t off = 0; off < 8; off++) {
+            om_arena a;
+            om_scene s;
+            om_diag d;
+            om_arena_init(&a, buf + off, bytes, "scene");
+            CHECK_OK(om_scene_parse(text, strlen(text), NULL, &a, &s, &d));
+            CHECK_EQ_U(a.used, bytes);
+            CHECK(((uintptr_t)s.verts & 3) == 0 && ((uintptr_t)s.idx & 3) == 0);
+            CHECK(((uintptr_t)s.tri_mat & 1) == 0 && ((uintptr_t)s.mats & 3) == 0);
+            if (bytes == 0) continue;
+            om_arena_init(&a, buf + off, bytes - 1, "scene");
+            CHECK(om_scene_parse(text, strlen(text), NULL, &a, &s, &d) == OM_E_BUDGET);
+            CHECK(d.status == OM_E_BUDGET && d.asked > d.left);
+            CHECK(strstr(d.msg, "scene arena") != NULL);
+            CHECK_EQ_U(a.used, 0);   /* a failed parse gives back what it carved */
+            CHECK(s.verts == NULL && s.ntris == 0);
+        }
+        free(buf);
+    }
+    /* the count is what the arrays take, plus alignment slack */
+    size_t bytes;
+    CHECK_OK(om_scene_bytes("box", 3, NULL, &bytes, NULL));
+    size_t arrays = 8 * sizeof(om_vec3) + 12 * 3 * 4 + 12 * 2 + sizeof(om_material);
+    CHECK(bytes >= arrays && bytes <= arrays + 4 * 8);
+    /* fault injection: a carve failing in the middle leaves the arena as it was */
+    static unsigned char buf[1 << 16];
+    const char *five = "box\nkey camera 0 eye 0 0 1 target 0 0 0";   /* five arrays */
+    for (uint32_t k = 1; k <= 6; k++) {
+        om_arena a;
+        om_scene s;
+        om_arena_init(&a, buf, sizeof buf, "scene");
+        a.fail_at = k;
+        om_status st = om_scene_parse(five, strlen(five), NULL, &a, &s, NULL);
+        CHECK(st == (k <= 5 ? OM_E_BUDGET : OM_OK));
+        if (k <= 5) CHECK_EQ_U(a.used, 0);
+    }
+}
+
+/* ---------------------------------------------------------------- shapes */
+
+static void shapes_closed(void)
+{
+    check_closed_convex("box", om__v3(0, 0, 0));
+    check_closed_convex("box size 0.05 1.2 0.05 translate 3 0.6 -1", om__v3(3, 0.6f, -1));
+    check_closed_convex("box size 1 2 3 rotate 10 20 30 translate 1 2 3", om__v3(1, 2, 3));
+    check_closed_convex("box scale -1 1 1", om__v3(0, 0, 0));
+    check_closed_convex("box scale 1 -2 -3 rotate 0 45 0", om__v3(0, 0, 0));
+    check_closed_convex("sphere", om__v3(0, 0, 0));
+    check_closed_convex("sphere segments 3 rings 2", om__v3(0, 0, 0));
+    check_closed_convex("sphere segments 4 rings 3 radius 2", om__v3(0, 0, 0));
+    check_closed_convex("sphere segments 96 rings 48 translate 0 1.2 -2", om__v3(0, 1.2f, -2));
+    check_closed_convex("sphere segments 7 rings 5 scale 1.5 0.6 1 rotate 0 30 0", om__v3(0, 0, 0));
+    check_closed_convex("sphere segments 9 rings 4 scale -1 1 1 rotate 30 0 60", om__v3(0, 0, 0));
+    check_closed_convex("cylinder", om__v3(0, 0.5f, 0));
+    check_closed_convex("cylinder segments 3 radius 2 height 0.5", om__v3(0, 0.25f, 0));
+    check_closed_convex("cylinder segments 128 radius 0.4 height 3 translate 3.5 0 -1", om__v3(3.5f, 1.5f, -1));
+    check_closed_convex("cylinder segments 5 scale 1 1 -1 rotate 90 0 0", om__v3(0, 0, 0.5f));
+
+    /* the plane: open along its border only, every triangle facing +y */
+    for (uint32_t div = 1; div <= 4; div++) {
+        char text[64];
+        parsed p;
+        snprintf(text, sizeof text, "plane size 3 5 divisions %u", div);
+        CHECK_OK(parse(text, &p));
+        CHECK_EQ_U(check_edges(&p.s, text), 4 * div);
+        for (uint32_t t = 0; t < p.s.ntris; t++) {
+            om_vec3 n = tri_normal(&p.s, t);
+            CHECK(n.y > 0 && n.x == 0 && n.z == 0);
+        }
+        CHECK(veq(p.s.lo, -1.5f, 0, -2.5f) && veq(p.s.hi, 1.5f, 0, 2.5f));
+        done(&p);
+    }
+}
+
+static void random_triangles(void)
+{
+    parsed p, q;
+    const char *text = "triangles count 1000 seed 3 area 2 in -1 0 -2 1 1 2";
+    CHECK_OK(parse(text, &p));
+    CHECK_EQ_U(p.s.ntris, 1000);
+    CHECK_EQ_U(p.s.nverts, 3000);
+    double total = 0, lo = 1e9, hi = 0, nz = 0;
+    for (uint32_t t = 0; t < p.s.ntris; t++) {
+        om_vec3 n = tri_normal(&p.s, t);
+        double a = 0.5 * sqrt((double)om__dot(n, n));
+        total += a;
+        if (a < lo) lo = a;
+        if (a > hi) hi = a;
+        nz += fabs(om__normalize(n).z);
+        for (int k = 0; k < 3; k++) CHECK(p.s.idx[3 * t + k] == 3 * t + (uint32_t)k);
+    }
+    CHECK_MSG(fabs(total - 2.0) < 1e-4, "total area %.9f", total);
+    CHECK_MSG(lo > 0.002 * 0.999 && hi < 0.002 * 1.001, "areas %g..%g", lo, hi);
+    /* random orientation: |n.z| averages 1/2 for normals uniform on the sphere */
+    CHECK_MSG(fabs(nz / 1000 - 0.5) < 0.05, "mean |n.z| %.3f", nz / 1000);
+    const float eps = 1e-6f;
+    CHECK(p.s.lo.x >= -1 - eps && p.s.lo.y >= -eps && p.s.lo.z >= -2 - eps);
+    CHECK(p.s.hi.x <= 1 + eps && p.s.hi.y <= 1 + eps && p.s.hi.z <= 2 + eps);
+    CHECK(p.s.hi.x - p.s.lo.x > 1.9f && p.s.hi.z - p.s.lo.z > 3.9f);   /* spread over the box */
+    /* the same seed gives the same bits, another seed other ones */
+    CHECK_OK(parse(text, &q));
+    CHECK(memcmp(p.s.verts, q.s.verts, 3000 * sizeof(om_vec3)) == 0);
+    done(&q);
+    CHECK_OK(parse("triangles count 1000 seed 4 area 2 in -1 0 -2 1 1 2", &q));
+    CHECK(memcmp(p.s.verts, q.s.verts, 3000 * sizeof(om_vec3)) != 0);
+    done(&q);
+    done(&p);
+    /* default box, and a box thinner than a triangle: still non-degenerate */
+    CHECK_OK(parse("triangles count 100", &p));
+    CHECK(p.s.lo.x >= -5 && p.s.hi.x <= 5 && p.s.lo.y >= 0.5f && p.s.hi.y <= 3);
+    done(&p);
+    CHECK_OK(parse("triangles count 10 area 10 in 0 0 0 0 0 0", &p));
+    for (uint32_t t = 0; t < p.s.ntris; t++) CHECK(om__dot(tri_normal(&p.s, t), tri_normal(&p.s, t)) > 0);
+    done(&p);
+}
+
+/* ---------------------------------------------------------------- errors */
+
+static void parse_errors(void)
+{
+    expect_err("sphre radius 1\n", OM_E_PARSE, 1, 1,
+               "line 1, col 1: unknown command 'sphre' (expected camera, light, material, plane, "
+               "box, sphere, cylinder, mesh, triangles, key)");
+    expect_err("# c\n\ncamera eye 0 5 10 target 0 0 0 fov\n", OM_E_PARSE, 3, 35,
+               "line 3, col 35: expected a number after 'fov'");
+    expect_err("box size 1 2x 3\n", OM_E_PARSE, 1, 12, "malformed number '2x'");
+    expect_err("box\nsphere radius nan\n", OM_E_PARSE, 2, 15,
+               "expected a number after 'radius', found 'nan'");
+    expect_err("sphere radius 1e999\n", OM_E_PARSE, 1, 15, "number '1e999' is not finite");
+    expect_err("box translate 1e30 0 0\n", OM_E_RANGE, 1, 15, "translate '1e30' is out of range");
+    expect_err("camera eye 1e30 0 0 target 0 0 0\n", OM_E_RANGE, 1, 12, "out of range");
+    expect_err("camera eye 0 1 2 target 0 0 0 fov 0\n", OM_E_RANGE, 1, 35, "fov '0' is out of range");
+    expect_err("camera eye 0 1 2 target 0 0 0 fov 180\n", OM_E_RANGE, 1, 35, "fov");
+    expect_err("camera eye 0 1 2 target 0 0 0 size 0 0\n", OM_E_RANGE, 1, 36, "size '0'");
+    expect_err("camera eye 0 1 2 target 0 0 0 size 640 8193\n", OM_E_RANGE, 1, 40, "1..8192");
+    expect_err("camera eye 0 1 2 target 0 0 0\ncamera eye 0 1 3 target 0 0 0\n", OM_E_PARSE, 2, 1,
+               "second 'camera' line");
+    expect_err("light spot pos 1 1 1 target 0 0 0\n  light directional dir 0 -1 0\n", OM_E_PARSE, 2,
+               3, "second 'light' line");
+    expect_err("key camera 1 eye 0 1 2 target 0 0 0\nkey camera 1 eye 0 1 3 target 0 0 0\n",
+               OM_E_PARSE, 2, 12, "times must increase");
+    expect_err("key light 5 pos 0 1 2 target 0 0 0\nkey light 4.5 pos 0 1 3 target 0 0 0\n",
+               OM_E_PARSE, 2, 11, "times must increase");
+    expect_err("material red albedo 1 0 0\nbox material blue\n", OM_E_PARSE, 2, 14,
+               "unknown material 'blue'");
+    expect_err("box material red\nmaterial red\n", OM_E_PARSE, 1, 14, "unknown material 'red'");
+    expect_err("camera eye 0 1 2 target 0 0", OM_E_PARSE, 1, 28, "expected 3 numbers after 'target'");
+    expect_err("box\nsphere radius 1e", OM_E_PARSE, 2, 15, "malformed number '1e'");
+    expect_err("box\nsphere radi", OM_E_PARSE, 2, 8, "unknown parameter 'radi'");
+    expect_err_n("box size 1 1\0 1\n", 16, OM_E_PARSE, 1, 13, "unexpected byte 0x00");
+    expect_err_n("box\n\0box\n", 9, OM_E_PARSE, 2, 1, "unexpected byte 0x00");
+    expect_err("box\x01\n", OM_E_PARSE, 1, 4, "0x01");
+    expect_err("sphere radius 1 segmnts 8\n", OM_E_PARSE, 1, 17,
+               "unknown parameter 'segmnts' for 'sphere' (expected radius, segments, rings, scale, "
+               "rotate, translate, albedo, opacity, material)");
+    expect_err("sphere radius 1 2\n", OM_E_PARSE, 1, 17, "too many values after 'radius' (it takes 1)");
+    expect_err("box 1\n", OM_E_PARSE, 1, 5, "unexpected value '1' for 'box'");
+    expect_err("box scale 1 2 translate 0 0 0\n", OM_E_PARSE, 1, 15,
+               "expected 1 or 3 numbers after 'scale', found 'translate'");
+    expect_err("box scale 1 2 3 4\n", OM_E_PARSE, 1, 17, "too many values after 'scale'");
+    expect_err("box scale\n", OM_E_PARSE, 1, 10, "expected 1 or 3 numbers after 'scale'");
+    expect_err("box scale 0 1 1\n", OM_E_RANGE, 1, 11, "scale '0' is out of range");
+    expect_err("box size 1 1 1 size 2 2 2\n", OM_E_PARSE, 1, 16, "parameter 'size' is given twice");
+    expect_err("camera eye 0 1 2 target 0 0 0 near 5 far 2\n", OM_E_RANGE, 1, 42,
+               "'far' must be greater than 'near'");
+    expect_err("camera eye 0 1 2 target 0 0 0 near 2000\n", OM_E_RANGE, 1, 36, "'far' must be greater");
+    expect_err("camera eye 1 1 1 target 1 1 1\n", OM_E_RANGE, 1, 25, "eye and target must differ");
+    expect_err("camera eye 0 0 1 target 0 0 0 up 0 0 0\n", OM_E_RANGE, 1, 34, "'up' must not be zero");
+    expect_err("camera eye 0 0 1\n", OM_E_PARSE, 1, 1, "'camera' needs eye X Y Z and target X Y Z");
+    expect_err("sphere segments 8.5\n", OM_E_PARSE, 1, 17,
+               "expected a whole number after 'segments', found '8.5'");
+    expect_err("sphere segments 2\n", OM_E_RANGE, 1, 17, "3..4096");
+    expect_err("sphere rings 4097\n", OM_E_RANGE, 1, 14, "2..4096");
+    expect_err("plane divisions 0\n", OM_E_RANGE, 1, 17, "1..4096");
+    expect_err("plane size 10 -1\n", OM_E_RANGE, 1, 15, "size '-1'");
+    expect_err("box albedo 1 1.5 0\n", OM_E_RANGE, 1, 14, "0..1");
+    expect_err("material m opacity -0.1\n", OM_E_RANGE, 1, 20, "0..1");
+    expect_err("material 1m\n", OM_E_PARSE, 1, 10, "bad material name '1m'");
+    expect_err("material\n", OM_E_PARSE, 1, 9, "expected a name after 'material'");
+    expect_err("box material\n", OM_E_PARSE, 1, 13, "expected a name after 'material'");
+    expect_err("key light 0 pos 1 2 3 target 0 0 0\nkey light 1 dir 0 -1 0\n", OM_E_PARSE, 2, 1,
+               "light keys mix");
+    expect_err("key light 0 pos 1 2 3 dir 0 -1 0\n", OM_E_PARSE, 1, 23, "either pos and target");
+    expect_err("light directional dir 0 -1 0\n\nkey light 0 pos 1 2 3 target 0 0 0\n", OM_E_PARSE, 3,
+               1, "the light is directional");
+    expect_err("key light 0 dir 0 -1 0\n", OM_E_PARSE, 1, 1, "the light is a spot light");
+    expect_err("key light 0 dir 0 0 0\nlight directional dir 0 -1 0", OM_E_RANGE, 1, 17, "'dir' must not be zero");
+    expect_err("light directional dir 0 0 0\n", OM_E_RANGE, 1, 23, "'dir' must not be zero");
+    expect_err("light point pos 1 2 3\n", OM_E_PARSE, 1, 7, "expected 'spot' or 'directional'");
+    expect_err("light\n", OM_E_PARSE, 1, 6, "expected 'spot' or 'directional'");
+    expect_err("light spot pos 1 2 3 target 1 2 3\n", OM_E_RANGE, 1, 29, "pos and target must differ");
+    expect_err("light spot pos 1 2 3\n", OM_E_PARSE, 1, 1, "needs pos X Y Z and target X Y Z");
+    expect_err("key\n", OM_E_PARSE, 1, 4, "expected 'camera' or 'light' after 'key'");
+    expect_err("key camera eye 0 0 1 target 0 0 0\n", OM_E_PARSE, 1, 12,
+               "expected a number after 'key camera', found 'eye'");
+    expect_err("key camera 0 eye 0 0 1\n", OM_E_PARSE, 1, 1, "needs eye X Y Z and target X Y Z");
+    expect_err("triangles seed 3\n", OM_E_PARSE, 1, 1, "'triangles' needs count N");
+    expect_err("triangles count 0\n", OM_E_RANGE, 1, 17, "1..10000000");
+    expect_err("triangles count 10000001\n", OM_E_RANGE, 1, 17, "1..10000000");
+    expect_err("triangles count 5 seed -1\n", OM_E_RANGE, 1, 24, "0..4294967295");
+    expect_err("triangles count 5 in 0 0 0 1 -1 1\n", OM_E_RANGE, 1, 30, "'in' needs X0 <= X1");
+    expect_err("mesh\n", OM_E_PARSE, 1, 5, "expected a file name after 'mesh'");
+    expect_err("box\n box size 1e7 1 1 translate 1e7 0 0\n", OM_E_RANGE, 2, 2,
+               "box reaches beyond 1e7");
+    expect_err("sphere radius 9e6 translate 2e6 0 0\n", OM_E_RANGE, 1, 1, "sphere reaches beyond 1e7");
+    expect_err("triangles count 3 in 1e7 0 0 1e7 1 1\n", OM_E_RANGE, 1, 1,
+               "triangles reaches beyond 1e7");
+    expect_err("camera\tfov 30\teye 0 0 1 target 0 0 0 far 0\n", OM_E_RANGE, 1, 42, "1e-6..1e8");
+
+    /* near the limit the check is exact, vertex by vertex */
+    parsed p;
+    CHECK_OK(parse("box size 1e7 1 1 translate 5e6 0 0", &p));   /* corners at exactly 1e7 */
+    CHECK(p.s.hi.x == 1e7f);
+    done(&p);
+    CHECK_OK(parse("sphere radius 9.9e6 segments 4 rings 2 rotate 0 45 0", &p));
+    CHECK(p.s.hi.x <= 1e7f);   /* its bounding box's corners would be beyond 1e7 */
+    done(&p);
+
+    /* a very long line: columns keep counting */
+    size_t n = 100000;
+    char *text = (char *)malloc(n + 16);
+    memset(text, ' ', n);
+    memcpy(text + n, "bogus\n", 6);
+    expect_err_n(text, n + 6, OM_E_PARSE, 1, (uint32_t)n + 1, "unknown command 'bogus'");
+    memcpy(text + n, "box  \n", 6);
+    CHECK_OK(parse_ld(text, n + 6, NULL, &p));
+    CHECK_EQ_U(p.s.ntris, 12);
+    done(&p);
+    /* a huge number of digits */
+    memcpy(text, "sphere radius 1", 15);
+    memset(text + 15, '0', 5000);
+    expect_err_n(text, 5015, OM_E_PARSE, 1, 15, "is not finite");
+    memcpy(text, "sphere radius 0", 15);
+    memset(text + 15, '0', 5000);
+    memcpy(text + 5015, ".5", 2);
+    CHECK_OK(parse_ld(text, 5017, NULL, &p));
+    CHECK(p.s.hi.y == 0.5f);
+    done(&p);
+    free(text);
+
+    /* more than 2^31 - 1 triangles in total */
+    const char line[] = "plane divisions 4096\n";   /* 33554432 triangles each */
+    size_t ll = sizeof line - 1;
+    text = (char *)malloc(64 * ll);
+    for (int i = 0; i < 64; i++) memcpy(text + i * ll, line, ll);
+    size_t bytes;
+    om_diag d;
+    CHECK(om_scene_bytes(text, 63 * ll, NULL, &bytes, &d) == OM_OK);
+    CHECK(bytes > (size_t)63 * 33554432 * 14 || sizeof(size_t) < 8);
+    expect_err_n(text, 64 * ll, OM_E_RANGE, 64, 1, "more than 2147483647");
+    free(text);
+
+    /* NULL arguments */
+    CHECK(om_scene_bytes("box", 3, NULL, NULL, NULL) == OM_E_INVALID);
+    om_scene s;
+    CHECK(om_scene_parse("box", 3, NULL, NULL, &s, NULL) == OM_E_INVALID);
+}
+
+/* ---------------------------------------------------------------- OBJ and meshes */
+
+typedef struct memfile { const char *name, *data; } memfile;
+
+static om_status mem_load(void *user, const char *name, const char **data, size_t *len)
+{
+    for (const memfile *f = (const memfile *)user; f->name; f++)
+        if (strcmp(f->name, name) == 0) {
+            *data = f->data;
+            *len = strlen(f->data);
+            return OM_OK;
+        }
+    return OM_E_NOTFOUND;
+}
+
+static void obj_count(void)
+{
+    uint32_t nv, nt;
+    om_diag d;
+    const char *obj =
+        "# a comment\n"
+        "mtllib x.mtl\n"
+        "o thing\n"
+        "v 0 0 0\n"
+        "v 1 0 0 1.0\n"              /* w is ignored */
+        "v 1 1 0\n"
+        "v 0 1 0 0.5 0.5 0.5\n"      /* vertex colours too */
+        "v 0.5 2 0\r\n"
+        "vt 0 0\nvn 0 0 1\ng grp\ns off\nusemtl m\nl 1 2\n"
+        "f 1 2 3\n"                  /* 1 */
+        "f 1/1 3/2 4/3\n"            /* 1 */
+        "f 1//1 2//1 3//1 4//1\n"    /* quad: 2 */
+        "f -5/1/1 -4/2/2 -3/3/3 -1/1/1 -2/2/2\n";   /* pentagon: 3 */
+    CHECK_OK(om_obj_count(obj, strlen(obj), &nv, &nt, &d));
+    CHECK_EQ_U(nv, 5);
+    CHECK_EQ_U(nt, 7);
+    CHECK_OK(om_obj_count("", 0, &nv, &nt, NULL));
+    CHECK(nv == 0 && nt == 0);
+    CHECK_OK(om_obj_count("v 1e20 0 0\n", 11, &nv, &nt, NULL));   /* no scene limit here */
+
+    static const struct { const char *text; uint32_t line, col; const char *msg; } bad[] = {
+        {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n", 4, 7, "vertex index 4 is out of range (3 vertices so far)"},
+        {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", 4, 3, "vertex index 0"},
+        {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -4\n", 4, 7, "vertex index -4 is out of range"},
+        {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\n", 4, 1, "at least 3 vertices, this one has 2"},
+        {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3/\n", 4, 7, "malformed vertex reference '3/'"},
+        {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3/1/\n", 4, 7, "malformed vertex reference"},
+        {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x\n", 4, 7, "malformed vertex reference 'x'"},
+        {"f 1 2 3\nv 0 0 0\nv 1 0 0\nv 0 1 0\n", 1, 3, "out of range (0 vertices so far)"},
+        {"v 0 0\n", 1, 6, "expected 3 numbers after 'v'"},
+        {"\n\nv 0 0 0x1\n", 3, 7, "malformed number '0x1'"},
+        {"v 0 nan 0\n", 1, 5, "malformed number 'nan'"},
+        {"v 0 1e999 0\n", 1, 5, "is not finite"},
+        {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\0\n", 4, 7, "malformed vertex reference"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        size_t len = strlen(bad[i].text);
+        if (i == sizeof bad / sizeof bad[0] - 1) len = 33;   /* the one with a NUL byte */
+        char *t = exact_copy(bad[i].text, len);
+        om_status st = om_obj_count(t, len, &nv, &nt, &d);
+        free(t);
+        CHECK_MSG(st == OM_E_PARSE && d.line == bad[i].line && d.col == bad[i].col,
+                  "obj case %zu: %s %u:%u (%s)", i, om_status_str(st), d.line, d.col, d.msg);
+        CHECK_MSG(strstr(d.msg, bad[i].msg) != NULL, "obj case %zu: '%s'", i, d.msg);
+        CHECK(strncmp(d.msg, "obj: line ", 10) == 0);
+    }
+    /* bytes after the length are never read; junk in skipped statements is fine */
+    CHECK_OK(om_obj_count("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3 99", 31, &nv, &nt, &d));
+    CHECK_EQ_U(nt, 1);
+    static const char junk[] = "vt \x01\x02\0\xff\nusemtl \0\n";
+    CHECK_OK(om_obj_count(junk, sizeof junk - 1, &nv, &nt, &d));
+}
+
+static void mesh_lines(void)
+{
+    static const memfile files[] = {
+        {"tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"},
+        {"quad.obj", "v 0 0 0\nv 1 0 0\nv 1 0 -1\nv 0 0 -1\nf 1/1/1 2/2/2 3/3/3 4/4/4\n"},
+        {"bad.obj", "v 0 0 0\nv 1 0 0\n\nf 1 2 3\n"},
+        {"far.obj", "v 0 0 0\nv 1 0 0\nv 9e6 1 0\nf 1 2 3\n"},
+        {"neg.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\nv 5 5 5\nf -1/1 -3/2 -4/3 2//1\n"},
+        {NULL, NULL},
+    };
+    om_loader ld = {mem_load, (void *)files};
+    parsed p;
+    const char *text =
+        "box\n"
+        "mesh quad.obj scale 2 translate 0 1 0 albedo 1 0 0\n"
+        "mesh tri.obj rotate 0 0 90\n"
+        "mesh quad.obj scale -1 1 1\n";
+    CHECK_OK(parse_ld(text, strlen(text), &ld, &p));
+    CHECK_EQ_U(p.s.nverts, 8 + 4 + 3 + 4);
+    CHECK_EQ_U(p.s.ntris, 12 + 2 + 1 + 2);
+    /* the quad: fan (1 2 3) (1 3 4), moved after the box's 8 vertices, scaled, lifted */
+    CHECK(p.s.idx[36] == 8 && p.s.idx[37] == 9 && p.s.idx[38] == 10);
+    CHECK(p.s.idx[39] == 8 && p.s.idx[40] == 10 && p.s.idx[41] == 11);
+    CHECK(veq(p.s.verts[10], 2, 1, -2));
+    CHECK(p.s.tri_mat[12] == 1 && p.s.mats[1].r == 1.0f && p.s.mats[1].g == 0.0f);
+    CHECK(tri_normal(&p.s, 12).y > 0);
+    /* rotated 90 degrees about z: (1,0,0) -> (0,1,0) */
+    CHECK(veq(p.s.verts[13], 0, 1, 0));
+    CHECK(p.s.idx[42] == 12 && p.s.idx[43] == 13 && p.s.idx[44] == 14);
+    /* mirrored: winding swapped, so the normal still points up */
+    CHECK(tri_normal(&p.s, 15).y > 0 && tri_normal(&p.s, 16).y > 0);
+    CHECK(veq(p.s.hi, 2, 1, 0.5f) && veq(p.s.lo, -1, -0.5f, -2));
+    done(&p);
+
+    /* negative indices count back from the last vertex read so far */
+    CHECK_OK(parse_ld("box\nmesh neg.obj\n", 17, &ld, &p));
+    CHECK_EQ_U(p.s.ntris, 12 + 1 + 2);
+    static const uint32_t want[9] = {8, 9, 10, 11, 9, 8, 11, 8, 9};   /* +8: after the box */
+    for (int i = 0; i < 9 && p.s.ntris == 15; i++) CHECK_EQ_U(p.s.idx[36 + i], want[i]);
+    done(&p);
+
+    /* errors: inside the OBJ (its own line and column, the file and the scene line named) */
+    om_diag d;
+    size_t bytes;
+    text = "box\nmesh bad.obj\n";
+    CHECK(om_scene_bytes(text, strlen(text), &ld, &bytes, &d) == OM_E_PARSE);
+    CHECK(d.line == 4 && d.col == 7);
+    CHECK_MSG(strcmp(d.msg, "bad.obj: line 4, col 7: vertex index 3 is out of range (2 vertices "
+                            "so far) (mesh on scene line 2)") == 0, "%s", d.msg);
+    /* a missing file: the loader's status, the file and the scene's line and column */
+    text = "box\n\nmesh  nothere.obj scale 2\n";
+    CHECK(om_scene_bytes(text, strlen(text), &ld, &bytes, &d) == OM_E_NOTFOUND);
+    CHECK(d.line == 3 && d.col == 7 && d.status == OM_E_NOTFOUND);
+    CHECK_MSG(strstr(d.msg, "line 3, col 7: cannot load mesh 'nothere.obj'") != NULL, "%s", d.msg);
+    /* no loader at all */
+    CHECK(om_scene_bytes(text, strlen(text), NULL, &bytes, &d) == OM_E_NOTFOUND);
+    CHECK(d.line == 3 && d.col == 7 && strstr(d.msg, "nothere.obj") != NULL);
+    om_loader none = {NULL, NULL};
+    CHECK(om_scene_bytes(text, strlen(text), &none, &bytes, &d) == OM_E_NOTFOUND);
+    /* beyond 1e7 once transformed */
+    text = "mesh far.obj translate 2e6 0 0\n";
+    CHECK(om_scene_bytes(text, strlen(text), &ld, &bytes, &d) == OM_E_RANGE);
+    CHECK(d.line == 1 && d.col == 1 && strstr(d.msg, "far.obj") && strstr(d.msg, "OBJ line 3"));
+    CHECK_OK(om_scene_bytes("mesh far.obj", 12, &ld, &bytes, &d));
+    /* an unknown parameter after the file name */
+    text = "mesh tri.obj colour 1\n";
+    CHECK(om_scene_bytes(text, strlen(text), &ld, &bytes, &d) == OM_E_PARSE);
+    CHECK(d.line == 1 && d.col == 14);
+}
+
+/* A loader whose file grows between the two passes: the parse must notice, not overrun. */
+static om_status growing_load(void *user, const char *name, const char **data, size_t *len)
+{
+    int *calls = (int *)user;
+    (void)name;
+    static const char small[] = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    static const char big[] = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 2 4\nf 1 3 4\n";
+    *data = (*calls)++ == 0 ? small : big;
+    *len = strlen(*data);
+    return OM_OK;
+}
+
+static void mesh_changing(void)
+{
+    int calls = 0;
+    om_loader ld = {growing_load, &calls};
+    size_t bytes;
+    CHECK_OK(om_scene_bytes("mesh a.obj", 10, &ld, &bytes, NULL));
+    unsigned char *buf = (unsigned char *)malloc(bytes);
+    om_arena a;
+    om_scene s;
+    om_diag d;
+    om_arena_init(&a, buf, bytes, "scene");
+    calls = 0;
+    CHECK(om_scene_parse("mesh a.obj", 10, &ld, &a, &s, &d) == OM_E_INVALID);
+    CHECK(strstr(d.msg, "changed") != NULL);
+    CHECK_EQ_U(a.used, 0);
+    free(buf);
+}
+
+/* ---------------------------------------------------------------- paths */
+
+static void scene_at(void)
+{
+    parsed p;
+    const char *text =
+        "camera eye 0 0 10 target 0 0 0 fov 33\n"
+        "light spot pos 0 10 0 target 0 0 0 fov 45\n"
+        "key camera 0 eye 0 0 10 target 0 0 0\n"
+        "key camera 1 eye 10 0 10 target 0 2 0\n"
+        "key camera 3 eye 10 0 0 target 0 4 0\n"
+        "key light 2 pos 0 10 0 target 0 0 0\n"
+        "key light 4 pos 4 10 0 target 4 0 0\n";
+    CHECK_OK(parse(text, &p));
+    om_camera c;
+    om_light l;
+    om_scene_at(&p.s, -5.0f, &c, &l);
+    CHECK(veq(c.eye, 0, 0, 10) && c.fovy_deg == 33.0f && veq(l.pos, 0, 10, 0) && l.fov_deg == 45.0f);
+    om_scene_at(&p.s, 0.5f, &c, &l);
+    CHECK(veq(c.eye, 5, 0, 10) && veq(c.target, 0, 1, 0));
+    om_scene_at(&p.s, 1.0f, &c, NULL);
+    CHECK(veq(c.eye, 10, 0, 10) && veq(c.target, 0, 2, 0));
+    om_scene_at(&p.s, 2.0f, &c, &l);
+    CHECK(veq(c.eye, 10, 0, 5) && veq(c.target, 0, 3, 0));
+    CHECK(veq(l.pos, 0, 10, 0));
+    om_scene_at(&p.s, 3.0f, &c, &l);
+    CHECK(veq(c.eye, 10, 0, 0) && veq(l.pos, 2, 10, 0) && veq(l.target, 2, 0, 0));
+    CHECK(feq(l.dir.y, -1, 1e-6f));
+    om_scene_at(&p.s, 100.0f, &c, &l);
+    CHECK(veq(c.eye, 10, 0, 0) && veq(c.target, 0, 4, 0) && veq(l.pos, 4, 10, 0));
+    CHECK(c.width == 640 && c.fovy_deg == 33.0f && l.kind == OM_LIGHT_SPOT);
+    om_scene_at(&p.s, NAN, &c, &l);   /* NaN clamps to the start */
+    CHECK(veq(c.eye, 0, 0, 10) && veq(l.pos, 0, 10, 0));
+    done(&p);
+
+    /* no keys: the scene's own; directional keys move dir */
+    CHECK_OK(parse("camera eye 1 2 3 target 0 0 0\nlight directional dir 0 -1 0\n"
+                   "key light 0 dir 0 -1 0\nkey light 2 dir 2 -1 0\n", &p));
+    om_scene_at(&p.s, 7.0f, &c, &l);
+    CHECK(veq(c.eye, 1, 2, 3) && l.kind == OM_LIGHT_DIRECTIONAL && veq(l.dir, 2, -1, 0));
+    om_scene_at(&p.s, 1.0f, NULL, &l);
+    CHECK(veq(l.dir, 1, -1, 0));
+    done(&p);
+
+    /* a single key holds everywhere */
+    CHECK_OK(parse("key camera 5 eye 1 1 1 target 0 0 0\n", &p));
+    om_scene_at(&p.s, 0.0f, &c, NULL);
+    CHECK(veq(c.eye, 1, 1, 1));
+    om_scene_at(&p.s, 9.0f, &c, NULL);
+    CHECK(veq(c.eye, 1, 1, 1));
+    done(&p);
+}
+
+/* ---------------------------------------------------------------- the default scene */
+
+static void default_scene(void)
+{
+    const char *text = om_scene_default_text();
+    parsed p;
+    CHECK_MSG(parse(text, &p) == OM_OK, "%s", p.d.msg);
+    if (p.st != OM_OK) return;
+    CHECK_MSG(p.s.ntris >= 20000 && p.s.ntris <= 30000, "%u triangles", p.s.ntris);
+    CHECK(p.s.camera.width == 640 && p.s.camera.height == 480 && p.s.camera.fovy_deg == 55.0f);
+    CHECK(veq(p.s.camera.eye, 0, 2.5f, 12) && p.s.camera.zfar == 200.0f);
+    CHECK(p.s.light.kind == OM_LIGHT_SPOT && p.s.light.znear == 20.0f);
+    CHECK(p.s.ncam_keys == 5 && p.s.nlight_keys == 2);
+    CHECK(p.s.lo.y == 0.0f && feq(p.s.lo.x, -30, 0) && feq(p.s.hi.z, 30, 0));
+    /* materials: distinct albedos and one semi-transparent */
+    uint32_t translucent = 0;
+    for (uint32_t i = 0; i < p.s.nmats; i++) translucent += p.s.mats[i].opacity < 1.0f;
+    CHECK_EQ_U(translucent, 1);
+    /* nothing below the floor, nothing through the camera's path */
+    for (uint32_t i = 0; i < p.s.nverts; i++) CHECK(p.s.verts[i].y >= 0.0f);
+    for (uint32_t k = 0; k < p.s.ncam_keys; k++) {
+        om_vec3 e = p.s.cam_keys[k].eye;
+        CHECK(e.y > 1.5f && e.y < 5);
+    }
+    /* the light's frustum holds the whole floor all along its path: every vertex
+     * projects inside it, at the start, in the middle and at the end */
+    for (int k = 0; k < 3; k++) {
+        om_light l;
+        om_mat4 view, proj, vp;
+        om_scene_at(&p.s, 2.0f * (float)k, NULL, &l);
+        CHECK(om__mat_look_at(&view, l.pos, l.target, om__v3(0, 1, 0)));
+        proj = om__mat_perspective(l.fov_deg, 1.0f, l.znear, l.zfar);
+        vp = om__mat_mul(&proj, &view);
+        uint32_t outside = 0;
+        for (uint32_t i = 0; i < p.s.nverts; i++) {
+            om_vec4 c = om__mat_apply(&vp, p.s.verts[i]);
+            if (!(c.w > 0 && fabsf(c.x) < c.w && fabsf(c.y) < c.w && c.z > 0 && c.z < c.w)) outside++;
+        }
+        CHECK_MSG(outside == 0, "%u vertices outside the light's frustum at t = %d", outside, 2 * k);
+    }
+    size_t bytes;
+    CHECK_OK(om_scene_bytes(text, strlen(text), NULL, &bytes, NULL));
+    CHECK_EQ_U(bytes, p.bytes);
+    done(&p);
+}
+
+/* ---------------------------------------------------------------- fuzz */
+
+static uint64_t rng_next(uint64_t *s)
+{
+    *s = *s * 6364136223846793005ull + 1442695040888963407ull;
+    return *s >> 33;
+}
+
+static unsigned char fuzz_mem[4 << 20];
+
+static void fuzz_mutations(void)
+{
+    const char *base = om_scene_default_text();
+    size_t blen = strlen(base), cap = blen + 4096;
+    char *t = (char *)malloc(cap);
+    static const char *snippets[] = {
+        "1e999", "nan", "-", "\n", "#", "\r\n", " 0 ", "4096", "1e30", "\0", "box", "material",
+        "key camera 0 eye 0 0 0 target 0 0 0\n", "mesh a.obj", "scale", "-1e7", "9999999999999999999999",
+        "triangles count 20000 ", "sphere segments 4096 ", ".", "\t", "\xff",
+    };
+    uint64_t seed = 12345;
+    uint32_t ok = 0, errs[OM_E_COUNT_] = {0};
+    for (int it = 0; it < 2000; it++) {
+        memcpy(t, base, blen);
+        size_t len = blen;
+        int edits = 1 + (int)(rng_next(&seed) % 6);
+        for (int e = 0; e < edits; e++) {
+            size_t at = len ? (size_t)(rng_next(&seed) % len) : 0;
+            switch (rng_next(&seed) % 6) {
+            case 0: /* flip a byte */
+                if (len) t[at] = (char)rng_next(&seed);
+                break;
+            case 1: /* delete a run */
+            {
+                size_t n = rng_next(&seed) % 40;
+                if (n > len - at) n = len - at;
+                memmove(t + at, t + at + n, len - at - n);
+                len -= n;
+                break;
+            }
+            case 2: /* insert a snippet */
+            {
+                const char *sn = snippets[rng_next(&seed) % (sizeof snippets / sizeof snippets[0])];
+                size_t n = sn[0] ? strlen(sn) : 1;
+                if (len + n > cap) break;
+                memmove(t + at + n, t + at, len - at);
+                memcpy(t + at, sn, n);
+                len += n;
+                break;
+            }
+            case 3: /* cut the text short */
+                len = at;
+                break;
+            case 4: /* replace a digit */
+                if (len && t[at] >= '0' && t[at] <= '9') t[at] = (char)('0' + rng_next(&seed) % 10);
+                else if (len) t[at] = ' ';
+                break;
+            default: /* duplicate a chunk */
+            {
+                size_t n = rng_next(&seed) % 80, from = len ? (size_t)(rng_next(&seed) % len) : 0;
+                if (n > len - from) n = len - from;
+                if (len + n > cap) break;
+                memmove(t + at + n, t + at, len - at);
+                memmove(t + at, t + (from < at ? from : from + n), n);
+                len += n;
+                break;
+            }
+            }
+        }
+        size_t bytes = 0;
+        om_diag d1, d2;
+        char *x = exact_copy(t, len);
+        om_status s1 = om_scene_bytes(x, len, NULL, &bytes, &d1);
+        om_arena a;
+        om_scene s;
+        om_arena_init(&a, fuzz_mem, sizeof fuzz_mem, "scene");
+        om_status s2 = om_scene_parse(x, len, NULL, &a, &s, &d2);
+        free(x);
+        CHECK((unsigned)s1 < OM_E_COUNT_ && (unsigned)s2 < OM_E_COUNT_);
+        CHECK(memchr(d1.msg, '\0', sizeof d1.msg) != NULL);
+        if (s1 != OM_OK) {
+            CHECK(s2 == s1 && d1.line == d2.line && d1.col == d2.col);
+            CHECK(d1.msg[0] != '\0');
+            if (s1 == OM_E_PARSE) CHECK(d1.line >= 1 && d1.col >= 1);
+            errs[s1]++;
+            continue;
+        }
+        if (s2 == OM_E_BUDGET) {
+            CHECK(bytes > sizeof fuzz_mem);
+            errs[OM_E_BUDGET]++;
+            continue;
+        }
+        CHECK(s2 == OM_OK && a.used == bytes);
+        if (s2 != OM_OK) continue;
+        ok++;
+        uint32_t badidx = 0, badmat = 0;
+        for (uint32_t i = 0; i < 3 * s.ntris; i++) badidx += s.idx[i] >= s.nverts;
+        for (uint32_t i = 0; i < s.ntris; i++) badmat += s.tri_mat[i] >= s.nmats;
+        CHECK(badidx == 0 && badmat == 0);
+        for (uint32_t i = 0; i < s.nverts; i++) {
+            om_vec3 v = s.verts[i];
+            CHECK(om__finite3(v) && fabsf(v.x) <= 1e7f && fabsf(v.y) <= 1e7f && fabsf(v.z) <= 1e7f);
+        }
+        om_camera c;
+        om_light l;
+        om_scene_at(&s, (float)(rng_next(&seed) % 50) * 0.1f - 0.5f, &c, &l);
+        CHECK(om__finite3(c.eye) && om__finite3(l.pos));
+    }
+    CHECK_MSG(ok > 100 && errs[OM_E_PARSE] > 100, "fuzz: %u ok, %u parse errors", ok, errs[OM_E_PARSE]);
+    free(t);
+}
+
+void suite_scene(void)
+{
+    RUN(numbers);
+    RUN(camera_light_values);
+    RUN(primitive_counts);
+    RUN(transforms_and_bounds);
+    RUN(materials);
+    RUN(keys_parse);
+    RUN(bytes_exact);
+    RUN(shapes_closed);
+    RUN(random_triangles);
+    RUN(parse_errors);
+    RUN(obj_count);
+    RUN(mesh_lines);
+    RUN(mesh_changing);
+    RUN(scene_at);
+    RUN(default_scene);
+    RUN(fuzz_mutations);
+}

@@ -1,0 +1,275 @@
+/* test_shadow.c — the reference and the conventional shadow map: analytic cases, the
+ * BVH walk against a brute-force loop over every triangle (semi-transparent casters
+ * included), the map's accuracy growing with its resolution, and bad budgets. */
+#include "test.h"
+#include "harness.h"
+#include "../engine/shadow/occlude.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+#define W 160
+#define H 120
+static uint8_t mask[W * H], mask2[W * H];
+static om_term terms[W * H];
+static om_sample samples[W * H];
+
+static void square_under_sun(void)
+{
+    h_scene hs;
+    if (!h_scene_parse(&hs, "camera eye 0 6 6 target 0 0 0 fov 60 size 160 120 near 0.1 far 100\n"
+                            "light directional dir 0 -1 0\n"
+                            "plane size 20 20\n"
+                            "plane size 2 2 translate 0 1 0\n"))
+        return;
+    CHECK_OK(h_render(&hs.s, "ref", NULL, 0, 0, 0, 0, mask, NULL, samples));
+    int checked = 0, shadowed = 0, wrong = 0;
+    for (int i = 0; i < W * H; i++) {
+        if (samples[i].tri == OM_NO_TRI || samples[i].p[1] > 0.5f) continue;   /* floor only */
+        float x = fabsf(samples[i].p[0]), z = fabsf(samples[i].p[2]);
+        if (fabsf(x - 1) < 1e-4f || fabsf(z - 1) < 1e-4f) continue;
+        bool expect_shadow = x < 1 && z < 1;
+        checked++;
+        shadowed += expect_shadow;
+        if ((mask[i] == OM_MASK_SHADOW) != expect_shadow) wrong++;
+    }
+    CHECK_MSG(wrong == 0, "%d of %d floor samples wrong", wrong, checked);
+    CHECK(shadowed > 200 && checked > 5000);
+    h_scene_free(&hs);
+}
+
+/* Segment p -> l against triangle (a, b, c) in double: 1 clearly hit, -1 clearly
+ * missed, 0 within eps of an edge or an end (left out of the comparison). */
+static int seg_tri(const double p[3], const double l[3], const om_vec3 *a, const om_vec3 *b,
+                   const om_vec3 *c, double eps)
+{
+    double d[3] = {l[0] - p[0], l[1] - p[1], l[2] - p[2]};
+    double e1[3] = {b->x - a->x, b->y - a->y, b->z - a->z}, e2[3] = {c->x - a->x, c->y - a->y, c->z - a->z};
+    double q[3] = {d[1] * e2[2] - d[2] * e2[1], d[2] * e2[0] - d[0] * e2[2], d[0] * e2[1] - d[1] * e2[0]};
+    double det = e1[0] * q[0] + e1[1] * q[1] + e1[2] * q[2];
+    if (fabs(det) < 1e-12) return -1;
+    double s[3] = {p[0] - a->x, p[1] - a->y, p[2] - a->z};
+    double u = (s[0] * q[0] + s[1] * q[1] + s[2] * q[2]) / det;
+    double r[3] = {s[1] * e1[2] - s[2] * e1[1], s[2] * e1[0] - s[0] * e1[2], s[0] * e1[1] - s[1] * e1[0]};
+    double v = (d[0] * r[0] + d[1] * r[1] + d[2] * r[2]) / det;
+    double t = (e2[0] * r[0] + e2[1] * r[1] + e2[2] * r[2]) / det;
+    if (u > eps && v > eps && u + v < 1 - eps && t > eps && t < 1 - eps) return 1;
+    if (u < -eps || v < -eps || u + v > 1 + eps || t < -eps || t > 1 + eps) return -1;
+    return 0;
+}
+
+static void sphere_under_spot(void)
+{
+    h_scene hs;
+    if (!h_scene_parse(&hs, "camera eye 0 5 7 target 0 0.5 0 fov 50 size 160 120 near 0.1 far 100\n"
+                            "light spot pos 1 8 0.5 target 0 0 0 fov 70 near 1 far 30\n"
+                            "plane size 20 20\n"
+                            "sphere radius 1 segments 48 rings 24 translate 0 1.5 0\n"))
+        return;
+    CHECK_OK(h_render(&hs.s, "ref", NULL, 0, 0, 0, 0, mask, terms, samples));
+    const double L[3] = {1, 8, 0.5};
+    int checked = 0, shadowed = 0, wrong = 0;
+    for (int i = 0; i < W * H; i++) {
+        /* floor samples inside the light's frustum (outside it nothing is lit) */
+        if (samples[i].tri == OM_NO_TRI || samples[i].tri >= 2 || !(terms[i].flags & OM_TERM_EXPOSED))
+            continue;
+        double p[3] = {samples[i].p[0], samples[i].p[1], samples[i].p[2]};
+        int verdict = -1;
+        for (uint32_t t = 2; t < hs.s.ntris && verdict != 1; t++) {
+            const uint32_t *ix = hs.s.idx + 3 * t;
+            int r = seg_tri(p, L, &hs.s.verts[ix[0]], &hs.s.verts[ix[1]], &hs.s.verts[ix[2]], 1e-4);
+            if (r == 1) verdict = 1;
+            else if (r == 0) verdict = 0;
+        }
+        if (verdict == 0) continue;
+        checked++;
+        shadowed += verdict == 1;
+        if ((mask[i] == OM_MASK_SHADOW) != (verdict == 1)) wrong++;
+    }
+    CHECK_MSG(wrong == 0, "%d of %d floor samples wrong", wrong, checked);
+    CHECK(shadowed > 200 && checked > 5000);
+    h_scene_free(&hs);
+}
+
+/* The reference's BVH walk must give exactly what testing every triangle gives. */
+static void bvh_equals_brute_force(void)
+{
+    static const char *scenes[] = {
+        "camera eye 0 5 8 target 0 0.5 0 fov 55 size 160 120\n"
+        "light spot pos 3 9 2 target 0 0 0 fov 75 near 1 far 40\n"
+        "plane size 14 14\n"
+        "triangles count 400 seed 3 area 25 in -3 0.3 -3 3 3 3\n"
+        "triangles count 200 seed 4 area 20 in -3 0.3 -3 3 3 3 albedo 1 0.6 0.2 opacity 0.5\n",
+        "camera eye 2 4 6 target 0 0.5 0 fov 60 size 160 120\n"
+        "light spot pos -4 7 -1 target 0 0 0 fov 80 near 0.5 far 40\n"
+        "plane size 14 14 divisions 6\n"
+        "sphere radius 0.8 segments 20 rings 10 translate 0.5 1.2 0 opacity 0.6 albedo 0.2 0.9 0.9\n"
+        "box size 1 2 1 translate -1 1 0\n"
+        "triangles count 150 seed 9 area 6 in -2 2 -2 2 3 2 opacity 0.3\n",
+    };
+    for (int k = 0; k < 2; k++) {
+        h_scene hs;
+        if (!h_scene_parse(&hs, scenes[k])) return;
+        CHECK_OK(h_render(&hs.s, "ref", NULL, 0, 0, 0, 0, NULL, terms, samples));
+        om_camera cam;
+        om_light light;
+        om_view v;
+        om_scene_at(&hs.s, 0, &cam, &light);
+        CHECK_OK(om_view_init(&v, &cam, &light, &hs.s, NULL));
+        static unsigned char mem[1 << 20];
+        om_arena a;
+        om_arena_init(&a, mem, sizeof mem, "t");
+        om__lspace ls;
+        CHECK_OK(om__lspace_init(&ls, &a, &hs.s, NULL));
+        om__lspace_begin(&ls, &v);
+        int diff = 0, partial = 0, blocked = 0;
+        for (int i = 0; i < W * H; i++) {
+            if (!(terms[i].flags & OM_TERM_EXPOSED)) continue;
+            om__lpoint p;
+            om__odepth od = {{0, 0, 0}};
+            if (om__lspace_point(&ls, &samples[i], &p))
+                for (uint32_t t = 0; t < hs.s.ntris; t++) {
+                    om__ltri lt;
+                    if (om__lspace_tri(&ls, t, &lt) && om__blocks(&lt, &p)) {
+                        om__odepth m = om__material_odepth(&hs.s.mats[hs.s.tri_mat[t]]);
+                        om__odepth_add(&od, &m);
+                    }
+                }
+            om_term want;
+            om__odepth_term(&od, &want);
+            if (want.r != terms[i].r || want.g != terms[i].g || want.b != terms[i].b) diff++;
+            partial += want.r != 255 && (want.r != 0 || want.g != 0);
+            blocked += want.r != 255;
+        }
+        CHECK_MSG(diff == 0, "scene %d: %d samples differ from brute force", k, diff);
+        CHECK_MSG(partial > 50 && blocked > 500, "scene %d: %d partial, %d blocked", k, partial, blocked);
+        h_scene_free(&hs);
+    }
+}
+
+static void transmittance_composes(void)
+{
+    om_material glass = {1.0f, 0.5f, 0.0f, 0.5f};
+    om__odepth o = om__material_odepth(&glass), acc = {{0, 0, 0}};
+    om_term t;
+    om__odepth_add(&acc, &o);
+    om__odepth_term(&acc, &t);
+    CHECK(t.r == 128 && t.g == 64 && t.b == 0);
+    om__odepth_add(&acc, &o);
+    om__odepth_term(&acc, &t);
+    CHECK_MSG(t.r == 64 && t.g == 16 && t.b == 0, "%d %d %d", t.r, t.g, t.b);
+    om_material opaque = {1, 1, 1, 1};
+    o = om__material_odepth(&opaque);
+    CHECK(om__odepth_opaque(&o));
+    CHECK(fabs(om__log2(0.3) - log2(0.3)) < 1e-13 && fabs(om__exp2(-3.7) - exp2(-3.7)) < 1e-15);
+}
+
+static const char *default_scene(void) { return om_scene_default_text(); }
+
+static void sm_improves_with_resolution(void)
+{
+    h_scene hs;
+    if (!h_scene_parse(&hs, default_scene())) return;
+    static uint8_t ref[320 * 240], sm[320 * 240];
+    CHECK_OK(h_render(&hs.s, "ref", NULL, 320, 240, 0, 0, ref, NULL, NULL));
+    uint64_t prev = UINT64_MAX;
+    for (uint32_t size = 512; size <= 4096; size *= 2) {
+        om_method_cfg c;
+        om_method_cfg_default(&c);
+        c.map_size = size;
+        CHECK_OK(h_render(&hs.s, "sm", &c, 320, 240, 0, 0, sm, NULL, NULL));
+        om_metrics m;
+        om_compare_masks(ref, sm, 320, 240, &m);
+        uint64_t bad = m.false_lit + m.false_shadowed;
+        CHECK_MSG(bad < prev, "map %u: %llu mismatches, not fewer than %llu", size,
+                  (unsigned long long)bad, (unsigned long long)prev);
+        CHECK_EQ_U(m.mismatched_bg, 0);
+        prev = bad;
+    }
+    CHECK(prev < 320 * 240 / 50);
+    h_scene_free(&hs);
+}
+
+static void methods_agree_on_samples(void)
+{
+    /* Every method sees the same samples: background and exposure match the reference. */
+    h_scene hs;
+    if (!h_scene_parse(&hs, default_scene())) return;
+    CHECK_OK(h_render(&hs.s, "ref", NULL, W, H, 0, 0, mask, NULL, NULL));
+    for (size_t i = 0; i < om_method_count(); i++) {
+        CHECK_OK(h_render(&hs.s, om_method_at(i)->name, NULL, W, H, 0, 7, mask2, NULL, NULL));
+        om_metrics m;
+        om_compare_masks(mask, mask2, W, H, &m);
+        CHECK_EQ_U(m.mismatched_bg, 0);
+    }
+    /* the reference through strips equals the reference whole */
+    CHECK_OK(h_render(&hs.s, "ref", NULL, W, H, 0, 5, mask2, NULL, NULL));
+    CHECK(!memcmp(mask, mask2, sizeof mask));
+    h_scene_free(&hs);
+}
+
+static void budgets_name_the_minimum(void)
+{
+    h_scene hs;
+    if (!h_scene_parse(&hs, default_scene())) return;
+    static const char *names[] = {"ref", "sm"};
+    for (int k = 0; k < 2; k++) {
+        const om_method *m = om_method_find(names[k]);
+        om_method_cfg c;
+        om_method_cfg_default(&c);
+        c.map_size = 256;
+        size_t mn, full;
+        CHECK_OK(m->bytes(&c, &hs.s, W, H, &mn, &full));
+        unsigned char *buf = malloc(mn + 64);
+        memset(buf, 0xC3, mn + 64);
+        om_arena a;
+        om_arena_init(&a, buf + 32, mn / 2, "method");
+        void *state;
+        om_diag d;
+        CHECK(m->init(&state, &a, &c, &hs.s, W, H, &d) == OM_E_BUDGET);
+        char num[32];
+        snprintf(num, sizeof num, "%zu", mn);
+        CHECK_MSG(strstr(d.msg, num) != NULL, "%s: '%s' does not name %s", names[k], d.msg, num);
+        om_arena_init(&a, buf + 32, mn, "method");
+        CHECK_OK(m->init(&state, &a, &c, &hs.s, W, H, &d));
+        CHECK(a.peak <= mn);
+        int guard = 0;
+        for (int i = 0; i < 32; i++) guard += buf[i] != 0xC3 || buf[32 + mn + i] != 0xC3;
+        CHECK_EQ_U(guard, 0);
+        free(buf);
+    }
+    h_scene_free(&hs);
+}
+
+static void odd_lights(void)
+{
+    /* A light inside a box, one behind the camera, one on the floor: frames render. */
+    static const char *lights[] = {
+        "light spot pos 0 0.5 0 target 0 0 3 fov 90 near 0.1 far 50\n",
+        "light spot pos 0 3 20 target 0 0 0 fov 40 near 1 far 60\n",
+        "light spot pos 2 0 2 target 0 0 0 fov 60 near 0.1 far 50\n",
+        "light directional dir 0 1 0\n",
+    };
+    for (int k = 0; k < 4; k++) {
+        char text[512];
+        snprintf(text, sizeof text, "camera eye 0 2 8 target 0 0.5 0 size 80 60\n%s"
+                 "plane size 10 10\nbox size 1 1 1 translate 0 0.5 0\n", lights[k]);
+        h_scene hs;
+        if (!h_scene_parse(&hs, text)) return;
+        for (size_t i = 0; i < om_method_count(); i++)
+            CHECK_OK(h_render(&hs.s, om_method_at(i)->name, NULL, 0, 0, 0, 0, mask, NULL, NULL));
+        h_scene_free(&hs);
+    }
+}
+
+void suite_shadow(void)
+{
+    RUN(square_under_sun);
+    RUN(sphere_under_spot);
+    RUN(bvh_equals_brute_force);
+    RUN(transmittance_composes);
+    RUN(sm_improves_with_resolution);
+    RUN(methods_agree_on_samples);
+    RUN(budgets_name_the_minimum);
+    RUN(odd_lights);
+}

@@ -1,0 +1,41 @@
+/* cli.h — what the `ombra` subcommands share: argument helpers, loading a scene
+ * (a file or the built-in default) into an arena sized by its bytes query, and
+ * one-line errors that name the file and position. */
+#ifndef OM_CLI_H
+#define OM_CLI_H
+
+#include "ombra.h"
+#include "../platform/platform.h"
+
+#include <stdio.h>
+
+typedef struct cli_scene {
+    const char *path;      /* NULL: the built-in default scene */
+    char *text;            /* file contents (malloc'd) or NULL */
+    void *mem;             /* the scene arena's buffer */
+    size_t bytes;
+    om_arena arena;
+    om_scene scene;
+    om_file_loader files;
+} cli_scene;
+
+/* Prints "ombra: <where>: <message>" to stderr; returns exit status 1 (2 for usage). */
+int cli_error(const char *where, const om_diag *d, om_status st);
+int cli_usage_error(const char *cmd, const char *fmt, const char *arg);
+
+om_status cli_scene_load(cli_scene *cs, const char *path, om_diag *d);
+void cli_scene_free(cli_scene *cs);
+
+bool cli_parse_size(const char *s, uint32_t *w, uint32_t *h);
+bool cli_parse_bytes(const char *s, size_t *out);     /* 123, 64K, 8M, 1G (binary) */
+bool cli_parse_u32(const char *s, uint32_t lo, uint32_t hi, uint32_t *out);
+bool cli_parse_float(const char *s, float *out);
+
+int cmd_render(int argc, char **argv);
+int cmd_info(int argc, char **argv);
+int cmd_compare(int argc, char **argv);
+
+/* Host memory ran out: OM_E_BUDGET with a message. */
+om_status cli_oom(om_diag *d);
+
+#endif

@@ -1,0 +1,37 @@
+/* ombra.c — the `ombra` command: dispatches to its subcommands. */
+#include "cli.h"
+
+#include <string.h>
+
+static const char usage[] =
+    "usage: ombra <command> [options]\n"
+    "\n"
+    "Hard shadows on small machines: renders a scene with a shadow method inside the\n"
+    "memory it is given, and writes PPM/PGM files.\n"
+    "\n"
+    "commands:\n"
+    "  render [SCENE]   render a frame (the built-in default scene without SCENE)\n"
+    "  info [SCENE]     triangles, bounds, and the bytes each method would need\n"
+    "  compare A B      compare two shadow masks (PGM), A the reference\n"
+    "  methods          list the shadow methods\n"
+    "\n"
+    "'ombra <command> --help' describes a command's options.\n";
+
+int main(int argc, char **argv)
+{
+    if (argc < 2 || !strcmp(argv[1], "--help") || !strcmp(argv[1], "-h") ||
+        !strcmp(argv[1], "help")) {
+        fputs(usage, argc < 2 ? stderr : stdout);
+        return argc < 2 ? 2 : 0;
+    }
+    if (!strcmp(argv[1], "render")) return cmd_render(argc - 1, argv + 1);
+    if (!strcmp(argv[1], "info")) return cmd_info(argc - 1, argv + 1);
+    if (!strcmp(argv[1], "compare")) return cmd_compare(argc - 1, argv + 1);
+    if (!strcmp(argv[1], "methods")) {
+        for (size_t i = 0; i < om_method_count(); i++)
+            printf("%-6s %s\n", om_method_at(i)->name, om_method_at(i)->summary);
+        return 0;
+    }
+    fprintf(stderr, "ombra: unknown command '%s'\n\n%s", argv[1], usage);
+    return 2;
+}

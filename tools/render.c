@@ -1,0 +1,410 @@
+/* render.c — `ombra render`, `ombra info` and `ombra compare`. Every arena is sized
+ * from the engine's bytes-needed queries for this scene, view and method; --budget caps
+ * the total, and the frame is then rendered through strips small enough to fit. */
+#include "cli.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+static const char render_help[] =
+    "usage: ombra render [SCENE] [options]\n"
+    "\n"
+    "Renders one frame of SCENE (the built-in default scene when omitted).\n"
+    "\n"
+    "  --method NAME     shadow method (default sm; 'ombra methods' lists them)\n"
+    "  --against NAME    also render NAME (usually ref) on the same visible samples and\n"
+    "                    print the method's accuracy against it\n"
+    "  --out FILE.ppm    shaded frame, binary PPM (default ombra.ppm)\n"
+    "  --mask FILE.pgm   shadow mask: 255 lit, 0 shadowed, 128 background\n"
+    "  --diff FILE.ppm   with --against: false lit red, false shadowed blue\n"
+    "  --size WxH        image size, 1..8192 each (default: the scene's camera)\n"
+    "  --time T          time along the scene's camera and light paths (default 0)\n"
+    "  --format F        framebuffer format: rgb888 (default), rgb565, l8\n"
+    "  --strip ROWS      render through strips of ROWS rows (default: whole frame)\n"
+    "  --budget BYTES    total memory for scene, frame and method (K, M, G suffixes);\n"
+    "                    the strip height shrinks to fit, down to one row\n"
+    "  --map N           shadow-map side for map-based methods (default 2048)\n"
+    "  --bias B          sm: constant bias in world units along the light ray\n"
+    "  --slope S         sm: slope-scaled bias in texels\n"
+    "  --offset O        sm: normal offset in texels\n"
+    "  --pcf K           sm: K x K percentage-closer filtering (1 = off)\n"
+    "  --quiet           print nothing but errors\n";
+
+/* One method's memory and state for a frame. */
+typedef struct run {
+    const om_method *m;
+    om_method_cfg cfg;
+    size_t min, full, given;
+    void *mem;
+    om_arena arena;
+    void *state;
+} run;
+
+static om_status run_init(run *r, const cli_scene *cs, uint32_t W, uint32_t H, om_diag *d)
+{
+    om_status st;
+    r->mem = malloc(r->given ? r->given : 1);
+    if (!r->mem) return cli_oom(d);
+    om_arena_init(&r->arena, r->mem, r->given, "method");
+    if ((st = r->m->init(&r->state, &r->arena, &r->cfg, &cs->scene, W, H, d)) != OM_OK) return st;
+    return OM_OK;
+}
+
+/* Where each strip goes: the PPM sink, and a whole-frame mask when asked. */
+typedef struct strip_out {
+    om_ppm_sink *ppm;
+    uint8_t *mask;
+} strip_out;
+
+static om_status on_strip(void *user, const om_strip *st, const om_framebuffer *fb)
+{
+    strip_out *o = (strip_out *)user;
+    if (o->mask)
+        for (uint32_t y = 0; y < st->rows; y++)
+            for (uint32_t x = 0; x < st->width; x++) {
+                size_t i = (size_t)y * st->width + x;
+                o->mask[(size_t)(st->y0 + y) * st->width + x] = om_mask_of(&st->samples[i], &st->terms[i]);
+            }
+    return o->ppm ? om_ppm_strip(o->ppm, st, fb) : OM_OK;
+}
+
+static om_status run_frame(run *r, const cli_scene *cs, const om_view *v, uint32_t rows,
+                           om_format fmt, strip_out *out, om_frame_stats *fs, size_t *frame_bytes,
+                           om_diag *d)
+{
+    uint32_t W = v->cam.width;
+    *frame_bytes = om_frame_bytes(W, rows);
+    void *frame_mem = malloc(*frame_bytes);
+    om_framebuffer fb;
+    fb.format = fmt;
+    fb.width = W;
+    fb.rows = rows;
+    fb.stride = (size_t)W * om_format_bpp(fmt);
+    fb.pixels = malloc(fb.stride * rows);
+    om_status st;
+    if (!frame_mem || !fb.pixels) {
+        st = cli_oom(d);
+    } else {
+        om_arena fa;
+        om_arena_init(&fa, frame_mem, *frame_bytes, "frame");
+        om_shade_cfg shade;
+        om_shade_cfg_default(&shade);
+        om_frame_desc fd;
+        memset(&fd, 0, sizeof fd);
+        fd.scene = &cs->scene;
+        fd.view = v;
+        fd.method = r->m;
+        fd.method_state = r->state;
+        fd.shade = &shade;
+        fd.strip_rows = rows;
+        fd.fb = &fb;
+        fd.on_strip = on_strip;
+        fd.user = out;
+        fd.clock = om_clock_ns;
+        st = om_render_frame(&fd, &fa, fs, d);
+    }
+    free(frame_mem);
+    free(fb.pixels);
+    return st;
+}
+
+static int parse_format(const char *s, om_format *f)
+{
+    if (!strcmp(s, "rgb888")) *f = OM_RGB888;
+    else if (!strcmp(s, "rgb565")) *f = OM_RGB565;
+    else if (!strcmp(s, "l8")) *f = OM_L8;
+    else return 0;
+    return 1;
+}
+
+static void print_metrics(const char *name, const char *against, const om_metrics *m)
+{
+    double n = m->samples ? (double)m->samples : 1.0, e = m->edge_samples ? (double)m->edge_samples : 1.0;
+    printf("accuracy of %s against %s: match %.4f%% of %llu samples; false lit %llu (%.4f%%), "
+           "false shadowed %llu (%.4f%%)\n",
+           name, against, 100.0 * om_metrics_match(m), (unsigned long long)m->samples,
+           (unsigned long long)m->false_lit, 100.0 * (double)m->false_lit / n,
+           (unsigned long long)m->false_shadowed, 100.0 * (double)m->false_shadowed / n);
+    printf("near reference edges (%d px): %llu samples; false lit %llu (%.3f%%), false shadowed %llu (%.3f%%)\n",
+           OM_EDGE_BAND, (unsigned long long)m->edge_samples, (unsigned long long)m->edge_false_lit,
+           100.0 * (double)m->edge_false_lit / e, (unsigned long long)m->edge_false_shadowed,
+           100.0 * (double)m->edge_false_shadowed / e);
+}
+
+int cmd_render(int argc, char **argv)
+{
+    const char *scene_path = NULL, *out = "ombra.ppm", *mask = NULL, *mname = "sm";
+    const char *against = NULL, *diff = NULL;
+    uint32_t w = 0, h = 0, strip = 0, map = 0, pcf = 0;
+    size_t budget = 0;
+    float t = 0.0f, bias = -1, slope = -1, offset = -1;
+    bool quiet = false;
+    om_format fmt = OM_RGB888;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        const char *v = i + 1 < argc ? argv[i + 1] : NULL;
+        if (!strcmp(a, "--help") || !strcmp(a, "-h")) { fputs(render_help, stdout); return 0; }
+        if (!strcmp(a, "--quiet")) { quiet = true; continue; }
+        static const char *const valued[] = {"--method", "--against", "--out", "--mask", "--diff",
+            "--size", "--strip", "--budget", "--map", "--pcf", "--bias", "--slope", "--offset",
+            "--time", "--format"};
+        bool known = false;
+        for (size_t k = 0; k < sizeof valued / sizeof valued[0]; k++) known |= !strcmp(a, valued[k]);
+        if (a[0] == '-' && !known) return cli_usage_error("render", "unknown option '%s'", a);
+        if (known && !v) return cli_usage_error("render", "%s needs a value", a);
+        if (!strcmp(a, "--method")) mname = v;
+        else if (!strcmp(a, "--against")) against = v;
+        else if (!strcmp(a, "--out")) out = v;
+        else if (!strcmp(a, "--mask")) mask = v;
+        else if (!strcmp(a, "--diff")) diff = v;
+        else if (!strcmp(a, "--size")) { if (!cli_parse_size(v, &w, &h)) return cli_usage_error("render", "--size takes WxH with each side 1..8192, not '%s'", v); }
+        else if (!strcmp(a, "--strip")) { if (!cli_parse_u32(v, 1, OM_MAX_DIM, &strip)) return cli_usage_error("render", "--strip takes a row count 1..8192, not '%s'", v); }
+        else if (!strcmp(a, "--budget")) { if (!cli_parse_bytes(v, &budget)) return cli_usage_error("render", "--budget takes bytes like 65536, 64K or 8M, not '%s'", v); }
+        else if (!strcmp(a, "--map")) { if (!cli_parse_u32(v, 1, OM_MAX_DIM, &map)) return cli_usage_error("render", "--map takes a size 1..8192, not '%s'", v); }
+        else if (!strcmp(a, "--pcf")) { if (!cli_parse_u32(v, 1, 9, &pcf)) return cli_usage_error("render", "--pcf takes a kernel size 1..9, not '%s'", v); }
+        else if (!strcmp(a, "--bias")) { if (!cli_parse_float(v, &bias) || bias < 0) return cli_usage_error("render", "--bias takes a non-negative number, not '%s'", v); }
+        else if (!strcmp(a, "--slope")) { if (!cli_parse_float(v, &slope) || slope < 0) return cli_usage_error("render", "--slope takes a non-negative number, not '%s'", v); }
+        else if (!strcmp(a, "--offset")) { if (!cli_parse_float(v, &offset) || offset < 0) return cli_usage_error("render", "--offset takes a non-negative number, not '%s'", v); }
+        else if (!strcmp(a, "--time")) { if (!cli_parse_float(v, &t)) return cli_usage_error("render", "--time takes a number, not '%s'", v); }
+        else if (!strcmp(a, "--format")) { if (!parse_format(v, &fmt)) return cli_usage_error("render", "--format is rgb888, rgb565 or l8, not '%s'", v); }
+        else if (a[0] == '-') return cli_usage_error("render", "unknown option '%s'", a);
+        else if (!scene_path) { scene_path = a; continue; }
+        else return cli_usage_error("render", "one scene only; unexpected '%s'", a);
+        i++;
+    }
+    if (diff && !against) return cli_usage_error("render", "%s needs --against", "--diff");
+    run main_run, ref_run;
+    memset(&main_run, 0, sizeof main_run);
+    memset(&ref_run, 0, sizeof ref_run);
+    main_run.m = om_method_find(mname);
+    if (!main_run.m) return cli_usage_error("render", "unknown method '%s' (see 'ombra methods')", mname);
+    if (against && !(ref_run.m = om_method_find(against)))
+        return cli_usage_error("render", "unknown method '%s' for --against (see 'ombra methods')", against);
+    om_method_cfg_default(&main_run.cfg);
+    if (map) main_run.cfg.map_size = map;
+    if (pcf) main_run.cfg.pcf = pcf;
+    if (bias >= 0) main_run.cfg.bias_const = bias;
+    if (slope >= 0) main_run.cfg.bias_slope = slope;
+    if (offset >= 0) main_run.cfg.normal_offset = offset;
+    om_method_cfg_default(&ref_run.cfg);
+
+    om_diag d;
+    memset(&d, 0, sizeof d);
+    cli_scene cs;
+    om_status st = cli_scene_load(&cs, scene_path, &d);
+    const char *where = scene_path ? scene_path : "default scene";
+    if (st != OM_OK) { cli_scene_free(&cs); return cli_error(where, &d, st); }
+
+    om_camera cam;
+    om_light light;
+    om_scene_at(&cs.scene, t, &cam, &light);
+    if (w) { cam.width = w; cam.height = h; }
+    om_view view;
+    int rc = 0;
+    uint8_t *mask_main = NULL, *mask_ref = NULL;
+    om_ppm_sink sink;
+    memset(&sink, 0, sizeof sink);
+    if ((st = om_view_init(&view, &cam, &light, &cs.scene, &d)) != OM_OK) { rc = cli_error(where, &d, st); goto out; }
+    const uint32_t W = cam.width, H = cam.height;
+    if ((st = main_run.m->bytes(&main_run.cfg, &cs.scene, W, H, &main_run.min, &main_run.full)) != OM_OK) {
+        rc = cli_error(mname, &d, st);
+        goto out;
+    }
+    /* Split the memory: the method gets what it needs for one pass if it can, the
+     * frame gets strips of as many rows as are left, at least one. */
+    uint32_t rows = strip && strip < H ? strip : H;
+    main_run.given = main_run.full;
+    if (budget) {
+        size_t one = om_frame_bytes(W, 1), row_bytes = om_frame_bytes(W, 2) - one;
+        size_t rest = budget > cs.bytes ? budget - cs.bytes : 0;
+        if (rest < main_run.full + one) main_run.given = main_run.min;
+        size_t left = rest > main_run.given ? rest - main_run.given : 0;
+        size_t fit = left >= one ? 1 + (left - one) / row_bytes : 0;
+        if (fit == 0) {
+            size_t need = cs.bytes + main_run.min + one;
+            fprintf(stderr, "ombra: --budget %zu is too small: this scene (%zu bytes), method '%s' "
+                    "(at least %zu) and one %u-pixel row (%zu) need %zu bytes; raise --budget "
+                    "or make --size smaller\n", budget, cs.bytes, mname, main_run.min, W, one, need);
+            rc = 1;
+            goto out;
+        }
+        if (fit < rows) rows = (uint32_t)fit;
+    }
+    if ((st = run_init(&main_run, &cs, W, H, &d)) != OM_OK) { rc = cli_error(mname, &d, st); goto out; }
+    if (against) {
+        /* The reference is a measuring instrument: it gets what it needs, outside --budget. */
+        if ((st = ref_run.m->bytes(&ref_run.cfg, &cs.scene, W, H, &ref_run.min, &ref_run.full)) != OM_OK ||
+            (ref_run.given = ref_run.full, st = run_init(&ref_run, &cs, W, H, &d)) != OM_OK) {
+            rc = cli_error(against, &d, st);
+            goto out;
+        }
+        mask_main = malloc((size_t)W * H);
+        mask_ref = malloc((size_t)W * H);
+        if (!mask_main || !mask_ref) { rc = cli_error(NULL, &d, cli_oom(&d)); goto out; }
+        strip_out ro = {NULL, mask_ref};
+        om_frame_stats rfs;
+        size_t rfb;
+        if ((st = run_frame(&ref_run, &cs, &view, rows, fmt, &ro, &rfs, &rfb, &d)) != OM_OK) {
+            rc = cli_error(against, &d, st);
+            goto out;
+        }
+    }
+    if ((st = om_ppm_open(&sink, out, mask, W, H, &d)) != OM_OK) { rc = cli_error(NULL, &d, st); goto out; }
+    strip_out so = {&sink, mask_main};
+    om_frame_stats fs;
+    size_t frame_bytes;
+    uint64_t t0 = om_clock_ns(NULL);
+    st = run_frame(&main_run, &cs, &view, rows, fmt, &so, &fs, &frame_bytes, &d);
+    uint64_t t1 = om_clock_ns(NULL);
+    om_status cst = om_ppm_close(&sink, st == OM_OK ? &d : NULL);
+    if (st != OM_OK) { rc = cli_error(mname, &d, st); goto out; }
+    if (cst != OM_OK) { rc = cli_error(NULL, &d, cst); goto out; }
+    if (!quiet) {
+        om_method_stats ms;
+        main_run.m->stats(main_run.state, &ms);
+        printf("%s: %ux%u, %u triangles, method %s, %u strip(s) of %u rows\n", where, W, H,
+               cs.scene.ntris, mname, fs.strips, rows);
+        printf("time: total %.2f ms (eye %.2f x%u, observe %.2f, build %.2f, resolve %.2f, shade %.2f)\n",
+               (double)(t1 - t0) / 1e6, (double)fs.ns_eye / 1e6, fs.eye_passes,
+               (double)fs.ns_observe / 1e6, (double)fs.ns_build / 1e6,
+               (double)fs.ns_resolve / 1e6, (double)fs.ns_shade / 1e6);
+        printf("memory: scene %zu, frame %zu (peak %zu), method %zu (peak %zu) bytes\n", cs.bytes,
+               frame_bytes, fs.frame_peak, main_run.given, main_run.arena.peak);
+        for (uint32_t k = 0; k < ms.ncounters; k++)
+            printf("%s%s %u", k ? ", " : "stats: ", ms.counter_names[k], ms.counters[k]);
+        if (ms.ncounters) printf("\n");
+        printf("hash: image %016llx mask %016llx\n", (unsigned long long)sink.hash_img,
+               (unsigned long long)sink.hash_mask);
+        printf("wrote %s%s%s\n", out, mask ? " and " : "", mask ? mask : "");
+    }
+    if (against) {
+        om_metrics mt;
+        om_compare_masks(mask_ref, mask_main, W, H, &mt);
+        print_metrics(mname, against, &mt);
+        if (diff) {
+            uint8_t *rgb = malloc((size_t)W * H * 3);
+            if (!rgb) { rc = cli_error(NULL, &d, cli_oom(&d)); goto out; }
+            om_diff_image(mask_ref, mask_main, W, H, rgb);
+            st = om_ppm_write(diff, rgb, W, H, &d);
+            free(rgb);
+            if (st != OM_OK) { rc = cli_error(NULL, &d, st); goto out; }
+        }
+    }
+out:
+    free(main_run.mem);
+    free(ref_run.mem);
+    free(mask_main);
+    free(mask_ref);
+    cli_scene_free(&cs);
+    return rc;
+}
+
+static const char info_help[] =
+    "usage: ombra info [SCENE] [--size WxH] [--map N]\n"
+    "\n"
+    "Prints the scene's triangles, vertices, materials and bounds, and the bytes the\n"
+    "scene, a frame and each method need at that image size.\n";
+
+int cmd_info(int argc, char **argv)
+{
+    const char *scene_path = NULL;
+    uint32_t w = 0, h = 0, map = 0;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
+        if (!strcmp(a, "--help") || !strcmp(a, "-h")) { fputs(info_help, stdout); return 0; }
+        if (!strcmp(a, "--size")) {
+            if (!v || !cli_parse_size(v, &w, &h)) return cli_usage_error("info", "--size takes WxH with each side 1..8192, not '%s'", v ? v : "");
+            i++;
+        } else if (!strcmp(a, "--map")) {
+            if (!v || !cli_parse_u32(v, 1, OM_MAX_DIM, &map)) return cli_usage_error("info", "--map takes a size 1..8192, not '%s'", v ? v : "");
+            i++;
+        } else if (a[0] == '-') return cli_usage_error("info", "unknown option '%s'", a);
+        else if (!scene_path) scene_path = a;
+        else return cli_usage_error("info", "one scene only; unexpected '%s'", a);
+    }
+    om_diag d;
+    memset(&d, 0, sizeof d);
+    cli_scene cs;
+    const char *where = scene_path ? scene_path : "default scene";
+    om_status st = cli_scene_load(&cs, scene_path, &d);
+    if (st != OM_OK) { cli_scene_free(&cs); return cli_error(where, &d, st); }
+    const om_scene *s = &cs.scene;
+    uint32_t W = w ? w : s->camera.width, H = w ? h : s->camera.height;
+    printf("scene: %s\n", where);
+    printf("triangles %u, vertices %u, materials %u, camera keys %u, light keys %u\n", s->ntris,
+           s->nverts, s->nmats, s->ncam_keys, s->nlight_keys);
+    printf("bounds: (%g, %g, %g) .. (%g, %g, %g)\n", s->lo.x, s->lo.y, s->lo.z, s->hi.x, s->hi.y,
+           s->hi.z);
+    printf("light: %s\n", s->light.kind == OM_LIGHT_SPOT ? "spot" : "directional");
+    printf("bytes at %ux%u: scene %zu, frame %zu (whole) / %zu (one row)\n", W, H, cs.bytes,
+           om_frame_bytes(W, H), om_frame_bytes(W, 1));
+    for (size_t i = 0; i < om_method_count(); i++) {
+        const om_method *m = om_method_at(i);
+        om_method_cfg cfg;
+        om_method_cfg_default(&cfg);
+        if (map) cfg.map_size = map;
+        size_t mn, full;
+        st = m->bytes(&cfg, s, W, H, &mn, &full);
+        if (st == OM_OK) printf("  %-6s min %zu, one pass %zu\n", m->name, mn, full);
+        else printf("  %-6s %s\n", m->name, om_status_str(st));
+    }
+    cli_scene_free(&cs);
+    return 0;
+}
+
+static const char compare_help[] =
+    "usage: ombra compare REF.pgm MASK.pgm [--diff D.ppm]\n"
+    "\n"
+    "Compares two shadow masks of the same frame (255 lit, 0 shadowed, 128 background),\n"
+    "the first taken as the reference: match share, false lit and false shadowed, the\n"
+    "same near the reference's shadow edges, and optionally a difference image (false\n"
+    "lit red, false shadowed blue).\n";
+
+int cmd_compare(int argc, char **argv)
+{
+    const char *a_path = NULL, *b_path = NULL, *diff = NULL;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        if (!strcmp(a, "--help") || !strcmp(a, "-h")) { fputs(compare_help, stdout); return 0; }
+        if (!strcmp(a, "--diff")) {
+            if (i + 1 >= argc) return cli_usage_error("compare", "%s needs a file name", a);
+            diff = argv[++i];
+        } else if (a[0] == '-') return cli_usage_error("compare", "unknown option '%s'", a);
+        else if (!a_path) a_path = a;
+        else if (!b_path) b_path = a;
+        else return cli_usage_error("compare", "two masks only; unexpected '%s'", a);
+    }
+    if (!b_path) return cli_usage_error("compare", "needs two masks%s", "");
+    om_diag d;
+    memset(&d, 0, sizeof d);
+    uint32_t wa, ha, wb, hb;
+    uint8_t *ma = NULL, *mb = NULL;
+    om_status st;
+    int rc = 0;
+    if ((st = om_pgm_read(a_path, &wa, &ha, &ma, &d)) != OM_OK ||
+        (st = om_pgm_read(b_path, &wb, &hb, &mb, &d)) != OM_OK) {
+        rc = cli_error(NULL, &d, st);
+    } else if (wa != wb || ha != hb) {
+        fprintf(stderr, "ombra: %s is %ux%u but %s is %ux%u: masks of one frame have one size\n",
+                a_path, wa, ha, b_path, wb, hb);
+        rc = 1;
+    } else {
+        om_metrics m;
+        om_compare_masks(ma, mb, wa, ha, &m);
+        print_metrics(b_path, a_path, &m);
+        if (m.mismatched_bg)
+            printf("warning: %llu pixels are background in one mask only: not the same frame?\n",
+                   (unsigned long long)m.mismatched_bg);
+        if (diff) {
+            uint8_t *rgb = malloc((size_t)wa * ha * 3);
+            if (rgb) {
+                om_diff_image(ma, mb, wa, ha, rgb);
+                if ((st = om_ppm_write(diff, rgb, wa, ha, &d)) != OM_OK) rc = cli_error(NULL, &d, st);
+            }
+            free(rgb);
+        }
+    }
+    free(ma);
+    free(mb);
+    return rc;
+}
