@@ -27,22 +27,26 @@ TEST_OBJ     = $(TEST_SRC:%.c=$(O)/%.o)
 
 all: $(O)/ombra
 
+# V=1 shows the full compiler lines.
+Q = $(if $(V),,@)
+
 $(O)/%.o: %.c $(wildcard include/*.h engine/*/*.h platform/*.h tools/*.h tests/*.h)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS_ALL) -c $< -o $@
+	@$(if $(V),,echo "  CC $(O)/$<")
+	$(Q)$(CC) $(CFLAGS_ALL) -c $< -o $@
 
 $(O)/libombra.a: $(ENGINE_OBJ)
 	@rm -f $@
-	ar rcs $@ $^
+	$(Q)ar rcs $@ $^
 
 $(O)/ombra: $(TOOL_OBJ) $(PLATFORM_OBJ) $(O)/libombra.a
-	$(CC) $(CFLAGS_ALL) -o $@ $^ $(LDLIBS)
+	$(Q)$(CC) $(CFLAGS_ALL) -o $@ $^ $(LDLIBS)
 
 $(O)/run-tests: $(TEST_OBJ) $(PLATFORM_OBJ) $(O)/libombra.a
-	$(CC) $(CFLAGS_ALL) -o $@ $^ $(LDLIBS)
+	$(Q)$(CC) $(CFLAGS_ALL) -o $@ $^ $(LDLIBS)
 
 $(O)/bench: $(BENCH_SRC) $(PLATFORM_OBJ) $(O)/libombra.a
-	$(CC) $(CFLAGS_ALL) -o $@ $^ $(LDLIBS)
+	$(Q)$(CC) $(CFLAGS_ALL) -o $@ $^ $(LDLIBS)
 
 run: $(O)/ombra
 	@mkdir -p out

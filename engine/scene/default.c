@@ -13,8 +13,9 @@ const char *om_scene_default_text(void)
         "\n"
         "camera eye 0 2.5 12 target 0 0.8 0 fov 55 size 640 480 near 0.1 far 200\n"
         "# Far away and wide: its square frustum covers the whole floor, so texels are\n"
-        "# large where the camera looks closely (the fence, the small cubes).\n"
-        "light spot pos 40 60 30 target 0 0 0 fov 70 near 20 far 200\n"
+        "# large where the camera looks closely (the fence, the small cubes). Low and\n"
+        "# behind the objects, so their long shadows fall towards the camera.\n"
+        "light spot pos 40 40 -60 target -3 0 3 fov 70 near 20 far 200\n"
         "\n"
         "material concrete albedo 0.75 0.74 0.70\n"
         "material brick albedo 0.70 0.42 0.32\n"
@@ -68,6 +69,6 @@ const char *om_scene_default_text(void)
         "key camera 3 eye 8 3.5 -10 target 0 0.8 -3\n"
         "key camera 4 eye 0 4 -14 target 0 0.8 -2\n"
         "# the light drifts a little: shadows must not flicker as it moves\n"
-        "key light 0 pos 40 60 30 target 0 0 0\n"
-        "key light 4 pos 36 60 34 target 0 0 0\n";
+        "key light 0 pos 40 40 -60 target -3 0 3\n"
+        "key light 4 pos 46 40 -55 target -3 0 3\n";
 }
