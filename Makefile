@@ -18,7 +18,7 @@ ENGINE_SRC   = $(sort $(wildcard engine/*/*.c))
 PLATFORM_SRC = $(sort $(wildcard platform/*.c))
 TOOL_SRC     = $(sort $(wildcard tools/*.c))
 TEST_SRC     = $(sort $(wildcard tests/*.c))
-BENCH_SRC    = tests/bench/bench.c
+BENCH_SRC    = $(sort $(wildcard tests/bench/*.c))
 
 ENGINE_OBJ   = $(ENGINE_SRC:%.c=$(O)/%.o)
 PLATFORM_OBJ = $(PLATFORM_SRC:%.c=$(O)/%.o)
@@ -45,8 +45,8 @@ $(O)/ombra: $(TOOL_OBJ) $(PLATFORM_OBJ) $(O)/libombra.a
 $(O)/run-tests: $(TEST_OBJ) $(PLATFORM_OBJ) $(O)/libombra.a
 	$(Q)$(CC) $(CFLAGS_ALL) -o $@ $^ $(LDLIBS)
 
-$(O)/bench: $(BENCH_SRC) $(PLATFORM_OBJ) $(O)/libombra.a
-	$(Q)$(CC) $(CFLAGS_ALL) -o $@ $^ $(LDLIBS)
+$(O)/bench: $(BENCH_SRC) $(PLATFORM_OBJ) $(O)/libombra.a $(wildcard tests/bench/*.h)
+	$(Q)$(CC) $(CFLAGS_ALL) -o $@ $(filter %.c %.o %.a,$^) $(LDLIBS)
 
 run: $(O)/ombra
 	@mkdir -p out

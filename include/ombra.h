@@ -245,14 +245,50 @@ uint32_t om_format_bpp(om_format f);   /* bytes per pixel */
 
 /* ---------------------------------------------------------------- methods */
 
-/* Every method's settings in one struct; each method reads its own fields. */
+/* Every method's settings in one struct; each method reads its own fields. Defaults
+ * come from om_method_cfg_default; om_method_cfg_fields lists them by name for hosts
+ * (the CLI's --set NAME=VALUE). */
 typedef struct om_method_cfg {
-    uint32_t map_size;     /* shadow-map side in texels (sm, rtw, spsm) */
-    float bias_const;      /* sm: constant depth bias, in light depth units */
-    float bias_slope;      /* sm: slope-scaled bias factor */
-    float normal_offset;   /* sm: world offset along the normal, in texels */
-    uint32_t pcf;          /* sm: k for k x k PCF, 1 = none */
+    uint32_t map_size;     /* sm, rtw, spsm: shadow-map side in texels */
+    float bias_const;      /* sm, rtw: constant bias, world units along the light ray */
+    float bias_slope;      /* sm, rtw: slope-scaled bias, in texels */
+    float normal_offset;   /* sm, rtw: offset along the normal, in texels */
+    uint32_t pcf;          /* sm, rtw: k for k x k PCF, 1 = none */
+    /* asm */
+    uint64_t asm_cap;      /* bytes the node structure may hold, at most */
+    uint32_t asm_tile;     /* texels per side of every node's tile */
+    uint32_t asm_cells;    /* cells per side of a node; a cell may hold a child node */
+    uint32_t asm_root;     /* texels per side of the root's view of the light frustum */
+    uint32_t asm_work;     /* per-frame work budget, in cost units */
+    uint32_t asm_stride;   /* analyse one visible sample in asm_stride (the paper: 8) */
+    float asm_cost_a, asm_cost_b;   /* cost of a node: a * texels required + b */
+    /* izb */
+    uint32_t izb_leaf;     /* most samples in a BSP leaf (the paper: 64) */
+    uint32_t izb_pool;     /* samples the pool holds; 0 = the whole frame in one pass */
+    /* rtw */
+    uint32_t rtw_importance;  /* importance map side */
+    uint32_t rtw_analysis;    /* 0 backward (visible samples), 1 forward, 2 hybrid */
+    uint32_t rtw_funcs;       /* importance functions: 1 desired view, 2 distance to eye,
+                                 4 shadow edge, 8 surface normal */
+    float rtw_sigma;          /* Gaussian blur, in super-cells */
+    float rtw_tess;           /* longest warped edge as a fraction of the map, 0 = off */
+    /* spsm */
+    uint32_t spsm_aa;      /* sub-samples at uncertain samples, 0 or 1 = off */
 } om_method_cfg;
+
+/* One settable field of om_method_cfg. */
+typedef struct om_cfg_field {
+    const char *name;      /* "map", "asm.cap", ... */
+    const char *help;
+    char kind;             /* 'u' uint32_t, 'z' uint64_t, 'f' float */
+    size_t offset;         /* offsetof(om_method_cfg, field) */
+    double min, max;
+} om_cfg_field;
+
+const om_cfg_field *om_method_cfg_fields(size_t *count);
+/* Sets a field by name; OM_E_NOTFOUND for an unknown name, OM_E_RANGE outside
+ * [min, max] or not whole for an integer field. */
+om_status om_method_cfg_set(om_method_cfg *c, const char *name, double value, om_diag *d);
 
 void om_method_cfg_default(om_method_cfg *c);
 

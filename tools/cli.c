@@ -111,3 +111,29 @@ om_status cli_oom(om_diag *d)
     }
     return OM_E_BUDGET;
 }
+
+bool cli_set(om_method_cfg *c, const char *setting)
+{
+    char name[64];
+    const char *eq = strchr(setting, '=');
+    if (!eq || (size_t)(eq - setting) >= sizeof name) {
+        fprintf(stderr, "ombra: --set takes NAME=VALUE, not '%s' (see 'ombra methods')\n", setting);
+        return false;
+    }
+    memcpy(name, setting, (size_t)(eq - setting));
+    name[eq - setting] = '\0';
+    char *end;
+    errno = 0;
+    double v = strtod(eq + 1, &end);
+    if (errno || end == eq + 1 || *end) {
+        fprintf(stderr, "ombra: %s takes a number, not '%s'\n", name, eq + 1);
+        return false;
+    }
+    om_diag d;
+    om_status st = om_method_cfg_set(c, name, v, &d);
+    if (st != OM_OK) {
+        fprintf(stderr, "ombra: setting '%s': %s (see 'ombra methods')\n", name, d.msg);
+        return false;
+    }
+    return true;
+}

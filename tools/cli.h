@@ -30,6 +30,8 @@ bool cli_parse_size(const char *s, uint32_t *w, uint32_t *h);
 bool cli_parse_bytes(const char *s, size_t *out);     /* 123, 64K, 8M, 1G (binary) */
 bool cli_parse_u32(const char *s, uint32_t lo, uint32_t hi, uint32_t *out);
 bool cli_parse_float(const char *s, float *out);
+/* Applies "NAME=VALUE" to a method configuration; prints the error and returns false. */
+bool cli_set(om_method_cfg *c, const char *setting);
 
 int cmd_render(int argc, char **argv);
 int cmd_info(int argc, char **argv);

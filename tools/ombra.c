@@ -30,6 +30,19 @@ int main(int argc, char **argv)
     if (!strcmp(argv[1], "methods")) {
         for (size_t i = 0; i < om_method_count(); i++)
             printf("%-6s %s\n", om_method_at(i)->name, om_method_at(i)->summary);
+        size_t n;
+        const om_cfg_field *f = om_method_cfg_fields(&n);
+        om_method_cfg c;
+        om_method_cfg_default(&c);
+        printf("\nsettings (--set NAME=VALUE):\n");
+        for (size_t i = 0; i < n; i++) {
+            const unsigned char *p = (const unsigned char *)&c + f[i].offset;
+            double v;
+            if (f[i].kind == 'u') { uint32_t u; memcpy(&u, p, sizeof u); v = u; }
+            else if (f[i].kind == 'z') { uint64_t u; memcpy(&u, p, sizeof u); v = (double)u; }
+            else { float x; memcpy(&x, p, sizeof x); v = x; }
+            printf("  %-15s %-11.9g %s\n", f[i].name, v, f[i].help);
+        }
         return 0;
     }
     fprintf(stderr, "ombra: unknown command '%s'\n\n%s", argv[1], usage);

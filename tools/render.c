@@ -23,11 +23,12 @@ static const char render_help[] =
     "  --strip ROWS      render through strips of ROWS rows (default: whole frame)\n"
     "  --budget BYTES    total memory for scene, frame and method (K, M, G suffixes);\n"
     "                    the strip height shrinks to fit, down to one row\n"
-    "  --map N           shadow-map side for map-based methods (default 2048)\n"
-    "  --bias B          sm: constant bias in world units along the light ray\n"
-    "  --slope S         sm: slope-scaled bias in texels\n"
-    "  --offset O        sm: normal offset in texels\n"
-    "  --pcf K           sm: K x K percentage-closer filtering (1 = off)\n"
+    "  --set NAME=VALUE  a method setting, repeatable ('ombra methods' lists them all)\n"
+    "  --map N           short for --set map=N (shadow-map side, default 2048)\n"
+    "  --bias B          short for --set bias=B (world units along the light ray)\n"
+    "  --slope S         short for --set slope=S (slope-scaled bias, texels)\n"
+    "  --offset O        short for --set offset=O (normal offset, texels)\n"
+    "  --pcf K           short for --set pcf=K (K x K percentage-closer filtering)\n"
     "  --quiet           print nothing but errors\n";
 
 /* One method's memory and state for a frame. */
@@ -135,19 +136,23 @@ int cmd_render(int argc, char **argv)
 {
     const char *scene_path = NULL, *out = "ombra.ppm", *mask = NULL, *mname = "sm";
     const char *against = NULL, *diff = NULL;
-    uint32_t w = 0, h = 0, strip = 0, map = 0, pcf = 0;
+    uint32_t w = 0, h = 0, strip = 0;
     size_t budget = 0;
-    float t = 0.0f, bias = -1, slope = -1, offset = -1;
+    float t = 0.0f;
     bool quiet = false;
     om_format fmt = OM_RGB888;
+    run main_run, ref_run;
+    memset(&main_run, 0, sizeof main_run);
+    memset(&ref_run, 0, sizeof ref_run);
+    om_method_cfg_default(&main_run.cfg);
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) { fputs(render_help, stdout); return 0; }
         if (!strcmp(a, "--quiet")) { quiet = true; continue; }
         static const char *const valued[] = {"--method", "--against", "--out", "--mask", "--diff",
-            "--size", "--strip", "--budget", "--map", "--pcf", "--bias", "--slope", "--offset",
-            "--time", "--format"};
+            "--size", "--strip", "--budget", "--time", "--format", "--set", "--map", "--pcf",
+            "--bias", "--slope", "--offset"};
         bool known = false;
         for (size_t k = 0; k < sizeof valued / sizeof valued[0]; k++) known |= !strcmp(a, valued[k]);
         if (a[0] == '-' && !known) return cli_usage_error("render", "unknown option '%s'", a);
@@ -160,32 +165,22 @@ int cmd_render(int argc, char **argv)
         else if (!strcmp(a, "--size")) { if (!cli_parse_size(v, &w, &h)) return cli_usage_error("render", "--size takes WxH with each side 1..8192, not '%s'", v); }
         else if (!strcmp(a, "--strip")) { if (!cli_parse_u32(v, 1, OM_MAX_DIM, &strip)) return cli_usage_error("render", "--strip takes a row count 1..8192, not '%s'", v); }
         else if (!strcmp(a, "--budget")) { if (!cli_parse_bytes(v, &budget)) return cli_usage_error("render", "--budget takes bytes like 65536, 64K or 8M, not '%s'", v); }
-        else if (!strcmp(a, "--map")) { if (!cli_parse_u32(v, 1, OM_MAX_DIM, &map)) return cli_usage_error("render", "--map takes a size 1..8192, not '%s'", v); }
-        else if (!strcmp(a, "--pcf")) { if (!cli_parse_u32(v, 1, 9, &pcf)) return cli_usage_error("render", "--pcf takes a kernel size 1..9, not '%s'", v); }
-        else if (!strcmp(a, "--bias")) { if (!cli_parse_float(v, &bias) || bias < 0) return cli_usage_error("render", "--bias takes a non-negative number, not '%s'", v); }
-        else if (!strcmp(a, "--slope")) { if (!cli_parse_float(v, &slope) || slope < 0) return cli_usage_error("render", "--slope takes a non-negative number, not '%s'", v); }
-        else if (!strcmp(a, "--offset")) { if (!cli_parse_float(v, &offset) || offset < 0) return cli_usage_error("render", "--offset takes a non-negative number, not '%s'", v); }
         else if (!strcmp(a, "--time")) { if (!cli_parse_float(v, &t)) return cli_usage_error("render", "--time takes a number, not '%s'", v); }
         else if (!strcmp(a, "--format")) { if (!parse_format(v, &fmt)) return cli_usage_error("render", "--format is rgb888, rgb565 or l8, not '%s'", v); }
-        else if (a[0] == '-') return cli_usage_error("render", "unknown option '%s'", a);
-        else if (!scene_path) { scene_path = a; continue; }
-        else return cli_usage_error("render", "one scene only; unexpected '%s'", a);
+        else {
+            /* --set NAME=VALUE and its short forms */
+            char setting[128];
+            if (!strcmp(a, "--set")) snprintf(setting, sizeof setting, "%s", v);
+            else snprintf(setting, sizeof setting, "%s=%s", a + 2, v);
+            if (!cli_set(&main_run.cfg, setting)) return 2;
+        }
         i++;
     }
     if (diff && !against) return cli_usage_error("render", "%s needs --against", "--diff");
-    run main_run, ref_run;
-    memset(&main_run, 0, sizeof main_run);
-    memset(&ref_run, 0, sizeof ref_run);
     main_run.m = om_method_find(mname);
     if (!main_run.m) return cli_usage_error("render", "unknown method '%s' (see 'ombra methods')", mname);
     if (against && !(ref_run.m = om_method_find(against)))
         return cli_usage_error("render", "unknown method '%s' for --against (see 'ombra methods')", against);
-    om_method_cfg_default(&main_run.cfg);
-    if (map) main_run.cfg.map_size = map;
-    if (pcf) main_run.cfg.pcf = pcf;
-    if (bias >= 0) main_run.cfg.bias_const = bias;
-    if (slope >= 0) main_run.cfg.bias_slope = slope;
-    if (offset >= 0) main_run.cfg.normal_offset = offset;
     om_method_cfg_default(&ref_run.cfg);
 
     om_diag d;
@@ -300,7 +295,7 @@ out:
 }
 
 static const char info_help[] =
-    "usage: ombra info [SCENE] [--size WxH] [--map N]\n"
+    "usage: ombra info [SCENE] [--size WxH] [--set NAME=VALUE ...]\n"
     "\n"
     "Prints the scene's triangles, vertices, materials and bounds, and the bytes the\n"
     "scene, a frame and each method need at that image size.\n";
@@ -308,15 +303,21 @@ static const char info_help[] =
 int cmd_info(int argc, char **argv)
 {
     const char *scene_path = NULL;
-    uint32_t w = 0, h = 0, map = 0;
+    uint32_t w = 0, h = 0;
+    om_method_cfg cfg;
+    om_method_cfg_default(&cfg);
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) { fputs(info_help, stdout); return 0; }
         if (!strcmp(a, "--size")) {
             if (!v || !cli_parse_size(v, &w, &h)) return cli_usage_error("info", "--size takes WxH with each side 1..8192, not '%s'", v ? v : "");
             i++;
-        } else if (!strcmp(a, "--map")) {
-            if (!v || !cli_parse_u32(v, 1, OM_MAX_DIM, &map)) return cli_usage_error("info", "--map takes a size 1..8192, not '%s'", v ? v : "");
+        } else if (!strcmp(a, "--set") || !strcmp(a, "--map")) {
+            char setting[128];
+            if (!v) return cli_usage_error("info", "%s needs a value", a);
+            if (!strcmp(a, "--set")) snprintf(setting, sizeof setting, "%s", v);
+            else snprintf(setting, sizeof setting, "map=%s", v);
+            if (!cli_set(&cfg, setting)) return 2;
             i++;
         } else if (a[0] == '-') return cli_usage_error("info", "unknown option '%s'", a);
         else if (!scene_path) scene_path = a;
@@ -340,9 +341,6 @@ int cmd_info(int argc, char **argv)
            om_frame_bytes(W, H), om_frame_bytes(W, 1));
     for (size_t i = 0; i < om_method_count(); i++) {
         const om_method *m = om_method_at(i);
-        om_method_cfg cfg;
-        om_method_cfg_default(&cfg);
-        if (map) cfg.map_size = map;
         size_t mn, full;
         st = m->bytes(&cfg, s, W, H, &mn, &full);
         if (st == OM_OK) printf("  %-6s min %zu, one pass %zu\n", m->name, mn, full);

@@ -1,0 +1,45 @@
+/* bench.h — what the benchmark programs share: scenes, medians, and one method run
+ * over one frame with per-stage times. `make bench` runs every benchmark listed in
+ * OM_BENCHES; `build/bench NAME` runs the ones whose name contains NAME. Benchmarks
+ * print figures and assert nothing. */
+#ifndef OM_BENCH_H
+#define OM_BENCH_H
+
+#include "../../engine/frame/frame.h"
+#include "../../platform/platform.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+
+#define RUNS 7
+
+typedef struct bscene { const char *name; char *text; void *mem; om_scene s; } bscene;
+
+/* Parses scene text into a heap arena; prints the error and returns non-zero on failure. */
+int bench_load(bscene *b, const char *name, const char *text);
+void bench_free(bscene *b);
+/* The random-triangle scenes of the Alias-Free Shadow Maps paper's Table 1: `count`
+ * small triangles of constant total area above a floor, at 1024x768. */
+int bench_load_random(bscene *b, unsigned count);
+
+double bench_median_ns(uint64_t *t, int n);   /* in ms */
+double bench_median(double *v, int n);
+
+/* One method over one frame at W x H: init (timed; the reference builds its BVH there),
+ * then the frame with per-stage times; the whole-frame mask goes to `mask` (may be
+ * NULL). cfg NULL = defaults. */
+typedef struct mrun {
+    double init_ms, eye_ms, observe_ms, build_ms, resolve_ms;
+    om_method_stats stats;
+} mrun;
+int bench_run(const bscene *b, const char *method, const om_method_cfg *cfg, uint32_t W,
+              uint32_t H, float t, uint8_t *mask, mrun *out);
+
+#define OM_BENCHES \
+    X(bench_raster) \
+    X(bench_shadow)
+#define X(name) void name(void);
+OM_BENCHES
+#undef X
+
+#endif

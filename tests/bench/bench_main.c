@@ -1,0 +1,137 @@
+/* bench_main.c — the benchmark driver and the helpers of bench.h. */
+#include "bench.h"
+
+#include <string.h>
+
+static int cmp_u64(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return x < y ? -1 : x > y;
+}
+
+double bench_median_ns(uint64_t *t, int n)
+{
+    qsort(t, (size_t)n, sizeof *t, cmp_u64);
+    return (double)t[n / 2] / 1e6;
+}
+
+double bench_median(double *v, int n)
+{
+    for (int i = 1; i < n; i++)
+        for (int j = i; j > 0 && v[j - 1] > v[j]; j--) { double t = v[j]; v[j] = v[j - 1]; v[j - 1] = t; }
+    return v[n / 2];
+}
+
+int bench_load(bscene *b, const char *name, const char *text)
+{
+    om_diag d;
+    size_t bytes;
+    memset(b, 0, sizeof *b);
+    b->name = name;
+    if (om_scene_bytes(text, strlen(text), NULL, &bytes, &d) != OM_OK) {
+        fprintf(stderr, "bench: %s: %s\n", name, d.msg);
+        return 1;
+    }
+    b->mem = malloc(bytes);
+    om_arena a;
+    om_arena_init(&a, b->mem, bytes, "scene");
+    if (om_scene_parse(text, strlen(text), NULL, &a, &b->s, &d) != OM_OK) {
+        fprintf(stderr, "bench: %s: %s\n", name, d.msg);
+        return 1;
+    }
+    return 0;
+}
+
+void bench_free(bscene *b)
+{
+    free(b->mem);
+    b->mem = NULL;
+}
+
+int bench_load_random(bscene *b, unsigned count)
+{
+    static char names[4][32];
+    static char text[512];
+    int slot = count >= 1000000 ? 3 : count >= 100000 ? 2 : count >= 10000 ? 1 : 0;
+    snprintf(names[slot], sizeof names[slot], "random-%uK", count / 1000);
+    snprintf(text, sizeof text,
+             "camera eye 0 6 14 target 0 1 0 fov 50 size 1024 768 near 0.1 far 100\n"
+             "light spot pos 8 20 6 target 0 0 0 fov 60 near 5 far 60\n"
+             "plane size 14 14 albedo 0.7 0.7 0.7\n"
+             "triangles count %u seed 7 area 20 in -5 0.5 -5 5 3 5\n", count);
+    return bench_load(b, names[slot], text);
+}
+
+typedef struct mask_sink { uint8_t *mask; } mask_sink;
+
+static om_status grab_mask(void *user, const om_strip *st, const om_framebuffer *fb)
+{
+    (void)fb;
+    uint8_t *m = ((mask_sink *)user)->mask;
+    if (!m) return OM_OK;
+    for (uint32_t i = 0; i < st->rows * st->width; i++)
+        m[(size_t)st->y0 * st->width + i] = om_mask_of(&st->samples[i], &st->terms[i]);
+    return OM_OK;
+}
+
+int bench_run(const bscene *b, const char *name, const om_method_cfg *cfg, uint32_t W,
+              uint32_t H, float t, uint8_t *mask, mrun *out)
+{
+    const om_method *m = om_method_find(name);
+    om_method_cfg c;
+    if (cfg) c = *cfg;
+    else om_method_cfg_default(&c);
+    om_camera cam;
+    om_light light;
+    om_scene_at(&b->s, t, &cam, &light);
+    cam.width = W;
+    cam.height = H;
+    om_view v;
+    om_diag d;
+    size_t mn, full;
+    memset(out, 0, sizeof *out);
+    if (!m || om_view_init(&v, &cam, &light, &b->s, &d) || m->bytes(&c, &b->s, W, H, &mn, &full)) {
+        fprintf(stderr, "bench: cannot set up %s\n", name);
+        return 1;
+    }
+    void *mem = malloc(full), *fmem = malloc(om_frame_bytes(W, H)), *px = malloc((size_t)W * H * 3);
+    om_arena ma, fa;
+    om_arena_init(&ma, mem, full, "method");
+    om_arena_init(&fa, fmem, om_frame_bytes(W, H), "frame");
+    void *state;
+    uint64_t t0 = om_clock_ns(NULL);
+    om_status st = m->init(&state, &ma, &c, &b->s, W, H, &d);
+    out->init_ms = (double)(om_clock_ns(NULL) - t0) / 1e6;
+    if (st == OM_OK) {
+        om_framebuffer fb = {OM_RGB888, W, H, (size_t)W * 3, (uint8_t *)px};
+        om_shade_cfg shade;
+        om_shade_cfg_default(&shade);
+        mask_sink ms = {mask};
+        om_frame_desc fd;
+        memset(&fd, 0, sizeof fd);
+        fd.scene = &b->s; fd.view = &v; fd.method = m; fd.method_state = state; fd.shade = &shade;
+        fd.fb = &fb; fd.on_strip = grab_mask; fd.user = &ms; fd.clock = om_clock_ns;
+        om_frame_stats fs;
+        st = om_render_frame(&fd, &fa, &fs, &d);
+        out->eye_ms = (double)fs.ns_eye / 1e6;
+        out->observe_ms = (double)fs.ns_observe / 1e6;
+        out->build_ms = (double)fs.ns_build / 1e6;
+        out->resolve_ms = (double)fs.ns_resolve / 1e6;
+        m->stats(state, &out->stats);
+    }
+    if (st) fprintf(stderr, "bench: %s: %s\n", name, d.msg);
+    free(mem);
+    free(fmem);
+    free(px);
+    return st != OM_OK;
+}
+
+int main(int argc, char **argv)
+{
+    const char *filter = argc > 1 ? argv[1] : NULL;
+    printf("ombra bench: medians of several runs, one core\n");
+#define X(name) if (!filter || strstr(#name, filter)) { name(); fflush(stdout); }
+    OM_BENCHES
+#undef X
+    return 0;
+}

@@ -1,0 +1,76 @@
+/* bench_raster.c — the rasterizer's figures: the eye pass at 1024x768 (depth + id,
+ * then visible samples) and the depth-only light pass at 1024x1024 and 2048x2048, for
+ * the default scene and for 100K random small triangles above a floor. */
+#include "bench.h"
+
+static void bench_eye(const bscene *b, uint32_t W, uint32_t H)
+{
+    om_camera cam = b->s.camera;
+    cam.width = W;
+    cam.height = H;
+    om_view v;
+    om_diag d;
+    if (om_view_init(&v, &cam, &b->s.light, &b->s, &d) != OM_OK) {
+        fprintf(stderr, "bench: %s\n", d.msg);
+        return;
+    }
+    size_t n = (size_t)W * H;
+    om_target tg = {W, H, 0, H, malloc(n * 4), malloc(n * 4)};
+    om_sample *smp = malloc(n * sizeof *smp);
+    om_strip st = {W, H, 0, H, smp, NULL};
+    uint64_t raster[RUNS], total[RUNS];
+    size_t covered = 0;
+    for (int r = 0; r < RUNS; r++) {
+        uint64_t t0 = om_clock_ns(NULL);
+        om__scene_raster(&b->s, &v.cam_vp, &tg, OM_RASTER_DEPTH_ID);
+        uint64_t t1 = om_clock_ns(NULL);
+        om__eye_pass(&b->s, &v, &tg, &st);
+        uint64_t t2 = om_clock_ns(NULL);
+        raster[r] = t1 - t0;
+        total[r] = t2 - t1;
+    }
+    for (size_t i = 0; i < n; i++) covered += smp[i].tri != OM_NO_TRI;
+    printf("%-12s eye pass %ux%u: %8.2f ms (raster alone %.2f ms), %u tris, %.0f%% covered\n",
+           b->name, W, H, bench_median_ns(total, RUNS), bench_median_ns(raster, RUNS), b->s.ntris,
+           100.0 * (double)covered / (double)n);
+    free(tg.depth);
+    free(tg.id);
+    free(smp);
+}
+
+static void bench_light(const bscene *b, uint32_t size)
+{
+    om_view v;
+    om_diag d;
+    if (om_view_init(&v, &b->s.camera, &b->s.light, &b->s, &d) != OM_OK) {
+        fprintf(stderr, "bench: %s\n", d.msg);
+        return;
+    }
+    size_t n = (size_t)size * size;
+    om_target tg = {size, size, 0, size, malloc(n * 4), NULL};
+    uint64_t t[RUNS];
+    for (int r = 0; r < RUNS; r++) {
+        uint64_t t0 = om_clock_ns(NULL);
+        om__scene_raster(&b->s, &v.light_vp, &tg, OM_RASTER_DEPTH);
+        t[r] = om_clock_ns(NULL) - t0;
+    }
+    size_t written = 0;
+    for (size_t i = 0; i < n; i++) written += tg.depth[i] != 0xFFFFFFFFu;
+    printf("%-12s light depth pass %ux%u: %8.2f ms, %.0f%% of texels written\n", b->name, size,
+           size, bench_median_ns(t, RUNS), 100.0 * (double)written / (double)n);
+    free(tg.depth);
+}
+
+void bench_raster(void)
+{
+    bscene def, rnd;
+    if (bench_load(&def, "default", om_scene_default_text()) || bench_load_random(&rnd, 100000)) return;
+    bench_eye(&def, 1024, 768);
+    bench_eye(&rnd, 1024, 768);
+    bench_light(&def, 1024);
+    bench_light(&def, 2048);
+    bench_light(&rnd, 1024);
+    bench_light(&rnd, 2048);
+    bench_free(&def);
+    bench_free(&rnd);
+}
