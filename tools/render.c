@@ -167,7 +167,11 @@ int cmd_render(int argc, char **argv)
         else if (!strcmp(a, "--budget")) { if (!cli_parse_bytes(v, &budget)) return cli_usage_error("render", "--budget takes bytes like 65536, 64K or 8M, not '%s'", v); }
         else if (!strcmp(a, "--time")) { if (!cli_parse_float(v, &t)) return cli_usage_error("render", "--time takes a number, not '%s'", v); }
         else if (!strcmp(a, "--format")) { if (!parse_format(v, &fmt)) return cli_usage_error("render", "--format is rgb888, rgb565 or l8, not '%s'", v); }
-        else {
+        else if (a[0] != '-') {
+            if (scene_path) return cli_usage_error("render", "one scene only; unexpected '%s'", a);
+            scene_path = a;
+            continue;
+        } else {
             /* --set NAME=VALUE and its short forms */
             char setting[128];
             if (!strcmp(a, "--set")) snprintf(setting, sizeof setting, "%s", v);
