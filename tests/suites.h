@@ -9,7 +9,8 @@
     X(suite_frame) \
     X(suite_platform) \
     X(suite_shadow) \
-    X(suite_measure)
+    X(suite_measure) \
+    /* end of list */
 #endif
 #define X(suite) void suite(void);
 OM_SUITES

@@ -37,7 +37,8 @@ int bench_run(const bscene *b, const char *method, const om_method_cfg *cfg, uin
 
 #define OM_BENCHES \
     X(bench_raster) \
-    X(bench_shadow)
+    X(bench_shadow) \
+    /* end of list */
 #define X(name) void name(void);
 OM_BENCHES
 #undef X
