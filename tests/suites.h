@@ -10,6 +10,7 @@
     X(suite_platform) \
     X(suite_shadow) \
     X(suite_measure) \
+    X(suite_izb) \
     /* end of list */
 #endif
 #define X(suite) void suite(void);

@@ -6,6 +6,7 @@ static const om_method *const methods[] = {
     &om__method_none,
     &om__method_ref,
     &om__method_sm,
+    &om__method_izb,
 };
 
 size_t om_method_count(void) { return sizeof methods / sizeof methods[0]; }

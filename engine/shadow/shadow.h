@@ -7,5 +7,6 @@
 extern const om_method om__method_none;
 extern const om_method om__method_ref;
 extern const om_method om__method_sm;
+extern const om_method om__method_izb;
 
 #endif

@@ -38,6 +38,7 @@ int bench_run(const bscene *b, const char *method, const om_method_cfg *cfg, uin
 #define OM_BENCHES \
     X(bench_raster) \
     X(bench_shadow) \
+    X(bench_izb) \
     /* end of list */
 #define X(name) void name(void);
 OM_BENCHES

@@ -1,0 +1,65 @@
+/* izb.h — the irregular z-buffer of Alias-Free Shadow Maps (Aila and Laine 2004),
+ * split into its three stages so the benchmark can time each as the paper's Table 1
+ * does: transform the visible samples to the light's image plane (section 3), build
+ * the 2-D BSP over them (section 5.1), rasterize every triangle through it (sections
+ * 3-5). The samples are never discretised to texels: they keep the light grid's
+ * 1/2^21 precision, and every test is the shared occlusion predicate of occlude.h, so
+ * the result equals the reference sample for sample. */
+#ifndef OM_IZB_H
+#define OM_IZB_H
+
+#include "occlude.h"
+
+/* A visible sample on the light's image plane, with its accumulated optical depth. */
+typedef struct om__izb_sample {
+    om__lpoint p;
+    uint32_t idx;          /* index of the sample in its strip */
+    om__odepth od;
+} om__izb_sample;
+
+/* What the BSP orders and the leaves scan: a sample's grid position, its light depth
+ * rounded up to float (enough to cull conservatively) and where the sample is, with
+ * OM_IZB_DONE set once it is opaquely shadowed. The 48-byte samples never move: the
+ * leaves touch one only when it lies inside a triangle's bounds. */
+typedef struct om__izb_key { int32_t x, y; uint32_t s; float z; } om__izb_key;
+#define OM_IZB_DONE 0x80000000u
+
+/* A BSP node: the bounds of its samples on the light grid, their largest light depth,
+ * and how many of them are not yet fully (opaquely) shadowed. Leaves have count > 0
+ * and no children; inner nodes have children at `child` and `child + 1`. */
+typedef struct om__izb_node {
+    int64_t x0, y0, x1, y1;
+    double zmax;
+    uint32_t first, count, child, open;
+} om__izb_node;
+
+typedef struct om__izb_stats {
+    uint32_t nodes, visited, culled_shadowed, culled_depth, tested, blocked, tiles;
+} om__izb_stats;
+
+typedef struct om__izb {
+    const om_scene *scene;
+    om__lspace ls;
+    om__odepth *mat_od;
+    om__izb_sample *samples;
+    om__izb_key *keys;
+    om__izb_node *nodes;
+    uint32_t cap;          /* samples the pool holds */
+    uint32_t node_cap;
+    uint32_t leaf;
+    uint32_t n, nnodes;    /* samples and nodes of the current tile */
+    om__izb_stats st;
+} om__izb;
+
+/* The izb method's state begins with an om__izb, so a state pointer converts to one. */
+
+/* Fills the pool from strip samples [*next, end) that are exposed, up to its capacity;
+ * advances *next. Returns the number taken. */
+uint32_t om__izb_transform(om__izb *z, const om_strip *st, size_t *next, size_t end);
+void om__izb_build(om__izb *z);
+/* Rasterizes every triangle of the scene through the BSP. */
+void om__izb_raster(om__izb *z);
+/* Writes the tile's terms into the strip. */
+void om__izb_write(const om__izb *z, om_strip *st);
+
+#endif

@@ -1,0 +1,98 @@
+/* bench_izb.c — Table 1 of the Alias-Free Shadow Maps paper for ombra's irregular
+ * z-buffer: 1K, 10K, 100K and 1M random small triangles of constant total area at
+ * 1024x768, with the paper's rows (BSP nodes, nodes visited, nodes culled, samples
+ * tested; transform, BSP construction, rasterization and total time), beside the BVH
+ * reference's time on the same frame; then the hot-spot scene. Medians of 3 runs. */
+#include "bench.h"
+#include "../../engine/shadow/izb.h"
+
+static void table_row(const bscene *b, uint32_t W, uint32_t H)
+{
+    const om_method *m = om_method_find("izb");
+    om_method_cfg cfg;
+    om_method_cfg_default(&cfg);
+    om_camera cam;
+    om_light light;
+    om_scene_at(&b->s, 0, &cam, &light);
+    cam.width = W;
+    cam.height = H;
+    om_view v;
+    om_diag d;
+    size_t mn, full, n = (size_t)W * H;
+    if (om_view_init(&v, &cam, &light, &b->s, &d) || m->bytes(&cfg, &b->s, W, H, &mn, &full)) return;
+    void *mem = malloc(full);
+    om_target tg = {W, H, 0, H, malloc(n * 4), malloc(n * 4)};
+    om_strip st = {W, H, 0, H, malloc(n * sizeof(om_sample)), malloc(n * sizeof(om_term))};
+    om__eye_pass(&b->s, &v, &tg, &st);
+    for (size_t i = 0; i < n; i++) {
+        st.terms[i].flags = st.samples[i].tri != OM_NO_TRI && om__exposed(&v, &st.samples[i]) ? OM_TERM_EXPOSED : 0;
+    }
+    double tt[3], tb[3], tr[3];
+    om__izb_stats stats;
+    memset(&stats, 0, sizeof stats);
+    for (int r = 0; r < 3; r++) {
+        om_arena a;
+        om_arena_init(&a, mem, full, "method");
+        void *state;
+        if (m->init(&state, &a, &cfg, &b->s, W, H, &d) || m->begin(state, &v, &d)) return;
+        om__izb *z = (om__izb *)state;
+        size_t next = 0;
+        uint64_t t0 = om_clock_ns(NULL);
+        om__izb_transform(z, &st, &next, n);
+        uint64_t t1 = om_clock_ns(NULL);
+        om__izb_build(z);
+        uint64_t t2 = om_clock_ns(NULL);
+        om__izb_raster(z);
+        uint64_t t3 = om_clock_ns(NULL);
+        tt[r] = (double)(t1 - t0) / 1e6;
+        tb[r] = (double)(t2 - t1) / 1e6;
+        tr[r] = (double)(t3 - t2) / 1e6;
+        stats = z->st;
+    }
+    double a = bench_median(tt, 3), bb = bench_median(tb, 3), c = bench_median(tr, 3);
+    /* the reference on the same frame: BVH build + shadow tests */
+    double rt[3];
+    mrun r;
+    for (int k = 0; k < 3; k++) {
+        if (bench_run(b, "ref", NULL, W, H, 0, NULL, &r)) return;
+        rt[k] = r.init_ms + r.resolve_ms;
+    }
+    printf("%-12s %8u %9u %8u %9u %9.1f %9.1f %9.1f %9.1f %10.1f\n", b->name, stats.nodes,
+           stats.visited, stats.culled_shadowed + stats.culled_depth, stats.tested, a, bb, c,
+           a + bb + c, bench_median(rt, 3));
+    free(mem);
+    free(tg.depth);
+    free(tg.id);
+    free(st.samples);
+    free(st.terms);
+}
+
+void bench_izb(void)
+{
+    printf("irregular z-buffer at 1024x768 (Table 1 of the paper; times in ms, medians of 3)\n");
+    printf("%-12s %8s %9s %8s %9s %9s %9s %9s %9s %10s\n", "scene", "nodes", "visited", "culled",
+           "tested", "transform", "bsp", "raster", "total", "ref total");
+    static const unsigned counts[] = {1000, 10000, 100000, 1000000};
+    for (int k = 0; k < 4; k++) {
+        bscene b;
+        if (bench_load_random(&b, counts[k])) return;
+        table_row(&b, 1024, 768);
+        bench_free(&b);
+    }
+    bscene b;
+    if (bench_load(&b, "hot-spot",
+                   "camera eye 0 3 10 target 0 0 -10 fov 60\n"
+                   "light spot pos 0 0.6 -60 target 0 0 0 fov 20 near 1 far 200\n"
+                   "plane size 80 80 divisions 4\n"
+                   "box size 0.05 1.5 0.05 translate -1 0.75 -30\n"
+                   "box size 0.05 1.5 0.05 translate 0 0.75 -30\n"
+                   "box size 0.05 1.5 0.05 translate 1 0.75 -30\n"
+                   "box size 3 0.05 0.05 translate 0 0.4 -25\n"
+                   "triangles count 10000 seed 3 area 4 in -6 0.2 -40 6 2 -20\n"))
+        return;
+    table_row(&b, 1024, 768);
+    bench_free(&b);
+    if (bench_load(&b, "default", om_scene_default_text())) return;
+    table_row(&b, 1024, 768);
+    bench_free(&b);
+}
