@@ -209,14 +209,20 @@ int cmd_render(int argc, char **argv)
         rc = cli_error(mname, &d, st);
         goto out;
     }
-    /* Split the memory: the method gets what it needs for one pass if it can, the
-     * frame gets strips of as many rows as are left, at least one. */
+    /* Split the memory: when the method's one-pass size and the whole frame do not
+     * both fit, the method gets its minimum plus half of what is left over and the
+     * frame the other half, as strips of as many rows as fit (at least one). Both
+     * halves cost the same kind of work: another strip or another method tile. */
     uint32_t rows = strip && strip < H ? strip : H;
     main_run.given = main_run.full;
     if (budget) {
         size_t one = om_frame_bytes(W, 1), row_bytes = om_frame_bytes(W, 2) - one;
         size_t rest = budget > cs.bytes ? budget - cs.bytes : 0;
-        if (rest < main_run.full + one) main_run.given = main_run.min;
+        if (rest < main_run.full + om_frame_bytes(W, rows)) {
+            size_t spare = rest > main_run.min + one ? rest - main_run.min - one : 0;
+            main_run.given = main_run.min + spare / 2;
+            if (main_run.given > main_run.full) main_run.given = main_run.full;
+        }
         size_t left = rest > main_run.given ? rest - main_run.given : 0;
         size_t fit = left >= one ? 1 + (left - one) / row_bytes : 0;
         if (fit == 0) {
