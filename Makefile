@@ -4,6 +4,7 @@
 #   make test       unit and property tests, gcc and clang, -O0 and -O2, + freestanding check
 #   make test-sanitize   the suite under ASan + UBSan
 #   make bench      benchmark figures (medians of several runs)
+#   make cross-test the same frames from every compiler and CPU (qemu-user)
 
 CC      ?= cc
 OPT     ?= -O2
@@ -78,7 +79,12 @@ bench:
 	$(MAKE) --no-print-directory $(O)/bench $(O)/ombra OPT="-O2 -DNDEBUG"
 	$(O)/bench
 
+# Bit-identical frames across compilers and CPUs (x86-64, i386, aarch64, riscv64,
+# armhf under qemu-user).
+cross-test:
+	sh tests/cross/run.sh
+
 clean:
 	rm -rf build out
 
-.PHONY: all run test check test-sanitize bench clean
+.PHONY: all run test check test-sanitize bench cross-test clean

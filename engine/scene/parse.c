@@ -973,7 +973,7 @@ static om_status do_object(parser *p, int cmd)
                             "'in' needs X0 <= X1, Y0 <= Y1 and Z0 <= Z1", NULL, 0, NULL);
     }
     om__xform xf;
-    uint16_t mat;
+    uint16_t mat = 0;
     if ((st = object_common(p, pl, &xf, &mat)) != OM_OK) return st;
     if (cmd == C_MESH) return do_mesh(p, &file, name, &xf, mat);
 
