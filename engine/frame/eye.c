@@ -83,6 +83,7 @@ void om__eye_pass(const om_scene *s, const om_view *v, const om_target *tg, om_s
 {
     om__scene_raster(s, &v->cam_vp, tg, OM_RASTER_DEPTH_ID);
     tri_cache cache;
+    memset(&cache, 0, sizeof cache);
     cache.tri = OM_NO_TRI;
     for (uint32_t y = 0; y < st->rows; y++) {
         double sy = 1.0 - ((double)(st->y0 + y) + 0.5) * 2.0 / (double)st->height;
