@@ -15,8 +15,15 @@ void om_host_puts(const char *line);
 #define H 120
 #define ROWS 8
 
-static unsigned char scene_mem[1u << 20];
-static unsigned char method_mem[24u << 20];
+#ifndef OM_CROSS_METHOD_MEM
+#define OM_CROSS_METHOD_MEM (24u << 20)
+#endif
+#ifndef OM_CROSS_SCENE_MEM
+#define OM_CROSS_SCENE_MEM (1u << 20)
+#endif
+
+static unsigned char scene_mem[OM_CROSS_SCENE_MEM];
+static unsigned char method_mem[OM_CROSS_METHOD_MEM];
 static unsigned char frame_mem[W * ROWS * 48];
 static uint8_t pixels[W * ROWS * 2];
 

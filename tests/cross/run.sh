@@ -66,5 +66,45 @@ for c in $configs; do
     IFS='
 '
 done
+# Cortex-M3 (mps2-an385) and Cortex-M4 (mps2-an386) under qemu-system-arm, through
+# platform/cortex-m: the same driver, the scene compiled into the firmware (the
+# default scene's text), method arenas in the board's 4 MB of RAM.
+MFLAGS="-std=c99 -Wall -Wextra -Werror -O2 -ffp-contract=off -ffreestanding -mthumb -Iinclude
+ -DOM_CROSS_METHOD_MEM=(3u<<20) -DOM_CROSS_SCENE_MEM=(512u<<10) -ffunction-sections -fdata-sections"
+for board in "cortex-m3 mps2-an385" "cortex-m4 mps2-an386"; do
+    IFS=' '
+    set -- $board
+    cpu=$1
+    machine=$2
+    name="$cpu-gcc-O2"
+    extra=""
+    [ "$cpu" = cortex-m4 ] && extra="-mfloat-abi=hard -mfpu=fpv4-sp-d16"
+    if ! command -v arm-none-eabi-gcc >/dev/null 2>&1 || ! command -v qemu-system-arm >/dev/null 2>&1; then
+        echo "cross: skip $name (arm-none-eabi-gcc or qemu-system-arm is not installed)"
+        skip=$((skip + 1))
+        continue
+    fi
+    msrc="$(ls engine/*/*.c | tr '\n' ' ') tests/cross/driver.c platform/cortex-m/startup.c platform/cortex-m/semihost.c"
+    if ! arm-none-eabi-gcc $(echo $MFLAGS) -mcpu=$cpu $extra $msrc -T platform/cortex-m/mps2.ld \
+            -nostartfiles -Wl,--gc-sections -lm -lc -lgcc -o "$out/$name.elf" 2>"$out/$name.err"; then
+        echo "cross: FAIL $name does not build: $(head -c 400 "$out/$name.err")"
+        fail=$((fail + 1))
+        continue
+    fi
+    if ! timeout 300 qemu-system-arm -M "$machine" -nographic -monitor none -serial none \
+            -semihosting-config enable=on,target=native -kernel "$out/$name.elf" >"$out/$name.txt" 2>&1; then
+        echo "cross: FAIL $name exits non-zero: $(head -c 400 "$out/$name.txt")"
+        fail=$((fail + 1))
+    elif [ -n "$ref" ] && [ "$(grep -v '^bytes' "$out/$ref.txt")" = "$(grep -v '^bytes' "$out/$name.txt")" ]; then
+        pass=$((pass + 1))
+        echo "cross: $name matches ($(arm-none-eabi-size "$out/$name.elf" | awk 'NR == 2 {print $1}') bytes of code)"
+        grep '^bytes' "$out/$name.txt" | sed 's/^bytes/    arena bytes:/'
+    else
+        fail=$((fail + 1))
+        echo "cross: FAIL $name differs from $ref:"
+        diff "$out/$ref.txt" "$out/$name.txt" | grep -v bytes | sed 's/^/    /'
+    fi
+done
+
 echo "cross: $pass passed, $fail failed, $skip skipped"
 [ "$fail" -eq 0 ]
