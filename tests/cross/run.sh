@@ -69,8 +69,8 @@ done
 # Cortex-M3 (mps2-an385) and Cortex-M4 (mps2-an386) under qemu-system-arm, through
 # platform/cortex-m: the same driver, the scene compiled into the firmware (the
 # default scene's text), method arenas in the board's 4 MB of RAM.
-MFLAGS="-std=c99 -Wall -Wextra -Werror -O2 -ffp-contract=off -ffreestanding -mthumb -Iinclude
- -DOM_CROSS_METHOD_MEM=(3u<<20) -DOM_CROSS_SCENE_MEM=(512u<<10) -ffunction-sections -fdata-sections"
+MFLAGS="-std=c99 -Wall -Wextra -Werror -O2 -ffp-contract=off -ffreestanding -mthumb -Iinclude"
+MFLAGS="$MFLAGS -DOM_CROSS_METHOD_MEM=(3u<<20) -DOM_CROSS_SCENE_MEM=(512u<<10) -ffunction-sections -fdata-sections"
 for board in "cortex-m3 mps2-an385" "cortex-m4 mps2-an386"; do
     IFS=' '
     set -- $board
@@ -85,7 +85,7 @@ for board in "cortex-m3 mps2-an385" "cortex-m4 mps2-an386"; do
         continue
     fi
     msrc="$(ls engine/*/*.c | tr '\n' ' ') tests/cross/driver.c platform/cortex-m/startup.c platform/cortex-m/semihost.c"
-    if ! arm-none-eabi-gcc $(echo $MFLAGS) -mcpu=$cpu $extra $msrc -T platform/cortex-m/mps2.ld \
+    if ! arm-none-eabi-gcc $MFLAGS -mcpu=$cpu $extra $msrc -T platform/cortex-m/mps2.ld \
             -nostartfiles -Wl,--gc-sections -lm -lc -lgcc -o "$out/$name.elf" 2>"$out/$name.err"; then
         echo "cross: FAIL $name does not build: $(head -c 400 "$out/$name.err")"
         fail=$((fail + 1))
