@@ -5,6 +5,7 @@
 #   make test-sanitize   the suite under ASan + UBSan
 #   make bench      benchmark figures (medians of several runs)
 #   make cross-test the same frames from every compiler and CPU (qemu-user)
+#   make fuzz       libFuzzer targets, FUZZ_SECONDS each; make test-valgrind
 
 CC      ?= cc
 OPT     ?= -O2
@@ -84,7 +85,17 @@ bench:
 cross-test:
 	sh tests/cross/run.sh
 
+# libFuzzer targets (clang, ASan, UBSan): FUZZ_SECONDS per target (default 60).
+fuzz: $(O)/ombra
+	sh tests/fuzz/run.sh
+
+# The suite under valgrind memcheck (no sanitizers in this build).
+test-valgrind:
+	$(MAKE) --no-print-directory $(O)/valgrind/run-tests O=$(O)/valgrind OPT=-O1
+	valgrind --error-exitcode=1 --leak-check=full --errors-for-leak-kinds=definite -q \
+	  $(O)/valgrind/run-tests
+
 clean:
 	rm -rf build out
 
-.PHONY: all run test check test-sanitize bench cross-test clean
+.PHONY: all run test check test-sanitize bench cross-test fuzz test-valgrind clean

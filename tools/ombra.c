@@ -14,6 +14,7 @@ static const char usage[] =
     "  info [SCENE]     triangles, bounds, and the bytes each method would need\n"
     "  compare A B      compare two shadow masks (PGM), A the reference\n"
     "  methods          list the shadow methods\n"
+    "  scene            print the built-in default scene (a start for your own)\n"
     "\n"
     "'ombra <command> --help' describes a command's options.\n";
 
@@ -27,6 +28,10 @@ int main(int argc, char **argv)
     if (!strcmp(argv[1], "render")) return cmd_render(argc - 1, argv + 1);
     if (!strcmp(argv[1], "info")) return cmd_info(argc - 1, argv + 1);
     if (!strcmp(argv[1], "compare")) return cmd_compare(argc - 1, argv + 1);
+    if (!strcmp(argv[1], "scene")) {
+        fputs(om_scene_default_text(), stdout);
+        return 0;
+    }
     if (!strcmp(argv[1], "methods")) {
         for (size_t i = 0; i < om_method_count(); i++)
             printf("%-6s %s\n", om_method_at(i)->name, om_method_at(i)->summary);
