@@ -92,7 +92,7 @@ fuzz: $(O)/ombra
 # The suite under valgrind memcheck (no sanitizers in this build).
 test-valgrind:
 	$(MAKE) --no-print-directory $(O)/valgrind/run-tests O=$(O)/valgrind OPT=-O1
-	valgrind --error-exitcode=1 --leak-check=full --errors-for-leak-kinds=definite -q \
+	OM_TEST_QUICK=1 valgrind --error-exitcode=1 --leak-check=full --errors-for-leak-kinds=definite -q \
 	  $(O)/valgrind/run-tests
 
 clean:

@@ -11,6 +11,7 @@
     X(suite_shadow) \
     X(suite_measure) \
     X(suite_izb) \
+    X(suite_robust) \
     /* end of list */
 #endif
 #define X(suite) void suite(void);

@@ -1,0 +1,284 @@
+/* test_robust.c — nothing crashes, nothing is lost: every arena carve of every method
+ * fails once in turn and the next frame still renders correctly; pathological geometry
+ * (NaN, infinities, 1e30, zero-area and needle triangles, coincident vertices) and
+ * views (empty scene, camera inside a mesh, everything behind the near plane, images
+ * of 0x0, 1x1 and 8192x8192) give a status and a message or a correct frame. */
+#include "test.h"
+#include "harness.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+#define W 48
+#define H 36
+
+static const char *small_scene =
+    "camera eye 0 3 6 target 0 0.5 0 size 48 36\n"
+    "light spot pos 2 7 1 target 0 0 0 fov 70 near 1 far 40\n"
+    "plane size 10 10\n"
+    "box size 1 1 1 translate 0 0.5 0\n"
+    "sphere radius 0.4 segments 12 rings 6 translate 1.2 0.6 0.5 opacity 0.5 albedo 0.2 0.5 0.9\n"
+    "triangles count 30 seed 4 area 1 in -2 1 -2 2 2 2\n";
+
+static om_method_cfg small_cfg(void)
+{
+    om_method_cfg c;
+    om_method_cfg_default(&c);
+    c.map_size = 128;
+    c.asm_cap = 1u << 20;
+    c.rtw_importance = 64;
+    return c;
+}
+
+typedef struct frame_ctx {
+    const om_scene *s;
+    om_view v;
+    const om_method *m;
+    om_method_cfg cfg;
+    uint8_t mask[W * H];
+} frame_ctx;
+
+static om_status grab(void *user, const om_strip *st, const om_framebuffer *fb)
+{
+    (void)fb;
+    uint8_t *mask = (uint8_t *)user;
+    for (uint32_t i = 0; i < st->rows * st->width; i++)
+        mask[st->y0 * st->width + i] = om_mask_of(&st->samples[i], &st->terms[i]);
+    return OM_OK;
+}
+
+static om_status frame(frame_ctx *f, void *state, om_arena *fa, uint8_t *mask)
+{
+    static uint8_t px[W * H * 3];
+    om_shade_cfg shade;
+    om_shade_cfg_default(&shade);
+    om_framebuffer fb = {OM_RGB888, W, 9, W * 3, px};
+    om_frame_desc fd;
+    memset(&fd, 0, sizeof fd);
+    fd.scene = f->s; fd.view = &f->v; fd.method = f->m; fd.method_state = state;
+    fd.shade = &shade; fd.strip_rows = 9; fd.fb = &fb; fd.on_strip = grab; fd.user = mask;
+    return om_render_frame(&fd, fa, NULL, NULL);
+}
+
+/* For every method: count the carves of init + two frames, then make each of them fail
+ * once in turn. The failing call returns OM_E_BUDGET; the frame after it (the carve
+ * counter has moved past the failure) renders the very mask of an undisturbed run. */
+static void failure_injection(void)
+{
+    h_scene hs;
+    if (!h_scene_parse(&hs, small_scene)) return;
+    frame_ctx f;
+    f.s = &hs.s;
+    f.cfg = small_cfg();
+    om_camera cam;
+    om_light light;
+    om_scene_at(&hs.s, 0, &cam, &light);
+    CHECK_OK(om_view_init(&f.v, &cam, &light, &hs.s, NULL));
+    static unsigned char fmem[W * 9 * 48];
+    for (size_t k = 0; k < om_method_count(); k++) {
+        f.m = om_method_at(k);
+        size_t mn, full;
+        CHECK_OK(f.m->bytes(&f.cfg, &hs.s, W, H, &mn, &full));
+        unsigned char *mem = malloc(full);
+        om_arena ma, fa;
+        void *state;
+        static uint8_t good[W * H], got[W * H];
+        /* undisturbed: two frames (progressive methods may change between them) */
+        om_arena_init(&ma, mem, full, "method");
+        om_arena_init(&fa, fmem, sizeof fmem, "frame");
+        CHECK_OK(f.m->init(&state, &ma, &f.cfg, &hs.s, W, H, NULL));
+        CHECK_OK(frame(&f, state, &fa, good));
+        uint32_t method_carves = ma.carves, frame_carves = fa.carves;
+        CHECK_OK(frame(&f, state, &fa, good));
+        method_carves = ma.carves;
+        CHECK_MSG(method_carves >= 1 && frame_carves == 4, "%s: %u method and %u frame carves",
+                  f.m->name, method_carves, frame_carves);
+        int bad = 0;
+        for (uint32_t n = 1; n <= method_carves + frame_carves; n++) {
+            om_arena_init(&ma, mem, full, "method");
+            om_arena_init(&fa, fmem, sizeof fmem, "frame");
+            if (n <= method_carves) ma.fail_at = n;
+            else fa.fail_at = n - method_carves;
+            om_status st = f.m->init(&state, &ma, &f.cfg, &hs.s, W, H, NULL);
+            if (st != OM_OK) {
+                if (st != OM_E_BUDGET) bad++;
+                /* init failed: a fresh init with the carve counter past the failure */
+                om_arena_init(&ma, mem, full, "method");
+                CHECK_OK(f.m->init(&state, &ma, &f.cfg, &hs.s, W, H, NULL));
+            }
+            st = frame(&f, state, &fa, got);
+            if (st != OM_OK && st != OM_E_BUDGET) bad++;
+            if (frame(&f, state, &fa, got) != OM_OK || memcmp(got, good, sizeof got) != 0) bad++;
+        }
+        CHECK_MSG(bad == 0, "%s: %d injected failures went wrong (of %u carves)", f.m->name, bad,
+                  method_carves + frame_carves);
+        free(mem);
+    }
+    /* the scene parser: every carve failing once gives OM_E_BUDGET, never a crash */
+    size_t bytes;
+    CHECK_OK(om_scene_bytes(small_scene, strlen(small_scene), NULL, &bytes, NULL));
+    unsigned char *smem = malloc(bytes);
+    for (uint32_t n = 1; n <= 8; n++) {
+        om_arena a;
+        om_scene s;
+        om_arena_init(&a, smem, bytes, "scene");
+        a.fail_at = n;
+        om_status st = om_scene_parse(small_scene, strlen(small_scene), NULL, &a, &s, NULL);
+        CHECK(st == OM_OK || st == OM_E_BUDGET);
+    }
+    free(smem);
+    h_scene_free(&hs);
+}
+
+/* A scene built by hand, so values the parser would refuse reach the engine. */
+static om_vec3 verts[32];
+static uint32_t idx[3 * 16];
+static uint16_t tmat[16];
+static om_material mats[1] = {{0.8f, 0.8f, 0.8f, 1.0f}};
+
+static void hand_scene(om_scene *s, uint32_t ntris)
+{
+    memset(s, 0, sizeof *s);
+    s->verts = verts; s->idx = idx; s->tri_mat = tmat; s->mats = mats;
+    s->nverts = 32; s->ntris = ntris; s->nmats = 1;
+    s->lo = (om_vec3){-10, 0, -10};
+    s->hi = (om_vec3){10, 3, 10};
+    s->camera = (om_camera){{0, 3, 6}, {0, 0.5f, 0}, {0, 1, 0}, 50, W, H, 0.1f, 100};
+    s->light.kind = OM_LIGHT_SPOT;
+    s->light.pos = (om_vec3){2, 7, 1};
+    s->light.target = (om_vec3){0, 0, 0};
+    s->light.fov_deg = 70;
+    s->light.znear = 1;
+    s->light.zfar = 40;
+    /* a floor (triangles 0, 1) and then whatever the case puts in triangles 2.. */
+    verts[0] = (om_vec3){-5, 0, -5}; verts[1] = (om_vec3){5, 0, -5};
+    verts[2] = (om_vec3){5, 0, 5}; verts[3] = (om_vec3){-5, 0, 5};
+    uint32_t fl[6] = {0, 2, 1, 0, 3, 2};
+    memcpy(idx, fl, sizeof fl);
+    for (int t = 2; t < 16; t++) { idx[3 * t] = 4 + 3 * (uint32_t)(t - 2) % 27; idx[3 * t + 1] = idx[3 * t] + 1; idx[3 * t + 2] = idx[3 * t] + 2; }
+}
+
+static void every_method_survives(const om_scene *s, const char *what)
+{
+    om_method_cfg c = small_cfg();
+    static uint8_t mask[W * H];
+    for (size_t k = 0; k < om_method_count(); k++) {
+        om_status st = h_render(s, om_method_at(k)->name, &c, W, H, 0, 7, mask, NULL, NULL);
+        CHECK_MSG(st == OM_OK, "%s: %s gave %s", what, om_method_at(k)->name, om_status_str(st));
+    }
+}
+
+static void pathological_geometry(void)
+{
+    om_scene s;
+    float nan = NAN, inf = INFINITY;
+    struct { const char *what; om_vec3 a, b, c; } cases[] = {
+        {"NaN vertex", {0, 1, 0}, {nan, 1, 0}, {0, 1, 1}},
+        {"infinite vertex", {0, 1, 0}, {inf, 1, 0}, {0, 1, -inf}},
+        {"1e30 coordinates", {-1e30f, 1, -1e30f}, {1e30f, 1, -1e30f}, {0, 1, 1e30f}},
+        {"zero-area triangle", {0, 1, 0}, {1, 1, 0}, {2, 1, 0}},
+        {"needle triangle", {-3, 1, 0}, {3, 1, 0}, {3, 1, 1e-6f}},
+        {"coincident vertices", {0.5f, 1, 0.5f}, {0.5f, 1, 0.5f}, {0.5f, 1, 0.5f}},
+        {"huge triangle", {-1e7f, 1.5f, -1e7f}, {1e7f, 1.5f, -1e7f}, {0, 1.5f, 1e7f}},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        hand_scene(&s, 3);
+        verts[4] = cases[k].a;
+        verts[5] = cases[k].b;
+        verts[6] = cases[k].c;
+        every_method_survives(&s, cases[k].what);
+    }
+    /* the parser refuses what it cannot represent, with line and column */
+    om_diag d;
+    size_t bytes;
+    CHECK(om_scene_bytes("box translate 1e30 0 0\n", 23, NULL, &bytes, &d) != OM_OK);
+    CHECK(d.line == 1 && d.col > 0);
+    CHECK(om_scene_bytes("box translate nan 0 0\n", 22, NULL, &bytes, &d) == OM_E_PARSE);
+}
+
+static void pathological_views(void)
+{
+    om_scene s;
+    hand_scene(&s, 0);
+    every_method_survives(&s, "empty scene");
+    /* camera inside a closed box */
+    h_scene hs;
+    if (!h_scene_parse(&hs, "camera eye 0 0.5 0 target 1 0.5 0 size 48 36\n"
+                            "light spot pos 2 7 1 target 0 0 0 fov 70 near 1 far 40\n"
+                            "plane size 10 10\nbox size 2 2 2 translate 0 1 0\n"))
+        return;
+    every_method_survives(&hs.s, "camera inside a box");
+    h_scene_free(&hs);
+    /* everything behind the near plane: all background */
+    if (!h_scene_parse(&hs, "camera eye 0 2 -20 target 0 2 -40 size 48 36\n"
+                            "light spot pos 2 7 1 target 0 0 0 fov 70 near 1 far 40\n"
+                            "plane size 10 10\nbox size 1 1 1\n"))
+        return;
+    every_method_survives(&hs.s, "scene behind the camera");
+    static uint8_t mask[W * H];
+    CHECK_OK(h_render(&hs.s, "ref", NULL, W, H, 0, 0, mask, NULL, NULL));
+    int fg = 0;
+    for (int i = 0; i < W * H; i++) fg += mask[i] != OM_MASK_BG;
+    CHECK_EQ_U(fg, 0);
+    h_scene_free(&hs);
+    /* image sizes */
+    hand_scene(&s, 2);
+    om_view v;
+    om_diag d;
+    om_camera cam = s.camera;
+    cam.width = cam.height = 0;
+    CHECK(om_view_init(&v, &cam, &s.light, &s, &d) == OM_E_INVALID);
+    CHECK(strstr(d.msg, "8192") != NULL);
+    cam.width = cam.height = 8193;
+    CHECK(om_view_init(&v, &cam, &s.light, &s, &d) == OM_E_INVALID);
+    om_method_cfg c = small_cfg();
+    for (size_t k = 0; k < om_method_count(); k++)
+        CHECK_OK(h_render(&s, om_method_at(k)->name, &c, 1, 1, 0, 0, mask, NULL, NULL));
+}
+
+/* The largest image, through strips, with the cheapest methods (the others follow the
+ * same frame code; their memory at this size is the stress runs' subject). */
+static void largest_image(void)
+{
+    if (getenv("OM_TEST_QUICK")) return;   /* valgrind runs skip the 67M-pixel frame */
+    om_scene s;
+    hand_scene(&s, 2);
+    static const char *names[] = {"none", "sm"};
+    om_method_cfg c = small_cfg();
+    for (int k = 0; k < 2; k++) {
+        const om_method *m = om_method_find(names[k]);
+        om_camera cam = s.camera;
+        cam.width = cam.height = 8192;
+        om_view v;
+        CHECK_OK(om_view_init(&v, &cam, &s.light, &s, NULL));
+        size_t mn, full, fbytes = om_frame_bytes(8192, 64);
+        CHECK_OK(m->bytes(&c, &s, 8192, 8192, &mn, &full));
+        void *mem = malloc(full), *fmem = malloc(fbytes), *px = malloc(8192 * 64 * 2);
+        om_arena ma, fa;
+        om_arena_init(&ma, mem, full, "method");
+        om_arena_init(&fa, fmem, fbytes, "frame");
+        void *state;
+        CHECK_OK(m->init(&state, &ma, &c, &s, 8192, 8192, NULL));
+        om_shade_cfg shade;
+        om_shade_cfg_default(&shade);
+        om_framebuffer fb = {OM_RGB565, 8192, 64, 8192 * 2, px};
+        om_frame_desc fd;
+        memset(&fd, 0, sizeof fd);
+        fd.scene = &s; fd.view = &v; fd.method = m; fd.method_state = state; fd.shade = &shade;
+        fd.strip_rows = 64; fd.fb = &fb;
+        om_frame_stats fs;
+        CHECK_OK(om_render_frame(&fd, &fa, &fs, NULL));
+        CHECK_EQ_U(fs.strips, 128);
+        free(mem);
+        free(fmem);
+        free(px);
+    }
+}
+
+void suite_robust(void)
+{
+    RUN(failure_injection);
+    RUN(pathological_geometry);
+    RUN(pathological_views);
+    RUN(largest_image);
+}
