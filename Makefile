@@ -85,6 +85,14 @@ bench:
 cross-test:
 	sh tests/cross/run.sh
 
+# Every method under every budget from 0 to one pass, with guard bytes.
+$(O)/stress: tests/stress/stress.c tests/bench/bench_main.c $(PLATFORM_OBJ) $(O)/libombra.a
+	$(Q)$(CC) $(CFLAGS_ALL) -DOM_BENCH_NO_MAIN -o $@ $(filter %.c %.o %.a,$^) $(LDLIBS)
+
+stress:
+	$(MAKE) --no-print-directory $(O)/stress OPT=-O2
+	$(O)/stress
+
 # libFuzzer targets (clang, ASan, UBSan): FUZZ_SECONDS per target (default 60).
 fuzz: $(O)/ombra
 	sh tests/fuzz/run.sh
@@ -98,4 +106,4 @@ test-valgrind:
 clean:
 	rm -rf build out
 
-.PHONY: all run test check test-sanitize bench cross-test fuzz test-valgrind clean
+.PHONY: all run test check test-sanitize bench cross-test fuzz test-valgrind stress clean

@@ -17,7 +17,8 @@ static om_status none_init(void **state, om_arena *a, const om_method_cfg *c,
                            const om_scene *s, uint32_t w, uint32_t h, om_diag *d)
 {
     (void)c; (void)s; (void)w; (void)h;
-    return om_arena_alloc(a, sizeof(none_state), 8, state, d);
+    om_status st = om__need(a, om_arena_need(sizeof(none_state), 8), "none", d);
+    return st ? st : om_arena_alloc(a, sizeof(none_state), 8, state, d);
 }
 
 static om_status none_begin(void *state, const om_view *v, om_diag *d)

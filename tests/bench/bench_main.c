@@ -126,6 +126,7 @@ int bench_run(const bscene *b, const char *name, const om_method_cfg *cfg, uint3
     return st != OM_OK;
 }
 
+#ifndef OM_BENCH_NO_MAIN
 int main(int argc, char **argv)
 {
     const char *filter = argc > 1 ? argv[1] : NULL;
@@ -135,3 +136,4 @@ int main(int argc, char **argv)
 #undef X
     return 0;
 }
+#endif
