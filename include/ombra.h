@@ -300,7 +300,9 @@ typedef struct om_method_stats {
 } om_method_stats;
 
 enum {
-    OM_METHOD_OBSERVES = 1u   /* wants every visible sample (observe) before build */
+    OM_METHOD_OBSERVES = 1u,  /* wants every visible sample (observe) before build */
+    OM_METHOD_EXACT = 2u      /* gives the reference's answer (charts of time against
+                                 triangle count compare these) */
 };
 
 /* A shadow method: a small table of functions behind one interface. A frame runs
@@ -328,6 +330,10 @@ typedef struct om_method {
 size_t om_method_count(void);
 const om_method *om_method_at(size_t i);
 const om_method *om_method_find(const char *name);
+/* The settings `ombra bench` sweeps for a method (listed beside it in the registry), as
+ * space-separated NAME=V1,V2,... lists whose product is swept; NULL = the defaults
+ * only, "" = left out of sweeps. */
+const char *om_method_sweep(const om_method *m);
 
 /* ---------------------------------------------------------------- rendering */
 

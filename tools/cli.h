@@ -36,6 +36,7 @@ bool cli_set(om_method_cfg *c, const char *setting);
 int cmd_render(int argc, char **argv);
 int cmd_info(int argc, char **argv);
 int cmd_compare(int argc, char **argv);
+int cmd_bench(int argc, char **argv);
 
 /* Host memory ran out: OM_E_BUDGET with a message. */
 om_status cli_oom(om_diag *d);

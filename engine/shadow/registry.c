@@ -9,6 +9,13 @@ static const om_method *const methods[] = {
     &om__method_izb,
 };
 
+/* What `ombra bench` sweeps, by method name (see om_method_sweep). */
+static const struct { const char *name, *sweep; } sweeps[] = {
+    {"none", ""},
+    {"sm", "map=256,512,1024,2048,4096,8192"},
+    {"izb", "izb.pool=0,65536,16384"},
+};
+
 size_t om_method_count(void) { return sizeof methods / sizeof methods[0]; }
 
 const om_method *om_method_at(size_t i)
@@ -26,6 +33,13 @@ const om_method *om_method_find(const char *name)
 {
     for (size_t i = 0; name && i < om_method_count(); i++)
         if (same_name(methods[i]->name, name)) return methods[i];
+    return NULL;
+}
+
+const char *om_method_sweep(const om_method *m)
+{
+    for (size_t i = 0; m && i < sizeof sweeps / sizeof sweeps[0]; i++)
+        if (same_name(sweeps[i].name, m->name)) return sweeps[i].sweep;
     return NULL;
 }
 

@@ -1,0 +1,445 @@
+/* bench.c — `ombra bench`: sweeps every method over the settings its registry entry
+ * names (om_method_sweep) on a set of scenes, and for each point prints and writes to
+ * CSV the median frame time per stage, the method's peak arena bytes and its accuracy
+ * against the reference on the same visible samples; then draws the charts: mismatch
+ * share against time per frame and against bytes (each method a series, its Pareto
+ * front dashed) and, for the exact methods, time against triangle count. A method
+ * joins every table and chart by its registry entry alone. */
+#define _POSIX_C_SOURCE 200809L
+#include "cli.h"
+#include "svg.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+static const char bench_help[] =
+    "usage: ombra bench [options]\n"
+    "\n"
+    "Sweeps every method's settings (see 'ombra methods') on a set of scenes and writes\n"
+    "a CSV table and SVG charts of accuracy against speed and memory.\n"
+    "\n"
+    "  --scenes LIST     comma-separated: default, random-1K, random-10K, random-100K,\n"
+    "                    random-1M, or scene files (default: default,random-10K)\n"
+    "  --methods LIST    comma-separated method names (default: every swept method)\n"
+    "  --size WxH        image size (default 640x480)\n"
+    "  --runs N          frames per point; times are their median (default 3)\n"
+    "  --tri-sweep       also time the exact methods on 1K..1M random triangles\n"
+    "  --out DIR         where bench.csv and the charts go (default out/bench)\n";
+
+typedef struct point {
+    char scene[64], method[16], setting[96];
+    double total, eye, observe, build, resolve, shade;
+    size_t bytes;
+    om_metrics m;
+    int ok;
+} point;
+
+static const char *random_scene(const char *name, char *buf, size_t n)
+{
+    unsigned count = 0;
+    if (!strcmp(name, "random-1K")) count = 1000;
+    else if (!strcmp(name, "random-10K")) count = 10000;
+    else if (!strcmp(name, "random-100K")) count = 100000;
+    else if (!strcmp(name, "random-1M")) count = 1000000;
+    if (!count) return NULL;
+    /* Table 1 of the Alias-Free Shadow Maps paper: constant total area. */
+    snprintf(buf, n,
+             "camera eye 0 6 14 target 0 1 0 fov 50 near 0.1 far 100\n"
+             "light spot pos 8 20 6 target 0 0 0 fov 60 near 5 far 60\n"
+             "plane size 14 14 albedo 0.7 0.7 0.7\n"
+             "triangles count %u seed 7 area 20 in -5 0.5 -5 5 3 5\n", count);
+    return buf;
+}
+
+static om_status load_scene(const char *name, cli_scene *cs, om_diag *d)
+{
+    char text[512];
+    if (!strcmp(name, "default")) return cli_scene_load(cs, NULL, d);
+    const char *r = random_scene(name, text, sizeof text);
+    if (!r) return cli_scene_load(cs, name, d);
+    memset(cs, 0, sizeof *cs);
+    size_t len = strlen(r);
+    om_status st = om_scene_bytes(r, len, NULL, &cs->bytes, d);
+    if (st) return st;
+    cs->mem = malloc(cs->bytes ? cs->bytes : 1);
+    om_arena_init(&cs->arena, cs->mem, cs->bytes, "scene");
+    return om_scene_parse(r, len, NULL, &cs->arena, &cs->scene, d);
+}
+
+typedef struct mask_out { uint8_t *mask; } mask_out;
+
+static om_status grab(void *user, const om_strip *st, const om_framebuffer *fb)
+{
+    (void)fb;
+    uint8_t *m = ((mask_out *)user)->mask;
+    for (uint32_t i = 0; i < st->rows * st->width; i++)
+        m[(size_t)st->y0 * st->width + i] = om_mask_of(&st->samples[i], &st->terms[i]);
+    return OM_OK;
+}
+
+static int cmp_d(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+static double median(double *v, int n)
+{
+    qsort(v, (size_t)n, sizeof *v, cmp_d);
+    return v[n / 2];
+}
+
+/* Init once, render `runs` frames (progressive methods refine meanwhile); times are
+ * medians over the frames, the mask is the last frame's. */
+static om_status measure(const om_method *m, const om_method_cfg *cfg, const cli_scene *cs,
+                         const om_view *v, int runs, uint8_t *mask, point *p, om_diag *d)
+{
+    uint32_t W = v->cam.width, H = v->cam.height;
+    size_t mn, full;
+    om_status st = m->bytes(cfg, &cs->scene, W, H, &mn, &full);
+    if (st) return st;
+    size_t fbytes = om_frame_bytes(W, H);
+    void *mem = malloc(full ? full : 1), *fmem = malloc(fbytes), *px = malloc((size_t)W * H * 3);
+    if (!mem || !fmem || !px) {
+        free(mem); free(fmem); free(px);
+        return cli_oom(d);
+    }
+    om_arena ma, fa;
+    om_arena_init(&ma, mem, full, "method");
+    om_arena_init(&fa, fmem, fbytes, "frame");
+    void *state;
+    double t[5][16];
+    if (runs > 16) runs = 16;
+    st = m->init(&state, &ma, cfg, &cs->scene, W, H, d);
+    for (int r = 0; r < runs && st == OM_OK; r++) {
+        om_shade_cfg shade;
+        om_shade_cfg_default(&shade);
+        om_framebuffer fb = {OM_RGB888, W, H, (size_t)W * 3, (uint8_t *)px};
+        mask_out mo = {mask};
+        om_frame_desc fd;
+        memset(&fd, 0, sizeof fd);
+        fd.scene = &cs->scene; fd.view = v; fd.method = m; fd.method_state = state;
+        fd.shade = &shade; fd.fb = &fb; fd.on_strip = grab; fd.user = &mo; fd.clock = om_clock_ns;
+        om_frame_stats fs;
+        st = om_render_frame(&fd, &fa, &fs, d);
+        t[0][r] = (double)fs.ns_eye / 1e6;
+        t[1][r] = (double)fs.ns_observe / 1e6;
+        t[2][r] = (double)fs.ns_build / 1e6;
+        t[3][r] = (double)fs.ns_resolve / 1e6;
+        t[4][r] = (double)fs.ns_shade / 1e6;
+    }
+    if (st == OM_OK) {
+        double tot[16];
+        for (int r = 0; r < runs; r++) tot[r] = t[0][r] + t[1][r] + t[2][r] + t[3][r] + t[4][r];
+        p->total = median(tot, runs);
+        p->eye = median(t[0], runs);
+        p->observe = median(t[1], runs);
+        p->build = median(t[2], runs);
+        p->resolve = median(t[3], runs);
+        p->shade = median(t[4], runs);
+        p->bytes = ma.peak;
+    }
+    free(mem);
+    free(fmem);
+    free(px);
+    return st;
+}
+
+/* The points of a sweep string: the product of its NAME=V1,V2 lists. */
+static int expand(const char *sweep, char out[][96], int max)
+{
+    char names[4][32], vals[4][8][24];
+    int nv[4] = {0}, nk = 0;
+    const char *s = sweep ? sweep : "";
+    while (*s && nk < 4) {
+        while (*s == ' ') s++;
+        const char *eq = strchr(s, '=');
+        if (!eq) break;
+        size_t l = (size_t)(eq - s) < 31 ? (size_t)(eq - s) : 31;
+        memcpy(names[nk], s, l);
+        names[nk][l] = 0;
+        s = eq + 1;
+        while (*s && *s != ' ' && nv[nk] < 8) {
+            size_t j = 0;
+            while (*s && *s != ',' && *s != ' ' && j < 23) vals[nk][nv[nk]][j++] = *s++;
+            vals[nk][nv[nk]++][j] = 0;
+            if (*s == ',') s++;
+        }
+        nk++;
+    }
+    int n = 1;
+    for (int k = 0; k < nk; k++) n *= nv[k];
+    if (n > max) n = max;
+    for (int i = 0; i < n; i++) {
+        out[i][0] = 0;
+        int rem = i;
+        for (int k = nk - 1; k >= 0; k--) {
+            char part[64];
+            snprintf(part, sizeof part, "%s=%s", names[k], vals[k][rem % nv[k]]);
+            rem /= nv[k];
+            char tmp[96];
+            snprintf(tmp, sizeof tmp, "%s%s%s", part, out[i][0] ? " " : "", out[i]);
+            memcpy(out[i], tmp, sizeof tmp);
+        }
+    }
+    return n;
+}
+
+static bool apply(om_method_cfg *c, const char *setting)
+{
+    char buf[96];
+    const char *p = setting;
+    while (*p) {   /* space-separated NAME=VALUE (no strtok: the caller is inside one) */
+        size_t n = strcspn(p, " ");
+        if (n && n < sizeof buf) {
+            memcpy(buf, p, n);
+            buf[n] = 0;
+            if (!cli_set(c, buf)) return false;
+        }
+        p += n;
+        while (*p == ' ') p++;
+    }
+    return true;
+}
+
+static bool in_list(const char *list, const char *name)
+{
+    if (!list) return true;
+    size_t n = strlen(name);
+    for (const char *p = list; (p = strstr(p, name)) != NULL; p += n)
+        if ((p == list || p[-1] == ',') && (p[n] == 0 || p[n] == ',')) return true;
+    return false;
+}
+
+static void progress(int i, int n, const point *p)
+{
+    if (isatty(2)) fprintf(stderr, "\r\033[K[%d/%d] %s %s %s", i, n, p->scene, p->method, p->setting);
+    else fprintf(stderr, "[%d/%d] %s %s %s\n", i, n, p->scene, p->method, p->setting);
+}
+
+static void chart(const char *dir, const char *file, const svg_chart *c, point *pts, int n,
+                  const char *scene, int ykind, int xkind)
+{
+    /* one series per method, over this scene's points */
+    svg_series s[16];
+    static double xs[16][64], ys[16][64];
+    static const char *labels[16][64];
+    size_t ns = 0;
+    for (size_t k = 0; k < om_method_count() && ns < 16; k++) {
+        const om_method *m = om_method_at(k);
+        size_t np = 0;
+        for (int i = 0; i < n && np < 64; i++) {
+            if (!pts[i].ok || strcmp(pts[i].method, m->name) || strcmp(pts[i].scene, scene)) continue;
+            double share = 1.0 - om_metrics_match(&pts[i].m);
+            xs[ns][np] = xkind == 0 ? pts[i].total : (double)pts[i].bytes;
+            ys[ns][np] = ykind == 0 ? share : pts[i].total;
+            labels[ns][np] = pts[i].setting;
+            np++;
+        }
+        if (!np) continue;
+        s[ns].name = m->name;
+        s[ns].x = xs[ns];
+        s[ns].y = ys[ns];
+        s[ns].n = np;
+        s[ns].labels = labels[ns];
+        ns++;
+    }
+    char path[1024];
+    snprintf(path, sizeof path, "%s/%s", dir, file);
+    FILE *f = fopen(path, "w");
+    if (!f || !svg_write(f, c, s, ns)) fprintf(stderr, "ombra: %s: cannot write\n", path);
+    if (f) fclose(f);
+}
+
+int cmd_bench(int argc, char **argv)
+{
+    const char *scenes = "default,random-10K", *methods = NULL, *dir = "out/bench";
+    uint32_t W = 640, H = 480, runs = 3;
+    bool tri_sweep = false;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
+        if (!strcmp(a, "--help") || !strcmp(a, "-h")) { fputs(bench_help, stdout); return 0; }
+        if (!strcmp(a, "--tri-sweep")) { tri_sweep = true; continue; }
+        if (!v) return cli_usage_error("bench", "unknown option or missing value: '%s'", a);
+        if (!strcmp(a, "--scenes")) scenes = v;
+        else if (!strcmp(a, "--methods")) methods = v;
+        else if (!strcmp(a, "--out")) dir = v;
+        else if (!strcmp(a, "--size")) { if (!cli_parse_size(v, &W, &H)) return cli_usage_error("bench", "--size takes WxH, not '%s'", v); }
+        else if (!strcmp(a, "--runs")) { if (!cli_parse_u32(v, 1, 16, &runs)) return cli_usage_error("bench", "--runs takes 1..16, not '%s'", v); }
+        else return cli_usage_error("bench", "unknown option '%s'", a);
+        i++;
+    }
+    char path[1024];
+    snprintf(path, sizeof path, "%s", dir);
+    for (char *p = path + 1; *p; p++)
+        if (*p == '/') { *p = 0; mkdir(path, 0777); *p = '/'; }
+    if (mkdir(path, 0777) != 0 && errno != EEXIST) {
+        fprintf(stderr, "ombra: %s: cannot create the output directory\n", dir);
+        return 1;
+    }
+    enum { MAXP = 512 };
+    point *pts = calloc(MAXP, sizeof *pts);
+    int np = 0;
+    uint8_t *ref = malloc((size_t)W * H), *mask = malloc((size_t)W * H);
+    char list[1024];
+    snprintf(list, sizeof list, "%s", scenes);
+    /* count the points for the progress line */
+    int total = 0, nscenes = 0;
+    for (const char *p = list; *p; nscenes++) { const char *c = strchr(p, ','); p = c ? c + 1 : p + strlen(p); }
+    for (size_t k = 0; k < om_method_count(); k++) {
+        const om_method *m = om_method_at(k);
+        char tmp[64][96];
+        if (om_method_sweep(m) && !om_method_sweep(m)[0]) continue;
+        if (in_list(methods, m->name)) total += expand(om_method_sweep(m), tmp, 64) * nscenes;
+    }
+    int rc = 0, done = 0;
+    for (char *name = strtok(list, ","); name; name = strtok(NULL, ",")) {
+        om_diag d;
+        memset(&d, 0, sizeof d);
+        cli_scene cs;
+        om_status st = load_scene(name, &cs, &d);
+        if (st) { rc = cli_error(name, &d, st); cli_scene_free(&cs); continue; }
+        om_camera cam;
+        om_light light;
+        om_view v;
+        om_scene_at(&cs.scene, 0, &cam, &light);
+        cam.width = W;
+        cam.height = H;
+        if ((st = om_view_init(&v, &cam, &light, &cs.scene, &d))) { rc = cli_error(name, &d, st); cli_scene_free(&cs); continue; }
+        point rp;
+        memset(&rp, 0, sizeof rp);
+        om_method_cfg rc_cfg;
+        om_method_cfg_default(&rc_cfg);
+        if ((st = measure(om_method_find("ref"), &rc_cfg, &cs, &v, 1, ref, &rp, &d))) {
+            rc = cli_error(name, &d, st);
+            cli_scene_free(&cs);
+            continue;
+        }
+        for (size_t k = 0; k < om_method_count() && np < MAXP; k++) {
+            const om_method *m = om_method_at(k);
+            if ((om_method_sweep(m) && !om_method_sweep(m)[0]) || !in_list(methods, m->name)) continue;
+            char settings[64][96];
+            int ns = expand(om_method_sweep(m), settings, 64);
+            if (ns == 0) { settings[0][0] = 0; ns = 1; }
+            for (int j = 0; j < ns && np < MAXP; j++) {
+                point *p = &pts[np];
+                snprintf(p->scene, sizeof p->scene, "%s", name);
+                snprintf(p->method, sizeof p->method, "%s", m->name);
+                snprintf(p->setting, sizeof p->setting, "%s", settings[j][0] ? settings[j] : "defaults");
+                progress(++done, total, p);
+                om_method_cfg cfg;
+                om_method_cfg_default(&cfg);
+                if (settings[j][0] && !apply(&cfg, settings[j])) continue;
+                st = measure(m, &cfg, &cs, &v, (int)runs, mask, p, &d);
+                if (st) {
+                    fprintf(stderr, "\nombra: %s %s on %s: %s\n", m->name, p->setting, name, d.msg);
+                    continue;
+                }
+                om_compare_masks(ref, mask, W, H, &p->m);
+                p->ok = 1;
+                np++;
+            }
+        }
+        cli_scene_free(&cs);
+    }
+    if (isatty(2)) fprintf(stderr, "\n");
+    /* the table */
+    snprintf(path, sizeof path, "%s/bench.csv", dir);
+    FILE *f = fopen(path, "w");
+    if (!f) { fprintf(stderr, "ombra: %s: cannot create\n", path); free(pts); return 1; }
+    fprintf(f, "scene,method,setting,width,height,time_ms,eye_ms,observe_ms,build_ms,resolve_ms,shade_ms,"
+               "bytes,samples,false_lit,false_shadowed,mismatch_share,edge_samples,edge_mismatch_share\n");
+    printf("%-12s %-5s %-28s %9s %9s %11s %9s %9s\n", "scene", "meth", "setting", "time ms",
+           "resolve", "bytes", "mismatch", "edge");
+    for (int i = 0; i < np; i++) {
+        point *p = &pts[i];
+        double share = 1.0 - om_metrics_match(&p->m);
+        double edge = p->m.edge_samples ? (double)(p->m.edge_false_lit + p->m.edge_false_shadowed) /
+                                              (double)p->m.edge_samples : 0.0;
+        fprintf(f, "%s,%s,%s,%u,%u,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%zu,%llu,%llu,%llu,%.6f,%llu,%.6f\n",
+                p->scene, p->method, p->setting, W, H, p->total, p->eye, p->observe, p->build,
+                p->resolve, p->shade, p->bytes, (unsigned long long)p->m.samples,
+                (unsigned long long)p->m.false_lit, (unsigned long long)p->m.false_shadowed, share,
+                (unsigned long long)p->m.edge_samples, edge);
+        printf("%-12s %-5s %-28s %9.2f %9.2f %11zu %8.4f%% %8.3f%%\n", p->scene, p->method,
+               p->setting, p->total, p->resolve, p->bytes, 100 * share, 100 * edge);
+    }
+    fclose(f);
+    /* the charts, one pair per scene */
+    snprintf(list, sizeof list, "%s", scenes);
+    for (char *name = strtok(list, ","); name; name = strtok(NULL, ",")) {
+        char file[256], title[256];
+        const char *base = strrchr(name, '/') ? strrchr(name, '/') + 1 : name;
+        svg_chart c = {title, "time per frame, ms", "mismatch share against ref", true, true, true, false};
+        snprintf(title, sizeof title, "%s at %ux%u: accuracy against speed", base, W, H);
+        snprintf(file, sizeof file, "%s-time.svg", base);
+        chart(dir, file, &c, pts, np, name, 0, 0);
+        svg_chart c2 = {title, "method bytes", "mismatch share against ref", true, true, true, false};
+        snprintf(title, sizeof title, "%s at %ux%u: accuracy against memory", base, W, H);
+        snprintf(file, sizeof file, "%s-bytes.svg", base);
+        chart(dir, file, &c2, pts, np, name, 0, 1);
+    }
+    /* time against triangle count, exact methods, random scenes 1K..1M */
+    if (tri_sweep) {
+        static const char *const counts[] = {"random-1K", "random-10K", "random-100K", "random-1M"};
+        static const double tris[] = {1e3, 1e4, 1e5, 1e6};
+        static double xs[16][4], ys[16][4];
+        svg_series s[16];
+        size_t ns = 0;
+        for (size_t k = 0; k < om_method_count() && ns < 16; k++) {
+            const om_method *m = om_method_at(k);
+            if (!(m->flags & OM_METHOD_EXACT)) continue;
+            size_t n = 0;
+            for (int j = 0; j < 4; j++) {
+                om_diag d;
+                cli_scene cs;
+                if (load_scene(counts[j], &cs, &d) == OM_OK) {
+                    om_camera cam;
+                    om_light light;
+                    om_view v;
+                    om_scene_at(&cs.scene, 0, &cam, &light);
+                    cam.width = W;
+                    cam.height = H;
+                    om_method_cfg cfg;
+                    om_method_cfg_default(&cfg);
+                    point p;
+                    memset(&p, 0, sizeof p);
+                    snprintf(p.scene, sizeof p.scene, "%s", counts[j]);
+                    snprintf(p.method, sizeof p.method, "%s", m->name);
+                    snprintf(p.setting, sizeof p.setting, "triangle sweep");
+                    progress(j + 1, 4, &p);
+                    if (om_view_init(&v, &cam, &light, &cs.scene, &d) == OM_OK &&
+                        measure(m, &cfg, &cs, &v, (int)runs, mask, &p, &d) == OM_OK) {
+                        xs[ns][n] = tris[j];
+                        ys[ns][n++] = p.total;
+                        printf("%-12s %-5s triangle sweep %9.2f ms\n", counts[j], m->name, p.total);
+                    }
+                }
+                cli_scene_free(&cs);
+            }
+            s[ns].name = m->name;
+            s[ns].x = xs[ns];
+            s[ns].y = ys[ns];
+            s[ns].n = n;
+            s[ns].labels = NULL;
+            ns++;
+        }
+        if (isatty(2)) fprintf(stderr, "\n");
+        snprintf(path, sizeof path, "%s/triangles.svg", dir);
+        FILE *g = fopen(path, "w");
+        char title[128];
+        snprintf(title, sizeof title, "exact methods at %ux%u: time against triangles", W, H);
+        svg_chart c = {title, "triangles", "time per frame, ms", true, true, false, true};
+        if (!g || !svg_write(g, &c, s, ns)) fprintf(stderr, "ombra: %s: cannot write\n", path);
+        if (g) fclose(g);
+    }
+    printf("wrote %s/bench.csv and the charts beside it\n", dir);
+    free(pts);
+    free(ref);
+    free(mask);
+    return rc;
+}
