@@ -329,7 +329,10 @@ int cmd_bench(int argc, char **argv)
                 point *p = &pts[np];
                 snprintf(p->scene, sizeof p->scene, "%s", name);
                 snprintf(p->method, sizeof p->method, "%s", m->name);
-                snprintf(p->setting, sizeof p->setting, "%s", settings[j][0] ? settings[j] : "defaults");
+                const char *label = settings[j][0] ? settings[j] : "defaults";
+                size_t ll = strlen(label) < sizeof p->setting ? strlen(label) : sizeof p->setting - 1;
+                memcpy(p->setting, label, ll);
+                p->setting[ll] = '\0';
                 progress(++done, total, p);
                 om_method_cfg cfg;
                 om_method_cfg_default(&cfg);
