@@ -94,6 +94,17 @@ has "$dir/err" "one size" "size mismatch explained"
 expect 1 "compare a non-PGM" -- "$OMBRA" compare "$dir/ref.pgm" "$dir/ok.scene"
 has "$dir/err" "ok.scene" "bad mask file named"
 
+# A small sweep: one CSV row per point with every column filled, well-formed SVG.
+expect 0 "bench sweep" -- "$OMBRA" bench --scenes "$dir/ok.scene" --size 48x36 --runs 1 --methods ref,izb --out "$dir/bench"
+rows=$(tail -n +2 "$dir/bench/bench.csv" | wc -l)
+if [ "$rows" -eq 4 ]; then ok; else bad "bench.csv has $rows rows, wanted 4 (ref + 3 izb pools)"; fi
+if awk -F, 'NR == 1 {n = NF} NF != n {exit 1} {for (i = 1; i <= NF; i++) if ($i == "") exit 1}' "$dir/bench/bench.csv"; then ok; else bad "bench.csv has empty or missing columns"; fi
+if [ -s "$dir/bench/ok.scene-time.svg" ] && [ -s "$dir/bench/ok.scene-bytes.svg" ]; then ok; else bad "bench charts written"; fi
+if command -v xmllint >/dev/null 2>&1; then
+    xmllint --noout "$dir"/bench/*.svg && ok || bad "bench SVG is not well-formed"
+fi
+expect 2 "bench with a bad option" -- "$OMBRA" bench --frobnicate 1
+
 # Frame hashes of every method on the default scene, for the cross-build comparison
 # that `make test` runs (the same frames from every compiler and optimisation level).
 hashes=$(dirname "$OMBRA")/frame-hashes.txt
