@@ -53,6 +53,7 @@ $(O)/bench: $(BENCH_SRC) $(PLATFORM_OBJ) $(O)/libombra.a $(wildcard tests/bench/
 run: $(O)/ombra
 	@mkdir -p out
 	$(O)/ombra render --out out/default.ppm --mask out/default-mask.pgm
+	$(O)/ombra report --scenes default --size 640x480 --runs 3 --out out/report
 
 # One suite, four builds: the same tests must pass under gcc and clang at -O0 and -O2.
 test:

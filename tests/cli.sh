@@ -104,6 +104,11 @@ if command -v xmllint >/dev/null 2>&1; then
     xmllint --noout "$dir"/bench/*.svg && ok || bad "bench SVG is not well-formed"
 fi
 expect 2 "bench with a bad option" -- "$OMBRA" bench --frobnicate 1
+expect 0 "report" -- "$OMBRA" report --scenes "$dir/ok.scene" --size 64x48 --runs 1 --out "$dir/report"
+if grep -q '<svg' "$dir/report/index.html" && grep -q 'data:image/png;base64' "$dir/report/index.html"; then ok; else bad "report carries its charts and crops"; fi
+if command -v xmllint >/dev/null 2>&1; then
+    xmllint --noout "$dir/report/index.html" && ok || bad "report page is not well-formed"
+fi
 
 # Frame hashes of every method on the default scene, for the cross-build comparison
 # that `make test` runs (the same frames from every compiler and optimisation level).

@@ -30,13 +30,6 @@ static const char bench_help[] =
     "  --tri-sweep       also time the exact methods on 1K..1M random triangles\n"
     "  --out DIR         where bench.csv and the charts go (default out/bench)\n";
 
-typedef struct point {
-    char scene[64], method[16], setting[96];
-    double total, eye, observe, build, resolve, shade;
-    size_t bytes;
-    om_metrics m;
-    int ok;
-} point;
 
 static const char *random_scene(const char *name, char *buf, size_t n)
 {
@@ -55,7 +48,7 @@ static const char *random_scene(const char *name, char *buf, size_t n)
     return buf;
 }
 
-static om_status load_scene(const char *name, cli_scene *cs, om_diag *d)
+om_status cli_load_named(const char *name, cli_scene *cs, om_diag *d)
 {
     char text[512];
     if (!strcmp(name, "default")) return cli_scene_load(cs, NULL, d);
@@ -70,14 +63,14 @@ static om_status load_scene(const char *name, cli_scene *cs, om_diag *d)
     return om_scene_parse(r, len, NULL, &cs->arena, &cs->scene, d);
 }
 
-typedef struct mask_out { uint8_t *mask; } mask_out;
+typedef struct mask_out { uint8_t *mask, *rgb; } mask_out;
 
 static om_status grab(void *user, const om_strip *st, const om_framebuffer *fb)
 {
-    (void)fb;
-    uint8_t *m = ((mask_out *)user)->mask;
+    mask_out *o = (mask_out *)user;
     for (uint32_t i = 0; i < st->rows * st->width; i++)
-        m[(size_t)st->y0 * st->width + i] = om_mask_of(&st->samples[i], &st->terms[i]);
+        o->mask[(size_t)st->y0 * st->width + i] = om_mask_of(&st->samples[i], &st->terms[i]);
+    if (o->rgb) memcpy(o->rgb + (size_t)st->y0 * st->width * 3, fb->pixels, (size_t)st->rows * fb->stride);
     return OM_OK;
 }
 
@@ -95,8 +88,8 @@ static double median(double *v, int n)
 
 /* Init once, render `runs` frames (progressive methods refine meanwhile); times are
  * medians over the frames, the mask is the last frame's. */
-static om_status measure(const om_method *m, const om_method_cfg *cfg, const cli_scene *cs,
-                         const om_view *v, int runs, uint8_t *mask, point *p, om_diag *d)
+om_status cli_measure(const om_method *m, const om_method_cfg *cfg, const cli_scene *cs,
+                      const om_view *v, int runs, uint8_t *mask, uint8_t *rgb, cli_point *p, om_diag *d)
 {
     uint32_t W = v->cam.width, H = v->cam.height;
     size_t mn, full;
@@ -119,7 +112,7 @@ static om_status measure(const om_method *m, const om_method_cfg *cfg, const cli
         om_shade_cfg shade;
         om_shade_cfg_default(&shade);
         om_framebuffer fb = {OM_RGB888, W, H, (size_t)W * 3, (uint8_t *)px};
-        mask_out mo = {mask};
+        mask_out mo = {mask, rgb};
         om_frame_desc fd;
         memset(&fd, 0, sizeof fd);
         fd.scene = &cs->scene; fd.view = v; fd.method = m; fd.method_state = state;
@@ -215,13 +208,13 @@ static bool in_list(const char *list, const char *name)
     return false;
 }
 
-static void progress(int i, int n, const point *p)
+static void progress(int i, int n, const cli_point *p)
 {
     if (isatty(2)) fprintf(stderr, "\r\033[K[%d/%d] %s %s %s", i, n, p->scene, p->method, p->setting);
     else fprintf(stderr, "[%d/%d] %s %s %s\n", i, n, p->scene, p->method, p->setting);
 }
 
-static void chart(const char *dir, const char *file, const svg_chart *c, point *pts, int n,
+static void chart(const char *dir, const char *file, const svg_chart *c, cli_point *pts, int n,
                   const char *scene, int ykind, int xkind)
 {
     /* one series per method, over this scene's points */
@@ -282,7 +275,7 @@ int cmd_bench(int argc, char **argv)
         return 1;
     }
     enum { MAXP = 512 };
-    point *pts = calloc(MAXP, sizeof *pts);
+    cli_point *pts = calloc(MAXP, sizeof *pts);
     int np = 0;
     uint8_t *ref = malloc((size_t)W * H), *mask = malloc((size_t)W * H);
     char list[1024];
@@ -301,7 +294,7 @@ int cmd_bench(int argc, char **argv)
         om_diag d;
         memset(&d, 0, sizeof d);
         cli_scene cs;
-        om_status st = load_scene(name, &cs, &d);
+        om_status st = cli_load_named(name, &cs, &d);
         if (st) { rc = cli_error(name, &d, st); cli_scene_free(&cs); continue; }
         om_camera cam;
         om_light light;
@@ -310,11 +303,11 @@ int cmd_bench(int argc, char **argv)
         cam.width = W;
         cam.height = H;
         if ((st = om_view_init(&v, &cam, &light, &cs.scene, &d))) { rc = cli_error(name, &d, st); cli_scene_free(&cs); continue; }
-        point rp;
+        cli_point rp;
         memset(&rp, 0, sizeof rp);
         om_method_cfg rc_cfg;
         om_method_cfg_default(&rc_cfg);
-        if ((st = measure(om_method_find("ref"), &rc_cfg, &cs, &v, 1, ref, &rp, &d))) {
+        if ((st = cli_measure(om_method_find("ref"), &rc_cfg, &cs, &v, 1, ref, NULL, &rp, &d))) {
             rc = cli_error(name, &d, st);
             cli_scene_free(&cs);
             continue;
@@ -326,7 +319,7 @@ int cmd_bench(int argc, char **argv)
             int ns = expand(om_method_sweep(m), settings, 64);
             if (ns == 0) { settings[0][0] = 0; ns = 1; }
             for (int j = 0; j < ns && np < MAXP; j++) {
-                point *p = &pts[np];
+                cli_point *p = &pts[np];
                 snprintf(p->scene, sizeof p->scene, "%s", name);
                 snprintf(p->method, sizeof p->method, "%s", m->name);
                 const char *label = settings[j][0] ? settings[j] : "defaults";
@@ -337,7 +330,7 @@ int cmd_bench(int argc, char **argv)
                 om_method_cfg cfg;
                 om_method_cfg_default(&cfg);
                 if (settings[j][0] && !apply(&cfg, settings[j])) continue;
-                st = measure(m, &cfg, &cs, &v, (int)runs, mask, p, &d);
+                st = cli_measure(m, &cfg, &cs, &v, (int)runs, mask, NULL, p, &d);
                 if (st) {
                     fprintf(stderr, "\nombra: %s %s on %s: %s\n", m->name, p->setting, name, d.msg);
                     continue;
@@ -359,7 +352,7 @@ int cmd_bench(int argc, char **argv)
     printf("%-12s %-5s %-28s %9s %9s %11s %9s %9s\n", "scene", "meth", "setting", "time ms",
            "resolve", "bytes", "mismatch", "edge");
     for (int i = 0; i < np; i++) {
-        point *p = &pts[i];
+        cli_point *p = &pts[i];
         double share = 1.0 - om_metrics_match(&p->m);
         double edge = p->m.edge_samples ? (double)(p->m.edge_false_lit + p->m.edge_false_shadowed) /
                                               (double)p->m.edge_samples : 0.0;
@@ -400,7 +393,7 @@ int cmd_bench(int argc, char **argv)
             for (int j = 0; j < 4; j++) {
                 om_diag d;
                 cli_scene cs;
-                if (load_scene(counts[j], &cs, &d) == OM_OK) {
+                if (cli_load_named(counts[j], &cs, &d) == OM_OK) {
                     om_camera cam;
                     om_light light;
                     om_view v;
@@ -409,14 +402,14 @@ int cmd_bench(int argc, char **argv)
                     cam.height = H;
                     om_method_cfg cfg;
                     om_method_cfg_default(&cfg);
-                    point p;
+                    cli_point p;
                     memset(&p, 0, sizeof p);
                     snprintf(p.scene, sizeof p.scene, "%s", counts[j]);
                     snprintf(p.method, sizeof p.method, "%s", m->name);
                     snprintf(p.setting, sizeof p.setting, "triangle sweep");
                     progress(j + 1, 4, &p);
                     if (om_view_init(&v, &cam, &light, &cs.scene, &d) == OM_OK &&
-                        measure(m, &cfg, &cs, &v, (int)runs, mask, &p, &d) == OM_OK) {
+                        cli_measure(m, &cfg, &cs, &v, (int)runs, mask, NULL, &p, &d) == OM_OK) {
                         xs[ns][n] = tris[j];
                         ys[ns][n++] = p.total;
                         printf("%-12s %-5s triangle sweep %9.2f ms\n", counts[j], m->name, p.total);

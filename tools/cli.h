@@ -38,6 +38,24 @@ int cmd_info(int argc, char **argv);
 int cmd_compare(int argc, char **argv);
 int cmd_bench(int argc, char **argv);
 
+/* One measured sweep point (ombra bench, ombra report). */
+typedef struct cli_point {
+    char scene[64], method[16], setting[96];
+    double total, eye, observe, build, resolve, shade;
+    size_t bytes;
+    om_metrics m;
+    int ok;
+} cli_point;
+
+/* Loads "default", "random-1K" ... "random-1M", or a scene file. */
+om_status cli_load_named(const char *name, cli_scene *cs, om_diag *d);
+/* Inits `m` with its one-pass bytes and renders `runs` frames of view `v`; median
+ * times into p, the last frame's mask (and shaded RGB888 pixels, if rgb) out. */
+om_status cli_measure(const om_method *m, const om_method_cfg *cfg, const cli_scene *cs,
+                      const om_view *v, int runs, uint8_t *mask, uint8_t *rgb, cli_point *p,
+                      om_diag *d);
+int cmd_report(int argc, char **argv);
+
 /* Host memory ran out: OM_E_BUDGET with a message. */
 om_status cli_oom(om_diag *d);
 

@@ -15,6 +15,7 @@ static const char usage[] =
     "  compare A B      compare two shadow masks (PGM), A the reference\n"
     "  bench            sweep the methods' settings: CSV and SVG charts of accuracy\n"
     "                   against time and memory\n"
+    "  report           the sweep as one HTML page: charts, table, crops\n"
     "  methods          list the shadow methods\n"
     "  scene            print the built-in default scene (a start for your own)\n"
     "\n"
@@ -31,6 +32,7 @@ int main(int argc, char **argv)
     if (!strcmp(argv[1], "info")) return cmd_info(argc - 1, argv + 1);
     if (!strcmp(argv[1], "compare")) return cmd_compare(argc - 1, argv + 1);
     if (!strcmp(argv[1], "bench")) return cmd_bench(argc - 1, argv + 1);
+    if (!strcmp(argv[1], "report")) return cmd_report(argc - 1, argv + 1);
     if (!strcmp(argv[1], "scene")) {
         fputs(om_scene_default_text(), stdout);
         return 0;
