@@ -53,6 +53,7 @@ $(O)/bench: $(BENCH_SRC) $(PLATFORM_OBJ) $(O)/libombra.a $(wildcard tests/bench/
 run: $(O)/ombra
 	@mkdir -p out
 	$(O)/ombra render --out out/default.ppm --mask out/default-mask.pgm
+	$(MAKE) --no-print-directory stability
 	$(O)/ombra report --scenes default --size 640x480 --runs 3 --out out/report
 
 # One suite, four builds: the same tests must pass under gcc and clang at -O0 and -O2.
@@ -94,6 +95,15 @@ stress:
 	$(MAKE) --no-print-directory $(O)/stress OPT=-O2
 	$(O)/stress
 
+# Every method along the failure cases' paths (tests/stability/*.scene).
+$(O)/stability: tests/stability/stability.c tests/bench/bench_main.c $(PLATFORM_OBJ) $(O)/libombra.a
+	$(Q)$(CC) $(CFLAGS_ALL) -DOM_BENCH_NO_MAIN -o $@ $(filter %.c %.o %.a,$^) $(LDLIBS)
+
+stability:
+	$(MAKE) --no-print-directory $(O)/stability OPT=-O2
+	@mkdir -p out/report
+	$(O)/stability --csv out/report/stability.csv $(sort $(wildcard tests/stability/*.scene))
+
 # libFuzzer targets (clang, ASan, UBSan): FUZZ_SECONDS per target (default 60).
 fuzz: $(O)/ombra
 	sh tests/fuzz/run.sh
@@ -107,4 +117,4 @@ test-valgrind:
 clean:
 	rm -rf build out
 
-.PHONY: all run test check test-sanitize bench cross-test fuzz test-valgrind stress clean
+.PHONY: all run test check test-sanitize bench cross-test fuzz test-valgrind stress stability clean

@@ -224,6 +224,18 @@ int cmd_report(int argc, char **argv)
     char *names[16];
     int nn = 0;
     for (char *name = strtok(list, ","); name && nn < 16; name = strtok(NULL, ",")) names[nn++] = name;
+    snprintf(path, sizeof path, "%s/stability.csv", dir);
+    FILE *st = fopen(path, "r");
+    if (st) {
+        fclose(st);
+        fprintf(f, "<h2>Stability: where each method is known to fail</h2>\n"
+                   "<p>Every method along the 30-frame camera and light paths of the cases in "
+                   "<code>tests/stability/</code> (<code>make stability</code>): mismatch share "
+                   "against the reference (mean and worst frame), the same near shadow edges, "
+                   "flicker (state changes the reference does not have), median frame time and "
+                   "arena bytes.</p>\n");
+        table(f, path);
+    }
     for (int i = 0; i < nn; i++)
         if ((rc = scene_section(f, names[i], W, H)) != 0) break;
     fprintf(f, "</body>\n</html>\n");
