@@ -54,7 +54,7 @@ run: $(O)/ombra
 	@mkdir -p out
 	$(O)/ombra render --out out/default.ppm --mask out/default-mask.pgm
 	$(MAKE) --no-print-directory stability
-	$(O)/ombra report --scenes default --size 640x480 --runs 3 --out out/report
+	$(O)/ombra report --scenes default --size 640x480 --runs 3 --tri-sweep --out out/report
 
 # One suite, four builds: the same tests must pass under gcc and clang at -O0 and -O2.
 test:

@@ -194,7 +194,7 @@ int cmd_report(int argc, char **argv)
     fprintf(f, "<!DOCTYPE html>\n<html xmlns=\"http://www.w3.org/1999/xhtml\" lang=\"en\">\n<head>\n"
                "<meta charset=\"utf-8\"/>\n<title>ombra report</title>\n<style>\n"
                "body { font-family: sans-serif; margin: 2em; color: #222; }\n"
-               "table { border-collapse: collapse; font-size: 12px; }\n"
+               "table { border-collapse: collapse; font-size: 12px; display: block; overflow-x: auto; }\n"
                "td, th { border: 1px solid #ccc; padding: 2px 6px; text-align: right; }\n"
                "img { image-rendering: pixelated; border: 1px solid #888; }\n"
                ".strip { display: flex; flex-wrap: wrap; gap: 8px; }\n"
