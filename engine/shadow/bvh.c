@@ -28,10 +28,18 @@ static float box_area(const box *b)
     return dx < 0 ? 0.0f : dx * dy + dy * dz + dz * dx;
 }
 
-size_t om__bvh_bytes(const om_scene *s)
+/* Every leaf holds at least half a leaf's worth (a split never leaves less), so there
+ * are at most n / that many leaves and twice as many nodes. */
+static size_t node_bound(size_t n, uint32_t leaf)
+{
+    size_t least = leaf / 2 ? leaf / 2 : 1, leaves = n / least;
+    return 2 * (leaves ? leaves : 1);
+}
+
+size_t om__bvh_bytes(const om_scene *s, uint32_t leaf)
 {
     size_t n = s->ntris ? s->ntris : 1;
-    return om_arena_need((2 * n - 1) * sizeof(om__bvh_node), 16) +
+    return om_arena_need(node_bound(n, leaf) * sizeof(om__bvh_node), 16) +
            om_arena_need(n * sizeof(uint32_t), 4);
 }
 
@@ -42,29 +50,74 @@ size_t om__bvh_scratch_bytes(const om_scene *s)
 
 typedef struct job { uint32_t node, first, count; } job;
 
-om_status om__bvh_build(om__bvh *b, om_arena *a, const om_scene *s, om_diag *d)
+/* A triangle's box: from the scratch array when the arena had room for it, else from
+ * its vertices (slower, the same numbers). */
+typedef struct boxes { const om_scene *s; const box *tb; } boxes;
+
+static box tri_box(const boxes *bx, uint32_t t)
+{
+    if (bx->tb) return bx->tb[t];
+    box r;
+    box_empty(&r);
+    for (int k = 0; k < 3; k++) {
+        const om_vec3 *v = &bx->s->verts[bx->s->idx[3 * (size_t)t + k]];
+        float p[3] = {v->x, v->y, v->z};
+        box_grow(&r, p, p);
+    }
+    return r;
+}
+
+static float centre(const boxes *bx, uint32_t t, int axis)
+{
+    box b = tri_box(bx, t);
+    return (b.lo[axis] + b.hi[axis]) * 0.5f;
+}
+
+/* Puts the k-th smallest centroid (along axis) of tris[0..n) at k: quickselect. */
+static void select_median(uint32_t *tris, const boxes *bx, uint32_t n, uint32_t k, int axis)
+{
+    uint32_t lo = 0, hi = n - 1;
+    while (lo < hi) {
+        float pivot = centre(bx, tris[lo + (hi - lo) / 2], axis);
+        uint32_t i = lo, j = hi;
+        while (i <= j) {
+            while (centre(bx, tris[i], axis) < pivot) i++;
+            while (centre(bx, tris[j], axis) > pivot) j--;
+            if (i <= j) {
+                uint32_t t = tris[i]; tris[i] = tris[j]; tris[j] = t;
+                i++;
+                if (j == 0) break;
+                j--;
+            }
+        }
+        if (k <= j) hi = j;
+        else if (k >= i) lo = i;
+        else return;
+    }
+}
+
+om_status om__bvh_build(om__bvh *b, om_arena *a, const om_scene *s, uint32_t leaf, om_diag *d)
 {
     void *pn, *pt, *pb;
     om_status st;
     size_t n = s->ntris ? s->ntris : 1;
+    const uint32_t least = leaf / 2 ? leaf / 2 : 1;
+    size_t cap = node_bound(n, leaf);
     memset(b, 0, sizeof *b);
-    if ((st = om_arena_alloc(a, (2 * n - 1) * sizeof(om__bvh_node), 16, &pn, d)) ||
+    if ((st = om_arena_alloc(a, cap * sizeof(om__bvh_node), 16, &pn, d)) ||
         (st = om_arena_alloc(a, n * sizeof(uint32_t), 4, &pt, d)))
         return st;
     b->nodes = (om__bvh_node *)pn;
     b->tris = (uint32_t *)pt;
     size_t mark = om_arena_mark(a);
-    if ((st = om_arena_alloc(a, n * sizeof(box), 4, &pb, d))) return st;
-    box *tb = (box *)pb;
-    for (uint32_t t = 0; t < s->ntris; t++) {
-        box_empty(&tb[t]);
-        for (int k = 0; k < 3; k++) {
-            const om_vec3 *v = &s->verts[s->idx[3 * t + k]];
-            float p[3] = {v->x, v->y, v->z};
-            box_grow(&tb[t], p, p);
-        }
-        b->tris[t] = t;
+    boxes bx = {s, NULL};
+    if (om_arena_left(a) >= om__bvh_scratch_bytes(s)) {
+        if ((st = om_arena_alloc(a, n * sizeof(box), 4, &pb, d))) return st;
+        box *tb = (box *)pb;
+        for (uint32_t t = 0; t < s->ntris; t++) tb[t] = tri_box(&bx, t);
+        bx.tb = tb;
     }
+    for (uint32_t t = 0; t < s->ntris; t++) b->tris[t] = t;
     b->nnodes = 1;
     job stack[STACK];
     int sp = 0;
@@ -80,10 +133,10 @@ om_status om__bvh_build(om__bvh *b, om_arena *a, const om_scene *s, om_diag *d)
         box_empty(&bb);
         box_empty(&cb);
         for (uint32_t i = j.first; i < j.first + j.count; i++) {
-            const box *t = &tb[b->tris[i]];
+            box t = tri_box(&bx, b->tris[i]);
             float c[3];
-            for (int k = 0; k < 3; k++) c[k] = (t->lo[k] + t->hi[k]) * 0.5f;
-            box_grow(&bb, t->lo, t->hi);
+            for (int k = 0; k < 3; k++) c[k] = (t.lo[k] + t.hi[k]) * 0.5f;
+            box_grow(&bb, t.lo, t.hi);
             box_grow(&cb, c, c);
         }
         if (j.count == 0) { box_empty(&bb); for (int k = 0; k < 3; k++) bb.lo[k] = bb.hi[k] = 0; }
@@ -91,7 +144,7 @@ om_status om__bvh_build(om__bvh *b, om_arena *a, const om_scene *s, om_diag *d)
         memcpy(nd->hi, bb.hi, sizeof bb.hi);
         nd->first = j.first;
         nd->count = j.count;
-        if (j.count <= OM_BVH_LEAF || sp + 2 > STACK) continue;
+        if (j.count <= leaf || sp + 2 > STACK || b->nnodes + 2 > cap) continue;
         int axis = 0;
         for (int k = 1; k < 3; k++)
             if (cb.hi[k] - cb.lo[k] > cb.hi[axis] - cb.lo[axis]) axis = k;
@@ -104,12 +157,12 @@ om_status om__bvh_build(om__bvh *b, om_arena *a, const om_scene *s, om_diag *d)
             for (int k = 0; k < BINS; k++) box_empty(&bin[k]);
             float scale = (float)BINS / ext;
             for (uint32_t i = j.first; i < j.first + j.count; i++) {
-                const box *t = &tb[b->tris[i]];
-                float c = (t->lo[axis] + t->hi[axis]) * 0.5f;
+                box t = tri_box(&bx, b->tris[i]);
+                float c = (t.lo[axis] + t.hi[axis]) * 0.5f;
                 int k = (int)((c - cb.lo[axis]) * scale);
                 k = k < 0 ? 0 : k >= BINS ? BINS - 1 : k;
                 cnt[k]++;
-                box_grow(&bin[k], t->lo, t->hi);
+                box_grow(&bin[k], t.lo, t.hi);
             }
             float right_area[BINS];
             uint32_t right_cnt[BINS];
@@ -137,8 +190,7 @@ om_status om__bvh_build(om__bvh *b, om_arena *a, const om_scene *s, om_diag *d)
                 /* partition in place: bins <= split go left */
                 uint32_t lo = j.first, hi = j.first + j.count;
                 while (lo < hi) {
-                    const box *t = &tb[b->tris[lo]];
-                    float cc = (t->lo[axis] + t->hi[axis]) * 0.5f;
+                    float cc = centre(&bx, b->tris[lo], axis);
                     int k = (int)((cc - cb.lo[axis]) * scale);
                     k = k < 0 ? 0 : k >= BINS ? BINS - 1 : k;
                     if (k <= split) lo++;
@@ -146,12 +198,17 @@ om_status om__bvh_build(om__bvh *b, om_arena *a, const om_scene *s, om_diag *d)
                 }
                 mid = lo;
             } else {
-                mid = j.first + j.count / 2;
+                mid = j.first;   /* no useful bin boundary: the median below */
             }
         } else {
-            mid = j.first + j.count / 2;   /* all centroids coincide: split by count */
+            mid = j.first;       /* all centroids coincide: the median below splits by count */
         }
-        if (mid == j.first || mid == j.first + j.count) mid = j.first + j.count / 2;
+        if (mid < j.first + least || mid > j.first + j.count - least) {
+            /* too small a child: split at the centroid median instead, which bounds the
+             * node count by the leaf size */
+            mid = j.first + j.count / 2;
+            select_median(b->tris + j.first, &bx, j.count, j.count / 2, axis);
+        }
         uint32_t child = b->nnodes;
         b->nnodes += 2;
         nd->first = child;

@@ -1,13 +1,13 @@
 /* bvh.h — a bounding volume hierarchy over a scene's triangles, built once in an arena
- * (binned surface-area heuristic, leaves of at most OM_BVH_LEAF triangles) and walked
- * along shadow segments. Nodes are 32 bytes; a node with count 0 is inner and its
- * children sit at `first` and `first + 1`. */
+ * (binned surface-area heuristic; a node splits while it holds more than `leaf`
+ * triangles, and never into a child of fewer than half that, so the node count is
+ * bounded by the leaf size) and walked along shadow segments. Nodes are 32 bytes; a
+ * node with count 0 is inner and its children sit at `first` and `first + 1`. */
 #ifndef OM_BVH_H
 #define OM_BVH_H
 
 #include "../core/core.h"
 
-#define OM_BVH_LEAF 4
 
 typedef struct om__bvh_node {
     float lo[3], hi[3];
@@ -21,9 +21,9 @@ typedef struct om__bvh {
 } om__bvh;
 
 /* Bytes the BVH keeps, and the scratch its build needs on top (released after). */
-size_t om__bvh_bytes(const om_scene *s);
+size_t om__bvh_bytes(const om_scene *s, uint32_t leaf);
 size_t om__bvh_scratch_bytes(const om_scene *s);
-om_status om__bvh_build(om__bvh *b, om_arena *a, const om_scene *s, om_diag *d);
+om_status om__bvh_build(om__bvh *b, om_arena *a, const om_scene *s, uint32_t leaf, om_diag *d);
 
 /* A segment o + t * dir, t in [0, tmax], with boxes grown by `margin` on every side.
  * `visit` is called for every triangle in a leaf whose box the segment meets; it

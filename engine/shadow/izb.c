@@ -37,9 +37,11 @@ static uint32_t node_bound(uint32_t samples, uint32_t leaf)
     return 2 * (leaves ? leaves : 1) + 1;
 }
 
-static size_t fixed_bytes(const om_scene *s)
+/* What izb keeps besides its pools; the per-frame vertex projection only when the
+ * arena has room for one pass (it speeds up triangle setup, it changes no result). */
+static size_t fixed_bytes(const om_scene *s, bool cache)
 {
-    return om_arena_need(sizeof(izb_state), 16) + om__lspace_bytes(s) +
+    return om_arena_need(sizeof(izb_state), 16) + (cache ? om__lspace_bytes(s) : 0) +
            om_arena_need((size_t)(s->nmats ? s->nmats : 1) * sizeof(om__odepth), 4);
 }
 
@@ -56,8 +58,8 @@ static om_status izb_bytes(const om_method_cfg *c, const om_scene *s, uint32_t w
     if (c->izb_leaf < 1) return OM_E_INVALID;
     uint32_t one_pass = w * h, smallest = w;   /* the smallest tile: one row */
     if (c->izb_pool) one_pass = smallest = c->izb_pool;
-    *min = fixed_bytes(s) + pool_bytes(smallest, c->izb_leaf);
-    *full = fixed_bytes(s) + pool_bytes(one_pass, c->izb_leaf);
+    *min = fixed_bytes(s, false) + pool_bytes(smallest, c->izb_leaf);
+    *full = fixed_bytes(s, true) + pool_bytes(one_pass, c->izb_leaf);
     return OM_OK;
 }
 
@@ -78,7 +80,11 @@ static om_status izb_init(void **state, om_arena *a, const om_method_cfg *c, con
     m->height = h;
     z->scene = s;
     z->leaf = c->izb_leaf;
-    if ((st = om__lspace_init(&z->ls, a, s, d))) return st;
+    if (om_arena_left(a) >= full - om_arena_need(sizeof(izb_state), 16)) {
+        if ((st = om__lspace_init(&z->ls, a, s, d))) return st;
+    } else {
+        om__lspace_init_lean(&z->ls, s);
+    }
     if ((st = om_arena_alloc(a, (size_t)(s->nmats ? s->nmats : 1) * sizeof(om__odepth), 4, &p, d)))
         return st;
     z->mat_od = (om__odepth *)p;
@@ -322,8 +328,9 @@ void om__izb_raster(om__izb *z)
         /* Cheap rejection by the projected vertices before any setup: the tile's
          * light-space bounds and its farthest sample. */
         const uint32_t *ix = sc->idx + (size_t)t * 3;
-        const om__lvert *a = &z->ls.verts[ix[0]], *b = &z->ls.verts[ix[1]], *c = &z->ls.verts[ix[2]];
-        if (a->x != INT32_MIN && b->x != INT32_MIN && c->x != INT32_MIN) {
+        const om__lvert *a = z->ls.verts ? &z->ls.verts[ix[0]] : NULL;
+        const om__lvert *b = a ? &z->ls.verts[ix[1]] : NULL, *c = a ? &z->ls.verts[ix[2]] : NULL;
+        if (a && a->x != INT32_MIN && b->x != INT32_MIN && c->x != INT32_MIN) {
             if ((a->x < root->x0 && b->x < root->x0 && c->x < root->x0) ||
                 (a->x > root->x1 && b->x > root->x1 && c->x > root->x1) ||
                 (a->y < root->y0 && b->y < root->y0 && c->y < root->y0) ||
@@ -363,7 +370,7 @@ static void izb_stats(const void *state, om_method_stats *out)
     const izb_state *m = (const izb_state *)state;
     const om__izb *z = &m->z;
     memset(out, 0, sizeof *out);
-    out->bytes_used = fixed_bytes(z->scene) + pool_bytes(z->cap, z->leaf);
+    out->bytes_used = fixed_bytes(z->scene, z->ls.verts != NULL) + pool_bytes(z->cap, z->leaf);
     static const char *const names[] = {"bsp nodes", "nodes visited", "nodes culled (shadowed)",
                                         "nodes culled (depth)", "samples tested", "tiles",
                                         "pool samples"};

@@ -17,11 +17,17 @@ om_status om__lspace_init(om__lspace *ls, om_arena *a, const om_scene *s, om_dia
     return st;
 }
 
+void om__lspace_init_lean(om__lspace *ls, const om_scene *s)
+{
+    memset(ls, 0, sizeof *ls);
+    ls->scene = s;
+}
+
 void om__lspace_begin(om__lspace *ls, const om_view *v)
 {
     const om_scene *s = ls->scene;
     ls->vp = v->light_vp;
-    for (uint32_t i = 0; i < s->nverts; i++) {
+    for (uint32_t i = 0; ls->verts && i < s->nverts; i++) {
         om_vec4 c = om__mat_apply(&ls->vp, s->verts[i]);
         om__lvert *o = &ls->verts[i];
         int64_t X, Y;
@@ -65,13 +71,14 @@ static void add_sub(om__ltri *lt, const int64_t x[3], const int64_t y[3], const 
 bool om__lspace_tri(const om__lspace *ls, uint32_t t, om__ltri *lt)
 {
     const uint32_t *ix = ls->scene->idx + (size_t)t * 3;
-    const om__lvert *a = &ls->verts[ix[0]], *b = &ls->verts[ix[1]], *c = &ls->verts[ix[2]];
     lt->n = 0;
     lt->tri = t;
     lt->lox = lt->loy = INT64_MAX;
     lt->hix = lt->hiy = INT64_MIN;
     lt->zmin = 4294967296.0;
-    if (a->x != INT32_MIN && b->x != INT32_MIN && c->x != INT32_MIN) {
+    const om__lvert *a = ls->verts ? &ls->verts[ix[0]] : NULL;
+    const om__lvert *b = ls->verts ? &ls->verts[ix[1]] : NULL, *c = ls->verts ? &ls->verts[ix[2]] : NULL;
+    if (a && a->x != INT32_MIN && b->x != INT32_MIN && c->x != INT32_MIN) {
         int64_t x[3] = {a->x, b->x, c->x}, y[3] = {a->y, b->y, c->y};
         double z[3] = {a->z, b->z, c->z};
         add_sub(lt, x, y, z);

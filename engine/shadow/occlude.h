@@ -34,11 +34,16 @@ typedef struct om__lvert { int32_t x, y; double z; } om__lvert;
 typedef struct om__lspace {
     const om_scene *scene;
     om_mat4 vp;            /* the light's world -> clip */
-    om__lvert *verts;      /* scene->nverts, from the caller's arena */
+    om__lvert *verts;      /* scene->nverts projected once per frame; NULL: lean mode */
 } om__lspace;
 
+/* Bytes of the per-frame vertex projection (om__lspace_init). */
 size_t om__lspace_bytes(const om_scene *s);
 om_status om__lspace_init(om__lspace *ls, om_arena *a, const om_scene *s, om_diag *d);
+/* Lean mode: no memory, every triangle is projected when it is set up. The results are
+ * the same bits (a vertex inside every plane projects exactly as clipping projects it);
+ * only the speed differs. */
+void om__lspace_init_lean(om__lspace *ls, const om_scene *s);
 /* Projects every vertex for this frame's light. */
 void om__lspace_begin(om__lspace *ls, const om_view *v);
 /* Projects a sample; false when it is not in front of the light. */
@@ -61,6 +66,7 @@ bool om__lspace_tri(const om__lspace *ls, uint32_t t, om__ltri *out);
  * a triangle that needs no clipping); true when the full test is needed. */
 static inline bool om__lspace_maybe(const om__lspace *ls, uint32_t t, const om__lpoint *p)
 {
+    if (!ls->verts) return true;
     const uint32_t *ix = ls->scene->idx + (size_t)t * 3;
     const om__lvert *a = &ls->verts[ix[0]], *b = &ls->verts[ix[1]], *c = &ls->verts[ix[2]];
     if (a->x == INT32_MIN || b->x == INT32_MIN || c->x == INT32_MIN) return true;

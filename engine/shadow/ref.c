@@ -17,12 +17,20 @@ typedef struct ref_state {
     om__odepth *mat_od;
     om_view view;
     float margin;
+    bool fast;             /* one-pass memory: vertex projection cache, small leaves */
     uint32_t samples, candidates, blocked;
 } ref_state;
 
-static size_t state_bytes(const om_scene *s)
+/* Two sizes: one pass (the per-frame vertex projection and a BVH with leaves of 4, the
+ * fastest) and the least (no projection cache, leaves of 32: a fraction of the nodes,
+ * for small machines). Both give the same bits; only the speed differs. */
+#define LEAF_FAST 4
+#define LEAF_SMALL 32
+
+static size_t state_bytes(const om_scene *s, bool fast)
 {
-    return om_arena_need(sizeof(ref_state), 16) + om__lspace_bytes(s) + om__bvh_bytes(s) +
+    return om_arena_need(sizeof(ref_state), 16) + (fast ? om__lspace_bytes(s) : 0) +
+           om__bvh_bytes(s, fast ? LEAF_FAST : LEAF_SMALL) +
            om_arena_need((size_t)(s->nmats ? s->nmats : 1) * sizeof(om__odepth), 4);
 }
 
@@ -30,7 +38,8 @@ static om_status ref_bytes(const om_method_cfg *c, const om_scene *s, uint32_t w
                            size_t *min, size_t *full)
 {
     (void)c; (void)w; (void)h;
-    *min = *full = state_bytes(s) + om__bvh_scratch_bytes(s);
+    *min = state_bytes(s, false);   /* the build then finds boxes from the vertices */
+    *full = state_bytes(s, true) + om__bvh_scratch_bytes(s);
     return OM_OK;
 }
 
@@ -40,16 +49,19 @@ static om_status ref_init(void **state, om_arena *a, const om_method_cfg *c, con
     (void)c; (void)w; (void)h;
     om_status st;
     void *p;
-    if ((st = om__need(a, state_bytes(s) + om__bvh_scratch_bytes(s), "ref", d))) return st;
+    if ((st = om__need(a, state_bytes(s, false), "ref", d))) return st;
+    bool fast = om_arena_left(a) >= state_bytes(s, true) + om__bvh_scratch_bytes(s);
     if ((st = om_arena_alloc(a, sizeof(ref_state), 16, &p, d))) return st;
     ref_state *r = (ref_state *)p;
     r->scene = s;
-    if ((st = om__lspace_init(&r->ls, a, s, d))) return st;
+    r->fast = fast;
+    if (fast && (st = om__lspace_init(&r->ls, a, s, d))) return st;
+    if (!fast) om__lspace_init_lean(&r->ls, s);
     if ((st = om_arena_alloc(a, (size_t)(s->nmats ? s->nmats : 1) * sizeof(om__odepth), 4, &p, d)))
         return st;
     r->mat_od = (om__odepth *)p;
     for (uint32_t i = 0; i < s->nmats; i++) r->mat_od[i] = om__material_odepth(&s->mats[i]);
-    if ((st = om__bvh_build(&r->bvh, a, s, d))) return st;
+    if ((st = om__bvh_build(&r->bvh, a, s, fast ? LEAF_FAST : LEAF_SMALL, d))) return st;
     *state = r;
     return OM_OK;
 }
@@ -145,7 +157,7 @@ static void ref_stats(const void *state, om_method_stats *out)
 {
     const ref_state *r = (const ref_state *)state;
     memset(out, 0, sizeof *out);
-    out->bytes_used = state_bytes(r->scene);
+    out->bytes_used = state_bytes(r->scene, r->fast);
     out->counters[0] = r->samples;
     out->counter_names[0] = "samples";
     out->counters[1] = r->candidates;
