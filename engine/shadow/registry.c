@@ -14,6 +14,9 @@ static const struct { const char *name, *sweep; } sweeps[] = {
     {"none", ""},
     {"sm", "map=256,512,1024,2048,4096,8192"},
     {"izb", "izb.pool=0,65536,16384"},
+    {"asm", "asm.cap=1048576,4194304,8388608,16777216"},
+    {"rtw", "map=512,1024,2048 rtw.tess=0,0.05,0.025"},
+    {"spsm", "map=512,1024,2048,4096"},
 };
 
 size_t om_method_count(void) { return sizeof methods / sizeof methods[0]; }
