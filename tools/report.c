@@ -18,25 +18,28 @@ static const char report_help[] =
     "the table, and crops of each scene where the methods disagree most (default: the\n"
     "default scene at 640x480 into out/report).\n";
 
-#define CROP 64
+#define CROP_MAX 64
 #define ZOOM 3
 
-/* mask -> grey RGB: lit light, shadowed dark, background black */
-static void mask_rgb(const uint8_t *mask, uint32_t W, uint32_t x0, uint32_t y0, uint8_t *rgb)
+/* mask -> grey RGB: lit light, shadowed dark, background black; crops are crop x crop
+ * (CROP_MAX, or less for a smaller image) */
+static void mask_rgb(const uint8_t *mask, uint32_t W, uint32_t x0, uint32_t y0, uint32_t crop,
+                     uint8_t *rgb)
 {
-    for (uint32_t y = 0; y < CROP; y++)
-        for (uint32_t x = 0; x < CROP; x++) {
+    for (uint32_t y = 0; y < crop; y++)
+        for (uint32_t x = 0; x < crop; x++) {
             uint8_t m = mask[(size_t)(y0 + y) * W + x0 + x];
             uint8_t v = m == OM_MASK_LIT ? 235 : m == OM_MASK_SHADOW ? 60 : 0;
-            uint8_t *o = rgb + 3 * ((size_t)y * CROP + x);
+            uint8_t *o = rgb + 3 * ((size_t)y * crop + x);
             o[0] = o[1] = o[2] = v;
         }
 }
 
-static void crop_rgb(const uint8_t *full, uint32_t W, uint32_t x0, uint32_t y0, uint8_t *rgb)
+static void crop_rgb(const uint8_t *full, uint32_t W, uint32_t x0, uint32_t y0, uint32_t crop,
+                     uint8_t *rgb)
 {
-    for (uint32_t y = 0; y < CROP; y++)
-        memcpy(rgb + (size_t)y * CROP * 3, full + ((size_t)(y0 + y) * W + x0) * 3, CROP * 3);
+    for (uint32_t y = 0; y < crop; y++)
+        memcpy(rgb + (size_t)y * crop * 3, full + ((size_t)(y0 + y) * W + x0) * 3, crop * 3);
 }
 
 static void img(FILE *f, const uint8_t *rgb, uint32_t w, uint32_t h, uint32_t zoom, const char *alt)
@@ -116,14 +119,15 @@ static int scene_section(FILE *f, const char *name, uint32_t W, uint32_t H)
         else free(masks[nm]);
     }
     /* the window (stepping by 8) with the most disagreements, summed over methods */
+    const uint32_t crop = W < CROP_MAX || H < CROP_MAX ? (W < H ? W : H) : CROP_MAX;
     uint32_t bx = 0, by = 0;
     uint64_t best = 0;
-    for (uint32_t y0 = 0; y0 + CROP <= H; y0 += 8)
-        for (uint32_t x0 = 0; x0 + CROP <= W; x0 += 8) {
+    for (uint32_t y0 = 0; y0 + crop <= H; y0 += 8)
+        for (uint32_t x0 = 0; x0 + crop <= W; x0 += 8) {
             uint64_t s = 0;
             for (size_t k = 0; k < nm; k++)
-                for (uint32_t y = y0; y < y0 + CROP; y += 2)
-                    for (uint32_t x = x0; x < x0 + CROP; x += 2) {
+                for (uint32_t y = y0; y < y0 + crop; y += 2)
+                    for (uint32_t x = x0; x < x0 + crop; x += 2) {
                         size_t i = (size_t)y * W + x;
                         s += masks[k][i] != ref[i] && ref[i] != OM_MASK_BG;
                     }
@@ -133,26 +137,26 @@ static int scene_section(FILE *f, const char *name, uint32_t W, uint32_t H)
     fprintf(f, "<h2>");
     svg_escape(f, base);
     fprintf(f, " at %ux%u</h2>\n<p>The reference frame; the crops below are its %ux%u pixels at "
-               "(%u, %u), where the methods disagree most with the reference.</p>\n", W, H, CROP, CROP, bx, by);
+               "(%u, %u), where the methods disagree most with the reference.</p>\n", W, H, crop, crop, bx, by);
     img(f, frame, W, H, 1, "reference frame");
-    uint8_t rgb[CROP * CROP * 3], *dm = malloc(n * 3);
+    uint8_t rgb[CROP_MAX * CROP_MAX * 3], *dm = malloc(n * 3);
     fprintf(f, "\n<div class=\"strip\">\n<figure>");
-    crop_rgb(frame, W, bx, by, rgb);
-    img(f, rgb, CROP, CROP, ZOOM, "frame crop");
+    crop_rgb(frame, W, bx, by, crop, rgb);
+    img(f, rgb, crop, crop, ZOOM, "frame crop");
     fprintf(f, "<figcaption>frame</figcaption></figure>\n<figure>");
-    mask_rgb(ref, W, bx, by, rgb);
-    img(f, rgb, CROP, CROP, ZOOM, "reference mask");
+    mask_rgb(ref, W, bx, by, crop, rgb);
+    img(f, rgb, crop, crop, ZOOM, "reference mask");
     fprintf(f, "<figcaption>ref</figcaption></figure>\n");
     for (size_t k = 0; k < nm; k++) {
         om_metrics mt;
         om_compare_masks(ref, masks[k], W, H, &mt);
         fprintf(f, "<figure>");
-        mask_rgb(masks[k], W, bx, by, rgb);
-        img(f, rgb, CROP, CROP, ZOOM, ms[k]->name);
+        mask_rgb(masks[k], W, bx, by, crop, rgb);
+        img(f, rgb, crop, crop, ZOOM, ms[k]->name);
         fprintf(f, "<figcaption>%s mask</figcaption></figure>\n<figure>", ms[k]->name);
         om_diff_image(ref, masks[k], W, H, dm);
-        crop_rgb(dm, W, bx, by, rgb);
-        img(f, rgb, CROP, CROP, ZOOM, "difference");
+        crop_rgb(dm, W, bx, by, crop, rgb);
+        img(f, rgb, crop, crop, ZOOM, "difference");
         fprintf(f, "<figcaption>%s diff, %.3f%% of the frame wrong</figcaption></figure>\n",
                 ms[k]->name, 100.0 * (1.0 - om_metrics_match(&mt)));
         free(masks[k]);

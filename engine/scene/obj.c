@@ -42,7 +42,6 @@ static om_status obj_fail(const obj_ctx *c, om_status st, uint32_t col, const ch
     return obj_end(c, &s, st);
 }
 
-static bool is_digit(char ch) { return ch >= '0' && ch <= '9'; }
 
 /* A signed integer; magnitudes saturate (an index that large is out of range anyway). */
 static bool read_int(const char *s, size_t n, size_t *i, int64_t *v)
@@ -50,9 +49,9 @@ static bool read_int(const char *s, size_t n, size_t *i, int64_t *v)
     size_t j = *i;
     bool neg = false;
     if (j < n && (s[j] == '-' || s[j] == '+')) neg = s[j++] == '-';
-    if (j >= n || !is_digit(s[j])) return false;
+    if (j >= n || !om__is_digit(s[j])) return false;
     int64_t x = 0;
-    for (; j < n && is_digit(s[j]); j++)
+    for (; j < n && om__is_digit(s[j]); j++)
         if (x < 1000000000000LL) x = x * 10 + (s[j] - '0');
     *v = neg ? -x : x;
     *i = j;

@@ -12,6 +12,15 @@
 
 /* ---- lines and tokens */
 
+static inline size_t om__cstr_len(const char *s)   /* strlen, which the engine may not call */
+{
+    size_t n = 0;
+    while (s[n]) n++;
+    return n;
+}
+
+static inline bool om__is_digit(char c) { return c >= '0' && c <= '9'; }
+
 /* A cursor over the lines of a text. A line's content stops at '#' (comment) or at
  * '\n'; '\r', ' ' and '\t' separate tokens, so CRLF text reads like LF text. */
 typedef struct om__line {
