@@ -12,6 +12,7 @@
     X(suite_measure) \
     X(suite_izb) \
     X(suite_robust) \
+    X(suite_rtw) \
     /* end of list */
 #endif
 #define X(suite) void suite(void);

@@ -3,13 +3,10 @@
  * Build: the scene's depth from the light with the engine's rasterizer (depth format of
  * raster.h: z/w * 2^32 as uint32, sampled at texel centres). Lookup: a sample, moved
  * along its normal by `normal_offset` texels, is shadowed in a texel when its light
- * depth minus the bias is beyond the stored depth. The bias is given in world units
- * along the light ray and converted to depth units at the sample:
- *     bias = bias_const + bias_slope * texel * tan(angle between normal and light)
- * (texel = the world size of one texel at the sample; tan clamped at 10), so the
- * slope term is in texels. k x k PCF averages the binary tests; a sample is lit only
- * when every tap is. */
+ * depth minus the bias is beyond the stored depth; the bias rules and PCF live in
+ * smlookup.c, shared with the RTW map. */
 #include "shadow.h"
+#include "smlookup.h"
 
 typedef struct sm_state {
     const om_scene *scene;
@@ -17,7 +14,7 @@ typedef struct sm_state {
     uint32_t size;
     uint32_t *depth;
     om_view view;
-    float span_per_dist;   /* spot: frustum width per unit of distance, 2 tan(fov / 2) */
+    om__smlook look;       /* the biased depth test, shared with rtw (smlookup.c) */
     uint32_t samples, shadowed;
 } sm_state;
 
@@ -53,6 +50,13 @@ static om_status sm_init(void **state, om_arena *a, const om_method_cfg *c, cons
     m->size = c->map_size;
     if ((st = om_arena_alloc(a, (size_t)m->size * m->size * sizeof(uint32_t), 16, &p, d))) return st;
     m->depth = (uint32_t *)p;
+    m->look.depth = m->depth;
+    m->look.size = m->size;
+    m->look.bias_const = c->bias_const;
+    m->look.bias_slope = c->bias_slope;
+    m->look.normal_offset = c->normal_offset;
+    m->look.pcf = c->pcf;
+    m->look.warp = NULL;
     *state = m;
     return OM_OK;
 }
@@ -62,7 +66,7 @@ static om_status sm_begin(void *state, const om_view *v, om_diag *d)
     (void)d;
     sm_state *m = (sm_state *)state;
     m->view = *v;
-    m->span_per_dist = 2.0f * (float)om__tan((double)v->light.fov_deg * OM_PI / 360.0);
+    om__smlook_begin(&m->look, &m->view);
     m->samples = m->shadowed = 0;
     return OM_OK;
 }
@@ -82,58 +86,6 @@ static om_status sm_build(void *state, om_diag *d)
     return OM_OK;
 }
 
-/* World size of one texel at distance `dist` along the light's axis. */
-static float texel_world(const sm_state *m, float dist)
-{
-    const om_view *v = &m->view;
-    float span = v->light.kind == OM_LIGHT_SPOT ? dist * m->span_per_dist
-                                                : 2.0f / fabsf(v->light_proj.m[0]);
-    return span / (float)m->size;
-}
-
-static void lookup(sm_state *m, const om_sample *smp, om_term *t)
-{
-    const om_view *v = &m->view;
-    om_vec3 p = om__v3(smp->p[0], smp->p[1], smp->p[2]);
-    om_vec3 n = om__v3(smp->n[0], smp->n[1], smp->n[2]);
-    if (om__dot(n, om__sub(v->cam.eye, p)) < 0.0f) n = om__scale(n, -1.0f);
-    om_vec3 l = om__to_light(v, p);
-    float dist = v->light.kind == OM_LIGHT_SPOT ? om__dot(om__sub(p, v->light.pos), v->light_axis) : 1.0f;
-    float texel = texel_world(m, dist);
-    float cosang = om__dot(n, l);
-    float tanang = cosang > 0.0995f ? sqrtf(1.0f - cosang * cosang) / cosang : 10.0f;
-    float bias = m->cfg.bias_const + m->cfg.bias_slope * texel * tanang;
-    p = om__add(p, om__scale(n, m->cfg.normal_offset * texel));
-    om_vec4 q = om__mat_apply(&v->light_vp, p);
-    if (!(q.w > 0.0f)) return;
-    double iw = 1.0 / (double)q.w;
-    double u = ((double)q.x * iw + 1.0) * 0.5 * m->size, w = (1.0 - (double)q.y * iw) * 0.5 * m->size;
-    double z = (double)q.z * iw * 4294967296.0;
-    /* bias from world units to depth units: d(z/w)/d(distance) at this sample */
-    double dz;
-    if (v->light.kind == OM_LIGHT_SPOT) {
-        double f = v->light.zfar, nn = v->light.znear, e = dist > nn * 0.5f ? dist : nn * 0.5;
-        dz = f * nn / ((f - nn) * e * e) * 4294967296.0;
-    } else {
-        dz = 4294967296.0 * fabs((double)v->light_proj.m[10]);
-    }
-    z -= (double)bias * dz;
-    int k = (int)m->cfg.pcf, half = k / 2, lit = 0;
-    int64_t cx = (int64_t)floor(u), cy = (int64_t)floor(w);
-    for (int dy = -half; dy < k - half; dy++)
-        for (int dx = -half; dx < k - half; dx++) {
-            int64_t x = cx + dx, y = cy + dy;
-            if (x < 0) x = 0;
-            if (y < 0) y = 0;
-            if (x >= m->size) x = m->size - 1;
-            if (y >= m->size) y = m->size - 1;
-            lit += z <= (double)m->depth[(size_t)y * m->size + (size_t)x];
-        }
-    uint8_t val = (uint8_t)((255 * lit + k * k / 2) / (k * k));
-    if (lit < k * k && val == 255) val = 254;   /* partly shadowed is never "lit" */
-    t->r = t->g = t->b = val;
-}
-
 static om_status sm_resolve(void *state, om_strip *st, om_diag *d)
 {
     (void)d;
@@ -144,7 +96,7 @@ static om_status sm_resolve(void *state, om_strip *st, om_diag *d)
         t->r = t->g = t->b = 255;
         if (!(t->flags & OM_TERM_EXPOSED)) continue;
         m->samples++;
-        lookup(m, &st->samples[i], t);
+        om__smlook_term(&m->look, &st->samples[i], t);
         if (t->r != 255) m->shadowed++;
     }
     return OM_OK;

@@ -1,0 +1,438 @@
+/* rtw.c — the `rtw` method: Rectilinear Texture Warping shadow maps (paper 003). A
+ * conventional depth texture plus two 1-D warp tables that give the light's image
+ * more texels where the view needs them (section 3).
+ *
+ * Per frame (section 4's algorithm):
+ *   observe  (a) backward analysis: every exposed visible sample raises the importance
+ *            of its cell (rtw_warp.c)
+ *   build    (a) forward analysis, if asked; (b) collapse, blur, warp tables
+ *            (rtw_warp.c); (c) render the warped map: vertices are warped after the
+ *            perspective divide (4.3), long edges tessellated first (6.1)
+ *   resolve  (d) lookup: the sample's light coordinates are warped (4.4) and tested
+ *            with the conventional map's bias rules, in warped texels (smlookup.c)
+ * All state lives in the method's arena; nothing persists between frames but the
+ * buffers. */
+#include "shadow.h"
+#include "rtw.h"
+
+/* ---------------------------------------------------------------- sizes */
+
+static size_t rtw_need(const om_method_cfg *c)
+{
+    size_t n = c->rtw_importance, nn = n * n, s = c->map_size;
+    size_t b = om_arena_need(sizeof(om__rtw), 16) + om_arena_need(nn * sizeof(float), 16) +
+               om_arena_need((nn + 7) / 8, 16) + om_arena_need(n * sizeof(double), 16) * 3 +
+               om_arena_need((OM_RTW_MAX_RADIUS + 1) * sizeof(double), 16) +
+               om_arena_need((n + 1) * sizeof(int32_t), 16) * 2 +
+               om_arena_need(s * s * sizeof(uint32_t), 16);
+    if (c->rtw_analysis != OM_RTW_BACKWARD) b += om_arena_need(nn * sizeof(uint32_t), 16) * 2;
+    return b;
+}
+
+static const char *check_cfg(const om_method_cfg *c)
+{
+    if (c->map_size < 1 || c->map_size > OM_MAX_DIM) return "rtw: map size must be 1..8192";
+    if (c->pcf < 1 || c->pcf > 9) return "rtw: pcf must be 1..9";
+    if (c->rtw_importance < 8 || c->rtw_importance > OM_MAX_DIM) return "rtw: importance map side must be 8..8192";
+    if (c->rtw_analysis > 2) return "rtw: analysis must be 0 (backward), 1 (forward) or 2 (hybrid)";
+    if (c->rtw_funcs > 15) return "rtw: importance functions are a mask of 1, 2, 4, 8";
+    if (!(c->rtw_sigma >= 0.0f && c->rtw_sigma <= 64.0f)) return "rtw: sigma must be 0..64";
+    if (!(c->rtw_tess >= 0.0f && c->rtw_tess <= 1.0f)) return "rtw: tessellation must be 0..1";
+    return NULL;
+}
+
+static om_status rtw_bytes(const om_method_cfg *c, const om_scene *s, uint32_t w, uint32_t h,
+                           size_t *min, size_t *full)
+{
+    (void)s; (void)w; (void)h;
+    if (check_cfg(c)) return OM_E_INVALID;
+    *min = *full = rtw_need(c);
+    return OM_OK;
+}
+
+static om_status carve(om_arena *a, size_t bytes, void **out, om_diag *d)
+{
+    return om_arena_alloc(a, bytes, 16, out, d);
+}
+
+/* The warp as smlookup.c's coordinate mapping. The density is the smaller axis's (the
+ * bias then covers the larger warped texel), kept above a sliver: a sample in a
+ * collapsed super-cell (possible only just outside what the analysis saw) must not
+ * get an infinite bias. */
+static void warp_uv(const void *user, double *u, double *v, double *density)
+{
+    const om__rtw *m = (const om__rtw *)user;
+    double dx, dy;
+    *u = om__rtw_apply(m->px, m->n, *u, &dx);
+    *v = om__rtw_apply(m->py, m->n, *v, &dy);
+    double dmin = dx < dy ? dx : dy;
+    *density = dmin > 1.0 / 64.0 ? dmin : 1.0 / 64.0;
+}
+
+static om_status rtw_init(void **state, om_arena *a, const om_method_cfg *c, const om_scene *s,
+                          uint32_t w, uint32_t h, om_diag *d)
+{
+    (void)w; (void)h;
+    om_status st;
+    void *p;
+    const char *bad = check_cfg(c);
+    if (bad) return om__fail(d, OM_E_INVALID, bad);
+    if ((st = om__need(a, rtw_need(c), "rtw", d))) return st;
+    if ((st = carve(a, sizeof(om__rtw), &p, d))) return st;
+    om__rtw *m = (om__rtw *)p;
+    m->scene = s;
+    m->cfg = *c;
+    m->n = c->rtw_importance;
+    m->size = c->map_size;
+    size_t n = m->n, nn = n * n;
+    if ((st = carve(a, nn * sizeof(float), &p, d))) return st;
+    m->imp = (float *)p;
+    if ((st = carve(a, (nn + 7) / 8, &p, d))) return st;
+    m->seen = (uint8_t *)p;
+    if ((st = carve(a, n * sizeof(double), &p, d))) return st;
+    m->cols = (double *)p;
+    if ((st = carve(a, n * sizeof(double), &p, d))) return st;
+    m->rows = (double *)p;
+    if ((st = carve(a, n * sizeof(double), &p, d))) return st;
+    m->scratch = (double *)p;
+    if ((st = carve(a, (OM_RTW_MAX_RADIUS + 1) * sizeof(double), &p, d))) return st;
+    m->kernel = (double *)p;
+    if ((st = carve(a, (n + 1) * sizeof(int32_t), &p, d))) return st;
+    m->px = (int32_t *)p;
+    if ((st = carve(a, (n + 1) * sizeof(int32_t), &p, d))) return st;
+    m->py = (int32_t *)p;
+    if ((st = carve(a, (size_t)m->size * m->size * sizeof(uint32_t), &p, d))) return st;
+    m->depth = (uint32_t *)p;
+    if (c->rtw_analysis != OM_RTW_BACKWARD) {
+        if ((st = carve(a, nn * sizeof(uint32_t), &p, d))) return st;
+        m->fdepth = (uint32_t *)p;
+        if ((st = carve(a, nn * sizeof(uint32_t), &p, d))) return st;
+        m->fid = (uint32_t *)p;
+    }
+    /* Tessellation limit in [0, 1] units of the map, never below one texel: shorter
+     * warped edges cannot bend visibly, and the recursion must end. */
+    m->limit = c->rtw_tess > 0.0f ? (double)c->rtw_tess : 0.0;
+    if (m->limit > 0.0 && m->limit < 1.0 / (double)m->size) m->limit = 1.0 / (double)m->size;
+    m->look.depth = m->depth;
+    m->look.size = m->size;
+    m->look.bias_const = c->bias_const;
+    m->look.bias_slope = c->bias_slope;
+    m->look.normal_offset = c->normal_offset;
+    m->look.pcf = c->pcf;
+    m->look.warp = warp_uv;
+    m->look.warp_user = m;
+    for (uint32_t k = 0; k <= m->n; k++) m->px[k] = m->py[k] = (int32_t)(((int64_t)k * OM_RTW_ONE + m->n / 2) / m->n);
+    *state = m;
+    return OM_OK;
+}
+
+void om__rtw_set_clock(void *state, om_clock_fn clock, void *user)
+{
+    om__rtw *m = (om__rtw *)state;
+    m->clock = clock;
+    m->clock_user = user;
+}
+
+static uint64_t now(const om__rtw *m)
+{
+    return m->clock ? m->clock(m->clock_user) : 0;
+}
+
+/* ---------------------------------------------------------------- frame */
+
+static om_status rtw_begin(void *state, const om_view *v, om_diag *d)
+{
+    (void)d;
+    om__rtw *m = (om__rtw *)state;
+    uint64_t t0 = now(m);
+    m->view = *v;
+    om__smlook_begin(&m->look, &m->view);
+    m->samples = m->shadowed = m->tris_drawn = 0;
+    m->ns[0] = m->ns[1] = m->ns[2] = m->ns[3] = 0;
+    om__rtw_importance_begin(m);
+    m->ns[0] += now(m) - t0;
+    return OM_OK;
+}
+
+static om_status rtw_observe(void *state, const om_strip *st, om_diag *d)
+{
+    (void)d;
+    om__rtw *m = (om__rtw *)state;
+    uint64_t t0 = now(m);
+    om__rtw_observe_strip(m, st);
+    m->ns[0] += now(m) - t0;
+    return OM_OK;
+}
+
+static om_status rtw_build(void *state, om_diag *d)
+{
+    (void)d;
+    om__rtw *m = (om__rtw *)state;
+    uint64_t t0 = now(m);
+    om__rtw_importance_finish(m);
+    uint64_t t1 = now(m);
+    om__rtw_build_tables(m);
+    uint64_t t2 = now(m);
+    om__rtw_render_map(m);
+    uint64_t t3 = now(m);
+    m->ns[0] += t1 - t0;
+    m->ns[1] += t2 - t1;
+    m->ns[2] += t3 - t2;
+    return OM_OK;
+}
+
+/* ---------------------------------------------------------------- the warped map */
+
+/* A vertex of the map's triangles: unwarped light clip coordinates (where subdivision
+ * happens: midpoints there are the triangle's own points) and its warped position. */
+typedef struct tvert {
+    om_vec4 c;
+    double u, v;           /* warped normalized coordinates */
+} tvert;
+
+typedef struct tess_ctx {
+    const om__rtw *m;
+    om_raster r;
+    uint32_t tri;
+    double limit2;         /* squared longest warped edge; 0 = no tessellation */
+    uint32_t drawn;
+    uint32_t cap;          /* most triangles a frame may draw before splitting stops */
+} tess_ctx;
+
+static void warp_vert(const om__rtw *m, tvert *t)
+{
+    double iw = 1.0 / (double)t->c.w;
+    t->u = om__rtw_apply(m->px, m->n, ((double)t->c.x * iw + 1.0) * 0.5, NULL);
+    t->v = om__rtw_apply(m->py, m->n, (1.0 - (double)t->c.y * iw) * 0.5, NULL);
+}
+
+/* The midpoint in clip space. (a + b) * 0.5 is the same bits whichever end comes
+ * first, so two triangles sharing an edge split it at the same vertex. */
+static tvert midpoint(const om__rtw *m, const tvert *a, const tvert *b)
+{
+    tvert r;
+    r.c.x = (a->c.x + b->c.x) * 0.5f;
+    r.c.y = (a->c.y + b->c.y) * 0.5f;
+    r.c.z = (a->c.z + b->c.z) * 0.5f;
+    r.c.w = (a->c.w + b->c.w) * 0.5f;
+    warp_vert(m, &r);
+    return r;
+}
+
+/* Whether an edge is split depends on the edge alone (its two ends, symmetrically),
+ * never on the triangle: neighbours make the same choice and the map has no cracks. */
+static bool too_long(const tess_ctx *x, const tvert *a, const tvert *b)
+{
+    double du = a->u - b->u, dv = a->v - b->v;
+    return du * du + dv * dv > x->limit2;
+}
+
+static void emit(tess_ctx *x, const tvert *a, const tvert *b, const tvert *c)
+{
+    /* Back to clip coordinates with the warped x/w and y/w and the same z and w, so
+     * the depth stays z/w (section 4.3; the lead's note on warping after the divide). */
+    const tvert *t[3] = {a, b, c};
+    om_vec4 o[3];
+    for (int k = 0; k < 3; k++) {
+        double w = (double)t[k]->c.w;
+        o[k].x = (float)((2.0 * t[k]->u - 1.0) * w);
+        o[k].y = (float)((1.0 - 2.0 * t[k]->v) * w);
+        o[k].z = t[k]->c.z;
+        o[k].w = t[k]->c.w;
+    }
+    om__raster_tri(&x->r, o, x->tri);
+    x->drawn++;
+}
+
+/* Section 6.1: subdivide until no warped edge is longer than the limit. An edge that
+ * is too long is halved; the 1, 2 or 3 split edges of a triangle give 2, 3 or 4 parts.
+ * The recursion ends because the warp's slope is at most n: halving shrinks every
+ * edge's warped length below the limit (>= one texel) within log2(2 n size) levels.
+ * Work stays bounded for hostile scenes (thousands of map-sized triangles): past a cap
+ * (64 triangles per scene triangle plus 64 map-covering layers at the limit; real
+ * scenes use a small part of it: 65K of 1.6M on the default scene at 2.5%) the rest of
+ * the frame is drawn without splitting. */
+static void tess(tess_ctx *x, const tvert *a, const tvert *b, const tvert *c, int depth)
+{
+    bool sab = false, sbc = false, sca = false;
+    if (x->limit2 > 0.0 && depth < 40 && x->drawn < x->cap) {
+        sab = too_long(x, a, b);
+        sbc = too_long(x, b, c);
+        sca = too_long(x, c, a);
+    }
+    int n = (int)sab + (int)sbc + (int)sca;
+    if (n == 0) { emit(x, a, b, c); return; }
+    /* rotate so that the split edges come first: ab when one, ab and bc when two */
+    if (n == 1) {
+        if (sbc) { const tvert *t = a; a = b; b = c; c = t; }
+        else if (sca) { const tvert *t = c; c = b; b = a; a = t; }
+        tvert mab = midpoint(x->m, a, b);
+        tess(x, a, &mab, c, depth + 1);
+        tess(x, &mab, b, c, depth + 1);
+    } else if (n == 2) {
+        if (!sab) { const tvert *t = a; a = b; b = c; c = t; }        /* bc, ca -> ab, bc */
+        else if (!sbc) { const tvert *t = c; c = b; b = a; a = t; }   /* ca, ab -> ab, bc */
+        tvert mab = midpoint(x->m, a, b), mbc = midpoint(x->m, b, c);
+        tess(x, &mab, b, &mbc, depth + 1);
+        tess(x, a, &mab, &mbc, depth + 1);
+        tess(x, a, &mbc, c, depth + 1);
+    } else {
+        tvert mab = midpoint(x->m, a, b), mbc = midpoint(x->m, b, c), mca = midpoint(x->m, c, a);
+        tess(x, a, &mab, &mca, depth + 1);
+        tess(x, &mab, b, &mbc, depth + 1);
+        tess(x, &mca, &mbc, c, depth + 1);
+        tess(x, &mab, &mbc, &mca, depth + 1);
+    }
+}
+
+/* Signed distance of a clip vertex to plane p: near z >= 0, far z <= w, then the four
+ * sides |x|, |y| <= g w of a band just beyond the map (what lies further out is never
+ * looked up, and the warp is the identity there anyway). */
+static float plane_dist(int p, const om_vec4 *v, float g)
+{
+    switch (p) {
+    case 0: return v->z;
+    case 1: return v->w - v->z;
+    case 2: return v->x + g * v->w;
+    case 3: return g * v->w - v->x;
+    case 4: return v->y + g * v->w;
+    default: return g * v->w - v->y;
+    }
+}
+
+/* Cut from the inside vertex towards the outside one, as the rasterizer does, so that
+ * an edge shared by two triangles is cut at the same point in both. */
+static om_vec4 cut(const om_vec4 *in, const om_vec4 *out, float din, float dout)
+{
+    float t = din / (din - dout);
+    om_vec4 r;
+    r.x = in->x + t * (out->x - in->x);
+    r.y = in->y + t * (out->y - in->y);
+    r.z = in->z + t * (out->z - in->z);
+    r.w = in->w + t * (out->w - in->w);
+    return r;
+}
+
+/* Clips a triangle before warping: the warp needs w > 0 (the near plane gives it), and
+ * tessellating geometry far outside the map would only waste time. */
+static int clip_tri(const om_vec4 in[3], float g, om_vec4 *out)
+{
+    om_vec4 buf[2][10];
+    int n = 3, cur = 0;
+    for (int i = 0; i < 3; i++) buf[0][i] = in[i];
+    for (int p = 0; p < 6 && n > 0; p++) {
+        om_vec4 *src = buf[cur], *dst = buf[cur ^ 1];
+        int k = 0;
+        bool any_out = false;
+        for (int i = 0; i < n; i++) any_out |= !(plane_dist(p, &src[i], g) >= 0.0f);
+        if (!any_out) continue;
+        for (int i = 0; i < n; i++) {
+            const om_vec4 *a = &src[i], *b = &src[i + 1 == n ? 0 : i + 1];
+            float da = plane_dist(p, a, g), db = plane_dist(p, b, g);
+            bool ina = da >= 0.0f, inb = db >= 0.0f;
+            if (ina) dst[k++] = *a;
+            if (ina && !inb) dst[k++] = cut(a, b, da, db);
+            else if (!ina && inb) dst[k++] = cut(b, a, db, da);
+        }
+        n = k;
+        cur ^= 1;
+    }
+    for (int i = 0; i < n; i++) out[i] = buf[cur][i];
+    return n < 3 ? 0 : n;
+}
+
+void om__rtw_render_map(om__rtw *m)
+{
+    const om_scene *s = m->scene;
+    om_target tg = {m->size, m->size, 0, m->size, m->depth, NULL};
+    om__target_clear(&tg);
+    tess_ctx x;
+    x.m = m;
+    x.r.target = &tg;
+    x.r.mode = OM_RASTER_DEPTH;
+    x.r.frag = NULL;
+    x.r.user = NULL;
+    x.limit2 = m->limit * m->limit;
+    x.drawn = 0;
+    {
+        /* enough to cover the whole map 64 times over at the limit, and 64 per triangle */
+        double cap = 65536.0 + 64.0 * (double)s->ntris;
+        if (m->limit > 0.0) cap += 64.0 / (m->limit * m->limit);
+        x.cap = cap < 4294967295.0 ? (uint32_t)cap : UINT32_MAX;
+    }
+    const float g = 1.0f + 4.0f / (float)m->size;
+    for (uint32_t t = 0; t < s->ntris; t++) {
+        const uint32_t *ix = s->idx + (size_t)t * 3;
+        om_vec4 c[3], poly[9];
+        bool ok = true;
+        for (int k = 0; k < 3; k++) {
+            c[k] = om__mat_apply(&m->view.light_vp, s->verts[ix[k]]);
+            ok = ok && om__finite(c[k].x) && om__finite(c[k].y) && om__finite(c[k].z) && om__finite(c[k].w);
+        }
+        if (!ok) continue;
+        int n = clip_tri(c, g, poly);
+        tvert v[9];
+        for (int k = 0; k < n; k++) {
+            if (!(poly[k].w > 0.0f)) { n = 0; break; }
+            v[k].c = poly[k];
+            warp_vert(m, &v[k]);
+        }
+        x.tri = t;
+        for (int k = 1; k + 1 < n; k++) tess(&x, &v[0], &v[k], &v[k + 1], 0);
+    }
+    m->tris_drawn = x.drawn;
+}
+
+/* ---------------------------------------------------------------- lookup */
+
+static om_status rtw_resolve(void *state, om_strip *st, om_diag *d)
+{
+    (void)d;
+    om__rtw *m = (om__rtw *)state;
+    uint64_t t0 = now(m);
+    size_t n = (size_t)st->rows * st->width;
+    for (size_t i = 0; i < n; i++) {
+        om_term *t = &st->terms[i];
+        t->r = t->g = t->b = 255;
+        if (!(t->flags & OM_TERM_EXPOSED)) continue;
+        m->samples++;
+        om__smlook_term(&m->look, &st->samples[i], t);
+        if (t->r != 255) m->shadowed++;
+    }
+    m->ns[3] += now(m) - t0;
+    return OM_OK;
+}
+
+static uint32_t sat_u32(double v)
+{
+    return !(v > 0.0) ? 0u : v >= 4294967295.0 ? 0xFFFFFFFFu : (uint32_t)(v + 0.5);
+}
+
+static void rtw_stats(const void *state, om_method_stats *out)
+{
+    const om__rtw *m = (const om__rtw *)state;
+    memset(out, 0, sizeof *out);
+    out->bytes_used = rtw_need(&m->cfg);
+    out->counters[0] = m->shadowed;
+    out->counters[1] = m->tris_drawn;
+    /* maximum effective resolution: the conventional map as dense as the densest
+     * super-cell (section 6), per axis */
+    out->counters[2] = sat_u32(m->dens_x * (double)m->size);
+    out->counters[3] = sat_u32(m->dens_y * (double)m->size);
+    for (int k = 0; k < 4; k++) out->counters[4 + k] = sat_u32((double)m->ns[k] / 1000.0);
+    out->counter_names[0] = "samples shadowed";
+    out->counter_names[1] = "triangles drawn";
+    out->counter_names[2] = "mer x";
+    out->counter_names[3] = "mer y";
+    out->counter_names[4] = "us importance";
+    out->counter_names[5] = "us warp";
+    out->counter_names[6] = "us map";
+    out->counter_names[7] = "us lookup";
+    out->ncounters = 8;
+}
+
+const om_method om__method_rtw = {
+    "rtw", "rectilinear texture warping: importance-warped shadow map with 1-D warp tables",
+    OM_METHOD_OBSERVES,
+    rtw_bytes, rtw_init, rtw_begin, rtw_observe, rtw_build, rtw_resolve, rtw_stats,
+};

@@ -1,0 +1,107 @@
+/* rtw.h — Rectilinear Texture Warping shadow maps (paper 003, Rosen 2012): the state of
+ * the `rtw` method and the pieces of its pipeline, declared here so that tests and the
+ * benchmark can reach them.
+ *
+ *   rtw_warp.c  the importance map (section 4.1, importance functions of section 5),
+ *               the 1-D collapse, the Gaussian blur and the warp tables (section 4.2)
+ *   rtw.c       the method: rendering the warped map with tessellation (4.3, 6.1) and
+ *               the lookup through the shared biased depth test (4.4, smlookup.c)
+ *
+ * Coordinates: the warp acts on normalized light-image coordinates, u = (x/w + 1) / 2
+ * to the right and v = (1 - y/w) / 2 downwards (row 0 of every map at the top), so
+ * [0, 1]^2 is the light's image. Importance cell (i, j) covers
+ * [i/n, (i+1)/n) x [j/n, (j+1)/n); super-cell k of a warp table is column (or row) k.
+ *
+ * A warp table holds n + 1 fixed-point entries P(k) = S(k) / S(n) in units of
+ * OM_RTW_ONE: where the edge between super-cells k - 1 and k lands in the warped map.
+ * The warp of DESIGN.md is warp(k) = P(k) - k/n (om__rtw_warp_at); u in [0, 1] maps to
+ * the linear interpolation of P between the super-cell edges around it, u outside
+ * [0, 1] is left alone. P is monotonic with P(0) = 0 and P(n) = OM_RTW_ONE. */
+#ifndef OM_RTW_H
+#define OM_RTW_H
+
+#include "smlookup.h"
+
+#define OM_RTW_ONE (1 << 30)       /* 1.0 in the warp tables' fixed point */
+#define OM_RTW_ALPHA 0.001f        /* shadow-edge function away from edges (section 5.3) */
+#define OM_RTW_BETA 2.0f           /* surface-normal bonus (section 5.4) */
+/* Visible samples' cells keep at least this share of the largest importance, so that a
+ * product of small factors (distance far away, alpha away from edges) never collapses
+ * a super-cell that holds something the camera sees. */
+#define OM_RTW_FLOOR (1.0f / 256.0f)
+#define OM_RTW_MAX_RADIUS 192      /* blur radius ceil(3 sigma) for sigma <= 64 */
+
+enum { OM_RTW_DV = 1, OM_RTW_DIST = 2, OM_RTW_EDGE = 4, OM_RTW_NORMAL = 8 };
+enum { OM_RTW_BACKWARD = 0, OM_RTW_FORWARD = 1, OM_RTW_HYBRID = 2 };
+
+/* ---- 1-D tables (rtw_warp.c) */
+
+/* Collapses the n x n map (row-major, row 0 at the top) by maximum: cols[i] over
+ * column i, rows[j] over row j (section 4.2 (i)). */
+void om__rtw_collapse(const float *imp, uint32_t n, double *cols, double *rows);
+/* Gaussian blur (section 4.2 (ii)) of I[0..n) in place, sigma in super-cells (0 = none),
+ * truncated at ceil(3 sigma) and renormalized at the ends so that a uniform input stays
+ * uniform. scratch: n doubles; kernel: OM_RTW_MAX_RADIUS + 1 doubles. */
+void om__rtw_blur(double *I, uint32_t n, float sigma, double *scratch, double *kernel);
+/* The warp table P[0..n] of importances I[0..n) (section 4.2 (iii), DESIGN.md's
+ * equation). An all-zero (or non-finite) I gives the identity; returns false then. */
+bool om__rtw_table(const double *I, uint32_t n, int32_t *P);
+/* warp(k) = P(k) - k/n, both in OM_RTW_ONE units (k/n rounded to nearest). */
+int32_t om__rtw_warp_at(const int32_t *P, uint32_t n, uint32_t k);
+/* Warps one coordinate; *density (if not NULL): warped length per unwarped length
+ * there (1 outside [0, 1]). */
+double om__rtw_apply(const int32_t *P, uint32_t n, double u, double *density);
+/* Largest warped length of a super-cell, times n: the densest super-cell's
+ * magnification (the maximum effective resolution is map_size times it). */
+double om__rtw_max_density(const int32_t *P, uint32_t n);
+
+/* ---- importance (rtw_warp.c) */
+
+/* The product of the importance functions `funcs` that a visible point can evaluate:
+ * distance to eye (5.2) and surface normal (5.4); the desired-view function (5.1) is
+ * the caller's (a backward sample is in view by construction; a forward texel is
+ * tested against the camera's frustum). n need not face the camera. */
+float om__rtw_point_importance(const om_view *v, unsigned funcs, om_vec3 p, om_vec3 n);
+
+/* ---- the method's state (rtw.c) */
+
+typedef struct om__rtw {
+    const om_scene *scene;
+    om_method_cfg cfg;
+    uint32_t n;                /* importance map side = super-cells per axis */
+    uint32_t size;             /* warped shadow map side */
+    float *imp;                /* n * n: importance; -1 where no visible sample fell */
+    uint8_t *seen;             /* n * n bits: a visible sample fell in the cell */
+    uint32_t *fdepth, *fid;    /* forward / hybrid: the n x n light depth image */
+    double *cols, *rows, *scratch, *kernel;
+    int32_t *px, *py;          /* warp tables, n + 1 each */
+    uint32_t *depth;           /* size * size warped shadow map */
+    om_view view;
+    om__smlook look;
+    double limit;              /* tessellation: longest warped edge in [0, 1] units; 0 = off */
+    /* per frame */
+    uint32_t samples, shadowed, tris_drawn;
+    double dens_x, dens_y;     /* densest super-cell per axis (MER = size * density) */
+    uint64_t ns[4];            /* importance, warp, map, lookup (with a clock) */
+    om_clock_fn clock;         /* the host's, for stage times; NULL = none */
+    void *clock_user;
+} om__rtw;
+
+/* Importance map stages (rtw_warp.c). begin clears, observe_strip records the backward
+ * analysis of one strip of visible samples (section 4.1: each exposed sample, projected
+ * into the light's image, keeps the largest importance of its cell), finish runs the
+ * forward analysis when asked (a light depth image of n x n texels, one per cell) and
+ * combines the two, then puts the floor under visible samples' cells. */
+void om__rtw_importance_begin(om__rtw *m);
+void om__rtw_observe_strip(om__rtw *m, const om_strip *st);
+void om__rtw_importance_finish(om__rtw *m);
+/* The 1-D tables of this frame's importance map: collapse, blur, warp (section 4.2). */
+void om__rtw_build_tables(om__rtw *m);
+
+/* Gives the method a clock for its per-stage times (stats counters in microseconds). */
+void om__rtw_set_clock(void *state, om_clock_fn clock, void *user);
+
+/* Renders the warped shadow map of this frame's tables (rtw.c; called by build). */
+void om__rtw_render_map(om__rtw *m);
+
+#endif

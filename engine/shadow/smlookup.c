@@ -1,0 +1,100 @@
+/* smlookup.c — the biased shadow-map depth test (see smlookup.h), moved out of sm.c so
+ * that the RTW map uses the very same rules; for the conventional map (warp == NULL)
+ * every operation is the one sm.c always did, so its frames are unchanged.
+ *
+ * The bias is given in world units along the light ray and converted to depth units at
+ * the sample:
+ *     bias = bias_const + bias_slope * texel * tan(angle between normal and light)
+ * (texel = the world size of one texel at the sample; tan clamped at 10), so the slope
+ * term is in texels. k x k PCF averages the binary tests; a sample is lit only when
+ * every tap is. */
+#include "smlookup.h"
+
+void om__smlook_begin(om__smlook *L, const om_view *v)
+{
+    L->view = v;
+    L->span_per_dist = 2.0f * (float)om__tan((double)v->light.fov_deg * OM_PI / 360.0);
+}
+
+/* World size of one (unwarped) texel at distance `dist` along the light's axis. */
+static float texel_world(const om__smlook *L, float dist)
+{
+    const om_view *v = L->view;
+    float span = v->light.kind == OM_LIGHT_SPOT ? dist * L->span_per_dist
+                                                : 2.0f / fabsf(v->light_proj.m[0]);
+    return span / (float)L->size;
+}
+
+void om__smlook_term(const om__smlook *L, const om_sample *smp, om_term *t)
+{
+    const om_view *v = L->view;
+    om_vec3 p = om__v3(smp->p[0], smp->p[1], smp->p[2]);
+    om_vec3 n = om__v3(smp->n[0], smp->n[1], smp->n[2]);
+    if (om__dot(n, om__sub(v->cam.eye, p)) < 0.0f) n = om__scale(n, -1.0f);
+    om_vec3 l = om__to_light(v, p);
+    float dist = v->light.kind == OM_LIGHT_SPOT ? om__dot(om__sub(p, v->light.pos), v->light_axis) : 1.0f;
+    float texel = texel_world(L, dist);
+    double u0 = 0.0, v0 = 0.0;
+    om_vec4 q0 = {0.0f, 0.0f, 0.0f, 0.0f};
+    if (L->warp) {
+        /* A warped texel covers 1/density of an unwarped one: where the warp stretches
+         * the map, texels are smaller in the world and the bias shrinks with them. */
+        q0 = om__mat_apply(&v->light_vp, p);
+        if (!(q0.w > 0.0f)) return;
+        double iw0 = 1.0 / (double)q0.w, dens = 1.0;
+        u0 = ((double)q0.x * iw0 + 1.0) * 0.5;
+        v0 = (1.0 - (double)q0.y * iw0) * 0.5;
+        L->warp(L->warp_user, &u0, &v0, &dens);
+        texel = (float)((double)texel / dens);
+    }
+    float cosang = om__dot(n, l);
+    float tanang = cosang > 0.0995f ? sqrtf(1.0f - cosang * cosang) / cosang : 10.0f;
+    float bias = L->bias_const + L->bias_slope * texel * tanang;
+    om_vec4 q;
+    if (L->warp && L->normal_offset == 0.0f) {
+        q = q0;   /* the point did not move: its projection and warp are done */
+    } else {
+        p = om__add(p, om__scale(n, L->normal_offset * texel));
+        q = om__mat_apply(&v->light_vp, p);
+        if (!(q.w > 0.0f)) return;
+    }
+    double iw = 1.0 / (double)q.w;
+    double u, w;
+    if (L->warp) {
+        if (L->normal_offset != 0.0f) {   /* the point moved: warp it anew */
+            double dens;
+            u0 = ((double)q.x * iw + 1.0) * 0.5;
+            v0 = (1.0 - (double)q.y * iw) * 0.5;
+            L->warp(L->warp_user, &u0, &v0, &dens);
+        }
+        u = u0 * L->size;
+        w = v0 * L->size;
+    } else {
+        u = ((double)q.x * iw + 1.0) * 0.5 * L->size;
+        w = (1.0 - (double)q.y * iw) * 0.5 * L->size;
+    }
+    double z = (double)q.z * iw * 4294967296.0;
+    /* bias from world units to depth units: d(z/w)/d(distance) at this sample */
+    double dz;
+    if (v->light.kind == OM_LIGHT_SPOT) {
+        double f = v->light.zfar, nn = v->light.znear, e = dist > nn * 0.5f ? dist : nn * 0.5;
+        dz = f * nn / ((f - nn) * e * e) * 4294967296.0;
+    } else {
+        dz = 4294967296.0 * fabs((double)v->light_proj.m[10]);
+    }
+    z -= (double)bias * dz;
+    int k = (int)L->pcf, half = k / 2, lit = 0;
+    int64_t cx = (int64_t)floor(u), cy = (int64_t)floor(w);
+    for (int dy = -half; dy < k - half; dy++)
+        for (int dx = -half; dx < k - half; dx++) {
+            int64_t x = cx + dx, y = cy + dy;
+            if (x < 0) x = 0;
+            if (y < 0) y = 0;
+            if (x >= L->size) x = L->size - 1;
+            if (y >= L->size) y = L->size - 1;
+            lit += z <= (double)L->depth[(size_t)y * L->size + (size_t)x];
+        }
+    uint8_t val = (uint8_t)((255 * lit + k * k / 2) / (k * k));
+    if (lit < k * k && val == 255) val = 254;   /* partly shadowed is never "lit" */
+    t->r = t->g = t->b = val;
+}

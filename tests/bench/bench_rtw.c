@@ -1,0 +1,159 @@
+/* bench_rtw.c — Rectilinear Texture Warping at 1024x768 for the default scene and the
+ * 10K and 100K random-triangle scenes: for RTW maps of 512, 1024 and 2048 with
+ * tessellation off, 5% and 2.5%, the time of each stage (importance, warp, map,
+ * lookup; medians of 5 interleaved runs), the method's time and the frame's against the
+ * conventional map of the same size (overhead), the mismatch share against the
+ * reference, the maximum effective resolution and the triangles drawn after
+ * tessellation; plus the 512 map with hybrid analysis and the shadow-edge function. */
+#include "bench.h"
+#include "../../engine/shadow/rtw.h"
+
+#include <string.h>
+
+typedef struct rtw_run {
+    double eye_ms, observe_ms, build_ms, resolve_ms, shade_ms;
+    om_method_stats stats;
+} rtw_run;
+
+typedef struct mask_grab { uint8_t *mask; } mask_grab;
+
+static om_status grab(void *user, const om_strip *st, const om_framebuffer *fb)
+{
+    (void)fb;
+    uint8_t *m = ((mask_grab *)user)->mask;
+    for (uint32_t i = 0; i < st->rows * st->width; i++)
+        m[(size_t)st->y0 * st->width + i] = om_mask_of(&st->samples[i], &st->terms[i]);
+    return OM_OK;
+}
+
+/* bench_run, with the method's clock set so that rtw reports its stages. */
+static int run(const bscene *b, const char *name, const om_method_cfg *c, uint32_t W, uint32_t H,
+               uint8_t *mask, rtw_run *out)
+{
+    const om_method *m = om_method_find(name);
+    om_camera cam;
+    om_light light;
+    om_view v;
+    om_diag d;
+    size_t mn, full;
+    om_scene_at(&b->s, 0, &cam, &light);
+    cam.width = W;
+    cam.height = H;
+    memset(out, 0, sizeof *out);
+    if (!m || om_view_init(&v, &cam, &light, &b->s, &d) || m->bytes(c, &b->s, W, H, &mn, &full)) {
+        fprintf(stderr, "bench: cannot set up %s\n", name);
+        return 1;
+    }
+    void *mem = malloc(full), *fmem = malloc(om_frame_bytes(W, H)), *px = malloc((size_t)W * H * 3);
+    om_arena ma, fa;
+    om_arena_init(&ma, mem, full, "method");
+    om_arena_init(&fa, fmem, om_frame_bytes(W, H), "frame");
+    void *state;
+    om_status st = m->init(&state, &ma, c, &b->s, W, H, &d);
+    if (st == OM_OK) {
+        if (!strcmp(name, "rtw")) om__rtw_set_clock(state, om_clock_ns, NULL);
+        om_framebuffer fb = {OM_RGB888, W, H, (size_t)W * 3, (uint8_t *)px};
+        om_shade_cfg shade;
+        om_shade_cfg_default(&shade);
+        mask_grab g = {mask};
+        om_frame_desc fd;
+        memset(&fd, 0, sizeof fd);
+        fd.scene = &b->s; fd.view = &v; fd.method = m; fd.method_state = state; fd.shade = &shade;
+        fd.fb = &fb; fd.on_strip = grab; fd.user = &g; fd.clock = om_clock_ns;
+        om_frame_stats fs;
+        st = om_render_frame(&fd, &fa, &fs, &d);
+        out->eye_ms = (double)fs.ns_eye / 1e6;
+        out->shade_ms = (double)fs.ns_shade / 1e6;
+        out->observe_ms = (double)fs.ns_observe / 1e6;
+        out->build_ms = (double)fs.ns_build / 1e6;
+        out->resolve_ms = (double)fs.ns_resolve / 1e6;
+        m->stats(state, &out->stats);
+    }
+    if (st) fprintf(stderr, "bench: %s: %s\n", name, d.msg);
+    free(mem);
+    free(fmem);
+    free(px);
+    return st != OM_OK;
+}
+
+static double share(const uint8_t *ref, const uint8_t *m, uint32_t W, uint32_t H)
+{
+    om_metrics mt;
+    om_compare_masks(ref, m, W, H, &mt);
+    return 100.0 * (1.0 - om_metrics_match(&mt));
+}
+
+/* Method time: what the method adds to a frame (observe + build + resolve); frame
+ * time: the whole frame with the eye pass and shading, as the paper's tables count.
+ * The runs of the conventional map and of every RTW setting are interleaved, so that a
+ * busy machine slows them alike and the ratios stay meaningful. */
+static void one_scene(const bscene *b)
+{
+    enum { N = 5, C = 4 };
+    static const struct { float tess; uint32_t analysis, funcs; } cf[C] = {
+        {0.0f, 0, 11}, {0.05f, 0, 11}, {0.025f, 0, 11}, {0.025f, 2, 15},
+    };
+    const uint32_t W = 1024, H = 768;
+    uint8_t *ref = malloc((size_t)W * H), *mk = malloc((size_t)W * H);
+    rtw_run r;
+    om_method_cfg rc;
+    om_method_cfg_default(&rc);
+    if (run(b, "ref", &rc, W, H, ref, &r)) goto out;
+    for (uint32_t size = 512; size <= 2048; size *= 2) {
+        double sm_m[N], sm_f[N], sm_b[N], sm_l[N], sm_share = 0.0;
+        double m_ms[C][N], f_ms[C][N], st[C][4][N], shr[C];
+        om_method_stats last[C];
+        int nc = size == 512 ? C : C - 1;   /* hybrid at 512 only */
+        for (int k = 0; k < N; k++) {
+            om_method_cfg c;
+            om_method_cfg_default(&c);
+            c.map_size = size;
+            if (run(b, "sm", &c, W, H, mk, &r)) goto out;
+            sm_b[k] = r.build_ms;
+            sm_l[k] = r.resolve_ms;
+            sm_m[k] = r.build_ms + r.resolve_ms;
+            sm_f[k] = r.eye_ms + sm_m[k] + r.shade_ms;
+            sm_share = share(ref, mk, W, H);
+            for (int t = 0; t < nc; t++) {
+                c.rtw_tess = cf[t].tess;
+                c.rtw_analysis = cf[t].analysis;
+                c.rtw_funcs = cf[t].funcs;
+                if (run(b, "rtw", &c, W, H, mk, &r)) goto out;
+                for (int s = 0; s < 4; s++) st[t][s][k] = r.stats.counters[4 + s] / 1e3;
+                m_ms[t][k] = r.observe_ms + r.build_ms + r.resolve_ms;
+                f_ms[t][k] = r.eye_ms + m_ms[t][k] + r.shade_ms;
+                shr[t] = share(ref, mk, W, H);
+                last[t] = r.stats;
+            }
+        }
+        double sm_ms = bench_median(sm_m, N), sm_frame = bench_median(sm_f, N);
+        printf("%-10s sm  %4u           : method %7.2f ms, frame %7.2f ms (map %6.2f, lookup %6.2f), mismatches %.4f%%\n",
+               b->name, size, sm_ms, sm_frame, bench_median(sm_b, N), bench_median(sm_l, N), sm_share);
+        for (int t = 0; t < nc; t++) {
+            double rtw_ms = bench_median(m_ms[t], N), rtw_frame = bench_median(f_ms[t], N);
+            printf("%-10s rtw %4u %s %3.1f%%: method %7.2f ms (%.2fx), frame %7.2f ms (%.2fx) [importance %5.2f, warp %4.2f, map %6.2f, lookup %6.2f], "
+                   "mismatches %.4f%%, MER %ux%u, %u tris\n",
+                   b->name, size, cf[t].analysis ? "hybrid" : "  tess", 100.0 * cf[t].tess, rtw_ms, rtw_ms / sm_ms,
+                   rtw_frame, rtw_frame / sm_frame, bench_median(st[t][0], N), bench_median(st[t][1], N),
+                   bench_median(st[t][2], N), bench_median(st[t][3], N), shr[t], last[t].counters[2],
+                   last[t].counters[3], last[t].counters[1]);
+        }
+    }
+out:
+    free(ref);
+    free(mk);
+}
+
+void bench_rtw(void)
+{
+    bscene b;
+    if (bench_load(&b, "default", om_scene_default_text())) return;
+    one_scene(&b);
+    bench_free(&b);
+    static const unsigned counts[] = {10000, 100000};
+    for (int k = 0; k < 2; k++) {
+        if (bench_load_random(&b, counts[k])) return;
+        one_scene(&b);
+        bench_free(&b);
+    }
+}

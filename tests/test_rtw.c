@@ -1,0 +1,410 @@
+/* test_rtw.c — Rectilinear Texture Warping: the warp tables' properties (identity for
+ * uniform importance, monotonic with fixed ends, a single important cell widening, no
+ * division by an all-zero map), shared edges staying closed in the warped map, the
+ * paper's accuracy claim on the default scene, tessellation helping, budgets and
+ * determinism. */
+#include "test.h"
+#include "harness.h"
+#include "../engine/shadow/rtw.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+static int32_t ident(uint32_t n, uint32_t k)
+{
+    return (int32_t)(((int64_t)k * OM_RTW_ONE + n / 2) / n);
+}
+
+static double scratch[8192], kernel[OM_RTW_MAX_RADIUS + 1];
+
+static void uniform_is_identity(void)
+{
+    static const uint32_t ns[] = {8, 37, 100, 512, 1000};
+    static const double vals[] = {1.0, 0.3, 1e-20, 7.5e10};
+    static double I[1024];
+    static int32_t P[1025];
+    for (int a = 0; a < 5; a++)
+        for (int b = 0; b < 4; b++)
+            for (int blur = 0; blur < 2; blur++) {
+                uint32_t n = ns[a];
+                for (uint32_t k = 0; k < n; k++) I[k] = vals[b];
+                om__rtw_blur(I, n, blur ? 3.0f : 0.0f, scratch, kernel);
+                CHECK(om__rtw_table(I, n, P));
+                int off = 0;
+                for (uint32_t k = 0; k <= n; k++) off += om__rtw_warp_at(P, n, k) != 0 || P[k] != ident(n, k);
+                CHECK_MSG(off == 0, "n %u value %g blur %d: %d entries off the identity", n, vals[b], blur, off);
+                CHECK(om__rtw_max_density(P, n) < 1.0 + 1e-6);
+            }
+    /* with a power-of-two n the identity maps every coordinate to itself exactly */
+    for (uint32_t k = 0; k <= 512; k++) I[k] = 1.0;
+    CHECK(om__rtw_table(I, 512, P));
+    int moved = 0;
+    for (int i = 0; i <= 4000; i++) {
+        double u = i / 4000.0, dens;
+        moved += om__rtw_apply(P, 512, u, &dens) != u || dens != 1.0;
+    }
+    CHECK_EQ_U(moved, 0);
+}
+
+static uint32_t rng(uint32_t *s)
+{
+    *s = *s * 1664525u + 1013904223u;
+    return *s >> 8;
+}
+
+static void warps_monotonic_with_fixed_ends(void)
+{
+    static double I[700];
+    static int32_t P[701];
+    uint32_t seed = 12345;
+    for (int trial = 0; trial < 40; trial++) {
+        uint32_t n = 8 + rng(&seed) % 690;
+        for (uint32_t k = 0; k < n; k++) {
+            uint32_t r = rng(&seed);
+            /* runs of zeros, tiny and huge values */
+            I[k] = r % 3 == 0 ? 0.0 : r % 7 == 0 ? 1e-9 * (r % 100) : r % 11 == 0 ? 1e6 : (double)(r % 1000);
+        }
+        om__rtw_blur(I, n, (float)(trial % 4) * 1.5f, scratch, kernel);
+        om__rtw_table(I, n, P);
+        CHECK(P[0] == 0 && P[n] == OM_RTW_ONE);
+        CHECK(om__rtw_warp_at(P, n, 0) == 0 && om__rtw_warp_at(P, n, n) == 0);
+        int down = 0;
+        for (uint32_t k = 0; k < n; k++) down += P[k + 1] < P[k];
+        CHECK_EQ_U(down, 0);
+        double prev = 0.0;
+        int back = 0;
+        for (int i = 0; i <= 5000; i++) {
+            double u = om__rtw_apply(P, n, i / 5000.0, NULL);
+            back += u < prev || u < 0.0 || u > 1.0;
+            prev = u;
+        }
+        CHECK_MSG(back == 0, "trial %d: %d steps backwards", trial, back);
+    }
+}
+
+static void important_cell_gets_more(void)
+{
+    static double I[64];
+    static int32_t P[65];
+    for (int blur = 0; blur < 2; blur++) {
+        for (int k = 0; k < 64; k++) I[k] = 1.0;
+        I[20] = 50.0;
+        om__rtw_blur(I, 64, blur ? 3.0f : 0.0f, scratch, kernel);
+        om__rtw_table(I, 64, P);
+        int32_t w20 = P[21] - P[20], unit = OM_RTW_ONE / 64;
+        CHECK_MSG(w20 > 2 * unit, "blur %d: cell 20 has %d, a uniform cell %d", blur, w20, unit);
+        int wider = 0;
+        for (int k = 0; k < 64; k++) wider += P[k + 1] - P[k] > w20;
+        CHECK_EQ_U(wider, 0);
+        /* the cells far away give up resolution */
+        CHECK(P[61] - P[60] < unit);
+        CHECK(om__rtw_max_density(P, 64) > 2.0);
+    }
+    /* zero-importance cells collapse to zero width */
+    for (int k = 0; k < 64; k++) I[k] = k >= 10 && k < 20 ? 1.0 : 0.0;
+    om__rtw_table(I, 64, P);
+    CHECK(P[10] == 0 && P[20] == OM_RTW_ONE && P[64] == OM_RTW_ONE);
+    CHECK(P[15] - P[14] == OM_RTW_ONE / 10 || P[15] - P[14] == OM_RTW_ONE / 10 + 1);
+}
+
+static void all_zero_is_safe(void)
+{
+    static double I[100];
+    static int32_t P[101];
+    for (int k = 0; k < 100; k++) I[k] = 0.0;
+    om__rtw_blur(I, 100, 3.0f, scratch, kernel);
+    CHECK(!om__rtw_table(I, 100, P));
+    int off = 0;
+    for (uint32_t k = 0; k <= 100; k++) off += P[k] != ident(100, k);
+    CHECK_EQ_U(off, 0);
+    double d;
+    double u = om__rtw_apply(P, 100, 0.37, &d);
+    CHECK(fabs(u - 0.37) < 1e-8 && fabs(d - 1.0) < 1e-6);
+    /* NaN and infinity count as nothing */
+    I[3] = NAN;
+    I[4] = INFINITY;
+    I[5] = -2.0;
+    CHECK(!om__rtw_table(I, 100, P));
+    I[50] = 1.0;
+    CHECK(om__rtw_table(I, 100, P));
+    CHECK(P[50] == 0 && P[51] == OM_RTW_ONE);
+    /* outside the map (and NaN) nothing moves */
+    CHECK(om__rtw_apply(P, 100, -0.25, &d) == -0.25 && d == 1.0);
+    CHECK(om__rtw_apply(P, 100, 1.5, &d) == 1.5);
+    CHECK(isnan(om__rtw_apply(P, 100, NAN, &d)));
+}
+
+static void collapse_by_maximum(void)
+{
+    static float imp[8 * 8];
+    double cols[8], rows[8];
+    memset(imp, 0, sizeof imp);
+    imp[2 * 8 + 5] = 3.0f;   /* row 2, column 5 */
+    imp[6 * 8 + 5] = 1.0f;
+    imp[6 * 8 + 1] = 2.0f;
+    om__rtw_collapse(imp, 8, cols, rows);
+    CHECK(cols[5] == 3.0 && cols[1] == 2.0 && cols[0] == 0.0 && cols[7] == 0.0);
+    CHECK(rows[2] == 3.0 && rows[6] == 2.0 && rows[0] == 0.0);
+}
+
+/* ---- whole frames, keeping the method's state for a look inside */
+
+typedef void (*inspect_fn)(const om__rtw *m, void *user);
+
+static om_status on_strip(void *user, const om_strip *st, const om_framebuffer *fb)
+{
+    om_term *out = (om_term *)user;
+    (void)fb;
+    if (out) memcpy(out + (size_t)st->y0 * st->width, st->terms, (size_t)st->rows * st->width * sizeof *out);
+    return OM_OK;
+}
+
+static om_status run_rtw(const om_scene *s, const om_method_cfg *c, uint32_t w, uint32_t h,
+                         uint32_t strip, om_term *terms, inspect_fn fn, void *user)
+{
+    om_camera cam;
+    om_light light;
+    om_view v;
+    om_scene_at(s, 0, &cam, &light);
+    cam.width = w;
+    cam.height = h;
+    om_status st = om_view_init(&v, &cam, &light, s, NULL);
+    if (st) return st;
+    const om_method *m = om_method_find("rtw");
+    size_t mn, full;
+    if (!m) return OM_E_NOTFOUND;
+    if ((st = m->bytes(c, s, w, h, &mn, &full))) return st;
+    uint32_t rows = strip ? strip : h;
+    void *mm = malloc(full), *fm = malloc(om_frame_bytes(w, rows)), *px = malloc((size_t)w * rows * 3);
+    om_arena ma, fa;
+    om_arena_init(&ma, mm, full, "method");
+    om_arena_init(&fa, fm, om_frame_bytes(w, rows), "frame");
+    void *state;
+    om_diag d;
+    st = m->init(&state, &ma, c, s, w, h, &d);
+    if (st == OM_OK) {
+        om_framebuffer fb = {OM_RGB888, w, rows, (size_t)w * 3, (uint8_t *)px};
+        om_shade_cfg shade;
+        om_shade_cfg_default(&shade);
+        om_frame_desc fd;
+        memset(&fd, 0, sizeof fd);
+        fd.scene = s; fd.view = &v; fd.method = m; fd.method_state = state; fd.shade = &shade;
+        fd.strip_rows = strip; fd.fb = &fb; fd.on_strip = on_strip; fd.user = terms;
+        st = om_render_frame(&fd, &fa, NULL, &d);
+        if (st == OM_OK && fn) fn((const om__rtw *)state, user);
+        CHECK(ma.peak <= mn);
+    }
+    if (st) fprintf(stderr, "  (run_rtw: %s)\n", d.msg);
+    free(mm);
+    free(fm);
+    free(px);
+    return st;
+}
+
+typedef struct crack_probe { uint32_t holes; double dens; uint32_t drawn; } crack_probe;
+
+static void count_holes(const om__rtw *m, void *user)
+{
+    crack_probe *p = (crack_probe *)user;
+    p->holes = 0;
+    for (size_t i = 0; i < (size_t)m->size * m->size; i++) p->holes += m->depth[i] == 0xFFFFFFFFu;
+    p->dens = m->dens_x > m->dens_y ? m->dens_x : m->dens_y;
+    p->drawn = m->tris_drawn;
+}
+
+/* A floor larger than the light's frustum covers every texel of the warped map, under a
+ * strong warp, with and without tessellation: a texel left empty is a crack between two
+ * triangles that share an edge (the edge split in one and not in the other, or cut at
+ * two different points). */
+static void warped_map_has_no_cracks(void)
+{
+    static const char *scenes[] = {
+        "camera eye 0 1.5 9 target 0 0 0 fov 60 size 160 120 near 0.1 far 100\n"
+        "light directional dir 0.3 -1 0.2\n"
+        "plane size 400 400 divisions 7\n"
+        "box size 1 1 1 translate 0 0.5 0\n",
+        "camera eye 1 2 6 target 0 0 -2 fov 70 size 160 120 near 0.1 far 100\n"
+        "light spot pos 3 12 4 target 0 0 0 fov 60 near 1 far 60\n"
+        "plane size 80 80 divisions 5\n"
+        "sphere radius 1 segments 24 rings 12 translate 0 1 0\n",
+    };
+    static const float tess[] = {0.0f, 0.05f, 0.025f, 0.01f};
+    for (int k = 0; k < 2; k++) {
+        h_scene hs;
+        if (!h_scene_parse(&hs, scenes[k])) return;
+        for (int t = 0; t < 4; t++) {
+            om_method_cfg c;
+            om_method_cfg_default(&c);
+            c.map_size = 256;
+            c.rtw_importance = 128;
+            c.rtw_tess = tess[t];
+            crack_probe p;
+            memset(&p, 0, sizeof p);
+            CHECK_OK(run_rtw(&hs.s, &c, 160, 120, 0, NULL, count_holes, &p));
+            CHECK_MSG(p.holes == 0, "scene %d tess %g: %u empty texels", k, tess[t], p.holes);
+            CHECK_MSG(p.dens > 2.0, "scene %d: the warp is too weak to test (%g)", k, p.dens);
+            if (t > 0) CHECK(p.drawn > hs.s.ntris);
+        }
+        h_scene_free(&hs);
+    }
+}
+
+static uint64_t mismatches(const uint8_t *ref, const uint8_t *m, uint32_t w, uint32_t h)
+{
+    om_metrics mt;
+    om_compare_masks(ref, m, w, h, &mt);
+    CHECK_EQ_U(mt.mismatched_bg, 0);
+    return mt.false_lit + mt.false_shadowed;
+}
+
+/* The paper's claim (Figure 1): a 512 x 512 RTW map is as accurate as a 2048 x 2048
+ * conventional one; and tessellation at 2.5% beats none (Figure 7). */
+static void rtw512_matches_sm2048(void)
+{
+    enum { w = 640, h = 480 };
+    h_scene hs;
+    if (!h_scene_parse(&hs, om_scene_default_text())) return;
+    static uint8_t ref[w * h], m[w * h];
+    CHECK_OK(h_render(&hs.s, "ref", NULL, w, h, 0, 0, ref, NULL, NULL));
+    om_method_cfg c;
+    om_method_cfg_default(&c);
+    c.map_size = 2048;
+    CHECK_OK(h_render(&hs.s, "sm", &c, w, h, 0, 0, m, NULL, NULL));
+    uint64_t sm2048 = mismatches(ref, m, w, h);
+    c.map_size = 512;
+    CHECK_OK(h_render(&hs.s, "sm", &c, w, h, 0, 0, m, NULL, NULL));
+    uint64_t sm512 = mismatches(ref, m, w, h);
+    CHECK_OK(h_render(&hs.s, "rtw", &c, w, h, 0, 0, m, NULL, NULL));
+    uint64_t rtw = mismatches(ref, m, w, h);
+    c.rtw_tess = 0.0f;
+    CHECK_OK(h_render(&hs.s, "rtw", &c, w, h, 0, 0, m, NULL, NULL));
+    uint64_t rtw_flat = mismatches(ref, m, w, h);
+    CHECK_MSG(rtw <= sm2048, "rtw 512: %llu mismatches, sm 2048: %llu", (unsigned long long)rtw,
+              (unsigned long long)sm2048);
+    CHECK_MSG(rtw < rtw_flat, "tessellated %llu, not fewer than untessellated %llu",
+              (unsigned long long)rtw, (unsigned long long)rtw_flat);
+    CHECK(rtw * 2 < sm512);
+    h_scene_free(&hs);
+}
+
+/* Every analysis and every single importance function renders and, on the default
+ * scene, beats the conventional map of the same size; with every function off the
+ * tables are the identity. */
+typedef struct table_probe { int off; double dens_x, dens_y; } table_probe;
+
+static void probe_tables(const om__rtw *m, void *user)
+{
+    table_probe *p = (table_probe *)user;
+    p->off = 0;
+    for (uint32_t k = 0; k <= m->n; k++) p->off += m->px[k] != ident(m->n, k) || m->py[k] != ident(m->n, k);
+    p->dens_x = m->dens_x;
+    p->dens_y = m->dens_y;
+}
+
+static void analyses_and_functions(void)
+{
+    enum { w = 320, h = 240 };
+    h_scene hs;
+    if (!h_scene_parse(&hs, om_scene_default_text())) return;
+    static uint8_t ref[w * h], m[w * h];
+    CHECK_OK(h_render(&hs.s, "ref", NULL, w, h, 0, 0, ref, NULL, NULL));
+    om_method_cfg c;
+    om_method_cfg_default(&c);
+    c.map_size = 512;
+    CHECK_OK(h_render(&hs.s, "sm", &c, w, h, 0, 0, m, NULL, NULL));
+    uint64_t sm = mismatches(ref, m, w, h);
+    static const struct { uint32_t analysis, funcs; } runs[] = {
+        {0, 1}, {0, 1 | 2}, {0, 1 | 8}, {0, 1 | 2 | 8}, {1, 1 | 2 | 4 | 8}, {1, 1 | 2},
+        {2, 1 | 2 | 4}, {2, 1 | 2 | 4 | 8},
+    };
+    for (size_t k = 0; k < sizeof runs / sizeof runs[0]; k++) {
+        c.rtw_analysis = runs[k].analysis;
+        c.rtw_funcs = runs[k].funcs;
+        CHECK_OK(h_render(&hs.s, "rtw", &c, w, h, 0, 0, m, NULL, NULL));
+        uint64_t bad = mismatches(ref, m, w, h);
+        CHECK_MSG(bad < sm, "analysis %u funcs %u: %llu mismatches, sm 512 %llu", runs[k].analysis,
+                  runs[k].funcs, (unsigned long long)bad, (unsigned long long)sm);
+    }
+    table_probe p;
+    c.rtw_analysis = 0;
+    c.rtw_funcs = 0;
+    CHECK_OK(run_rtw(&hs.s, &c, w, h, 0, NULL, probe_tables, &p));
+    CHECK_EQ_U(p.off, 0);
+    c.rtw_funcs = 1;
+    CHECK_OK(run_rtw(&hs.s, &c, w, h, 0, NULL, probe_tables, &p));
+    CHECK(p.off > 0 && p.dens_x > 1.5 && p.dens_y > 1.5);
+    h_scene_free(&hs);
+}
+
+static void budget_and_determinism(void)
+{
+    enum { w = 160, h = 120 };
+    h_scene hs;
+    if (!h_scene_parse(&hs, om_scene_default_text())) return;
+    const om_method *m = om_method_find("rtw");
+    CHECK(m != NULL);
+    if (!m) return;
+    for (uint32_t analysis = 0; analysis < 3; analysis++) {
+        om_method_cfg c;
+        om_method_cfg_default(&c);
+        c.map_size = 256;
+        c.rtw_importance = 64;
+        c.rtw_analysis = analysis;
+        size_t mn, full;
+        CHECK_OK(m->bytes(&c, &hs.s, w, h, &mn, &full));
+        CHECK(mn == full && mn >= 256 * 256 * 4);
+        unsigned char *buf = malloc(mn + 64);
+        memset(buf, 0xC3, mn + 64);
+        om_arena a;
+        om_arena_init(&a, buf + 32, mn - 1, "method");
+        void *state;
+        om_diag d;
+        CHECK(m->init(&state, &a, &c, &hs.s, w, h, &d) == OM_E_BUDGET);
+        CHECK_EQ_U(a.used, 0);
+        char num[32];
+        snprintf(num, sizeof num, "%zu", mn);
+        CHECK_MSG(strstr(d.msg, num) != NULL, "'%s' does not name %s", d.msg, num);
+        int guard = 0;
+        for (int i = 0; i < 32; i++) guard += buf[i] != 0xC3 || buf[32 + mn + i] != 0xC3;
+        CHECK_EQ_U(guard, 0);
+        free(buf);
+    }
+    /* identical runs, and the frame through strips, give the same bits */
+    static om_term t1[w * h], t2[w * h], t3[w * h];
+    om_method_cfg c;
+    om_method_cfg_default(&c);
+    c.map_size = 512;
+    for (uint32_t analysis = 0; analysis < 3; analysis++) {
+        c.rtw_analysis = analysis;
+        c.rtw_funcs = 15;
+        CHECK_OK(run_rtw(&hs.s, &c, w, h, 0, t1, NULL, NULL));
+        CHECK_OK(run_rtw(&hs.s, &c, w, h, 0, t2, NULL, NULL));
+        CHECK_OK(run_rtw(&hs.s, &c, w, h, 7, t3, NULL, NULL));
+        CHECK(!memcmp(t1, t2, sizeof t1));
+        CHECK(!memcmp(t1, t3, sizeof t1));
+    }
+    /* settings out of range are refused cleanly */
+    void *state;
+    om_arena a;
+    static unsigned char small[64];
+    om_arena_init(&a, small, sizeof small, "method");
+    c.rtw_sigma = NAN;
+    CHECK(m->init(&state, &a, &c, &hs.s, w, h, NULL) == OM_E_INVALID);
+    c.rtw_sigma = 3.0f;
+    c.rtw_analysis = 3;
+    CHECK(m->init(&state, &a, &c, &hs.s, w, h, NULL) == OM_E_INVALID);
+    h_scene_free(&hs);
+}
+
+void suite_rtw(void)
+{
+    RUN(uniform_is_identity);
+    RUN(warps_monotonic_with_fixed_ends);
+    RUN(important_cell_gets_more);
+    RUN(all_zero_is_safe);
+    RUN(collapse_by_maximum);
+    RUN(warped_map_has_no_cracks);
+    RUN(rtw512_matches_sm2048);
+    RUN(analyses_and_functions);
+    RUN(budget_and_determinism);
+}
