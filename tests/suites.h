@@ -13,6 +13,7 @@
     X(suite_izb) \
     X(suite_robust) \
     X(suite_rtw) \
+    X(suite_spsm) \
     /* end of list */
 #endif
 #define X(suite) void suite(void);

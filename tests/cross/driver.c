@@ -98,7 +98,7 @@ int om_cross_main(void)
          * 256 KiB method arena of the Cortex-M build. */
         om_method_cfg cfg;
         om_method_cfg_default(&cfg);
-        cfg.map_size = 120;
+        cfg.map_size = 96;
         cfg.asm_cap = 192u << 10;
         cfg.rtw_importance = 64;
         size_t mn, full;

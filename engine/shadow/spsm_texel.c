@@ -1,0 +1,171 @@
+/* spsm_texel.c — the SPSM's storage formats (paper 004, sections 3.3 and 3.4) and its
+ * tangent look-up table (section 4.2, Figure 8): vertex offsets in 16 bits, depth
+ * derivatives in 8 bits, and the 512 depth-test patterns. Everything here is integer
+ * or built from the engine's deterministic functions, so every build agrees. */
+#include "spsm.h"
+#include "occlude.h"
+
+/* ---- o16 vertex offsets (section 3.3; our choice of code, see spsm.h) */
+
+uint16_t om__spsm_o16_encode(int64_t v)
+{
+    uint16_t sign = 0;
+    uint64_t a;
+    if (v < 0) { sign = 0x8000u; a = (uint64_t)(-(v + 1)) + 1u; }
+    else a = (uint64_t)v;
+    if (a < 2048u) return (uint16_t)(sign | a);
+    /* e = bit length of a - 11, found in five steps: this runs for every texel written */
+    unsigned len = 1;
+    uint64_t x = a;
+    if (x >> 32) { x >>= 32; len += 32; }
+    if (x >> 16) { x >>= 16; len += 16; }
+    if (x >> 8) { x >>= 8; len += 8; }
+    if (x >> 4) { x >>= 4; len += 4; }
+    if (x >> 2) { x >>= 2; len += 2; }
+    if (x >> 1) len += 1;
+    unsigned e = len - 11;
+    /* round half up to the step 2^(e-1); a carry moves to the next exponent */
+    uint64_t m = e == 1 ? a : (a + (1ull << (e - 2))) >> (e - 1);
+    if (m >= 4096u) { m >>= 1; e++; }
+    if (e > 15) return (uint16_t)(sign | (15u << 11) | 2047u);   /* saturate */
+    return (uint16_t)(sign | (e << 11) | (unsigned)(m - 2048u));
+}
+
+int64_t om__spsm_o16_decode(uint16_t c)
+{
+    unsigned e = (c >> 11) & 15u, m = c & 2047u;
+    int64_t a = e == 0 ? (int64_t)m : (int64_t)(2048u + m) << (e - 1);
+    return (c & 0x8000u) ? -a : a;
+}
+
+/* ---- derivative code (section 3.4) */
+
+uint8_t om__spsm_q_encode(double d)
+{
+    if (d != d) return 127;
+    if (d < 0) return (uint8_t)(254 - om__spsm_q_encode(-d));   /* odd, exactly */
+    double x = 2.0 / OM_PI * om__atan(d);
+    double x5 = x * x * x * x * x;     /* odd power: the sign survives (Equation 3) */
+    double v = floor(127.0 * (1.0 + x5) + 0.5);
+    return (uint8_t)(v < 0.0 ? 0.0 : v > 254.0 ? 254.0 : v);
+}
+
+/* Equation 4 at a real-valued code: the signed fifth root, then tan. */
+static double decode_at(double q)
+{
+    double y = q / 127.0 - 1.0;
+    if (y == 0.0) return 0.0;
+    double r = om__exp2(om__log2(fabs(y)) / 5.0);
+    if (r > 1.0) r = 1.0;
+    return om__tan(OM_PI / 2.0 * (y < 0.0 ? -r : r));
+}
+
+void om__spsm_qtable_build(om__spsm_qtable *t)
+{
+    /* The positive half, mirrored: the code is odd, and the table is exactly so. */
+    t->dec[127] = t->err[127] = 0.0;
+    for (int q = 128; q < 254; q++) t->dec[q] = decode_at((double)q);
+    t->dec[254] = 2.0 * t->dec[253];   /* tan(pi/2): the code saturates */
+    /* A derivative d gets code q when the rounding boundaries q -+ 1/2 enclose it; the
+     * bound is the larger distance from the decoded value to either boundary. */
+    for (int q = 127; q < 254; q++) {
+        double lo = q == 127 ? -decode_at(127.5) : decode_at((double)q - 0.5), hi = decode_at((double)q + 0.5);
+        t->err[q] = fmax(t->dec[q] - lo, hi - t->dec[q]);
+    }
+    /* Saturated codes stand for every steeper slope: no bound but their own size. */
+    t->err[254] = t->dec[254];
+    for (int q = 0; q < 127; q++) {
+        t->dec[q] = -t->dec[254 - q];
+        t->err[q] = t->err[254 - q];
+    }
+    t->dec[255] = t->err[255] = 0.0;
+}
+
+/* ---- tangent table (section 4.2) */
+
+static bool bit(unsigned m, int dx, int dy)
+{
+    if (dx < -1 || dx > 1 || dy < -1 || dy > 1) return false;
+    return (m >> ((dy + 1) * 3 + (dx + 1))) & 1u;
+}
+
+void om__spsm_tangent_build(om__spsm_tangent lut[512])
+{
+    /* Candidate tangents for symmetric patterns (first moment zero): the one along which
+     * the occluding texels spread most, compared without division or roots. */
+    static const int cand[8][2] = {{1, 0}, {0, 1}, {1, 1}, {1, -1}, {2, 1}, {1, 2}, {2, -1}, {1, -2}};
+    for (unsigned m = 0; m < 512; m++) {
+        om__spsm_tangent *e = &lut[m];
+        memset(e, 0, sizeof *e);
+        /* Figure 7(b, c): a texel with no 4-neighbour in the pattern is isolated; the
+         * conservative rasterization guarantees the silhouette does not come from it.
+         * The sample's own texel is kept whatever its neighbours. */
+        unsigned keep = 0;
+        for (int dy = -1; dy <= 1; dy++)
+            for (int dx = -1; dx <= 1; dx++) {
+                if (!bit(m, dx, dy)) continue;
+                bool centre = dx == 0 && dy == 0;
+                if (centre || bit(m, dx - 1, dy) || bit(m, dx + 1, dy) || bit(m, dx, dy - 1) ||
+                    bit(m, dx, dy + 1))
+                    keep |= 1u << ((dy + 1) * 3 + (dx + 1));
+            }
+        e->keep = (uint16_t)keep;
+        if (keep == 0 || keep == 511) continue;
+        int gx = 0, gy = 0;
+        for (int dy = -1; dy <= 1; dy++)
+            for (int dx = -1; dx <= 1; dx++)
+                if (bit(keep, dx, dy)) { gx += dx; gy += dy; }
+        if (gx != 0 || gy != 0) {
+            /* the occluders' side: the shadow lies towards their first moment */
+            e->nn = 1;
+            e->n[0][0] = (int8_t)gx;
+            e->n[0][1] = (int8_t)gy;
+            continue;
+        }
+        /* Balanced pattern: a thin occluder through the texel. Its tangent is the axis of
+         * largest spread; the shadow may lie on either side, so both normals are tried. */
+        int best = -1, second = -1;
+        int64_t bnum = -1, bden = 1, snum = -1, sden = 1;
+        for (int c = 0; c < 8; c++) {
+            int64_t num = 0, den = cand[c][0] * cand[c][0] + cand[c][1] * cand[c][1];
+            for (int dy = -1; dy <= 1; dy++)
+                for (int dx = -1; dx <= 1; dx++)
+                    if (bit(keep, dx, dy)) {
+                        int64_t p = dx * cand[c][0] + dy * cand[c][1];
+                        num += p * p;
+                    }
+            if (best < 0 || num * bden > bnum * den) {
+                second = best; snum = bnum; sden = bden;
+                best = c; bnum = num; bden = den;
+            } else if (second < 0 || num * sden > snum * den) {
+                second = c; snum = num; sden = den;
+            }
+        }
+        if (bnum * sden == snum * bden) continue;   /* isotropic: no tangent */
+        e->nn = 2;
+        e->n[0][0] = (int8_t)-cand[best][1];
+        e->n[0][1] = (int8_t)cand[best][0];
+        e->n[1][0] = (int8_t)cand[best][1];
+        e->n[1][1] = (int8_t)-cand[best][0];
+    }
+}
+
+/* ---- packing (section 3.3, Figure 4) */
+
+void om__spsm_pack(om__spsm_texel *out, const om__rtri *t, int32_t x, int32_t y, uint8_t qx,
+                   uint8_t qy)
+{
+    const om__tri2 *e = &t->e;
+    const int64_t cx = (int64_t)x * OM_SUBPIX + OM_SUBPIX / 2, cy = (int64_t)y * OM_SUBPIX + OM_SUBPIX / 2;
+    for (int i = 0; i < 3; i++) {
+        out->vx[i] = om__spsm_o16_encode(e->x[i] - cx);
+        out->vy[i] = om__spsm_o16_encode(e->y[i] - cy);
+    }
+    /* The plane at the centre, not clamped to the triangle's depth range: the lookup
+     * extrapolates from here with the derivatives (Equation 1). */
+    double z = t->z0 + t->zx * (double)(cx - e->x[0]) + t->zy * (double)(cy - e->y[0]);
+    double s = floor(z / 65536.0 + 0.5);
+    out->z = (uint16_t)(s >= 0.0 ? (s > 65535.0 ? 65535.0 : s) : 0.0);   /* NaN: 0 */
+    out->qx = qx;
+    out->qy = qy;
+}
