@@ -11,8 +11,9 @@
     X(suite_shadow) \
     X(suite_measure) \
     X(suite_izb) \
-    X(suite_robust) \
     X(suite_rtw) \
+    X(suite_asm) \
+    X(suite_robust) \
     X(suite_spsm) \
     /* end of list */
 #endif

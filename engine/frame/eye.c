@@ -11,17 +11,10 @@ static void clip_tri(const om_scene *s, const om_mat4 *vp, uint32_t t, om_vec4 c
     for (int k = 0; k < 3; k++) c[k] = om__mat_apply(vp, s->verts[ix[k]]);
 }
 
-/* Per-triangle data reused while neighbouring pixels see the same triangle. */
-typedef struct tri_cache {
-    uint32_t tri;
-    double adj[9];         /* adjugate of the 3x3 matrix of (x, y, w) columns */
-    om_vec3 v[3], n;
-} tri_cache;
-
-static void cache_tri(const om_scene *s, const om_view *v, uint32_t t, tri_cache *c)
+void om__persp_setup(const om_scene *s, const om_mat4 *vp, uint32_t t, om__persp_tri *c)
 {
     om_vec4 q[3];
-    clip_tri(s, &v->cam_vp, t, q);
+    clip_tri(s, vp, t, q);
     /* M has columns (x_i, y_i, w_i); we need M^-1 up to scale: the adjugate. */
     double m[9] = {q[0].x, q[1].x, q[2].x, q[0].y, q[1].y, q[2].y, q[0].w, q[1].w, q[2].w};
     c->adj[0] = m[4] * m[8] - m[5] * m[7];
@@ -39,7 +32,7 @@ static void cache_tri(const om_scene *s, const om_view *v, uint32_t t, tri_cache
     c->tri = t;
 }
 
-static void resolve_pixel(const tri_cache *c, double sx, double sy, om_sample *out)
+om_vec3 om__persp_point(const om__persp_tri *c, double sx, double sy)
 {
     double b[3], sum = 0.0;
     for (int k = 0; k < 3; k++) {
@@ -54,9 +47,15 @@ static void resolve_pixel(const tri_cache *c, double sx, double sy, om_sample *o
         py += w * c->v[k].y;
         pz += w * c->v[k].z;
     }
-    out->p[0] = (float)px;
-    out->p[1] = (float)py;
-    out->p[2] = (float)pz;
+    return om__v3((float)px, (float)py, (float)pz);
+}
+
+static void resolve_pixel(const om__persp_tri *c, double sx, double sy, om_sample *out)
+{
+    om_vec3 p = om__persp_point(c, sx, sy);
+    out->p[0] = p.x;
+    out->p[1] = p.y;
+    out->p[2] = p.z;
     out->n[0] = c->n.x;
     out->n[1] = c->n.y;
     out->n[2] = c->n.z;
@@ -82,7 +81,7 @@ void om__scene_raster(const om_scene *s, const om_mat4 *vp, const om_target *tg,
 void om__eye_pass(const om_scene *s, const om_view *v, const om_target *tg, om_strip *st)
 {
     om__scene_raster(s, &v->cam_vp, tg, OM_RASTER_DEPTH_ID);
-    tri_cache cache;
+    om__persp_tri cache;
     memset(&cache, 0, sizeof cache);
     cache.tri = OM_NO_TRI;
     for (uint32_t y = 0; y < st->rows; y++) {
@@ -96,7 +95,7 @@ void om__eye_pass(const om_scene *s, const om_view *v, const om_target *tg, om_s
                 smp->tri = OM_NO_TRI;
                 continue;
             }
-            if (cache.tri != t) cache_tri(s, v, t, &cache);
+            if (cache.tri != t) om__persp_setup(s, &v->cam_vp, t, &cache);
             double sx = ((double)x + 0.5) * 2.0 / (double)st->width - 1.0;
             resolve_pixel(&cache, sx, sy, smp);
         }

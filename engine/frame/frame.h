@@ -19,6 +19,19 @@ void om__scene_raster(const om_scene *s, const om_mat4 *vp, const om_target *tg,
  * triangle under each pixel centre, by perspective-correct barycentrics. */
 void om__eye_pass(const om_scene *s, const om_view *v, const om_target *tg, om_strip *st);
 
+/* The exact point of a triangle under an image position, by perspective-correct
+ * barycentrics in homogeneous clip space (no division by w, so triangles crossing the
+ * viewer's plane need no special case). Set up once per triangle, then evaluated at
+ * NDC positions (sx, sy) of the image that `vp` projects onto. */
+typedef struct om__persp_tri {
+    uint32_t tri;
+    double adj[9];         /* adjugate of the 3x3 matrix of (x, y, w) columns */
+    om_vec3 v[3], n;       /* world vertices and the unit geometric normal */
+} om__persp_tri;
+
+void om__persp_setup(const om_scene *s, const om_mat4 *vp, uint32_t t, om__persp_tri *c);
+om_vec3 om__persp_point(const om__persp_tri *c, double sx, double sy);
+
 /* The parts of the lit rule that no occluder decides, the same for every method:
  * the normal turned towards the camera faces the light, and the point lies inside
  * the light's frustum. */

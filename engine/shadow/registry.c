@@ -6,6 +6,7 @@ static const om_method *const methods[] = {
     &om__method_none,
     &om__method_ref,
     &om__method_sm,
+    &om__method_asm,
     &om__method_rtw,
     &om__method_spsm,
     &om__method_izb,

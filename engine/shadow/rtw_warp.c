@@ -183,52 +183,8 @@ void om__rtw_observe_strip(om__rtw *m, const om_strip *st)
     }
 }
 
-/* ---- forward analysis: the world point under a light texel, by perspective-correct
- * barycentrics of the texel centre in the triangle's light clip space (the eye pass's
- * method), so triangles crossing the light's w = 0 plane need no special case. */
-typedef struct fwd_tri {
-    uint32_t tri;
-    double adj[9];
-    om_vec3 v[3], n;
-} fwd_tri;
-
-static void fwd_setup(const om__rtw *m, uint32_t t, fwd_tri *c)
-{
-    const uint32_t *ix = m->scene->idx + (size_t)t * 3;
-    om_vec4 q[3];
-    for (int k = 0; k < 3; k++) {
-        c->v[k] = m->scene->verts[ix[k]];
-        q[k] = om__mat_apply(&m->view.light_vp, c->v[k]);
-    }
-    double a[9] = {q[0].x, q[1].x, q[2].x, q[0].y, q[1].y, q[2].y, q[0].w, q[1].w, q[2].w};
-    c->adj[0] = a[4] * a[8] - a[5] * a[7];
-    c->adj[1] = a[2] * a[7] - a[1] * a[8];
-    c->adj[2] = a[1] * a[5] - a[2] * a[4];
-    c->adj[3] = a[5] * a[6] - a[3] * a[8];
-    c->adj[4] = a[0] * a[8] - a[2] * a[6];
-    c->adj[5] = a[2] * a[3] - a[0] * a[5];
-    c->adj[6] = a[3] * a[7] - a[4] * a[6];
-    c->adj[7] = a[1] * a[6] - a[0] * a[7];
-    c->adj[8] = a[0] * a[4] - a[1] * a[3];
-    c->n = om__normalize(om__cross(om__sub(c->v[1], c->v[0]), om__sub(c->v[2], c->v[0])));
-    c->tri = t;
-}
-
-static om_vec3 fwd_point(const fwd_tri *c, double sx, double sy)
-{
-    double b[3], sum = 0.0, x = 0.0, y = 0.0, z = 0.0;
-    for (int k = 0; k < 3; k++) {
-        b[k] = c->adj[k * 3] * sx + c->adj[k * 3 + 1] * sy + c->adj[k * 3 + 2];
-        sum += b[k];
-    }
-    double inv = sum != 0.0 ? 1.0 / sum : 0.0;
-    for (int k = 0; k < 3; k++) {
-        x += b[k] * inv * c->v[k].x;
-        y += b[k] * inv * c->v[k].y;
-        z += b[k] * inv * c->v[k].z;
-    }
-    return om__v3((float)x, (float)y, (float)z);
-}
+/* ---- forward analysis: the world point under a light texel, by the eye pass's
+ * perspective-correct barycentrics (om__persp_point) in the light's clip space. */
 
 static bool in_camera(const om_view *v, om_vec3 p)
 {
@@ -276,7 +232,8 @@ static void forward(om__rtw *m)
     const bool hybrid = m->cfg.rtw_analysis == OM_RTW_HYBRID;
     om_target tg = {n, n, 0, n, m->fdepth, m->fid};
     om__scene_raster(m->scene, &m->view.light_vp, &tg, OM_RASTER_DEPTH_ID);
-    fwd_tri cache;
+    om__persp_tri cache;
+    memset(&cache, 0, sizeof cache);
     cache.tri = OM_NO_TRI;
     for (uint32_t j = 0; j < n; j++)
         for (uint32_t i = 0; i < n; i++) {
@@ -288,10 +245,10 @@ static void forward(om__rtw *m)
             }
             uint32_t t = m->fid[c];
             if (t == OM_NO_TRI) { m->imp[c] = 0.0f; continue; }
-            if (cache.tri != t) fwd_setup(m, t, &cache);
+            if (cache.tri != t) om__persp_setup(m->scene, &m->view.light_vp, t, &cache);
             double sx = ((double)i + 0.5) * 2.0 / (double)n - 1.0;
             double sy = 1.0 - ((double)j + 0.5) * 2.0 / (double)n;
-            om_vec3 p = fwd_point(&cache, sx, sy);
+            om_vec3 p = om__persp_point(&cache, sx, sy);
             float imp = edge;
             if ((funcs & OM_RTW_DV) && !in_camera(&m->view, p)) imp = 0.0f;
             if (imp > 0.0f) imp *= om__rtw_point_importance(&m->view, funcs, p, cache.n);

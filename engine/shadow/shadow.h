@@ -7,6 +7,7 @@
 extern const om_method om__method_none;
 extern const om_method om__method_ref;
 extern const om_method om__method_sm;
+extern const om_method om__method_asm;
 extern const om_method om__method_rtw;
 extern const om_method om__method_spsm;
 extern const om_method om__method_izb;

@@ -40,6 +40,7 @@ int bench_run(const bscene *b, const char *method, const om_method_cfg *cfg, uin
     X(bench_shadow) \
     X(bench_izb) \
     X(bench_rtw) \
+    X(bench_asm) \
     X(bench_spsm) \
     /* end of list */
 #define X(name) void name(void);

@@ -94,8 +94,8 @@ int om_cross_main(void)
     int bad = 0;
     for (size_t k = 0; k < om_method_count(); k++) {
         const om_method *m = om_method_at(k);
-        /* One configuration everywhere (the hashes must agree), small enough for the
-         * 256 KiB method arena of the Cortex-M build. */
+        /* One configuration everywhere (the hashes must agree), small enough for small
+         * machines: the bytes lines say which methods fit 256 KiB. */
         om_method_cfg cfg;
         om_method_cfg_default(&cfg);
         cfg.map_size = 96;
@@ -139,6 +139,11 @@ int om_cross_main(void)
         n = 6 + strlen(m->name);
         line[n++] = ' ';
         put_dec(num, ma.peak);
+        memcpy(line + n, num, strlen(num));
+        n += strlen(num);
+        memcpy(line + n, " min ", 5);
+        n += 5;
+        put_dec(num, mn);
         memcpy(line + n, num, strlen(num) + 1);
         om_host_puts(line);
     }

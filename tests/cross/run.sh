@@ -68,9 +68,10 @@ for c in $configs; do
 done
 # Cortex-M3 (mps2-an385) and Cortex-M4 (mps2-an386) under qemu-system-arm, through
 # platform/cortex-m: the same driver, the scene compiled into the firmware (the
-# default scene's text), every method in a 256 KiB arena.
+# default scene's text), every method in an arena of up to 2 MiB; the table says which
+# fit the 256 KiB target (their minimum at this configuration).
 MFLAGS="-std=c99 -Wall -Wextra -Werror -O2 -ffp-contract=off -ffreestanding -mthumb -Iinclude"
-MFLAGS="$MFLAGS -DOM_CROSS_METHOD_MEM=(256u<<10) -DOM_CROSS_SCENE_MEM=(512u<<10) -ffunction-sections -fdata-sections"
+MFLAGS="$MFLAGS -DOM_CROSS_METHOD_MEM=(2u<<20) -DOM_CROSS_SCENE_MEM=(512u<<10) -ffunction-sections -fdata-sections"
 for board in "cortex-m3 mps2-an385" "cortex-m4 mps2-an386"; do
     IFS=' '
     set -- $board
@@ -98,7 +99,7 @@ for board in "cortex-m3 mps2-an385" "cortex-m4 mps2-an386"; do
     elif [ -n "$ref" ] && [ "$(grep -v '^bytes' "$out/$ref.txt")" = "$(grep -v '^bytes' "$out/$name.txt")" ]; then
         pass=$((pass + 1))
         echo "cross: $name matches ($(arm-none-eabi-size "$out/$name.elf" | awk 'NR == 2 {print $1}') bytes of code)"
-        grep '^bytes' "$out/$name.txt" | sed 's/^bytes/    arena bytes:/'
+        grep '^bytes' "$out/$name.txt" | awk '{printf "    %-5s peak %8d, minimum %8d: %s\n", $2, $3, $5, $5 <= 262144 ? "fits 256 KiB" : "over 256 KiB"}'
     else
         fail=$((fail + 1))
         echo "cross: FAIL $name differs from $ref:"
@@ -107,9 +108,11 @@ for board in "cortex-m3 mps2-an385" "cortex-m4 mps2-an386"; do
 done
 
 # Code size: .text of each part of the engine for Cortex-M3 at -Os.
+IFS=' 	
+'
 if command -v arm-none-eabi-gcc >/dev/null 2>&1; then
     echo "cross: .text bytes for Cortex-M3 at -Os:"
-    for part in core raster scene frame measure shadow/occlude shadow/bvh shadow/registry \
+    for part in core raster scene frame measure shadow/occlude shadow/bvh shadow/smlookup shadow/registry \
                 $(ls engine/shadow/*.c | sed -n 's|engine/shadow/\([a-z]*\)\.c|\1|p' | \
                   grep -v -x -e occlude -e bvh -e registry -e smlookup -e asm_tree -e rtw_warp -e spsm_texel); do
         case $part in

@@ -1,0 +1,560 @@
+/* asm.c — Adaptive Shadow Maps (Fernando, Fernandez, Bala, Greenberg 2001; paper 002)
+ * under a user-set memory cap: the frame flow, the view-driven analysis, rendering of
+ * node tiles and the lookup. The tree, its pool and its removal rules are asm_tree.c.
+ *
+ * A frame:
+ *  begin    takes the view. If the light's matrix differs from the one the tiles were
+ *           rendered with, every tile is stale: the tree is dropped and the base is
+ *           re-rendered (a rebuild; root tiles follow in build). A directional light
+ *           is fitted to the visible samples every frame, so with one the tree is
+ *           rebuilt whenever the view moves.
+ *  observe  (every strip, before build) one visible sample in asm.stride is analysed
+ *           (section 4.3: the paper uses one in eight): it descends to its leaf cell,
+ *           making its root tile if there is none and memory is free, and below the
+ *           root tiles, at every
+ *           level it passes, it counts towards the benefit of that level's cell
+ *           when it straddles a discontinuity and the level's texel is larger on the
+ *           surface than its eye pixel (sections 3.1, 4.1 — both footprints analytic).
+ *  build    makes the root tiles still missing (most samples first, by the rules of
+ *           section 3.2; root tiles are outside the budget: the root covers what the
+ *           eye sees), then orders the empty cells with a
+ *           benefit by benefit / cost, cost = a * N_required + b (section 3.1), and
+ *           creates their nodes, best first, until asm.work cost units are spent;
+ *           memory comes back by the rules of section 3.2 (asm_tree.c).
+ *  resolve  finds the deepest node over each sample (caching the last leaf, section
+ *           4.3) and tests polygon ID, then depth (section 4.2).
+ *
+ * "Straddles a discontinuity" is decided where it matters: the sample's own shadow test
+ * (ID, then depth) against its texel and the eight around it does not agree, i.e. a
+ * depth or ID discontinuity that changes its answer lies within a texel of it.
+ * A node's benefit is the same count for the samples inside it at its parent's
+ * resolution: what would be lost without it. So a still view compares like with like
+ * when a node must be replaced, and the tree settles instead of oscillating.
+ *
+ * Where memory runs out (a cap too small for the root tiles the view asks for), the
+ * base answers: one tile over the whole frustum, coarse but never absent, so every
+ * cap from the smallest (the base and one tile) renders.
+ *
+ * Bias: the constant and slope-scaled bias of the conventional map (cfg bias_const,
+ * bias_slope in texels of the node the sample is tested in); the paper notes the ID
+ * test does not remove the bias problem. pcf and normal_offset do not apply. */
+#include "shadow.h"
+#include "asm.h"
+
+#include <float.h>
+
+typedef struct asm_dvec { double x, y, z, w; } asm_dvec;
+
+typedef struct asm_state {
+    const om_scene *scene;
+    om_method_cfg cfg;
+    om__asm_tree tree;
+    om_view view;
+    om_mat4 built_vp;      /* the light the tiles hold */
+    bool built;
+    bool prepared;         /* this frame's projections are done */
+    asm_dvec *vclip;       /* per vertex: light clip coordinates, in double */
+    float *tbox;           /* per triangle: base-texel bounds u0, v0, u1, v1 */
+    uint32_t *cull;        /* triangles that meet the region being rendered */
+    uint32_t *sdepth, *sid;   /* one tile of scratch for the rasterizer */
+    om__asm_cand *cand;
+    uint32_t ncand_max;
+    double inv_scale[OM__ASM_MAX_LEVEL + 1];   /* a level-L texel in base texels */
+    float span_per_dist;   /* spot: frustum width per unit of distance */
+    float pix_per_dist;    /* eye: pixel height per unit of distance */
+    uint32_t cache;        /* the last leaf found by resolve, or OM__ASM_NONE */
+    om__asm_tile cache_tile;
+    uint32_t samples, shadowed, analysed, straddling, candidates, rebuilds;
+} asm_state;
+
+/* What the analysis and the lookup need of one sample. */
+typedef struct asm_pt {
+    double u, v;           /* base texels, x right, y down */
+    double z;              /* light depth z/w * 2^32 */
+    double bias_c, bias_s; /* constant bias; slope bias for a base texel (depth units) */
+    double ratio0;         /* a base texel's surface footprint / the eye pixel's */
+    uint32_t tri;
+} asm_pt;
+
+static size_t scratch_bytes(const om_scene *s, const om__asm_layout *l, uint64_t ncand)
+{
+    const size_t t2 = (size_t)l->tile * l->tile;
+    return om_arena_need((size_t)(s->nverts ? s->nverts : 1) * sizeof(asm_dvec), 8) +
+           om_arena_need((size_t)(s->ntris ? s->ntris : 1) * 4 * sizeof(float), 8) +
+           om_arena_need((size_t)(s->ntris ? s->ntris : 1) * sizeof(uint32_t), 8) +
+           2 * om_arena_need(t2 * sizeof(uint32_t), 8) +
+           om_arena_need((size_t)ncand * sizeof(om__asm_cand), 8);
+}
+
+static uint64_t cand_count(const om__asm_layout *l)
+{
+    uint64_t n = om__asm_cand_max(l);
+    return n ? n : 1;
+}
+
+static size_t asm_need(const om_scene *s, const om__asm_layout *l)
+{
+    return om_arena_need(sizeof(asm_state), 16) + l->arena_bytes + scratch_bytes(s, l, cand_count(l));
+}
+
+static om_status asm_bytes(const om_method_cfg *c, const om_scene *s, uint32_t w, uint32_t h,
+                           size_t *min, size_t *full)
+{
+    (void)w; (void)h;
+    om__asm_layout l;
+    om_status st = om__asm_layout_of(&l, c, s->ntris, NULL);
+    if (st) return st;
+    /* Below the smallest cap the figure is what the state needs to say so (init fails
+     * with OM_E_BUDGET naming the smallest cap). */
+    *min = *full = asm_need(s, &l);
+    return OM_OK;
+}
+
+static om_status asm_init(void **state, om_arena *a, const om_method_cfg *c, const om_scene *s,
+                          uint32_t w, uint32_t h, om_diag *d)
+{
+    om_status st;
+    om__asm_layout l;
+    void *p;
+    *state = NULL;   /* a host that ignores a failed init gets OM_E_INVALID, not a crash */
+    if ((st = om__asm_layout_of(&l, c, s->ntris, d))) return st;
+    if (l.count == 0) {
+        char tmp[8];
+        om__str b = om__diag_begin(d, OM_E_BUDGET, tmp, sizeof tmp);
+        if (d) { d->asked = (size_t)l.min_cap; d->left = (size_t)(c->asm_cap < SIZE_MAX ? c->asm_cap : SIZE_MAX); }
+        om__str_s(&b, "asm: asm.cap ");
+        om__str_u(&b, c->asm_cap);
+        om__str_s(&b, " is below the root node and one tile; the smallest cap is ");
+        om__str_u(&b, l.min_cap);
+        om__str_s(&b, " bytes");
+        return OM_E_BUDGET;
+    }
+    if (w < 1 || h < 1) return om__fail(d, OM_E_INVALID, "asm: image size must be at least 1x1");
+    if ((st = om__need(a, asm_need(s, &l), "asm", d))) return st;
+    if ((st = om_arena_alloc(a, sizeof(asm_state), 16, &p, d))) return st;
+    asm_state *m = (asm_state *)p;
+    m->scene = s;
+    m->cfg = *c;
+    if ((st = om__asm_tree_init(&m->tree, a, &l, d))) return st;
+    const size_t t2 = (size_t)l.tile * l.tile;
+    uint64_t nc = cand_count(&l);
+    if ((st = om_arena_alloc(a, (size_t)(s->nverts ? s->nverts : 1) * sizeof(asm_dvec), 8, &p, d))) return st;
+    m->vclip = (asm_dvec *)p;
+    if ((st = om_arena_alloc(a, (size_t)(s->ntris ? s->ntris : 1) * 4 * sizeof(float), 8, &p, d))) return st;
+    m->tbox = (float *)p;
+    if ((st = om_arena_alloc(a, (size_t)(s->ntris ? s->ntris : 1) * sizeof(uint32_t), 8, &p, d))) return st;
+    m->cull = (uint32_t *)p;
+    if ((st = om_arena_alloc(a, t2 * sizeof(uint32_t), 8, &p, d))) return st;
+    m->sdepth = (uint32_t *)p;
+    if ((st = om_arena_alloc(a, t2 * sizeof(uint32_t), 8, &p, d))) return st;
+    m->sid = (uint32_t *)p;
+    if ((st = om_arena_alloc(a, (size_t)nc * sizeof(om__asm_cand), 8, &p, d))) return st;
+    m->cand = (om__asm_cand *)p;
+    m->ncand_max = nc > UINT32_MAX ? UINT32_MAX : (uint32_t)nc;
+    for (uint32_t i = 0; i <= OM__ASM_MAX_LEVEL; i++) m->inv_scale[i] = (double)l.tile / om__asm_grid(&l, i);
+    m->cache = OM__ASM_NONE;
+    *state = m;
+    return OM_OK;
+}
+
+static om_status asm_begin(void *state, const om_view *v, om_diag *d)
+{
+    asm_state *m = (asm_state *)state;
+    if (!m) return om__fail(d, OM_E_INVALID, "asm: no state (did init fail?)");
+    m->view = *v;
+    m->span_per_dist = 2.0f * (float)om__tan((double)v->light.fov_deg * OM_PI / 360.0);
+    m->pix_per_dist = 2.0f * (float)om__tan((double)v->cam.fovy_deg * OM_PI / 360.0) / (float)v->cam.height;
+    m->samples = m->shadowed = m->analysed = m->straddling = m->candidates = m->rebuilds = 0;
+    m->prepared = false;
+    m->cache = OM__ASM_NONE;
+    om__asm_frame(&m->tree);
+    return OM_OK;
+}
+
+/* ---- rendering tiles */
+
+static asm_dvec dapply(const om_mat4 *mt, om_vec3 p)
+{
+    const float *a = mt->m;
+    asm_dvec r;
+    r.x = (double)a[0] * p.x + (double)a[1] * p.y + (double)a[2] * p.z + (double)a[3];
+    r.y = (double)a[4] * p.x + (double)a[5] * p.y + (double)a[6] * p.z + (double)a[7];
+    r.z = (double)a[8] * p.x + (double)a[9] * p.y + (double)a[10] * p.z + (double)a[11];
+    r.w = (double)a[12] * p.x + (double)a[13] * p.y + (double)a[14] * p.z + (double)a[15];
+    return r;
+}
+
+/* Renders texels [ox, ox + tile) x [oy, oy + tile) of level `level`'s grid into a
+ * tile's depth and ids, from the triangles whose light bounds meet the region. The light's clip space is composed with the window that maps the
+ * region's tile to [-1, 1] (x' = s x + k w), so the engine's rasterizer, clipping and
+ * fill rule apply unchanged at any depth of the tree. */
+static void render(asm_state *m, uint32_t level, uint32_t ox, uint32_t oy, uint32_t *depth,
+                   uint16_t *id16, uint32_t *id32)
+{
+    const om__asm_layout *l = &m->tree.lay;
+    const om_scene *s = m->scene;
+    const uint32_t T = l->tile;
+    const double s_ = om__asm_grid(l, level) / (double)T;
+    const double kx = s_ - 2.0 * (double)ox / (double)T - 1.0;
+    const double ky = 1.0 - s_ + 2.0 * (double)oy / (double)T;
+    /* the region in base texels, one texel of margin against rounding */
+    const double ic = m->inv_scale[level];
+    const float u0 = (float)(((double)ox - 1.0) * ic), u1 = (float)(((double)ox + T + 1.0) * ic);
+    const float v0 = (float)(((double)oy - 1.0) * ic), v1 = (float)(((double)oy + T + 1.0) * ic);
+    om_target tg = {T, T, 0, T, m->sdepth, m->sid};
+    om__target_clear(&tg);
+    om_raster r = {&tg, OM_RASTER_DEPTH_ID, NULL, NULL};
+    /* Gather first, without branches (most triangles miss a deep node's region). */
+    uint32_t n = 0;
+    for (uint32_t k = 0; k < s->ntris; k++) {
+        const float *b = &m->tbox[(size_t)k * 4];
+        m->cull[n] = k;
+        n += !((b[2] < u0) | (b[0] > u1) | (b[3] < v0) | (b[1] > v1));
+    }
+    for (uint32_t k = 0; k < n; k++) {
+        const uint32_t t = m->cull[k];
+        const uint32_t *ix = s->idx + (size_t)t * 3;
+        om_vec4 c[3];
+        for (int i = 0; i < 3; i++) {
+            const asm_dvec *q = &m->vclip[ix[i]];
+            c[i].x = (float)(q->x * s_ + q->w * kx);
+            c[i].y = (float)(q->y * s_ + q->w * ky);
+            c[i].z = (float)q->z;
+            c[i].w = (float)q->w;
+        }
+        om__raster_tri(&r, c, t);
+    }
+    const size_t t2 = (size_t)T * T;
+    memcpy(depth, m->sdepth, t2 * sizeof *depth);
+    if (id16)
+        for (size_t i = 0; i < t2; i++) id16[i] = m->sid[i] == OM_NO_TRI ? (uint16_t)0xFFFFu : (uint16_t)m->sid[i];
+    else
+        memcpy(id32, m->sid, t2 * sizeof *id32);
+}
+
+static void render_node(asm_state *m, uint32_t index)
+{
+    om__asm_tile tl;
+    om__asm_tile_of(&m->tree, index, &tl);
+    render(m, tl.node->level, tl.node->ox, tl.node->oy, tl.depth, tl.id16, tl.id32);
+}
+
+/* This frame's projections (once, from the first observe or build), and the rebuild
+ * when the light has moved. */
+static void prepare(asm_state *m)
+{
+    if (m->prepared) return;
+    m->prepared = true;
+    const om_scene *s = m->scene;
+    const double R = m->tree.lay.tile;   /* bounds in base texels */
+    for (uint32_t i = 0; i < s->nverts; i++) m->vclip[i] = dapply(&m->view.light_vp, s->verts[i]);
+    for (uint32_t k = 0; k < s->ntris; k++) {
+        const uint32_t *ix = s->idx + (size_t)k * 3;
+        float *b = &m->tbox[(size_t)k * 4];
+        double lo_u = 0, lo_v = 0, hi_u = 0, hi_v = 0;
+        bool all = false;
+        for (int i = 0; i < 3; i++) {
+            const asm_dvec *q = &m->vclip[ix[i]];
+            /* Behind or on the light's plane: the triangle's image is unbounded; let the
+             * rasterizer's clipping decide for every tile. */
+            if (!(q->w > 1e-9 * (fabs(q->x) + fabs(q->y)))) { all = true; break; }
+            double u = (q->x / q->w + 1.0) * 0.5 * R, v = (1.0 - q->y / q->w) * 0.5 * R;
+            if (i == 0 || u < lo_u) lo_u = u;
+            if (i == 0 || v < lo_v) lo_v = v;
+            if (i == 0 || u > hi_u) hi_u = u;
+            if (i == 0 || v > hi_v) hi_v = v;
+        }
+        if (all || !(lo_u > -1e30 && hi_u < 1e30 && lo_v > -1e30 && hi_v < 1e30)) {
+            b[0] = b[1] = -FLT_MAX;
+            b[2] = b[3] = FLT_MAX;
+        } else {   /* widened by far more than float rounding: never narrower than in double */
+            b[0] = (float)(lo_u - (1.0 / 256 + fabs(lo_u) * 1e-6));
+            b[1] = (float)(lo_v - (1.0 / 256 + fabs(lo_v) * 1e-6));
+            b[2] = (float)(hi_u + (1.0 / 256 + fabs(hi_u) * 1e-6));
+            b[3] = (float)(hi_v + (1.0 / 256 + fabs(hi_v) * 1e-6));
+        }
+    }
+    if (!m->built || memcmp(&m->built_vp, &m->view.light_vp, sizeof m->built_vp) != 0) {
+        om__asm_tree_clear(&m->tree);
+        render_node(m, OM__ASM_ROOT);
+        m->built_vp = m->view.light_vp;
+        m->built = true;
+        m->rebuilds++;
+    }
+}
+
+/* ---- one sample */
+
+/* Where the sample lands on the light's image, and its light depth. */
+static bool setup_uv(const asm_state *m, const om_sample *smp, asm_pt *o)
+{
+    asm_dvec q = dapply(&m->view.light_vp, om__v3(smp->p[0], smp->p[1], smp->p[2]));
+    if (!(q.w > 0.0)) return false;
+    const double R = m->tree.lay.tile, iw = 1.0 / q.w;
+    o->u = (q.x * iw + 1.0) * 0.5 * R;
+    o->v = (1.0 - q.y * iw) * 0.5 * R;
+    o->z = q.z * iw * 4294967296.0;
+    o->tri = smp->tri;
+    return o->u > -1e9 && o->u < 1e9 && o->v > -1e9 && o->v < 1e9 && o->z > -1e30 && o->z < 1e30;
+}
+
+/* Its bias and, with `analyse`, the footprint ratio, which only the analysis needs. */
+static void setup_bias(const asm_state *m, const om_sample *smp, asm_pt *o, bool analyse)
+{
+    const om_view *v = &m->view;
+    const double R = m->tree.lay.tile;
+    om_vec3 p = om__v3(smp->p[0], smp->p[1], smp->p[2]);
+    om_vec3 n = om__v3(smp->n[0], smp->n[1], smp->n[2]);
+    om_vec3 e = om__sub(v->cam.eye, p);
+    if (om__dot(n, e) < 0.0f) n = om__scale(n, -1.0f);
+    /* A base texel's world size across the light ray, and depth units per world unit
+     * along it, as the conventional map computes them. */
+    om_vec3 l = om__to_light(v, p);
+    double texel, dz;
+    if (v->light.kind == OM_LIGHT_SPOT) {
+        float dist = om__dot(om__sub(p, v->light.pos), v->light_axis);
+        double f = v->light.zfar, nn = v->light.znear, ee = dist > nn * 0.5f ? dist : nn * 0.5;
+        texel = (double)dist * m->span_per_dist / R;
+        dz = f * nn / ((f - nn) * ee * ee) * 4294967296.0;
+    } else {
+        texel = 2.0 / fabs((double)v->light_proj.m[0]) / R;
+        dz = 4294967296.0 * fabs((double)v->light_proj.m[10]);
+    }
+    float cosl = om__dot(n, l);
+    double tanl = cosl > 0.0995f ? sqrt(1.0 - (double)cosl * cosl) / cosl : 10.0;
+    o->bias_c = (double)m->cfg.bias_const * dz;
+    o->bias_s = (double)m->cfg.bias_slope * texel * tanl * dz;
+    o->ratio0 = 0.0;
+    if (!analyse) return;
+    /* Footprints on the surface (sections 3.1 and 4.1, computed rather than read from a
+     * mip-map): an eye pixel spans dist * 2 tan(fovy / 2) / height across the view ray,
+     * a texel its size across the light ray; on the surface each covers that squared
+     * over the cosine between the normal and its ray (clamped at 0.1). The ratio kept
+     * is linear: the square root of the paper's ratio of projected areas. */
+    float de = sqrtf(om__dot(e, e));
+    float cose = de > 0.0f ? fabsf(om__dot(n, e)) / de : 1.0f;
+    if (cose < 0.1f) cose = 0.1f;
+    if (cosl < 0.1f) cosl = 0.1f;
+    double pix = (double)de * m->pix_per_dist;
+    o->ratio0 = pix > 0.0 ? texel / pix * sqrt((double)cose / (double)cosl) : 0.0;
+}
+
+/* Section 4.2: the polygon ID first; when it differs, the depth comparison. */
+static inline bool texel_lit(const om__asm_tile *tl, uint32_t x, uint32_t y, const asm_pt *p, double zl)
+{
+    size_t i = (size_t)y * tl->size + x;
+    if (tl->id16 ? tl->id16[i] == (uint16_t)p->tri : tl->id32[i] == p->tri) return true;
+    return zl <= (double)tl->depth[i];
+}
+
+static inline double level_z(const asm_state *m, const asm_pt *p, uint32_t level)
+{
+    return p->z - p->bias_c - p->bias_s * m->inv_scale[level];
+}
+
+static bool straddles(const om__asm_tile *tl, uint32_t x, uint32_t y, const asm_pt *p, double zl)
+{
+    bool c = texel_lit(tl, x, y, p, zl);
+    uint32_t x0 = x ? x - 1 : 0, y0 = y ? y - 1 : 0;
+    uint32_t x1 = x + 1 < tl->size ? x + 1 : x, y1 = y + 1 < tl->size ? y + 1 : y;
+    for (uint32_t j = y0; j <= y1; j++)
+        for (uint32_t i = x0; i <= x1; i++)
+            if (texel_lit(tl, i, j, p, zl) != c) return true;
+    return false;
+}
+
+/* The texel of (u, v) (level-grid texels) in a tile, clamped: as om__asm_find does it. */
+static inline void texel_of(const om__asm_tile *tl, double u, double v, uint32_t *x, uint32_t *y)
+{
+    double lx = floor(u - (double)tl->node->ox), ly = floor(v - (double)tl->node->oy);
+    *x = !(lx > 0.0) ? 0u : lx >= (double)tl->size ? tl->size - 1 : (uint32_t)lx;
+    *y = !(ly > 0.0) ? 0u : ly >= (double)tl->size ? tl->size - 1 : (uint32_t)ly;
+}
+
+static om_status asm_observe(void *state, const om_strip *st, om_diag *d)
+{
+    (void)d;
+    asm_state *m = (asm_state *)state;
+    om__asm_tree *t = &m->tree;
+    const om__asm_layout *l = &t->lay;
+    const uint32_t stride = m->cfg.asm_stride ? m->cfg.asm_stride : 1;
+    const double ncell = (double)l->cp * l->cp;
+    prepare(m);
+    for (uint32_t y = 0; y < st->rows; y++) {
+        const uint32_t gy = st->y0 + y;
+        /* one sample in `stride`, on diagonals so no column or row is favoured */
+        for (uint32_t x = (uint32_t)((stride - (3u * gy) % stride) % stride); x < st->width; x += stride) {
+            size_t i = (size_t)y * st->width + x;
+            if (!(st->terms[i].flags & OM_TERM_EXPOSED)) continue;
+            asm_pt p;
+            if (!setup_uv(m, &st->samples[i], &p)) continue;
+            setup_bias(m, &st->samples[i], &p, true);
+            m->analysed++;
+            uint32_t index = OM__ASM_ROOT, level = 0;
+            for (;;) {
+                om__asm_tile tl;
+                uint32_t tx, ty;
+                bool want = false;
+                float nreq = 0.0f;
+                om__asm_tile_of(t, index, &tl);
+                texel_of(&tl, p.u * l->scale[level], p.v * l->scale[level], &tx, &ty);
+                tl.node->stamp = t->frame;
+                uint32_t c = (ty / tl.cp) * tl.cells + tx / tl.cp;
+                uint32_t child = tl.child[c];
+                if (level == 0) {   /* the base: into the root tile, made on first touch */
+                    if (child == OM__ASM_NONE) {
+                        /* Only from free or unused memory here (benefit 0 replaces
+                         * nothing): the counts that rule replacement are not complete
+                         * until every strip is seen. Build retries the rest. */
+                        child = om__asm_make(t, OM__ASM_ROOT, c, 0);
+                        if (child == OM__ASM_NONE) {
+                            tl.ben[c]++;
+                            break;
+                        }
+                        render_node(m, child);
+                    }
+                    om__asm_node_at(t, child)->benefit++;
+                } else {
+                    double r = p.ratio0 * m->inv_scale[level];
+                    want = r > 1.0 && straddles(&tl, tx, ty, &p, level_z(m, &p, level));
+                    nreq = (float)(ncell * r * r);
+                    if (child != OM__ASM_NONE && want) om__asm_node_at(t, child)->benefit++;
+                }
+                if (child != OM__ASM_NONE) {
+                    index = child;
+                    level++;
+                    continue;
+                }
+                if (want && level < l->max_level) {
+                    /* Section 3.1: N_required = N_current * (texel area / pixel area). */
+                    tl.ben[c]++;
+                    if (nreq > tl.need[c]) tl.need[c] = nreq;
+                    m->straddling++;
+                }
+                break;
+            }
+        }
+    }
+    return OM_OK;
+}
+
+static om_status asm_build(void *state, om_diag *d)
+{
+    (void)d;
+    asm_state *m = (asm_state *)state;
+    om__asm_tree *t = &m->tree;
+    prepare(m);
+    /* Root tiles first, wherever samples fell, most samples first: the root level is
+     * what a conventional map at asm.root would give, and every refinement hangs off it. */
+    uint32_t n = om__asm_candidates(t, true, 0.0f, 0.0f, m->cand, m->ncand_max);
+    while (n > 0) {
+        om__asm_cand c;
+        n = om__asm_cand_pop(m->cand, n, &c);
+        uint32_t k = om__asm_make(t, OM__ASM_ROOT, c.cell, c.benefit);
+        if (k == OM__ASM_NONE) break;   /* no room: the rest have fewer samples still */
+        render_node(m, k);
+    }
+    n = om__asm_candidates(t, false, m->cfg.asm_cost_a, m->cfg.asm_cost_b, m->cand, m->ncand_max);
+    m->candidates = n;
+    double spent = 0.0;
+    uint32_t refused = 0;   /* a refused benefit: lesser ones cannot replace anything */
+    while (n > 0 && spent < (double)m->cfg.asm_work) {
+        om__asm_cand c;
+        n = om__asm_cand_pop(m->cand, n, &c);
+        if (c.benefit <= refused) continue;
+        const om__asm_node *pn = om__asm_node_at(t, c.node);   /* may have gone to make room */
+        if (!pn->alive || pn->gen != c.gen) continue;
+        uint32_t k = om__asm_make(t, c.node, c.cell, c.benefit);
+        if (k == OM__ASM_NONE) {
+            refused = c.benefit;
+            continue;
+        }
+        render_node(m, k);
+        spent += (double)c.cost;
+    }
+    m->cache = OM__ASM_NONE;
+    return OM_OK;
+}
+
+/* The deepest node over (u, v): the last leaf when it still is, else a descent. */
+static void find(asm_state *m, double u, double v, om__asm_tile *tl, uint32_t *tx, uint32_t *ty)
+{
+    om__asm_tree *t = &m->tree;
+    if (m->cache != OM__ASM_NONE) {
+        const om__asm_tile *c = &m->cache_tile;
+        const double s = t->lay.scale[c->node->level];   /* the descent's own arithmetic */
+        double lx = floor(u * s - (double)c->node->ox), ly = floor(v * s - (double)c->node->oy);
+        if (lx >= 0.0 && ly >= 0.0 && lx < (double)c->size && ly < (double)c->size) {
+            uint32_t x = (uint32_t)lx, y = (uint32_t)ly;
+            if (c->child[(y / c->cp) * c->cells + x / c->cp] == OM__ASM_NONE) {
+                c->node->stamp = t->frame;
+                *tl = *c;
+                *tx = x;
+                *ty = y;
+                return;
+            }
+        }
+    }
+    uint32_t k = om__asm_find(t, u, v, true, tx, ty);
+    om__asm_tile_of(t, k, tl);
+    m->cache = k;
+    m->cache_tile = *tl;
+}
+
+static om_status asm_resolve(void *state, om_strip *st, om_diag *d)
+{
+    (void)d;
+    asm_state *m = (asm_state *)state;
+    size_t n = (size_t)st->rows * st->width;
+    prepare(m);
+    for (size_t i = 0; i < n; i++) {
+        om_term *t = &st->terms[i];
+        t->r = t->g = t->b = 255;
+        if (!(t->flags & OM_TERM_EXPOSED)) continue;
+        m->samples++;
+        asm_pt p;
+        if (!setup_uv(m, &st->samples[i], &p)) continue;
+        uint32_t tx, ty;
+        om__asm_tile tl;
+        find(m, p.u, p.v, &tl, &tx, &ty);
+        /* Section 4.2: the polygon ID first; the bias is only needed when it differs. */
+        size_t k = (size_t)ty * tl.size + tx;
+        if (tl.id16 ? tl.id16[k] == (uint16_t)p.tri : tl.id32[k] == p.tri) continue;
+        setup_bias(m, &st->samples[i], &p, false);
+        if (!(level_z(m, &p, tl.node->level) <= (double)tl.depth[k])) {
+            t->r = t->g = t->b = 0;
+            m->shadowed++;
+        }
+    }
+    return OM_OK;
+}
+
+static void asm_stats(const void *state, om_method_stats *out)
+{
+    const asm_state *m = (const asm_state *)state;
+    const om__asm_tree *t = &m->tree;
+    memset(out, 0, sizeof *out);
+    out->bytes_used = asm_need(m->scene, &t->lay);
+    uint64_t inuse = om__asm_bytes_in_use(t);
+    double eff = om__asm_grid(&t->lay, om__asm_depth(t));
+    const uint32_t v[8] = {t->pool.in_use, t->created, t->evicted,
+                           inuse > UINT32_MAX ? UINT32_MAX : (uint32_t)inuse,
+                           eff > 4294967295.0 ? UINT32_MAX : (uint32_t)eff, m->candidates,
+                           m->samples, m->shadowed};
+    for (int i = 0; i < 8; i++) out->counters[i] = v[i];
+    out->counter_names[0] = "nodes";
+    out->counter_names[1] = "created";
+    out->counter_names[2] = "evicted";
+    out->counter_names[3] = "bytes in use";
+    out->counter_names[4] = "effective resolution";
+    out->counter_names[5] = "refinable cells";
+    out->counter_names[6] = "samples";
+    out->counter_names[7] = "samples shadowed";
+    out->ncounters = 8;
+}
+
+const om_method om__method_asm = {
+    "asm", "adaptive shadow map: a tree of tiles refined where the eye needs it, within asm.cap",
+    OM_METHOD_OBSERVES,
+    asm_bytes, asm_init, asm_begin, asm_observe, asm_build, asm_resolve, asm_stats,
+};

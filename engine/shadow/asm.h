@@ -1,0 +1,147 @@
+/* asm.h — the Adaptive Shadow Map's tree (Fernando et al. 2001, paper 002): the node
+ * pool carved from the user's memory cap, the cells that may hold children, and the
+ * rules that create, find and remove nodes (section 3). The method itself (frame flow,
+ * analysis, tile rendering, lookup) is asm.c; the tree is here so tests can drive it.
+ *
+ * Geometry. The root ("base") is one node whose tile of asm.tile texels covers the
+ * light's whole image plane; it is cut into B = asm.root / asm.tile cells per side, and
+ * each of its cells may hold a root tile: a node of asm.tile texels, so the root level
+ * sees the light's image at asm.root texels per side, as one shadow map would. Root
+ * tiles exist where visible samples fall (they are made before any refinement and
+ * outside the work budget); where the cap has no room for one, the base answers,
+ * coarsely. Every other tile is cut into square cells of cp = asm.tile / asm.cells
+ * texels; a cell may hold a child node of asm.tile texels, so each level below the
+ * root tiles multiplies the resolution by asm.cells. Level 0 is the base (grid side
+ * asm.tile), level 1 the root tiles (asm.root), level L > 1 asm.root * asm.cells^(L-1).
+ * A node of level L covers texels [ox, ox + tile) x [oy, oy + tile) of its level's
+ * grid; the grid side is "the effective resolution".
+ *
+ * Memory. The cap counts the base (tile, cell links and per-cell analysis) and every
+ * node in use (header, cells, tile, pool link): bytes in use never exceed it. Depth is
+ * 32 bits per texel; the polygon ID is 16 bits when the scene has fewer than 65535
+ * triangles, else 32 ("model no more than a scene needs"). */
+#ifndef OM_ASM_H
+#define OM_ASM_H
+
+#include "../frame/frame.h"
+
+#define OM__ASM_NONE 0xFFFFFFFFu   /* no node (an empty cell) */
+#define OM__ASM_ROOT 0xFFFFFFFEu   /* the root's index: it is not in the pool */
+#define OM__ASM_MAX_LEVEL 12u
+
+/* The head of every pool item (and of the root). */
+typedef struct om__asm_node {
+    uint32_t parent;       /* index of the parent node (OM__ASM_ROOT for level 1) */
+    uint32_t pcell;        /* the parent's cell this node fills */
+    uint32_t level;        /* 0 root, 1 its children, ... */
+    uint32_t ox, oy;       /* origin on the level's grid, texels */
+    uint32_t stamp;        /* frame it was last used: looked up or analysed */
+    uint32_t benefit;      /* this frame's benefit of keeping it (see om__asm_make) */
+    uint32_t nchild;       /* cells holding a child */
+    uint32_t alive;
+    uint32_t gen;          /* bumped on every reuse, so stale references can tell */
+} om__asm_node;
+
+/* A node's arrays. */
+typedef struct om__asm_tile {
+    om__asm_node *node;
+    uint32_t size;         /* texels per side */
+    uint32_t cells;        /* cells per side */
+    uint32_t cp;           /* texels per cell side */
+    uint32_t *child;       /* cells^2: child index or OM__ASM_NONE */
+    uint32_t *ben;         /* cells^2: this frame's benefit of refining the cell */
+    float *need;           /* cells^2: this frame's largest N_required in the cell */
+    uint32_t *depth;       /* size^2, row-major, row 0 at the top (light +y) */
+    uint16_t *id16;        /* size^2 polygon IDs when the scene is small, else NULL */
+    uint32_t *id32;        /* size^2 polygon IDs otherwise, else NULL */
+} om__asm_tile;
+
+/* Sizes that follow from a configuration and a scene (om__asm_layout). */
+typedef struct om__asm_layout {
+    uint32_t root, tile, cells, cp;   /* cp: texels per cell side below the base */
+    uint32_t base_cells, base_cp;     /* the base: B cells per side of T / B texels */
+    uint32_t max_level;               /* deepest level: its grid stays within 2^21 */
+    double mul[OM__ASM_MAX_LEVEL + 1];   /* grid side of level L + 1 over level L's */
+    double scale[OM__ASM_MAX_LEVEL + 1]; /* grid side of level L over the base's: a point
+                                            at base texels u is at u * scale[L] there */
+    bool id16;
+    size_t root_bytes;                /* the base's arrays, as the cap counts them */
+    size_t item_bytes;                /* one pool item (header, cells, tile) */
+    size_t node_bytes;                /* what one node in use costs the cap */
+    uint64_t min_cap;                 /* the base and one node */
+    uint32_t count;                   /* nodes the cap holds (0 when below min_cap) */
+    size_t arena_bytes;               /* what om__asm_tree_init carves */
+} om__asm_layout;
+
+typedef struct om__asm_tree {
+    om__asm_layout lay;
+    om__asm_node root;
+    uint32_t *root_child, *root_ben, *root_depth, *root_id32;
+    uint16_t *root_id16;
+    float *root_need;
+    om_pool pool;
+    size_t off_child, off_ben, off_need, off_depth, off_id;   /* within a pool item */
+    uint32_t frame;        /* current frame number, starts at 2 */
+    uint32_t serial;       /* nodes made so far: each node's gen */
+    uint32_t created, evicted, replaced;   /* this frame */
+    uint64_t total_created, total_evicted;
+} om__asm_tree;
+
+/* Fills `l` for cfg and a scene of ntris triangles: OM_E_INVALID (with a message in d)
+ * when tile, cells and root do not fit together; cap below min_cap is not an error
+ * here (count is 0), so hosts can still ask for the bytes and init names the minimum. */
+om_status om__asm_layout_of(om__asm_layout *l, const om_method_cfg *c, uint32_t ntris,
+                            om_diag *d);
+/* Carves the root and the pool (lay.count nodes) from `a`; the root starts cleared. */
+om_status om__asm_tree_init(om__asm_tree *t, om_arena *a, const om__asm_layout *l,
+                            om_diag *d);
+/* Drops every node (the light moved: every tile is stale) and clears the root's cells. */
+void om__asm_tree_clear(om__asm_tree *t);
+/* Starts frame analysis: frame++, per-frame counters and benefits to zero. */
+void om__asm_frame(om__asm_tree *t);
+
+om__asm_node *om__asm_node_at(om__asm_tree *t, uint32_t index);
+void om__asm_tile_of(om__asm_tree *t, uint32_t index, om__asm_tile *out);
+/* The grid side of a level, R_L (as double: exact for power-of-two cells). */
+double om__asm_grid(const om__asm_layout *l, uint32_t level);
+
+/* Bytes of the cap in use now: the root and every node in use. */
+uint64_t om__asm_bytes_in_use(const om__asm_tree *t);
+/* Deepest level in use (0: the root only). */
+uint32_t om__asm_depth(const om__asm_tree *t);
+
+/* Removes node `index` and its descendants and unlinks it from its parent. */
+void om__asm_evict(om__asm_tree *t, uint32_t index);
+
+/* Creates a child in cell `cell` of node `parent` for a refinement of benefit `benefit`
+ * (section 3.2): a free pool item if there is one; else the least recently used node
+ * not used in the last frame (stamp + 1 < frame), with its subtree; else, when every
+ * node is in use, the leaf of least benefit, only if `benefit` is greater. Never a
+ * node on the path to `parent`. Returns the new index, or OM__ASM_NONE when the cell
+ * already has a child, the level would pass max_level, or nothing may be replaced. */
+uint32_t om__asm_make(om__asm_tree *t, uint32_t parent, uint32_t cell, uint32_t benefit);
+
+/* The deepest node covering (u, v), given in base texels (x right, y down, both in
+ * [0, tile)); also the texel inside it. Stamps every node on the way when `stamp`. */
+uint32_t om__asm_find(om__asm_tree *t, double u, double v, bool stamp, uint32_t *tx,
+                      uint32_t *ty);
+
+/* A refinement candidate: an empty cell with a benefit this frame (section 3.1). */
+typedef struct om__asm_cand {
+    uint32_t node, cell, gen, benefit;
+    float cost, prio;      /* prio = benefit / cost */
+} om__asm_cand;
+
+/* Gathers every empty cell with a benefit into `out` (at most `max`) and orders them as
+ * a max-heap on priority (ties: lower node index, then lower cell, so results depend on
+ * nothing but the analysis). `base`: the base's empty cells, the root tiles to make,
+ * by the number of samples in them; otherwise every other node's, with cost =
+ * a * min(N_required, tile^2) + b. Returns the count. */
+uint32_t om__asm_candidates(om__asm_tree *t, bool base, float a, float b, om__asm_cand *out,
+                            uint32_t max);
+/* Takes the best candidate off the heap of n; returns the new n. */
+uint32_t om__asm_cand_pop(om__asm_cand *heap, uint32_t n, om__asm_cand *best);
+/* Upper bound of om__asm_candidates' count for a layout. */
+uint64_t om__asm_cand_max(const om__asm_layout *l);
+
+#endif

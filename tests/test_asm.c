@@ -1,0 +1,493 @@
+/* test_asm.c — Adaptive Shadow Maps (issue 5): the tree's rules driven directly (pool,
+ * LRU among nodes not used last frame, replacement only by greater benefit, subtrees
+ * go with their node, the descent), the memory cap along camera paths for caps from the
+ * smallest usable to generous, progressive refinement of a still view against the
+ * reference and the conventional map of the same memory, budgets that name their
+ * minimum, and bit-identical frames (strips included). */
+#include "test.h"
+#include "harness.h"
+#include "../engine/shadow/asm.h"
+
+#include <stdlib.h>
+#include <math.h>
+
+/* One ASM state kept across frames, as a host keeps it. */
+typedef struct arun {
+    const om_scene *s;
+    const om_method *m;
+    void *mem, *fmem, *px, *state;
+    size_t bytes;
+    uint32_t W, H;
+} arun;
+
+static bool arun_init(arun *r, const om_scene *s, const om_method_cfg *c, uint32_t W, uint32_t H)
+{
+    size_t mn, full;
+    om_diag d;
+    memset(r, 0, sizeof *r);
+    r->s = s;
+    r->m = om_method_find("asm");
+    r->W = W;
+    r->H = H;
+    if (!r->m) { CHECK_MSG(0, "asm is not registered"); return false; }
+    CHECK_OK(r->m->bytes(c, s, W, H, &mn, &full));
+    r->bytes = full;
+    r->mem = malloc(full);
+    r->fmem = malloc(om_frame_bytes(W, H));
+    r->px = malloc((size_t)W * H * 3);
+    om_arena a;
+    om_arena_init(&a, r->mem, full, "method");
+    om_status st = r->m->init(&r->state, &a, c, s, W, H, &d);
+    CHECK_MSG(st == OM_OK, "asm init: %s", d.msg);
+    CHECK(a.peak <= full);
+    return st == OM_OK;
+}
+
+static void arun_free(arun *r)
+{
+    free(r->mem);
+    free(r->fmem);
+    free(r->px);
+}
+
+typedef struct agrab { uint8_t *mask; om_term *terms; } agrab;
+
+static om_status agrab_strip(void *user, const om_strip *st, const om_framebuffer *fb)
+{
+    agrab *g = (agrab *)user;
+    (void)fb;
+    for (uint32_t i = 0; i < st->rows * st->width; i++) {
+        size_t o = (size_t)st->y0 * st->width + i;
+        if (g->mask) g->mask[o] = om_mask_of(&st->samples[i], &st->terms[i]);
+        if (g->terms) g->terms[o] = st->terms[i];
+    }
+    return OM_OK;
+}
+
+/* A frame with the camera at time t and the light at time tl. */
+static om_status arun_frame(arun *r, float t, float tl, uint32_t strip, uint8_t *mask, om_term *terms,
+                            om_method_stats *ms)
+{
+    om_camera cam, c2;
+    om_light light, l2;
+    om_view v;
+    om_diag d;
+    om_scene_at(r->s, t, &cam, &l2);
+    om_scene_at(r->s, tl, &c2, &light);
+    cam.width = r->W;
+    cam.height = r->H;
+    om_status st = om_view_init(&v, &cam, &light, r->s, &d);
+    if (st) return st;
+    uint32_t rows = strip ? strip : r->H;
+    om_arena fa;
+    om_arena_init(&fa, r->fmem, om_frame_bytes(r->W, rows), "frame");
+    om_framebuffer fb = {OM_RGB888, r->W, rows, (size_t)r->W * 3, (uint8_t *)r->px};
+    om_shade_cfg shade;
+    om_shade_cfg_default(&shade);
+    agrab g = {mask, terms};
+    om_frame_desc fd;
+    memset(&fd, 0, sizeof fd);
+    fd.scene = r->s; fd.view = &v; fd.method = r->m; fd.method_state = r->state; fd.shade = &shade;
+    fd.strip_rows = strip; fd.fb = &fb; fd.on_strip = agrab_strip; fd.user = &g;
+    st = om_render_frame(&fd, &fa, NULL, &d);
+    if (st) fprintf(stderr, "  (asm frame: %s)\n", d.msg);
+    if (ms) r->m->stats(r->state, ms);
+    return st;
+}
+
+static uint32_t counter(const om_method_stats *ms, const char *name)
+{
+    for (uint32_t k = 0; k < ms->ncounters; k++)
+        if (!strcmp(ms->counter_names[k], name)) return ms->counters[k];
+    CHECK_MSG(0, "no counter '%s'", name);
+    return 0;
+}
+
+/* ---- the tree alone */
+
+static void small_cfg(om_method_cfg *c, uint32_t nodes)
+{
+    om_method_cfg_default(c);
+    c->asm_root = 64;
+    c->asm_tile = 16;
+    c->asm_cells = 4;
+    om__asm_layout l;
+    om__asm_layout_of(&l, c, 100, NULL);
+    c->asm_cap = l.root_bytes + (uint64_t)nodes * l.node_bytes;
+}
+
+static void tree_layout(void)
+{
+    om_method_cfg c;
+    om_method_cfg_default(&c);
+    om__asm_layout l;
+    CHECK_OK(om__asm_layout_of(&l, &c, 22984, NULL));
+    CHECK_EQ_U(l.cp, 8);
+    CHECK_EQ_U(l.base_cells, 16);   /* 16 x 16 root tiles of 64 make the 1024 root */
+    CHECK_EQ_U(l.base_cp, 4);
+    CHECK_EQ_U(l.max_level, 4);     /* level 4: 1024 * 8^3 = 524,288 <= 2^21 < 1024 * 8^4 */
+    CHECK(om__asm_grid(&l, 0) == 64 && om__asm_grid(&l, 1) == 1024 && om__asm_grid(&l, 4) == 524288);
+    CHECK(l.min_cap < (64u << 10));   /* the base and one tile: small devices can run it */
+    CHECK(l.id16);
+    CHECK(l.count > 100 && l.root_bytes + (uint64_t)l.count * l.node_bytes <= c.asm_cap);
+    CHECK(l.root_bytes + (uint64_t)(l.count + 1) * l.node_bytes > c.asm_cap);
+    CHECK_OK(om__asm_layout_of(&l, &c, 70000, NULL));
+    CHECK(!l.id16);
+    c.asm_cells = 5;   /* 64 is not a multiple of 5 */
+    CHECK(om__asm_layout_of(&l, &c, 10, NULL) == OM_E_INVALID);
+    c.asm_cells = 8;
+    c.asm_root = 1000;   /* not a multiple of the tile */
+    CHECK(om__asm_layout_of(&l, &c, 10, NULL) == OM_E_INVALID);
+    c.asm_root = 64 * 3;   /* 3 root tiles a side do not divide a 64-texel base */
+    CHECK(om__asm_layout_of(&l, &c, 10, NULL) == OM_E_INVALID);
+}
+
+static void tree_rules(void)
+{
+    om_method_cfg c;
+    small_cfg(&c, 3);
+    om__asm_layout l;
+    CHECK_OK(om__asm_layout_of(&l, &c, 100, NULL));
+    CHECK_EQ_U(l.count, 3);
+    CHECK_EQ_U(l.base_cells, 4);   /* a 16-texel base of 4 x 4 cells; root tiles make 64 */
+    CHECK_EQ_U(l.max_level, 8);    /* 64 * 4^7 <= 2^21 */
+    unsigned char *mem = malloc(l.arena_bytes);
+    om_arena a;
+    om_arena_init(&a, mem, l.arena_bytes, "tree");
+    om__asm_tree t;
+    CHECK_OK(om__asm_tree_init(&t, &a, &l, NULL));
+    CHECK(a.peak <= l.arena_bytes);
+    om__asm_frame(&t);
+    /* three nodes: two root tiles, one under the first */
+    uint32_t n0 = om__asm_make(&t, OM__ASM_ROOT, 5, 5);    /* base cell (1, 1) */
+    uint32_t n1 = om__asm_make(&t, OM__ASM_ROOT, 10, 9);   /* base cell (2, 2) */
+    CHECK(n0 != OM__ASM_NONE && n1 != OM__ASM_NONE);
+    CHECK(om__asm_make(&t, OM__ASM_ROOT, 5, 99) == OM__ASM_NONE);   /* cell taken */
+    uint32_t n2 = om__asm_make(&t, n0, 5, 4);
+    CHECK(n2 != OM__ASM_NONE);
+    CHECK_EQ_U(om__asm_node_at(&t, n2)->level, 2);
+    CHECK_EQ_U(om__asm_depth(&t), 2);
+    CHECK_EQ_U(om__asm_bytes_in_use(&t), c.asm_cap);
+    /* n0 covers base texels [4, 8) x [4, 8): texels [16, 32) of the 64-texel root */
+    CHECK_EQ_U(om__asm_node_at(&t, n0)->ox, 16);
+    CHECK_EQ_U(om__asm_node_at(&t, n0)->oy, 16);
+    /* n2 is cell (1, 1) of n0: root texels [20, 24), origin 80 on level 2's grid */
+    CHECK_EQ_U(om__asm_node_at(&t, n2)->ox, 80);
+    uint32_t tx, ty;
+    CHECK_EQ_U(om__asm_find(&t, 5.5, 5.25, false, &tx, &ty), n2);   /* 88 - 80 = 8, 84 - 80 = 4 */
+    CHECK_EQ_U(tx, 8);
+    CHECK_EQ_U(ty, 4);
+    CHECK_EQ_U(om__asm_find(&t, 6.5, 4.25, false, &tx, &ty), n0);   /* cell (2, 0) of n0 is empty */
+    CHECK_EQ_U(om__asm_find(&t, 14.5, 2.5, false, &tx, &ty), OM__ASM_ROOT);
+    CHECK(tx == 14 && ty == 2);
+
+    /* Full, and every node used this frame: only a greater benefit replaces a leaf,
+     * the least beneficial one (n2, benefit 4), never the parent of the new node. */
+    CHECK(om__asm_make(&t, OM__ASM_ROOT, 3, 4) == OM__ASM_NONE);
+    uint32_t n3 = om__asm_make(&t, n1, 0, 5);
+    CHECK(n3 != OM__ASM_NONE);
+    CHECK(!om__asm_node_at(&t, n2)->alive || om__asm_node_at(&t, n2)->parent != n0);
+    CHECK_EQ_U(t.replaced, 1);
+    CHECK_EQ_U(om__asm_node_at(&t, n1)->nchild, 1);
+    CHECK_EQ_U(om__asm_node_at(&t, n0)->nchild, 0);
+    /* n1 (benefit 9) has a child and n3's parent is n1: the only leaves left are n0 (5)
+     * and n3 (5); a benefit of 5 replaces neither */
+    CHECK(om__asm_make(&t, OM__ASM_ROOT, 3, 5) == OM__ASM_NONE);
+
+    /* Two frames later with only n1 and n3 used in between: n0 was not used in the last
+     * frame, so it goes first (least recently used), whatever the benefits. */
+    om__asm_frame(&t);
+    om__asm_find(&t, 8.25, 8.25, true, &tx, &ty);   /* root texel 33: n1, its cell 0: n3 */
+    om__asm_frame(&t);
+    CHECK_EQ_U(om__asm_find(&t, 8.25, 8.25, true, &tx, &ty), n3);
+    uint32_t n4 = om__asm_make(&t, OM__ASM_ROOT, 15, 1);
+    CHECK(n4 != OM__ASM_NONE);
+    CHECK(om__asm_find(&t, 5.5, 5.25, false, &tx, &ty) == OM__ASM_ROOT);   /* n0 is gone */
+    CHECK_EQ_U(t.evicted, 1);
+    CHECK(om__asm_bytes_in_use(&t) <= c.asm_cap);
+
+    /* A subtree leaves with its root node. */
+    om__asm_evict(&t, n1);
+    CHECK_EQ_U(t.pool.in_use, 1);
+    CHECK_EQ_U(t.root.nchild, 1);
+    om__asm_tree_clear(&t);
+    CHECK_EQ_U(t.pool.in_use, 0);
+    CHECK_EQ_U(t.root.nchild, 0);
+    free(mem);
+}
+
+static void tree_candidates_order(void)
+{
+    om_method_cfg c;
+    small_cfg(&c, 4);
+    om__asm_layout l;
+    CHECK_OK(om__asm_layout_of(&l, &c, 100, NULL));
+    unsigned char *mem = malloc(l.arena_bytes);
+    om_arena a;
+    om_arena_init(&a, mem, l.arena_bytes, "tree");
+    om__asm_tree t;
+    CHECK_OK(om__asm_tree_init(&t, &a, &l, NULL));
+    om__asm_frame(&t);
+    uint32_t n0 = om__asm_make(&t, OM__ASM_ROOT, 5, 2);
+    CHECK(n0 != OM__ASM_NONE);
+    om__asm_tile tl;
+    om__asm_tile_of(&t, n0, &tl);
+    tl.ben[3] = 10; tl.need[3] = 16;      /* cost 1 + 16 / 4096 */
+    tl.ben[7] = 10; tl.need[7] = 1e6f;    /* capped at 256 texels */
+    tl.ben[9] = 2; tl.need[9] = 16;
+    tl.ben[11] = 10; tl.need[11] = 16;    /* ties with cell 3: lower cell first */
+    CHECK(om__asm_make(&t, n0, 9, 2) != OM__ASM_NONE);
+    om__asm_cand h[64];
+    uint32_t n = om__asm_candidates(&t, false, 1.0f / 4096, 1.0f, h, 64);
+    CHECK_EQ_U(n, 3);   /* cell 9 holds a child now */
+    om__asm_cand b;
+    n = om__asm_cand_pop(h, n, &b);
+    CHECK_EQ_U(b.cell, 3);
+    n = om__asm_cand_pop(h, n, &b);
+    CHECK_EQ_U(b.cell, 11);
+    n = om__asm_cand_pop(h, n, &b);
+    CHECK_EQ_U(b.cell, 7);
+    CHECK(fabsf(b.cost - (1.0f + 256.0f / 4096.0f)) < 1e-6f);
+    CHECK_EQ_U(n, 0);
+    /* root tiles to make: by samples, whatever the costs */
+    t.root_ben[2] = 5;
+    t.root_ben[5] = 50;   /* holds n0 already */
+    t.root_ben[12] = 9;
+    n = om__asm_candidates(&t, true, 1.0f, 1.0f, h, 64);
+    CHECK_EQ_U(n, 2);
+    n = om__asm_cand_pop(h, n, &b);
+    CHECK_EQ_U(b.cell, 12);
+    CHECK_EQ_U(b.node, OM__ASM_ROOT);
+    free(mem);
+}
+
+/* ---- the method */
+
+static void budgets_name_minimum(void)
+{
+    h_scene hs;
+    if (!h_scene_parse(&hs, om_scene_default_text())) return;
+    const om_method *m = om_method_find("asm");
+    if (!m) { CHECK_MSG(0, "asm is not registered"); return; }
+    om_method_cfg c;
+    om_method_cfg_default(&c);
+    om__asm_layout l;
+    CHECK_OK(om__asm_layout_of(&l, &c, hs.s.ntris, NULL));
+    /* a cap below one root node (and one child) */
+    c.asm_cap = l.min_cap - 1;
+    size_t mn, full;
+    CHECK_OK(m->bytes(&c, &hs.s, 160, 120, &mn, &full));
+    void *buf = malloc(full), *state;
+    om_arena a;
+    om_diag d;
+    om_arena_init(&a, buf, full, "method");
+    CHECK(m->init(&state, &a, &c, &hs.s, 160, 120, &d) == OM_E_BUDGET);
+    char num[32];
+    snprintf(num, sizeof num, "%llu", (unsigned long long)l.min_cap);
+    CHECK_MSG(strstr(d.msg, num) != NULL, "'%s' does not name %s", d.msg, num);
+    CHECK_EQ_U(d.asked, l.min_cap);
+    free(buf);
+    /* the smallest cap works; an arena below the bytes query names the bytes */
+    c.asm_cap = l.min_cap;
+    CHECK_OK(m->bytes(&c, &hs.s, 160, 120, &mn, &full));
+    unsigned char *g = malloc(full + 64);
+    memset(g, 0xA5, full + 64);
+    om_arena_init(&a, g + 32, full - 1, "method");
+    CHECK(m->init(&state, &a, &c, &hs.s, 160, 120, &d) == OM_E_BUDGET);
+    snprintf(num, sizeof num, "%zu", full);
+    CHECK_MSG(strstr(d.msg, num) != NULL, "'%s' does not name %s", d.msg, num);
+    om_arena_init(&a, g + 32, full, "method");
+    CHECK_OK(m->init(&state, &a, &c, &hs.s, 160, 120, &d));
+    CHECK(a.peak <= full);
+    int guard = 0;
+    for (int i = 0; i < 32; i++) guard += g[i] != 0xA5 || g[32 + full + i] != 0xA5;
+    CHECK_EQ_U(guard, 0);
+    free(g);
+    h_scene_free(&hs);
+}
+
+/* The default scene's layout and paths with coarser curved shapes (about 2K triangles),
+ * so that hundreds of frames stay quick under -O0 and the sanitizers. */
+static const char *light_scene =
+    "camera eye 0 2.5 12 target 0 0.8 0 fov 55 size 160 120 near 0.1 far 200\n"
+    "light spot pos 40 40 -60 target -3 0 3 fov 70 near 20 far 200\n"
+    "plane size 60 60 divisions 8\n"
+    "box size 4 4 4 translate -7 2 -8\n"
+    "box size 1 1 1 rotate 0 25 0 translate 2 0.5 -4\n"
+    "box size 0.8 2 0.8 rotate 0 -15 0 translate 6 1 -2\n"
+    "sphere radius 1.2 segments 24 rings 12 translate 0 1.2 -2\n"
+    "cylinder radius 0.4 height 3 segments 24 translate 3.5 0 -0.5\n"
+    "box size 0.2 0.2 0.2 translate -1 0.1 3\n"
+    "box size 0.2 0.2 0.2 rotate 0 30 0 translate -1 0.3 3\n"
+    "sphere radius 0.25 segments 16 rings 8 translate 1.8 0.25 1.5\n"
+    "box size 0.05 1.2 0.05 translate -6.0 0.6 0.5\n"
+    "box size 0.05 1.2 0.05 translate -5.4 0.6 0.5\n"
+    "box size 0.05 1.2 0.05 translate -4.8 0.6 0.5\n"
+    "box size 2.8 0.05 0.05 translate -4.65 1.175 0.5\n"
+    "box size 1.6 1.6 0.05 rotate 0 40 0 translate 1.5 0.8 -0.5 opacity 0.5\n"
+    "key camera 0 eye 0 2.5 12 target 0 0.8 0\n"
+    "key camera 1 eye 7 2.2 9 target 0 0.8 -1\n"
+    "key camera 2 eye 11 2.8 1 target 0 0.8 -2\n"
+    "key camera 3 eye 8 3.5 -10 target 0 0.8 -3\n"
+    "key camera 4 eye 0 4 -14 target 0 0.8 -2\n"
+    "key light 0 pos 40 40 -60 target -3 0 3\n"
+    "key light 4 pos 46 40 -55 target -3 0 3\n";
+
+/* Over 60 frames of the walkthrough, for caps from the smallest usable to generous:
+ * every frame renders and bytes in use never pass the cap — with the scene's own
+ * drifting light (a rebuild every frame) and with the light held still, where the
+ * tree persists and a tight cap must evict as the camera moves. */
+static void cap_holds_along_path(void)
+{
+    h_scene hs;
+    if (!h_scene_parse(&hs, light_scene)) return;
+    om_method_cfg c;
+    om_method_cfg_default(&c);
+    c.asm_root = 512;   /* the paper's; a quarter of the root to re-render per frame */
+    om__asm_layout l;
+    CHECK_OK(om__asm_layout_of(&l, &c, hs.s.ntris, NULL));
+    const uint64_t caps[4] = {l.min_cap, l.min_cap + 8 * l.node_bytes, l.min_cap + 64 * l.node_bytes,
+                              64u << 20};
+    static uint8_t mask[160 * 120];
+    for (int held = 0; held < 2; held++)
+        for (int k = 0; k < 4; k++) {
+            if (!held && (k == 1 || k == 2)) continue;   /* the tree is dropped every frame */
+            c.asm_cap = caps[k];
+            arun r;
+            if (!arun_init(&r, &hs.s, &c, 160, 120)) continue;
+            uint32_t worst = 0, evicted = 0, most = 0, failed = 0;
+            for (int f = 0; f < 60; f++) {
+                float t = 4.0f * (float)f / 59.0f;
+                om_method_stats ms;
+                if (arun_frame(&r, t, held ? 0.0f : t, 0, mask, NULL, &ms) != OM_OK) { failed++; continue; }
+                uint32_t b = counter(&ms, "bytes in use");
+                if (b > worst) worst = b;
+                if (counter(&ms, "nodes") > most) most = counter(&ms, "nodes");
+                if (held) evicted += counter(&ms, "evicted");
+            }
+            CHECK_MSG(failed == 0, "cap %llu: %u frames failed", (unsigned long long)caps[k], failed);
+            CHECK_MSG(worst <= caps[k], "cap %llu: %u bytes in use", (unsigned long long)caps[k], worst);
+            CHECK(most >= 1);
+            /* a held light with a tight cap: the pool fills and nodes are evicted */
+            if (held && k < 2) CHECK_MSG(evicted > 0, "cap %llu: nothing evicted", (unsigned long long)caps[k]);
+            arun_free(&r);
+        }
+    h_scene_free(&hs);
+}
+
+/* A still view refines progressively: mismatches against the reference never grow
+ * from frame to frame, fall, and end well below the conventional map of the same
+ * memory (16 MiB: a 2048 x 2048 map of 32-bit depth). */
+static void still_view_converges(void)
+{
+    h_scene hs;
+    if (!h_scene_parse(&hs, om_scene_default_text())) return;
+    enum { SW = 320, SH = 240 };
+    static uint8_t ref[SW * SH], sm[SW * SH], m[SW * SH];
+    for (int view = 0; view < 2; view++) {
+        float t = view ? 2.0f : 0.0f;
+        CHECK_OK(h_render(&hs.s, "ref", NULL, SW, SH, t, 0, ref, NULL, NULL));
+        om_method_cfg c;
+        om_method_cfg_default(&c);
+        c.map_size = 2048;
+        CHECK_OK(h_render(&hs.s, "sm", &c, SW, SH, t, 0, sm, NULL, NULL));
+        om_metrics mt;
+        om_compare_masks(ref, sm, SW, SH, &mt);
+        uint64_t sm_bad = mt.false_lit + mt.false_shadowed;
+        CHECK_EQ_U(c.asm_cap, (uint64_t)2048 * 2048 * 4);
+        c.asm_work = 8;   /* a few nodes a frame, so refinement spans several frames */
+        arun r;
+        if (!arun_init(&r, &hs.s, &c, SW, SH)) continue;
+        uint64_t prev = UINT64_MAX, first = 0;
+        uint32_t eff = 0;
+        for (int f = 0; f < 10; f++) {
+            om_method_stats ms;
+            CHECK_OK(arun_frame(&r, t, t, 0, m, NULL, &ms));
+            om_compare_masks(ref, m, SW, SH, &mt);
+            CHECK_EQ_U(mt.mismatched_bg, 0);
+            uint64_t bad = mt.false_lit + mt.false_shadowed;
+            CHECK_MSG(bad <= prev, "t %.0f frame %d: %llu mismatches, up from %llu", t, f,
+                      (unsigned long long)bad, (unsigned long long)prev);
+            if (f == 0) first = bad;
+            prev = bad;
+            eff = counter(&ms, "effective resolution");
+        }
+        CHECK_MSG(prev < first, "t %.0f: no progress (%llu)", t, (unsigned long long)prev);
+        CHECK_MSG(prev * 3 < sm_bad * 2, "t %.0f: asm %llu mismatches, sm 2048 %llu", t,
+                  (unsigned long long)prev, (unsigned long long)sm_bad);
+        CHECK_MSG(eff >= 8192, "t %.0f: effective resolution %u", t, eff);
+        arun_free(&r);
+    }
+    h_scene_free(&hs);
+}
+
+/* Identical runs give identical frames; strips give the frames the whole image gives. */
+static void runs_are_bit_identical(void)
+{
+    h_scene hs;
+    if (!h_scene_parse(&hs, om_scene_default_text())) return;
+    enum { BW = 200, BH = 150 };
+    static om_term terms[3][BW * BH];
+    om_method_cfg c;
+    om_method_cfg_default(&c);
+    c.asm_cap = 8u << 20;
+    arun r[3];
+    for (int k = 0; k < 3; k++)
+        if (!arun_init(&r[k], &hs.s, &c, BW, BH)) return;
+    int differ = 0;
+    for (int f = 0; f < 8; f++) {
+        float t = 0.4f * (float)(f / 2);   /* each view twice: a rebuild, then a refinement */
+        for (int k = 0; k < 3; k++)
+            CHECK_OK(arun_frame(&r[k], t, 0.0f, k == 2 ? 7 : 0, NULL, terms[k], NULL));
+        differ += memcmp(terms[0], terms[1], sizeof terms[0]) != 0;
+        differ += memcmp(terms[0], terms[2], sizeof terms[0]) != 0;
+    }
+    CHECK_EQ_U(differ, 0);
+    for (int k = 0; k < 3; k++) arun_free(&r[k]);
+    h_scene_free(&hs);
+}
+
+/* Settings at their edges still give frames: no refinement at all, every sample
+ * analysed, one cell per node, a light that moves every frame. */
+static void odd_settings_render(void)
+{
+    h_scene hs;
+    if (!h_scene_parse(&hs, "camera eye 0 3 6 target 0 0 0 size 80 60\n"
+                            "light spot pos 1 6 1 target 0 0 0 fov 120 near 0.5 far 50\n"
+                            "plane size 10 10\nbox size 1 1 1 translate 0 0.5 0\n"
+                            "triangles count 50 seed 2 area 3 in -2 0.2 -2 2 2 2\n"
+                            "key light 0 pos 1 6 1 target 0 0 0\nkey light 1 pos -3 5 0 target 0 0 0\n"))
+        return;
+    static const char *sets[][2] = {{"asm.work", "0"}, {"asm.stride", "1"}, {"asm.cells", "1"},
+                                    {"asm.a", "0"}, {"asm.b", "0"}, {"asm.root", "16"}};
+    static uint8_t mask[80 * 60];
+    for (int k = 0; k < 6; k++) {
+        om_method_cfg c;
+        om_method_cfg_default(&c);
+        c.asm_cap = 4u << 20;
+        c.asm_tile = 16;
+        c.asm_root = 64;
+        CHECK_OK(om_method_cfg_set(&c, sets[k][0], atof(sets[k][1]), NULL));
+        arun r;
+        if (!arun_init(&r, &hs.s, &c, 80, 60)) continue;
+        for (int f = 0; f < 4; f++) {
+            om_method_stats ms;
+            CHECK_OK(arun_frame(&r, 0.0f, 0.3f * (float)f, 0, mask, NULL, &ms));
+            CHECK(counter(&ms, "bytes in use") <= c.asm_cap);
+        }
+        arun_free(&r);
+    }
+    h_scene_free(&hs);
+}
+
+void suite_asm(void)
+{
+    RUN(tree_layout);
+    RUN(tree_rules);
+    RUN(tree_candidates_order);
+    RUN(budgets_name_minimum);
+    RUN(cap_holds_along_path);
+    RUN(still_view_converges);
+    RUN(runs_are_bit_identical);
+    RUN(odd_settings_render);
+}
