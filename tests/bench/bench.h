@@ -29,11 +29,15 @@ double bench_median(double *v, int n);
  * then the frame with per-stage times; the whole-frame mask goes to `mask` (may be
  * NULL). cfg NULL = defaults. */
 typedef struct mrun {
-    double init_ms, eye_ms, observe_ms, build_ms, resolve_ms;
+    double init_ms, eye_ms, observe_ms, build_ms, resolve_ms, shade_ms;
     om_method_stats stats;
 } mrun;
 int bench_run(const bscene *b, const char *method, const om_method_cfg *cfg, uint32_t W,
               uint32_t H, float t, uint8_t *mask, mrun *out);
+/* bench_run with `hook` called on the method's state after init (e.g. to give it a
+ * clock for per-stage counters); hook may be NULL. */
+int bench_run_hooked(const bscene *b, const char *method, const om_method_cfg *cfg, uint32_t W,
+                     uint32_t H, float t, uint8_t *mask, mrun *out, void (*hook)(void *state));
 
 #define OM_BENCHES \
     X(bench_raster) \

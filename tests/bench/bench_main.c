@@ -77,6 +77,12 @@ static om_status grab_mask(void *user, const om_strip *st, const om_framebuffer 
 int bench_run(const bscene *b, const char *name, const om_method_cfg *cfg, uint32_t W,
               uint32_t H, float t, uint8_t *mask, mrun *out)
 {
+    return bench_run_hooked(b, name, cfg, W, H, t, mask, out, NULL);
+}
+
+int bench_run_hooked(const bscene *b, const char *name, const om_method_cfg *cfg, uint32_t W,
+                     uint32_t H, float t, uint8_t *mask, mrun *out, void (*hook)(void *state))
+{
     const om_method *m = om_method_find(name);
     om_method_cfg c;
     if (cfg) c = *cfg;
@@ -102,6 +108,7 @@ int bench_run(const bscene *b, const char *name, const om_method_cfg *cfg, uint3
     uint64_t t0 = om_clock_ns(NULL);
     om_status st = m->init(&state, &ma, &c, &b->s, W, H, &d);
     out->init_ms = (double)(om_clock_ns(NULL) - t0) / 1e6;
+    if (st == OM_OK && hook) hook(state);
     if (st == OM_OK) {
         om_framebuffer fb = {OM_RGB888, W, H, (size_t)W * 3, (uint8_t *)px};
         om_shade_cfg shade;
@@ -117,6 +124,7 @@ int bench_run(const bscene *b, const char *name, const om_method_cfg *cfg, uint3
         out->observe_ms = (double)fs.ns_observe / 1e6;
         out->build_ms = (double)fs.ns_build / 1e6;
         out->resolve_ms = (double)fs.ns_resolve / 1e6;
+        out->shade_ms = (double)fs.ns_shade / 1e6;
         m->stats(state, &out->stats);
     }
     if (st) fprintf(stderr, "bench: %s: %s\n", name, d.msg);

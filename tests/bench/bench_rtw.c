@@ -10,70 +10,13 @@
 
 #include <string.h>
 
-typedef struct rtw_run {
-    double eye_ms, observe_ms, build_ms, resolve_ms, shade_ms;
-    om_method_stats stats;
-} rtw_run;
+/* Gives rtw the host's clock, so its stats report per-stage times. */
+static void clock_hook(void *state) { om__rtw_set_clock(state, om_clock_ns, NULL); }
 
-typedef struct mask_grab { uint8_t *mask; } mask_grab;
-
-static om_status grab(void *user, const om_strip *st, const om_framebuffer *fb)
-{
-    (void)fb;
-    uint8_t *m = ((mask_grab *)user)->mask;
-    for (uint32_t i = 0; i < st->rows * st->width; i++)
-        m[(size_t)st->y0 * st->width + i] = om_mask_of(&st->samples[i], &st->terms[i]);
-    return OM_OK;
-}
-
-/* bench_run, with the method's clock set so that rtw reports its stages. */
 static int run(const bscene *b, const char *name, const om_method_cfg *c, uint32_t W, uint32_t H,
-               uint8_t *mask, rtw_run *out)
+               uint8_t *mask, mrun *out)
 {
-    const om_method *m = om_method_find(name);
-    om_camera cam;
-    om_light light;
-    om_view v;
-    om_diag d;
-    size_t mn, full;
-    om_scene_at(&b->s, 0, &cam, &light);
-    cam.width = W;
-    cam.height = H;
-    memset(out, 0, sizeof *out);
-    if (!m || om_view_init(&v, &cam, &light, &b->s, &d) || m->bytes(c, &b->s, W, H, &mn, &full)) {
-        fprintf(stderr, "bench: cannot set up %s\n", name);
-        return 1;
-    }
-    void *mem = malloc(full), *fmem = malloc(om_frame_bytes(W, H)), *px = malloc((size_t)W * H * 3);
-    om_arena ma, fa;
-    om_arena_init(&ma, mem, full, "method");
-    om_arena_init(&fa, fmem, om_frame_bytes(W, H), "frame");
-    void *state;
-    om_status st = m->init(&state, &ma, c, &b->s, W, H, &d);
-    if (st == OM_OK) {
-        if (!strcmp(name, "rtw")) om__rtw_set_clock(state, om_clock_ns, NULL);
-        om_framebuffer fb = {OM_RGB888, W, H, (size_t)W * 3, (uint8_t *)px};
-        om_shade_cfg shade;
-        om_shade_cfg_default(&shade);
-        mask_grab g = {mask};
-        om_frame_desc fd;
-        memset(&fd, 0, sizeof fd);
-        fd.scene = &b->s; fd.view = &v; fd.method = m; fd.method_state = state; fd.shade = &shade;
-        fd.fb = &fb; fd.on_strip = grab; fd.user = &g; fd.clock = om_clock_ns;
-        om_frame_stats fs;
-        st = om_render_frame(&fd, &fa, &fs, &d);
-        out->eye_ms = (double)fs.ns_eye / 1e6;
-        out->shade_ms = (double)fs.ns_shade / 1e6;
-        out->observe_ms = (double)fs.ns_observe / 1e6;
-        out->build_ms = (double)fs.ns_build / 1e6;
-        out->resolve_ms = (double)fs.ns_resolve / 1e6;
-        m->stats(state, &out->stats);
-    }
-    if (st) fprintf(stderr, "bench: %s: %s\n", name, d.msg);
-    free(mem);
-    free(fmem);
-    free(px);
-    return st != OM_OK;
+    return bench_run_hooked(b, name, c, W, H, 0, mask, out, strcmp(name, "rtw") ? NULL : clock_hook);
 }
 
 static double share(const uint8_t *ref, const uint8_t *m, uint32_t W, uint32_t H)
@@ -95,7 +38,7 @@ static void one_scene(const bscene *b)
     };
     const uint32_t W = 1024, H = 768;
     uint8_t *ref = malloc((size_t)W * H), *mk = malloc((size_t)W * H);
-    rtw_run r;
+    mrun r;
     om_method_cfg rc;
     om_method_cfg_default(&rc);
     if (run(b, "ref", &rc, W, H, ref, &r)) goto out;
