@@ -20,7 +20,9 @@ typedef struct arun {
     uint32_t W, H;
 } arun;
 
-static bool arun_init(arun *r, const om_scene *s, const om_method_cfg *c, uint32_t W, uint32_t H)
+/* A state in the bytes a single fast pass needs, or with `lean` in the minimum. */
+static bool arun_init(arun *r, const om_scene *s, const om_method_cfg *c, uint32_t W, uint32_t H,
+                      bool lean)
 {
     size_t mn, full;
     om_diag d;
@@ -31,6 +33,8 @@ static bool arun_init(arun *r, const om_scene *s, const om_method_cfg *c, uint32
     r->H = H;
     if (!r->m) { CHECK_MSG(0, "asm is not registered"); return false; }
     CHECK_OK(r->m->bytes(c, s, W, H, &mn, &full));
+    CHECK(mn <= full);
+    if (lean) full = mn;
     r->bytes = full;
     r->mem = malloc(full);
     r->fmem = malloc(om_frame_bytes(W, H));
@@ -287,20 +291,23 @@ static void budgets_name_minimum(void)
     CHECK_MSG(strstr(d.msg, num) != NULL, "'%s' does not name %s", d.msg, num);
     CHECK_EQ_U(d.asked, l.min_cap);
     free(buf);
-    /* the smallest cap works; an arena below the bytes query names the bytes */
+    /* the smallest cap works; an arena below the minimum names the minimum, which the
+     * lean mode needs: the cap and a tile of scratch, nothing per vertex or triangle */
     c.asm_cap = l.min_cap;
     CHECK_OK(m->bytes(&c, &hs.s, 160, 120, &mn, &full));
-    unsigned char *g = malloc(full + 64);
-    memset(g, 0xA5, full + 64);
-    om_arena_init(&a, g + 32, full - 1, "method");
+    CHECK(mn < full);
+    CHECK(mn < l.arena_bytes + 64 * 1024);
+    unsigned char *g = malloc(mn + 64);
+    memset(g, 0xA5, mn + 64);
+    om_arena_init(&a, g + 32, mn - 1, "method");
     CHECK(m->init(&state, &a, &c, &hs.s, 160, 120, &d) == OM_E_BUDGET);
-    snprintf(num, sizeof num, "%zu", full);
+    snprintf(num, sizeof num, "%zu", mn);
     CHECK_MSG(strstr(d.msg, num) != NULL, "'%s' does not name %s", d.msg, num);
-    om_arena_init(&a, g + 32, full, "method");
+    om_arena_init(&a, g + 32, mn, "method");
     CHECK_OK(m->init(&state, &a, &c, &hs.s, 160, 120, &d));
-    CHECK(a.peak <= full);
+    CHECK(a.peak <= mn);
     int guard = 0;
-    for (int i = 0; i < 32; i++) guard += g[i] != 0xA5 || g[32 + full + i] != 0xA5;
+    for (int i = 0; i < 32; i++) guard += g[i] != 0xA5 || g[32 + mn + i] != 0xA5;
     CHECK_EQ_U(guard, 0);
     free(g);
     h_scene_free(&hs);
@@ -354,7 +361,7 @@ static void cap_holds_along_path(void)
             if (!held && (k == 1 || k == 2)) continue;   /* the tree is dropped every frame */
             c.asm_cap = caps[k];
             arun r;
-            if (!arun_init(&r, &hs.s, &c, 160, 120)) continue;
+            if (!arun_init(&r, &hs.s, &c, 160, 120, false)) continue;
             uint32_t worst = 0, evicted = 0, most = 0, failed = 0;
             for (int f = 0; f < 60; f++) {
                 float t = 4.0f * (float)f / 59.0f;
@@ -397,7 +404,7 @@ static void still_view_converges(void)
         CHECK_EQ_U(c.asm_cap, (uint64_t)2048 * 2048 * 4);
         c.asm_work = 8;   /* a few nodes a frame, so refinement spans several frames */
         arun r;
-        if (!arun_init(&r, &hs.s, &c, SW, SH)) continue;
+        if (!arun_init(&r, &hs.s, &c, SW, SH, false)) continue;
         uint64_t prev = UINT64_MAX, first = 0;
         uint32_t eff = 0;
         for (int f = 0; f < 10; f++) {
@@ -421,7 +428,9 @@ static void still_view_converges(void)
     h_scene_free(&hs);
 }
 
-/* Identical runs give identical frames; strips give the frames the whole image gives. */
+/* Identical runs give identical frames; strips give the frames the whole image gives;
+ * the lean mode (the minimum bytes: no per-vertex or per-triangle arrays) gives the
+ * frames the fast mode gives. */
 static void runs_are_bit_identical(void)
 {
     h_scene hs;
@@ -433,7 +442,7 @@ static void runs_are_bit_identical(void)
     c.asm_cap = 8u << 20;
     arun r[3];
     for (int k = 0; k < 3; k++)
-        if (!arun_init(&r[k], &hs.s, &c, BW, BH)) return;
+        if (!arun_init(&r[k], &hs.s, &c, BW, BH, k == 1)) return;
     int differ = 0;
     for (int f = 0; f < 8; f++) {
         float t = 0.4f * (float)(f / 2);   /* each view twice: a rebuild, then a refinement */
@@ -469,7 +478,7 @@ static void odd_settings_render(void)
         c.asm_root = 64;
         CHECK_OK(om_method_cfg_set(&c, sets[k][0], atof(sets[k][1]), NULL));
         arun r;
-        if (!arun_init(&r, &hs.s, &c, 80, 60)) continue;
+        if (!arun_init(&r, &hs.s, &c, 80, 60, false)) continue;
         for (int f = 0; f < 4; f++) {
             om_method_stats ms;
             CHECK_OK(arun_frame(&r, 0.0f, 0.3f * (float)f, 0, mask, NULL, &ms));

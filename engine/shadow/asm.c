@@ -53,9 +53,10 @@ typedef struct asm_state {
     om_mat4 built_vp;      /* the light the tiles hold */
     bool built;
     bool prepared;         /* this frame's projections are done */
-    asm_dvec *vclip;       /* per vertex: light clip coordinates, in double */
-    float *tbox;           /* per triangle: base-texel bounds u0, v0, u1, v1 */
-    uint32_t *cull;        /* triangles that meet the region being rendered */
+    bool lean;             /* no per-vertex or per-triangle arrays: see render */
+    asm_dvec *vclip;       /* per vertex: light clip coordinates, in double (not lean) */
+    float *tbox;           /* per triangle: base-texel bounds u0, v0, u1, v1 (not lean) */
+    uint32_t *cull;        /* triangles that meet the region being rendered (not lean) */
     uint32_t *sdepth, *sid;   /* one tile of scratch for the rasterizer */
     om__asm_cand *cand;
     uint32_t ncand_max;
@@ -76,13 +77,19 @@ typedef struct asm_pt {
     uint32_t tri;
 } asm_pt;
 
-static size_t scratch_bytes(const om_scene *s, const om__asm_layout *l, uint64_t ncand)
+/* The scene-sized arrays of the fast mode: projections once per frame, bounds once
+ * per frame, a cull list per tile. */
+static size_t scene_bytes(const om_scene *s)
 {
-    const size_t t2 = (size_t)l->tile * l->tile;
     return om_arena_need((size_t)(s->nverts ? s->nverts : 1) * sizeof(asm_dvec), 8) +
            om_arena_need((size_t)(s->ntris ? s->ntris : 1) * 4 * sizeof(float), 8) +
-           om_arena_need((size_t)(s->ntris ? s->ntris : 1) * sizeof(uint32_t), 8) +
-           2 * om_arena_need(t2 * sizeof(uint32_t), 8) +
+           om_arena_need((size_t)(s->ntris ? s->ntris : 1) * sizeof(uint32_t), 8);
+}
+
+static size_t scratch_bytes(const om__asm_layout *l, uint64_t ncand)
+{
+    const size_t t2 = (size_t)l->tile * l->tile;
+    return 2 * om_arena_need(t2 * sizeof(uint32_t), 8) +
            om_arena_need((size_t)ncand * sizeof(om__asm_cand), 8);
 }
 
@@ -92,9 +99,10 @@ static uint64_t cand_count(const om__asm_layout *l)
     return n ? n : 1;
 }
 
-static size_t asm_need(const om_scene *s, const om__asm_layout *l)
+static size_t asm_need(const om_scene *s, const om__asm_layout *l, bool lean)
 {
-    return om_arena_need(sizeof(asm_state), 16) + l->arena_bytes + scratch_bytes(s, l, cand_count(l));
+    return om_arena_need(sizeof(asm_state), 16) + l->arena_bytes + scratch_bytes(l, cand_count(l)) +
+           (lean ? 0 : scene_bytes(s));
 }
 
 static om_status asm_bytes(const om_method_cfg *c, const om_scene *s, uint32_t w, uint32_t h,
@@ -105,8 +113,9 @@ static om_status asm_bytes(const om_method_cfg *c, const om_scene *s, uint32_t w
     om_status st = om__asm_layout_of(&l, c, s->ntris, NULL);
     if (st) return st;
     /* Below the smallest cap the figure is what the state needs to say so (init fails
-     * with OM_E_BUDGET naming the smallest cap). */
-    *min = *full = asm_need(s, &l);
+     * with OM_E_BUDGET naming the smallest cap). The lean mode renders the same frame. */
+    *min = asm_need(s, &l, true);
+    *full = asm_need(s, &l, false);
     return OM_OK;
 }
 
@@ -130,20 +139,27 @@ static om_status asm_init(void **state, om_arena *a, const om_method_cfg *c, con
         return OM_E_BUDGET;
     }
     if (w < 1 || h < 1) return om__fail(d, OM_E_INVALID, "asm: image size must be at least 1x1");
-    if ((st = om__need(a, asm_need(s, &l), "asm", d))) return st;
+    if ((st = om__need(a, asm_need(s, &l, true), "asm", d))) return st;
+    const bool lean = om_arena_left(a) < asm_need(s, &l, false);
     if ((st = om_arena_alloc(a, sizeof(asm_state), 16, &p, d))) return st;
     asm_state *m = (asm_state *)p;
     m->scene = s;
     m->cfg = *c;
+    m->lean = lean;
+    m->vclip = NULL;
+    m->tbox = NULL;
+    m->cull = NULL;
     if ((st = om__asm_tree_init(&m->tree, a, &l, d))) return st;
     const size_t t2 = (size_t)l.tile * l.tile;
     uint64_t nc = cand_count(&l);
-    if ((st = om_arena_alloc(a, (size_t)(s->nverts ? s->nverts : 1) * sizeof(asm_dvec), 8, &p, d))) return st;
-    m->vclip = (asm_dvec *)p;
-    if ((st = om_arena_alloc(a, (size_t)(s->ntris ? s->ntris : 1) * 4 * sizeof(float), 8, &p, d))) return st;
-    m->tbox = (float *)p;
-    if ((st = om_arena_alloc(a, (size_t)(s->ntris ? s->ntris : 1) * sizeof(uint32_t), 8, &p, d))) return st;
-    m->cull = (uint32_t *)p;
+    if (!lean) {
+        if ((st = om_arena_alloc(a, (size_t)(s->nverts ? s->nverts : 1) * sizeof(asm_dvec), 8, &p, d))) return st;
+        m->vclip = (asm_dvec *)p;
+        if ((st = om_arena_alloc(a, (size_t)(s->ntris ? s->ntris : 1) * 4 * sizeof(float), 8, &p, d))) return st;
+        m->tbox = (float *)p;
+        if ((st = om_arena_alloc(a, (size_t)(s->ntris ? s->ntris : 1) * sizeof(uint32_t), 8, &p, d))) return st;
+        m->cull = (uint32_t *)p;
+    }
     if ((st = om_arena_alloc(a, t2 * sizeof(uint32_t), 8, &p, d))) return st;
     m->sdepth = (uint32_t *)p;
     if ((st = om_arena_alloc(a, t2 * sizeof(uint32_t), 8, &p, d))) return st;
@@ -184,6 +200,52 @@ static asm_dvec dapply(const om_mat4 *mt, om_vec3 p)
     return r;
 }
 
+/* A triangle's bounds on the light's image in base texels (R per side), from its
+ * vertices' light clip coordinates. */
+static void tri_box(const asm_dvec q[3], double R, float b[4])
+{
+    double lo_u = 0, lo_v = 0, hi_u = 0, hi_v = 0;
+    bool all = false;
+    for (int i = 0; i < 3; i++) {
+        /* Behind or on the light's plane: the triangle's image is unbounded; let the
+         * rasterizer's clipping decide for every tile. */
+        if (!(q[i].w > 1e-9 * (fabs(q[i].x) + fabs(q[i].y)))) { all = true; break; }
+        double u = (q[i].x / q[i].w + 1.0) * 0.5 * R, v = (1.0 - q[i].y / q[i].w) * 0.5 * R;
+        if (i == 0 || u < lo_u) lo_u = u;
+        if (i == 0 || v < lo_v) lo_v = v;
+        if (i == 0 || u > hi_u) hi_u = u;
+        if (i == 0 || v > hi_v) hi_v = v;
+    }
+    if (all || !(lo_u > -1e30 && hi_u < 1e30 && lo_v > -1e30 && hi_v < 1e30)) {
+        b[0] = b[1] = -FLT_MAX;
+        b[2] = b[3] = FLT_MAX;
+    } else {   /* widened by far more than float rounding: never narrower than in double */
+        b[0] = (float)(lo_u - (1.0 / 256 + fabs(lo_u) * 1e-6));
+        b[1] = (float)(lo_v - (1.0 / 256 + fabs(lo_v) * 1e-6));
+        b[2] = (float)(hi_u + (1.0 / 256 + fabs(hi_u) * 1e-6));
+        b[3] = (float)(hi_v + (1.0 / 256 + fabs(hi_v) * 1e-6));
+    }
+}
+
+static inline bool box_meets(const float *b, float u0, float v0, float u1, float v1)
+{
+    return !((b[2] < u0) | (b[0] > u1) | (b[3] < v0) | (b[1] > v1));
+}
+
+/* One triangle into the tile: its clip coordinates composed with the tile's window. */
+static void render_tri(om_raster *r, const asm_dvec q[3], double s_, double kx, double ky,
+                       uint32_t t)
+{
+    om_vec4 c[3];
+    for (int i = 0; i < 3; i++) {
+        c[i].x = (float)(q[i].x * s_ + q[i].w * kx);
+        c[i].y = (float)(q[i].y * s_ + q[i].w * ky);
+        c[i].z = (float)q[i].z;
+        c[i].w = (float)q[i].w;
+    }
+    om__raster_tri(r, c, t);
+}
+
 /* Renders texels [ox, ox + tile) x [oy, oy + tile) of level `level`'s grid into a
  * tile's depth and ids, from the triangles whose light bounds meet the region. The light's clip space is composed with the window that maps the
  * region's tile to [-1, 1] (x' = s x + k w), so the engine's rasterizer, clipping and
@@ -204,25 +266,30 @@ static void render(asm_state *m, uint32_t level, uint32_t ox, uint32_t oy, uint3
     om_target tg = {T, T, 0, T, m->sdepth, m->sid};
     om__target_clear(&tg);
     om_raster r = {&tg, OM_RASTER_DEPTH_ID, NULL, NULL};
-    /* Gather first, without branches (most triangles miss a deep node's region). */
-    uint32_t n = 0;
-    for (uint32_t k = 0; k < s->ntris; k++) {
-        const float *b = &m->tbox[(size_t)k * 4];
-        m->cull[n] = k;
-        n += !((b[2] < u0) | (b[0] > u1) | (b[3] < v0) | (b[1] > v1));
-    }
-    for (uint32_t k = 0; k < n; k++) {
-        const uint32_t t = m->cull[k];
-        const uint32_t *ix = s->idx + (size_t)t * 3;
-        om_vec4 c[3];
-        for (int i = 0; i < 3; i++) {
-            const asm_dvec *q = &m->vclip[ix[i]];
-            c[i].x = (float)(q->x * s_ + q->w * kx);
-            c[i].y = (float)(q->y * s_ + q->w * ky);
-            c[i].z = (float)q->z;
-            c[i].w = (float)q->w;
+    if (m->lean) {
+        /* The same triangles in the same order as the fast path below, so the same tile:
+         * projections and bounds are made per tile instead of kept per frame. */
+        for (uint32_t t = 0; t < s->ntris; t++) {
+            const uint32_t *ix = s->idx + (size_t)t * 3;
+            asm_dvec q[3];
+            float b[4];
+            for (int i = 0; i < 3; i++) q[i] = dapply(&m->view.light_vp, s->verts[ix[i]]);
+            tri_box(q, T, b);
+            if (box_meets(b, u0, v0, u1, v1)) render_tri(&r, q, s_, kx, ky, t);
         }
-        om__raster_tri(&r, c, t);
+    } else {
+        /* Gather first, without branches (most triangles miss a deep node's region). */
+        uint32_t n = 0;
+        for (uint32_t k = 0; k < s->ntris; k++) {
+            m->cull[n] = k;
+            n += box_meets(&m->tbox[(size_t)k * 4], u0, v0, u1, v1);
+        }
+        for (uint32_t k = 0; k < n; k++) {
+            const uint32_t t = m->cull[k];
+            const uint32_t *ix = s->idx + (size_t)t * 3;
+            const asm_dvec q[3] = {m->vclip[ix[0]], m->vclip[ix[1]], m->vclip[ix[2]]};
+            render_tri(&r, q, s_, kx, ky, t);
+        }
     }
     const size_t t2 = (size_t)T * T;
     memcpy(depth, m->sdepth, t2 * sizeof *depth);
@@ -246,32 +313,12 @@ static void prepare(asm_state *m)
     if (m->prepared) return;
     m->prepared = true;
     const om_scene *s = m->scene;
-    const double R = m->tree.lay.tile;   /* bounds in base texels */
-    for (uint32_t i = 0; i < s->nverts; i++) m->vclip[i] = dapply(&m->view.light_vp, s->verts[i]);
-    for (uint32_t k = 0; k < s->ntris; k++) {
-        const uint32_t *ix = s->idx + (size_t)k * 3;
-        float *b = &m->tbox[(size_t)k * 4];
-        double lo_u = 0, lo_v = 0, hi_u = 0, hi_v = 0;
-        bool all = false;
-        for (int i = 0; i < 3; i++) {
-            const asm_dvec *q = &m->vclip[ix[i]];
-            /* Behind or on the light's plane: the triangle's image is unbounded; let the
-             * rasterizer's clipping decide for every tile. */
-            if (!(q->w > 1e-9 * (fabs(q->x) + fabs(q->y)))) { all = true; break; }
-            double u = (q->x / q->w + 1.0) * 0.5 * R, v = (1.0 - q->y / q->w) * 0.5 * R;
-            if (i == 0 || u < lo_u) lo_u = u;
-            if (i == 0 || v < lo_v) lo_v = v;
-            if (i == 0 || u > hi_u) hi_u = u;
-            if (i == 0 || v > hi_v) hi_v = v;
-        }
-        if (all || !(lo_u > -1e30 && hi_u < 1e30 && lo_v > -1e30 && hi_v < 1e30)) {
-            b[0] = b[1] = -FLT_MAX;
-            b[2] = b[3] = FLT_MAX;
-        } else {   /* widened by far more than float rounding: never narrower than in double */
-            b[0] = (float)(lo_u - (1.0 / 256 + fabs(lo_u) * 1e-6));
-            b[1] = (float)(lo_v - (1.0 / 256 + fabs(lo_v) * 1e-6));
-            b[2] = (float)(hi_u + (1.0 / 256 + fabs(hi_u) * 1e-6));
-            b[3] = (float)(hi_v + (1.0 / 256 + fabs(hi_v) * 1e-6));
+    if (!m->lean) {
+        for (uint32_t i = 0; i < s->nverts; i++) m->vclip[i] = dapply(&m->view.light_vp, s->verts[i]);
+        for (uint32_t k = 0; k < s->ntris; k++) {
+            const uint32_t *ix = s->idx + (size_t)k * 3;
+            const asm_dvec q[3] = {m->vclip[ix[0]], m->vclip[ix[1]], m->vclip[ix[2]]};
+            tri_box(q, m->tree.lay.tile, &m->tbox[(size_t)k * 4]);
         }
     }
     if (!m->built || memcmp(&m->built_vp, &m->view.light_vp, sizeof m->built_vp) != 0) {
@@ -534,7 +581,7 @@ static void asm_stats(const void *state, om_method_stats *out)
     const asm_state *m = (const asm_state *)state;
     const om__asm_tree *t = &m->tree;
     memset(out, 0, sizeof *out);
-    out->bytes_used = asm_need(m->scene, &t->lay);
+    out->bytes_used = asm_need(m->scene, &t->lay, m->lean);
     uint64_t inuse = om__asm_bytes_in_use(t);
     double eff = om__asm_grid(&t->lay, om__asm_depth(t));
     const uint32_t v[8] = {t->pool.in_use, t->created, t->evicted,
