@@ -1,16 +1,15 @@
 /* parse.c — the scene text format (see om_scene_parse in ombra.h and the grammar in the
- * README): commands, parameters with their ranges, and the two passes over the text.
+ * README): the commands and the two passes over the text (parameters, their ranges
+ * and the messages are params.c's).
  * The first pass validates every line and counts what it will produce (om_scene_bytes
  * stops there), so every error comes with a line and column before any memory is
  * carved; the second pass runs the very same code with a sink that writes into arrays
  * carved once, at their exact sizes. Lines, tokens and numbers are lex.c's; camera and
  * light paths are paths.c's. */
-#include "scene.h"
+#include "parse.h"
 
 #include <math.h>
 #include <string.h>
-
-/* ================================================================ parameters */
 
 enum {
     C_CAMERA, C_LIGHT, C_MATERIAL, C_PLANE, C_BOX, C_SPHERE, C_CYLINDER, C_MESH,
@@ -21,55 +20,7 @@ static const char *const cmd_names[C_N_] = {
     "triangles", "key",
 };
 
-enum {
-    P_EYE, P_TARGET, P_UP, P_FOV, P_SIZE, P_NEAR, P_FAR, P_POS, P_DIR, P_ALBEDO, P_OPACITY,
-    P_SIZE2, P_DIVISIONS, P_SIZE3, P_RADIUS, P_SEGMENTS, P_RINGS, P_HEIGHT, P_COUNT, P_SEED,
-    P_AREA, P_IN, P_SCALE, P_ROTATE, P_TRANSLATE, P_MATERIAL, P_N_
-};
-enum { K_NUM, K_INT, K_SCALE, K_WORD };
-enum {
-    R_COORD, R_LEN, R_FOV, R_UNIT, R_DIM, R_DIV, R_SEG, R_RING, R_COUNT, R_SEED, R_NEAR,
-    R_FAR, R_AREA, R_SCALE, R_N_
-};
-
-typedef struct pdef { const char *name; uint8_t n, kind, rng; } pdef;
-static const pdef pdefs[P_N_] = {
-    [P_EYE] = {"eye", 3, K_NUM, R_COORD},        [P_TARGET] = {"target", 3, K_NUM, R_COORD},
-    [P_UP] = {"up", 3, K_NUM, R_COORD},          [P_FOV] = {"fov", 1, K_NUM, R_FOV},
-    [P_SIZE] = {"size", 2, K_INT, R_DIM},        [P_NEAR] = {"near", 1, K_NUM, R_NEAR},
-    [P_FAR] = {"far", 1, K_NUM, R_FAR},          [P_POS] = {"pos", 3, K_NUM, R_COORD},
-    [P_DIR] = {"dir", 3, K_NUM, R_COORD},        [P_ALBEDO] = {"albedo", 3, K_NUM, R_UNIT},
-    [P_OPACITY] = {"opacity", 1, K_NUM, R_UNIT}, [P_SIZE2] = {"size", 2, K_NUM, R_LEN},
-    [P_DIVISIONS] = {"divisions", 1, K_INT, R_DIV},
-    [P_SIZE3] = {"size", 3, K_NUM, R_LEN},       [P_RADIUS] = {"radius", 1, K_NUM, R_LEN},
-    [P_SEGMENTS] = {"segments", 1, K_INT, R_SEG}, [P_RINGS] = {"rings", 1, K_INT, R_RING},
-    [P_HEIGHT] = {"height", 1, K_NUM, R_LEN},    [P_COUNT] = {"count", 1, K_INT, R_COUNT},
-    [P_SEED] = {"seed", 1, K_INT, R_SEED},       [P_AREA] = {"area", 1, K_NUM, R_AREA},
-    [P_IN] = {"in", 6, K_NUM, R_COORD},          [P_SCALE] = {"scale", 3, K_SCALE, R_SCALE},
-    [P_ROTATE] = {"rotate", 3, K_NUM, R_COORD},  [P_TRANSLATE] = {"translate", 3, K_NUM, R_COORD},
-    [P_MATERIAL] = {"material", 1, K_WORD, 0},
-};
-
-/* Every number has a range; `mag` ranges bound the magnitude (scale may be negative:
- * a mirror) and `open` ones exclude their ends. */
-typedef struct rdef { double lo, hi; bool open, mag; const char *text; } rdef;
-static const rdef rdefs[R_N_] = {
-    [R_COORD] = {-1e7, 1e7, false, false, "-1e7..1e7"},
-    [R_LEN] = {1e-6, 1e7, false, false, "1e-6..1e7"},
-    [R_FOV] = {0.0, 180.0, true, false, "above 0 and below 180"},
-    [R_UNIT] = {0.0, 1.0, false, false, "0..1"},
-    [R_DIM] = {1.0, 8192.0, false, false, "1..8192"},
-    [R_DIV] = {1.0, 4096.0, false, false, "1..4096"},
-    [R_SEG] = {3.0, 4096.0, false, false, "3..4096"},
-    [R_RING] = {2.0, 4096.0, false, false, "2..4096"},
-    [R_COUNT] = {1.0, 1e7, false, false, "1..10000000"},
-    [R_SEED] = {0.0, 4294967295.0, false, false, "0..4294967295"},
-    [R_NEAR] = {1e-6, 1e7, false, false, "1e-6..1e7"},
-    [R_FAR] = {1e-6, 1e8, false, false, "1e-6..1e8"},
-    [R_AREA] = {1e-6, 1e12, false, false, "1e-6..1e12"},
-    [R_SCALE] = {1e-6, 1e6, false, true, "1e-6..1e6 in magnitude"},
-};
-
+/* The parameters each command takes. */
 #define COMMON_PARAMS P_SCALE, P_ROTATE, P_TRANSLATE, P_ALBEDO, P_OPACITY, P_MATERIAL
 static const uint8_t cam_params[] = {P_EYE, P_TARGET, P_UP, P_FOV, P_SIZE, P_NEAR, P_FAR};
 static const uint8_t spot_params[] = {P_POS, P_TARGET, P_FOV, P_NEAR, P_FAR};
@@ -84,272 +35,6 @@ static const uint8_t tris_params[] = {P_COUNT, P_SEED, P_AREA, P_IN, COMMON_PARA
 static const uint8_t keycam_params[] = {P_EYE, P_TARGET};
 static const uint8_t keylight_params[] = {P_POS, P_TARGET, P_DIR};
 #define NP(a) (sizeof(a) / sizeof((a)[0]))
-
-/* One parameter as read from a line. */
-typedef struct pv {
-    bool has;
-    uint8_t n;             /* values read (scale: 1 or 3) */
-    uint32_t col;          /* column of the parameter's name */
-    uint32_t vcol[6];      /* column of each value */
-    double v[6];
-    om__tok w;             /* K_WORD: the word */
-} pv;
-
-/* ================================================================ the parser */
-
-#define MCACHE 64          /* material names remembered; a miss rescans earlier lines */
-
-typedef struct mslot { size_t at, len; uint32_t ord; bool used; } mslot;
-
-typedef struct parser {
-    const char *text;
-    size_t len;
-    const om_loader *ld;
-    om_diag *d;
-    om__line l;
-    om__tok cmd;           /* the current line's command */
-    bool fill;             /* second pass: write into the scene */
-    uint64_t nv, nt;       /* vertices and triangles so far */
-    uint32_t nnamed, ninline, ncam, nlight;
-    uint32_t nnamed_total; /* second pass: named materials in the whole text */
-    bool have_cam, have_light;
-    uint32_t cam_line, light_line;
-    float cam_t, light_t;  /* time of the last key of each kind */
-    uint32_t cam_t_line, light_t_line;
-    int lkey_form;         /* 0 none yet, 1 spot (pos/target), 2 directional (dir) */
-    uint32_t lkey_line, lkey_col;
-    om_camera cam;
-    om_light light;
-    om_scene *s;           /* second pass */
-    om__sink out;          /* second pass: the whole scene's sink */
-    mslot cache[MCACHE];
-} parser;
-
-static om__str fail_begin(parser *p, om_status st, uint32_t col, char *tmp, size_t cap)
-{
-    return om__perr(p->d, st, NULL, p->l.no, col, tmp, cap);
-}
-
-/* "line L, col C: <a>'<q>'<b>" — most messages have this shape. */
-static om_status fail(parser *p, om_status st, uint32_t col, const char *a, const char *q,
-                      size_t qn, const char *b)
-{
-    char tmp[4];
-    om__str s = fail_begin(p, st, col, tmp, sizeof tmp);
-    om__str_s(&s, a);
-    if (q) om__str_tok(&s, q, qn);
-    if (b) om__str_s(&s, b);
-    return st;
-}
-
-static om_status fail_tok(parser *p, om_status st, const om__tok *t, const char *a,
-                          const char *b)
-{
-    return fail(p, st, t->col, a, p->text + t->at, t->len, b);
-}
-
-static om_status bad_byte(parser *p, const om__tok *t)
-{
-    static const char hex[] = "0123456789abcdef";
-    unsigned char c = (unsigned char)p->text[t->at];
-    char code[5] = {'0', 'x', hex[c >> 4], hex[c & 15], '\0'};
-    char tmp[4];
-    om__str s = fail_begin(p, OM_E_PARSE, t->col, tmp, sizeof tmp);
-    om__str_s(&s, "unexpected byte ");
-    om__str_s(&s, code);
-    om__str_s(&s, " (scene files are text)");
-    return OM_E_PARSE;
-}
-
-static void list_names(om__str *s, const uint8_t *ids, size_t n)
-{
-    for (size_t i = 0; i < n; i++) {
-        if (i) om__str_s(s, ", ");
-        om__str_s(s, pdefs[ids[i]].name);
-    }
-}
-
-static void expected_numbers(om__str *s, unsigned want, bool integer)
-{
-    om__str_s(s, "expected ");
-    if (want == 0) om__str_s(s, "1 or 3 numbers");
-    else if (want == 1) om__str_s(s, integer ? "a whole number" : "a number");
-    else {
-        om__str_u(s, want);
-        om__str_s(s, integer ? " whole numbers" : " numbers");
-    }
-}
-
-/* Reads one value of parameter `what`; want (0: "1 or 3") only shapes messages. */
-static om_status read_value(parser *p, const char *what, uint8_t kind, uint8_t rng,
-                            unsigned want, double *v, uint32_t *col)
-{
-    om__tok t;
-    int r = om__tok_next(&p->l, &t);
-    if (r < 0) return bad_byte(p, &t);
-    if (r == 0 || !om__numlike(p->text + t.at, t.len)) {
-        char tmp[4];
-        om__str s = fail_begin(p, OM_E_PARSE, r == 0 ? om__line_end_col(&p->l) : t.col, tmp,
-                               sizeof tmp);
-        expected_numbers(&s, want, kind == K_INT);
-        om__str_s(&s, " after '");
-        om__str_s(&s, what);
-        om__str_s(&s, "'");
-        if (r != 0) {
-            om__str_s(&s, ", found ");
-            om__str_tok(&s, p->text + t.at, t.len);
-        }
-        return OM_E_PARSE;
-    }
-    *col = t.col;
-    if (!om__num(p->text + t.at, t.len, v))
-        return fail_tok(p, OM_E_PARSE, &t, "malformed number ", NULL);
-    if (!(*v - *v == 0.0))
-        return fail_tok(p, OM_E_PARSE, &t, "number ", " is not finite");
-    if (kind == K_INT && *v != floor(*v)) {
-        char tmp[4];
-        om__str s = fail_begin(p, OM_E_PARSE, t.col, tmp, sizeof tmp);
-        om__str_s(&s, "expected a whole number after '");
-        om__str_s(&s, what);
-        om__str_s(&s, "', found ");
-        om__str_tok(&s, p->text + t.at, t.len);
-        return OM_E_PARSE;
-    }
-    const rdef *rd = &rdefs[rng];
-    double x = rd->mag ? fabs(*v) : *v;
-    bool ok = rd->open ? x > rd->lo && x < rd->hi : x >= rd->lo && x <= rd->hi;
-    if (!ok) {
-        char tmp[4];
-        om__str s = fail_begin(p, OM_E_RANGE, t.col, tmp, sizeof tmp);
-        om__str_s(&s, what);
-        om__str_s(&s, " ");
-        om__str_tok(&s, p->text + t.at, t.len);
-        om__str_s(&s, " is out of range (");
-        om__str_s(&s, rd->text);
-        om__str_s(&s, ")");
-        return OM_E_RANGE;
-    }
-    return OM_OK;
-}
-
-static bool peek_number(parser *p, om__tok *t)
-{
-    return om__tok_peek(&p->l, t) == 1 && om__numlike(p->text + t->at, t->len);
-}
-
-/* Reads `name value...` pairs to the end of the line, any order, each at most once. */
-static om_status read_params(parser *p, const char *what, const uint8_t *ids, size_t nids,
-                             pv *pl)
-{
-    memset(pl, 0, sizeof(pv) * P_N_);
-    om__tok t;
-    int r;
-    while ((r = om__tok_next(&p->l, &t)) != 0) {
-        if (r < 0) return bad_byte(p, &t);
-        int id = -1;
-        for (size_t i = 0; i < nids && id < 0; i++)
-            if (om__tok_is(p->text, &t, pdefs[ids[i]].name)) id = ids[i];
-        if (id < 0) {
-            char tmp[4];
-            bool num = om__numlike(p->text + t.at, t.len);
-            om__str s = fail_begin(p, OM_E_PARSE, t.col, tmp, sizeof tmp);
-            om__str_s(&s, num ? "unexpected value " : "unknown parameter ");
-            om__str_tok(&s, p->text + t.at, t.len);
-            om__str_s(&s, " for '");
-            om__str_s(&s, what);
-            om__str_s(&s, "' (expected ");
-            list_names(&s, ids, nids);
-            om__str_s(&s, ")");
-            return OM_E_PARSE;
-        }
-        const pdef *pd = &pdefs[id];
-        pv *v = &pl[id];
-        if (v->has) return fail_tok(p, OM_E_PARSE, &t, "parameter ", " is given twice");
-        v->has = true;
-        v->col = t.col;
-        om_status st;
-        if (pd->kind == K_WORD) {
-            r = om__tok_next(&p->l, &v->w);
-            if (r < 0) return bad_byte(p, &v->w);
-            if (r == 0)
-                return fail(p, OM_E_PARSE, om__line_end_col(&p->l), "expected a name after ",
-                            pd->name, om__cstr_len(pd->name), NULL);
-            continue;
-        }
-        if (pd->kind == K_SCALE) {
-            om__tok nx;
-            while (v->n < 4 && peek_number(p, &nx)) {
-                if (v->n == 3)
-                    return fail(p, OM_E_PARSE, nx.col, "too many values after ", pd->name,
-                                om__cstr_len(pd->name), " (it takes 1 or 3)");
-                if ((st = read_value(p, pd->name, K_NUM, pd->rng, 0, &v->v[v->n],
-                                     &v->vcol[v->n])) != OM_OK)
-                    return st;
-                v->n++;
-            }
-            if (v->n != 1 && v->n != 3) {
-                /* reads the offending token (or the end of the line) for the message */
-                double dummy;
-                uint32_t dcol;
-                return read_value(p, pd->name, K_NUM, pd->rng, 0, &dummy, &dcol);
-            }
-            if (v->n == 1) v->v[1] = v->v[2] = v->v[0];
-            continue;
-        }
-        for (unsigned i = 0; i < pd->n; i++)
-            if ((st = read_value(p, pd->name, pd->kind, pd->rng, pd->n, &v->v[i],
-                                 &v->vcol[i])) != OM_OK)
-                return st;
-        v->n = pd->n;
-        om__tok nx;
-        if (peek_number(p, &nx)) {
-            char tmp[4];
-            om__str s = fail_begin(p, OM_E_PARSE, nx.col, tmp, sizeof tmp);
-            om__str_s(&s, "too many values after '");
-            om__str_s(&s, pd->name);
-            om__str_s(&s, "' (it takes ");
-            om__str_u(&s, pd->n);
-            om__str_s(&s, ")");
-            return OM_E_PARSE;
-        }
-    }
-    return OM_OK;
-}
-
-static om_vec3 pv3(const pv *v, int i) { return om__v3((float)v->v[i], (float)v->v[i + 1], (float)v->v[i + 2]); }
-static double val(const pv *pl, int id, int i, double def) { return pl[id].has ? pl[id].v[i] : def; }
-static bool v3_eq(om_vec3 a, om_vec3 b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
-static bool v3_zero(om_vec3 a) { return a.x == 0.0f && a.y == 0.0f && a.z == 0.0f; }
-
-static om_status missing(parser *p, const char *what, const char *need)
-{
-    char tmp[4];
-    om__str s = fail_begin(p, OM_E_PARSE, p->cmd.col, tmp, sizeof tmp);
-    om__str_s(&s, "'");
-    om__str_s(&s, what);
-    om__str_s(&s, "' needs ");
-    om__str_s(&s, need);
-    return OM_E_PARSE;
-}
-
-static om_status check_near_far(parser *p, const pv *pl, float zn, float zf)
-{
-    if (zf > zn) return OM_OK;
-    uint32_t col = pl[P_FAR].has ? pl[P_FAR].vcol[0] : pl[P_NEAR].vcol[0];
-    return fail(p, OM_E_RANGE, col, "'far' must be greater than 'near'", NULL, 0, NULL);
-}
-
-static om_status second_line(parser *p, const char *what, uint32_t first)
-{
-    char tmp[4];
-    om__str s = fail_begin(p, OM_E_PARSE, p->cmd.col, tmp, sizeof tmp);
-    om__str_s(&s, "a second '");
-    om__str_s(&s, what);
-    om__str_s(&s, "' line (a scene has one; the first is on line ");
-    om__str_u(&s, first);
-    om__str_s(&s, ")");
-    return OM_E_PARSE;
-}
 
 /* ---------------------------------------------------------------- camera and light */
 
@@ -382,9 +67,9 @@ static om_status do_camera(parser *p)
 {
     pv pl[P_N_];
     om_status st;
-    if (p->have_cam) return second_line(p, "camera", p->cam_line);
-    if ((st = read_params(p, "camera", cam_params, NP(cam_params), pl)) != OM_OK) return st;
-    if (!pl[P_EYE].has || !pl[P_TARGET].has) return missing(p, "camera", "eye X Y Z and target X Y Z");
+    if (p->have_cam) return om__parse_second_line(p, "camera", p->cam_line);
+    if ((st = om__parse_params(p, "camera", cam_params, NP(cam_params), pl)) != OM_OK) return st;
+    if (!pl[P_EYE].has || !pl[P_TARGET].has) return om__parse_missing(p, "camera", "eye X Y Z and target X Y Z");
     om_camera c;
     default_camera(&c);
     c.eye = pv3(&pl[P_EYE], 0);
@@ -396,11 +81,11 @@ static om_status do_camera(parser *p)
     c.znear = (float)val(pl, P_NEAR, 0, 0.1);
     c.zfar = (float)val(pl, P_FAR, 0, 1000.0);
     if (v3_eq(c.eye, c.target))
-        return fail(p, OM_E_RANGE, pl[P_TARGET].vcol[0], "camera eye and target must differ",
+        return om__parse_fail(p, OM_E_RANGE, pl[P_TARGET].vcol[0], "camera eye and target must differ",
                     NULL, 0, NULL);
     if (v3_zero(c.up))
-        return fail(p, OM_E_RANGE, pl[P_UP].vcol[0], "'up' must not be zero", NULL, 0, NULL);
-    if ((st = check_near_far(p, pl, c.znear, c.zfar)) != OM_OK) return st;
+        return om__parse_fail(p, OM_E_RANGE, pl[P_UP].vcol[0], "'up' must not be zero", NULL, 0, NULL);
+    if ((st = om__parse_near_far(p, pl, c.znear, c.zfar)) != OM_OK) return st;
     p->cam = c;
     p->have_cam = true;
     p->cam_line = p->l.no;
@@ -412,42 +97,42 @@ static om_status do_light(parser *p)
     pv pl[P_N_];
     om_status st;
     om__tok t;
-    if (p->have_light) return second_line(p, "light", p->light_line);
+    if (p->have_light) return om__parse_second_line(p, "light", p->light_line);
     int r = om__tok_next(&p->l, &t);
-    if (r < 0) return bad_byte(p, &t);
+    if (r < 0) return om__parse_bad_byte(p, &t);
     bool spot = r > 0 && om__tok_is(p->text, &t, "spot");
     if (!spot && !(r > 0 && om__tok_is(p->text, &t, "directional"))) {
         if (r == 0)
-            return fail(p, OM_E_PARSE, om__line_end_col(&p->l),
+            return om__parse_fail(p, OM_E_PARSE, om__line_end_col(&p->l),
                         "expected 'spot' or 'directional' after 'light'", NULL, 0, NULL);
-        return fail_tok(p, OM_E_PARSE, &t, "expected 'spot' or 'directional' after 'light', found ",
+        return om__parse_fail_tok(p, OM_E_PARSE, &t, "expected 'spot' or 'directional' after 'light', found ",
                         NULL);
     }
     om_light l;
     default_light(&l);
     if (spot) {
-        if ((st = read_params(p, "light spot", spot_params, NP(spot_params), pl)) != OM_OK) return st;
+        if ((st = om__parse_params(p, "light spot", spot_params, NP(spot_params), pl)) != OM_OK) return st;
         if (!pl[P_POS].has || !pl[P_TARGET].has)
-            return missing(p, "light spot", "pos X Y Z and target X Y Z");
+            return om__parse_missing(p, "light spot", "pos X Y Z and target X Y Z");
         l.pos = pv3(&pl[P_POS], 0);
         l.target = pv3(&pl[P_TARGET], 0);
         l.fov_deg = (float)val(pl, P_FOV, 0, 60.0);
         l.znear = (float)val(pl, P_NEAR, 0, 0.5);
         l.zfar = (float)val(pl, P_FAR, 0, 1000.0);
         if (v3_eq(l.pos, l.target))
-            return fail(p, OM_E_RANGE, pl[P_TARGET].vcol[0], "light pos and target must differ",
+            return om__parse_fail(p, OM_E_RANGE, pl[P_TARGET].vcol[0], "light pos and target must differ",
                         NULL, 0, NULL);
-        if ((st = check_near_far(p, pl, l.znear, l.zfar)) != OM_OK) return st;
+        if ((st = om__parse_near_far(p, pl, l.znear, l.zfar)) != OM_OK) return st;
         l.dir = om__normalize(om__sub(l.target, l.pos));
     } else {
-        if ((st = read_params(p, "light directional", dir_params, NP(dir_params), pl)) != OM_OK)
+        if ((st = om__parse_params(p, "light directional", dir_params, NP(dir_params), pl)) != OM_OK)
             return st;
-        if (!pl[P_DIR].has) return missing(p, "light directional", "dir X Y Z");
+        if (!pl[P_DIR].has) return om__parse_missing(p, "light directional", "dir X Y Z");
         l.kind = OM_LIGHT_DIRECTIONAL;
         l.pos = l.target = om__v3(0, 0, 0);
         l.dir = pv3(&pl[P_DIR], 0);
         if (v3_zero(l.dir))
-            return fail(p, OM_E_RANGE, pl[P_DIR].vcol[0], "'dir' must not be zero", NULL, 0, NULL);
+            return om__parse_fail(p, OM_E_RANGE, pl[P_DIR].vcol[0], "'dir' must not be zero", NULL, 0, NULL);
     }
     p->light = l;
     p->have_light = true;
@@ -514,7 +199,7 @@ static bool valid_name(const char *s, size_t n)
 static om_status add_material(parser *p)
 {
     if (1u + p->nnamed + p->ninline >= 65535u)
-        return fail(p, OM_E_RANGE, p->cmd.col, "too many materials (a scene has at most 65535)",
+        return om__parse_fail(p, OM_E_RANGE, p->cmd.col, "too many materials (a scene has at most 65535)",
                     NULL, 0, NULL);
     return OM_OK;
 }
@@ -525,14 +210,14 @@ static om_status do_material(parser *p)
     om_status st;
     om__tok name;
     int r = om__tok_next(&p->l, &name);
-    if (r < 0) return bad_byte(p, &name);
+    if (r < 0) return om__parse_bad_byte(p, &name);
     if (r == 0)
-        return fail(p, OM_E_PARSE, om__line_end_col(&p->l), "expected a name after 'material'",
+        return om__parse_fail(p, OM_E_PARSE, om__line_end_col(&p->l), "expected a name after 'material'",
                     NULL, 0, NULL);
     if (!valid_name(p->text + name.at, name.len))
-        return fail_tok(p, OM_E_PARSE, &name, "bad material name ",
+        return om__parse_fail_tok(p, OM_E_PARSE, &name, "bad material name ",
                         " (a letter or _, then letters, digits, _ . -)");
-    if ((st = read_params(p, "material", mat_params, NP(mat_params), pl)) != OM_OK) return st;
+    if ((st = om__parse_params(p, "material", mat_params, NP(mat_params), pl)) != OM_OK) return st;
     if ((st = add_material(p)) != OM_OK) return st;
     if (p->fill) {
         om_material *m = &p->s->mats[1 + p->nnamed];
@@ -561,7 +246,7 @@ static om_status object_common(parser *p, const pv *pl, om__xform *xf, uint16_t 
         uint32_t ord;
         const om__tok *w = &pl[P_MATERIAL].w;
         if (!mat_find(p, w, &ord))
-            return fail_tok(p, OM_E_PARSE, w, "unknown material ",
+            return om__parse_fail_tok(p, OM_E_PARSE, w, "unknown material ",
                             " (define it on a 'material' line above)");
         m = 1 + ord;
     }
@@ -589,7 +274,7 @@ static om_status object_common(parser *p, const pv *pl, om__xform *xf, uint16_t 
 static om_status check_totals(parser *p, uint64_t nv, uint64_t nt)
 {
     if (p->nv + nv > OM__MAX_ELEMS || p->nt + nt > OM__MAX_ELEMS)
-        return fail(p, OM_E_RANGE, p->cmd.col,
+        return om__parse_fail(p, OM_E_RANGE, p->cmd.col,
                     "the scene would have more than 2147483647 vertices or triangles", NULL, 0,
                     NULL);
     return OM_OK;
@@ -681,7 +366,7 @@ static bool box_inside(const om__xform *xf, const double lo[3], const double hi[
 static om_status out_of_range(parser *p, const char *what)
 {
     char tmp[4];
-    om__str s = fail_begin(p, OM_E_RANGE, p->cmd.col, tmp, sizeof tmp);
+    om__str s = om__parse_fail_begin(p, OM_E_RANGE, p->cmd.col, tmp, sizeof tmp);
     om__str_s(&s, what);
     om__str_s(&s, " reaches beyond 1e7 in some coordinate after its scale, rotate and translate");
     return OM_E_RANGE;
@@ -694,7 +379,7 @@ static om_status do_mesh(parser *p, const om__tok *file, const char *name, const
 {
     om_diag *d = p->d;
     if (!p->ld || !p->ld->load)
-        return fail(p, OM_E_NOTFOUND, file->col, "mesh ", name, file->len,
+        return om__parse_fail(p, OM_E_NOTFOUND, file->col, "mesh ", name, file->len,
                     ": no file loader was given to read it");
     const char *data = NULL;
     size_t dlen = 0;
@@ -708,7 +393,7 @@ static om_status do_mesh(parser *p, const om__tok *file, const char *name, const
         if (d) memcpy(why, d->msg, sizeof why);
         why[sizeof why - 1] = '\0';
         char tmp[4];
-        om__str s = fail_begin(p, st, file->col, tmp, sizeof tmp);
+        om__str s = om__parse_fail_begin(p, st, file->col, tmp, sizeof tmp);
         om__str_s(&s, "cannot load mesh ");
         om__str_tok(&s, name, file->len);
         om__str_s(&s, ": ");
@@ -720,7 +405,7 @@ static om_status do_mesh(parser *p, const om__tok *file, const char *name, const
         om__sink_begin(&p->out, xf, mat);
         if ((st = om__obj_run(data, dlen, name, p->l.no, &p->out, d)) != OM_OK) return st;
         if (p->out.out_of_range)   /* passed the first pass: the file has changed since */
-            return fail(p, OM_E_INVALID, file->col, "mesh ", name, file->len,
+            return om__parse_fail(p, OM_E_INVALID, file->col, "mesh ", name, file->len,
                         " changed between the counting and filling passes");
         p->nv += p->out.nv - nv0;
         p->nt += p->out.nt - nt0;
@@ -732,7 +417,7 @@ static om_status do_mesh(parser *p, const om__tok *file, const char *name, const
     if ((st = om__obj_run(data, dlen, name, p->l.no, &k, d)) != OM_OK) return st;
     if (k.out_of_range) {
         char tmp[4];
-        om__str s = fail_begin(p, OM_E_RANGE, p->cmd.col, tmp, sizeof tmp);
+        om__str s = om__parse_fail_begin(p, OM_E_RANGE, p->cmd.col, tmp, sizeof tmp);
         om__str_s(&s, "mesh ");
         om__str_tok(&s, name, file->len);
         om__str_s(&s, " reaches beyond 1e7 after its transform (vertex on OBJ line ");
@@ -762,21 +447,21 @@ static om_status do_object(parser *p, int cmd)
     char name[256];
     if (cmd == C_MESH) {
         int r = om__tok_next(&p->l, &file);
-        if (r < 0) return bad_byte(p, &file);
+        if (r < 0) return om__parse_bad_byte(p, &file);
         if (r == 0)
-            return fail(p, OM_E_PARSE, om__line_end_col(&p->l), "expected a file name after 'mesh'",
+            return om__parse_fail(p, OM_E_PARSE, om__line_end_col(&p->l), "expected a file name after 'mesh'",
                         NULL, 0, NULL);
         if (file.len >= sizeof name)
-            return fail(p, OM_E_PARSE, file.col, "file name longer than 255 bytes", NULL, 0, NULL);
+            return om__parse_fail(p, OM_E_PARSE, file.col, "file name longer than 255 bytes", NULL, 0, NULL);
         memcpy(name, p->text + file.at, file.len);
         name[file.len] = '\0';
     }
-    if ((st = read_params(p, cmd_names[cmd], sets[cmd].ids, sets[cmd].n, pl)) != OM_OK) return st;
+    if ((st = om__parse_params(p, cmd_names[cmd], sets[cmd].ids, sets[cmd].n, pl)) != OM_OK) return st;
     if (cmd == C_TRIANGLES) {
-        if (!pl[P_COUNT].has) return missing(p, "triangles", "count N");
+        if (!pl[P_COUNT].has) return om__parse_missing(p, "triangles", "count N");
         for (int i = 0; i < 3 && pl[P_IN].has; i++)
             if (pl[P_IN].v[i] > pl[P_IN].v[i + 3])
-                return fail(p, OM_E_RANGE, pl[P_IN].vcol[i + 3],
+                return om__parse_fail(p, OM_E_RANGE, pl[P_IN].vcol[i + 3],
                             "'in' needs X0 <= X1, Y0 <= Y1 and Z0 <= Z1", NULL, 0, NULL);
     }
     om__xform xf;
@@ -812,7 +497,7 @@ static om_status do_object(parser *p, int cmd)
 static om_status key_order(parser *p, const char *what, uint32_t col, float last, uint32_t line)
 {
     char tmp[4];
-    om__str s = fail_begin(p, OM_E_PARSE, col, tmp, sizeof tmp);
+    om__str s = om__parse_fail_begin(p, OM_E_PARSE, col, tmp, sizeof tmp);
     om__str_s(&s, what);
     om__str_s(&s, " times must increase (the key before, on line ");
     om__str_u(&s, line);
@@ -828,28 +513,28 @@ static om_status do_key(parser *p)
     om_status st;
     om__tok t;
     int r = om__tok_next(&p->l, &t);
-    if (r < 0) return bad_byte(p, &t);
+    if (r < 0) return om__parse_bad_byte(p, &t);
     bool cam = r > 0 && om__tok_is(p->text, &t, "camera");
     if (!cam && !(r > 0 && om__tok_is(p->text, &t, "light"))) {
         if (r == 0)
-            return fail(p, OM_E_PARSE, om__line_end_col(&p->l),
+            return om__parse_fail(p, OM_E_PARSE, om__line_end_col(&p->l),
                         "expected 'camera' or 'light' after 'key'", NULL, 0, NULL);
-        return fail_tok(p, OM_E_PARSE, &t, "expected 'camera' or 'light' after 'key', found ", NULL);
+        return om__parse_fail_tok(p, OM_E_PARSE, &t, "expected 'camera' or 'light' after 'key', found ", NULL);
     }
     const char *what = cam ? "key camera" : "key light";
     double T;
     uint32_t tcol;
-    if ((st = read_value(p, what, K_NUM, R_COORD, 1, &T, &tcol)) != OM_OK) return st;
+    if ((st = om__parse_value(p, what, K_NUM, R_COORD, 1, &T, &tcol)) != OM_OK) return st;
     float tf = (float)T;
     if (cam) {
-        if ((st = read_params(p, what, keycam_params, NP(keycam_params), pl)) != OM_OK) return st;
-        if (!pl[P_EYE].has || !pl[P_TARGET].has) return missing(p, what, "eye X Y Z and target X Y Z");
+        if ((st = om__parse_params(p, what, keycam_params, NP(keycam_params), pl)) != OM_OK) return st;
+        if (!pl[P_EYE].has || !pl[P_TARGET].has) return om__parse_missing(p, what, "eye X Y Z and target X Y Z");
         om_camera_key k;
         k.t = tf;
         k.eye = pv3(&pl[P_EYE], 0);
         k.target = pv3(&pl[P_TARGET], 0);
         if (v3_eq(k.eye, k.target))
-            return fail(p, OM_E_RANGE, pl[P_TARGET].vcol[0], "camera eye and target must differ",
+            return om__parse_fail(p, OM_E_RANGE, pl[P_TARGET].vcol[0], "camera eye and target must differ",
                         NULL, 0, NULL);
         if (p->ncam && !(tf > p->cam_t)) return key_order(p, what, tcol, p->cam_t, p->cam_t_line);
         if (p->fill) p->s->cam_keys[p->ncam] = k;
@@ -858,34 +543,34 @@ static om_status do_key(parser *p)
         p->cam_t_line = p->l.no;
         return OM_OK;
     }
-    if ((st = read_params(p, what, keylight_params, NP(keylight_params), pl)) != OM_OK) return st;
+    if ((st = om__parse_params(p, what, keylight_params, NP(keylight_params), pl)) != OM_OK) return st;
     int form;
     om_light_key k;
     memset(&k, 0, sizeof k);
     k.t = tf;
     if (pl[P_DIR].has) {
         if (pl[P_POS].has || pl[P_TARGET].has)
-            return fail(p, OM_E_PARSE, pl[P_DIR].col,
+            return om__parse_fail(p, OM_E_PARSE, pl[P_DIR].col,
                         "a light key has either pos and target (spot) or dir (directional)", NULL,
                         0, NULL);
         form = 2;
         k.dir = pv3(&pl[P_DIR], 0);
         if (v3_zero(k.dir))
-            return fail(p, OM_E_RANGE, pl[P_DIR].vcol[0], "'dir' must not be zero", NULL, 0, NULL);
+            return om__parse_fail(p, OM_E_RANGE, pl[P_DIR].vcol[0], "'dir' must not be zero", NULL, 0, NULL);
     } else {
         if (!pl[P_POS].has || !pl[P_TARGET].has)
-            return missing(p, what, "pos X Y Z and target X Y Z, or dir X Y Z");
+            return om__parse_missing(p, what, "pos X Y Z and target X Y Z, or dir X Y Z");
         form = 1;
         k.pos = pv3(&pl[P_POS], 0);
         k.target = pv3(&pl[P_TARGET], 0);
         if (v3_eq(k.pos, k.target))
-            return fail(p, OM_E_RANGE, pl[P_TARGET].vcol[0], "light pos and target must differ",
+            return om__parse_fail(p, OM_E_RANGE, pl[P_TARGET].vcol[0], "light pos and target must differ",
                         NULL, 0, NULL);
         k.dir = om__normalize(om__sub(k.target, k.pos));
     }
     if (p->lkey_form && form != p->lkey_form) {
         char tmp[4];
-        om__str s = fail_begin(p, OM_E_PARSE, p->cmd.col, tmp, sizeof tmp);
+        om__str s = om__parse_fail_begin(p, OM_E_PARSE, p->cmd.col, tmp, sizeof tmp);
         om__str_s(&s, "light keys mix pos/target and dir (the first key, on line ");
         om__str_u(&s, p->lkey_line);
         om__str_s(&s, form == 1 ? ", uses dir)" : ", uses pos/target)");
@@ -915,7 +600,7 @@ static om_status run(parser *p)
     while (om__line_next(&p->l)) {
         om__tok t;
         int r = om__tok_next(&p->l, &t);
-        if (r < 0) return bad_byte(p, &t);
+        if (r < 0) return om__parse_bad_byte(p, &t);
         if (r == 0) continue;
         p->cmd = t;
         int cmd = -1;
@@ -928,7 +613,7 @@ static om_status run(parser *p)
         case C_KEY: st = do_key(p); break;
         case -1: {
             char tmp[4];
-            om__str s = fail_begin(p, OM_E_PARSE, t.col, tmp, sizeof tmp);
+            om__str s = om__parse_fail_begin(p, OM_E_PARSE, t.col, tmp, sizeof tmp);
             om__str_s(&s, "unknown command ");
             om__str_tok(&s, p->text + t.at, t.len);
             om__str_s(&s, " (expected ");
