@@ -195,6 +195,7 @@ typedef struct tess_ctx {
     om_raster r;
     uint32_t tri;
     double limit2;         /* squared longest warped edge; 0 = no tessellation */
+    double bend2;          /* squared RTW_BEND in [0, 1] units of the map */
     uint32_t drawn;
     uint32_t cap;          /* most triangles a frame may draw before splitting stops */
 } tess_ctx;
@@ -220,11 +221,19 @@ static tvert midpoint(const om__rtw *m, const tvert *a, const tvert *b)
 }
 
 /* Whether an edge is split depends on the edge alone (its two ends, symmetrically),
- * never on the triangle: neighbours make the same choice and the map has no cracks. */
-static bool too_long(const tess_ctx *x, const tvert *a, const tvert *b)
+ * never on the triangle: neighbours make the same choice and the map has no cracks.
+ * An edge is split when it is longer than the limit and the warp bends it: its warped
+ * midpoint (*mid, made here) lies off the straight line between its warped ends by more
+ * than RTW_BEND texels. Where the warp is straight along an edge (a region of even
+ * density, however magnified) splitting would move no texel, so it is not done. */
+#define RTW_BEND 0.25
+static bool too_long(const tess_ctx *x, const tvert *a, const tvert *b, tvert *mid)
 {
     double du = a->u - b->u, dv = a->v - b->v;
-    return du * du + dv * dv > x->limit2;
+    if (!(du * du + dv * dv > x->limit2)) return false;
+    *mid = midpoint(x->m, a, b);
+    double eu = mid->u - (a->u + b->u) * 0.5, ev = mid->v - (a->v + b->v) * 0.5;
+    return eu * eu + ev * ev > x->bend2;
 }
 
 static void emit(tess_ctx *x, const tvert *a, const tvert *b, const tvert *c)
@@ -255,29 +264,27 @@ static void emit(tess_ctx *x, const tvert *a, const tvert *b, const tvert *c)
 static void tess(tess_ctx *x, const tvert *a, const tvert *b, const tvert *c, int depth)
 {
     bool sab = false, sbc = false, sca = false;
+    tvert mab, mbc, mca;
     if (x->limit2 > 0.0 && depth < 40 && x->drawn < x->cap) {
-        sab = too_long(x, a, b);
-        sbc = too_long(x, b, c);
-        sca = too_long(x, c, a);
+        sab = too_long(x, a, b, &mab);
+        sbc = too_long(x, b, c, &mbc);
+        sca = too_long(x, c, a, &mca);
     }
     int n = (int)sab + (int)sbc + (int)sca;
     if (n == 0) { emit(x, a, b, c); return; }
     /* rotate so that the split edges come first: ab when one, ab and bc when two */
     if (n == 1) {
-        if (sbc) { const tvert *t = a; a = b; b = c; c = t; }
-        else if (sca) { const tvert *t = c; c = b; b = a; a = t; }
-        tvert mab = midpoint(x->m, a, b);
+        if (sbc) { const tvert *t = a; a = b; b = c; c = t; mab = mbc; }
+        else if (sca) { const tvert *t = c; c = b; b = a; a = t; mab = mca; }
         tess(x, a, &mab, c, depth + 1);
         tess(x, &mab, b, c, depth + 1);
     } else if (n == 2) {
-        if (!sab) { const tvert *t = a; a = b; b = c; c = t; }        /* bc, ca -> ab, bc */
-        else if (!sbc) { const tvert *t = c; c = b; b = a; a = t; }   /* ca, ab -> ab, bc */
-        tvert mab = midpoint(x->m, a, b), mbc = midpoint(x->m, b, c);
+        if (!sab) { const tvert *t = a; a = b; b = c; c = t; mab = mbc; mbc = mca; }   /* bc, ca -> ab, bc */
+        else if (!sbc) { const tvert *t = c; c = b; b = a; a = t; mbc = mab; mab = mca; }   /* ca, ab -> ab, bc */
         tess(x, &mab, b, &mbc, depth + 1);
         tess(x, a, &mab, &mbc, depth + 1);
         tess(x, a, &mbc, c, depth + 1);
     } else {
-        tvert mab = midpoint(x->m, a, b), mbc = midpoint(x->m, b, c), mca = midpoint(x->m, c, a);
         tess(x, a, &mab, &mca, depth + 1);
         tess(x, &mab, b, &mbc, depth + 1);
         tess(x, &mca, &mbc, c, depth + 1);
@@ -353,6 +360,7 @@ void om__rtw_render_map(om__rtw *m)
     x.r.frag = NULL;
     x.r.user = NULL;
     x.limit2 = m->limit * m->limit;
+    x.bend2 = (RTW_BEND / (double)m->size) * (RTW_BEND / (double)m->size);
     x.drawn = 0;
     {
         /* enough to cover the whole map 64 times over at the limit, and 64 per triangle */

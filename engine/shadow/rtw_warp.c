@@ -230,19 +230,22 @@ static void forward(om__rtw *m)
     const uint32_t n = m->n;
     const unsigned funcs = m->cfg.rtw_funcs;
     const bool hybrid = m->cfg.rtw_analysis == OM_RTW_HYBRID;
-    om_target tg = {n, n, 0, n, m->fdepth, m->fid};
-    om__scene_raster(m->scene, &m->view.light_vp, &tg, OM_RASTER_DEPTH_ID);
+    /* hybrid needs only the depths (for edges); forward also the triangle under a texel */
+    om_target tg = {n, n, 0, n, m->fdepth, hybrid ? NULL : m->fid};
+    om__scene_raster(m->scene, &m->view.light_vp, &tg, hybrid ? OM_RASTER_DEPTH : OM_RASTER_DEPTH_ID);
     om__persp_tri cache;
     memset(&cache, 0, sizeof cache);
     cache.tri = OM_NO_TRI;
     for (uint32_t j = 0; j < n; j++)
         for (uint32_t i = 0; i < n; i++) {
             size_t c = (size_t)j * n + i;
-            float edge = (funcs & OM_RTW_EDGE) && !is_edge(m, i, j) ? OM_RTW_ALPHA : 1.0f;
-            if (hybrid) {   /* desired view, distance, normal from the samples; edges here */
-                m->imp[c] *= edge;
+            if (hybrid) {
+                /* desired view, distance, normal from the samples; edges here, and only
+                 * where a sample asked for something (0 times alpha is 0) */
+                if ((funcs & OM_RTW_EDGE) && m->imp[c] > 0.0f && !is_edge(m, i, j)) m->imp[c] *= OM_RTW_ALPHA;
                 continue;
             }
+            float edge = (funcs & OM_RTW_EDGE) && !is_edge(m, i, j) ? OM_RTW_ALPHA : 1.0f;
             uint32_t t = m->fid[c];
             if (t == OM_NO_TRI) { m->imp[c] = 0.0f; continue; }
             if (cache.tri != t) om__persp_setup(m->scene, &m->view.light_vp, t, &cache);
