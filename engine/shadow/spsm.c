@@ -36,6 +36,16 @@
 #define LIT_CAP (64.0 * STEP)    /* a plane known this loosely proves nothing lit */
 #define PAT_CAP (16.0 * STEP)    /* the pattern's tests use at most this much slack */
 
+/* A texel's record decoded around the sample's texel: grid coordinates relative to
+ * the centre of the sample's texel, plane in raw depth per grid unit. */
+typedef struct dtri {
+    bool empty, ok;              /* ok: a 2-D triangle with area */
+    om__tri2 e;
+    int64_t rx[3], ry[3];        /* the vertices as decoded (e holds them reordered) */
+    int64_t cx, cy;              /* this texel's centre */
+    double z, gx, gy, ex, ey;    /* centre depth, slopes and their error bounds */
+} dtri;
+
 typedef struct spsm_state {
     const om_scene *scene;
     om_method_cfg cfg;
@@ -49,6 +59,12 @@ typedef struct spsm_state {
     /* per frame */
     uint32_t samples, lit, shadowed, uncertain, recovered;
     int last;                    /* how the last sample was decided (enum path) */
+    /* The lookup's 3x3 of decoded texels. Consecutive samples mostly fall in the same
+     * texel, so t[4] (the sample's own texel, which depends on nothing but the map and
+     * its index) is kept from one sample to the next while `t4_at` names it; the build
+     * forgets it. The others are scratch. */
+    dtri t[9];
+    size_t t4_at;
 } spsm_state;
 
 static bool size_ok(const om_method_cfg *c) { return c->map_size >= 1 && c->map_size <= OM_MAX_DIM; }
@@ -95,6 +111,7 @@ static om_status spsm_init(void **state, om_arena *a, const om_method_cfg *c, co
     m->depth = (uint32_t *)p;
     if ((st = om_arena_alloc(a, n * sizeof(uint32_t), 16, &p, d))) return st;
     m->cdepth = (uint32_t *)p;
+    m->t4_at = (size_t)-1;
     om__spsm_qtable_build(&m->q);
     om__spsm_tangent_build(m->lut);
     *state = m;
@@ -160,6 +177,7 @@ static om_status spsm_build(void *state, om_diag *d)
     spsm_state *m = (spsm_state *)state;
     const om_scene *s = m->scene;
     size_t n = (size_t)m->size * m->size;
+    m->t4_at = (size_t)-1;   /* no texel index: the map is about to change */
     /* the plain map at texel centres, for the fallback of 4.2: the engine's own pass */
     om_target tc = {m->size, m->size, 0, m->size, m->cdepth, NULL};
     om__scene_raster(s, &m->view.light_vp, &tc, OM_RASTER_DEPTH);
@@ -185,15 +203,6 @@ static om_status spsm_build(void *state, om_diag *d)
 
 /* ---------------------------------------------------------------- lookup (4) */
 
-/* A texel's record decoded around the sample's texel: grid coordinates relative to
- * the centre of the sample's texel, plane in raw depth per grid unit. */
-typedef struct dtri {
-    bool empty, ok;              /* ok: a 2-D triangle with area */
-    om__tri2 e;
-    int64_t rx[3], ry[3];        /* the vertices as decoded (e holds them reordered) */
-    int64_t cx, cy;              /* this texel's centre */
-    double z, gx, gy, ex, ey;    /* centre depth, slopes and their error bounds */
-} dtri;
 
 /* Decodes texel k of the 3x3 (k = (dy + 1) * 3 + dx + 1) into t[k]. Neighbours often
  * hold the same triangle: its edge setup is then copied from one decoded before
@@ -515,8 +524,9 @@ static uint8_t lookup(spsm_state *m, const om_strip *st, size_t i)
      * accept a stored triangle that does not cover the sample but lies in its plane
      * (the other half of a floor quad): it too was the nearest thing in the texel.
      * That halves the uncertain samples at no measured cost in accuracy. */
-    dtri t[9];
-    decode(m, tx, ty, t, 4);
+    dtri *t = m->t;
+    size_t at = (size_t)ty * m->size + (size_t)tx;
+    if (at != m->t4_at) { decode(m, tx, ty, t, 4); m->t4_at = at; }
     if (t[4].empty) { m->lit++; return 255; }
     if (t[4].ok) {
         double z = plane_at(&t[4], px, py), tol = tol_at(&t[4], px, py);
