@@ -140,6 +140,12 @@ typedef struct build_ctx {
     double zx, zy;               /* the plane whose codes are cached */
     uint8_t qx, qy;
     bool have;
+    /* the y codes of the row being filled, for the triangle with these y coordinates:
+     * the fill runs along rows, so most texels written reuse them */
+    int64_t ry[3];
+    int32_t row;
+    bool have_row;
+    uint16_t vy[3];
 } build_ctx;
 
 static void frag(void *user, int32_t x, int32_t y, const om__rtri *t)
@@ -168,7 +174,13 @@ static void frag(void *user, int32_t x, int32_t y, const om__rtri *t)
         b->zy = t->zy;
         b->have = true;
     }
-    om__spsm_pack(&m->tex[i], t, x, y, b->qx, b->qy);
+    if (!b->have_row || y != b->row || memcmp(b->ry, e->y, sizeof b->ry)) {
+        om__spsm_row_codes(b->vy, t, y);
+        memcpy(b->ry, e->y, sizeof b->ry);
+        b->row = y;
+        b->have_row = true;
+    }
+    om__spsm_pack_row(&m->tex[i], t, x, y, b->qx, b->qy, b->vy);
 }
 
 static om_status spsm_build(void *state, om_diag *d)

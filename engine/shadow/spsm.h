@@ -73,4 +73,11 @@ void om__spsm_tangent_build(om__spsm_tangent lut[512]);
 void om__spsm_pack(om__spsm_texel *out, const om__rtri *t, int32_t x, int32_t y, uint8_t qx,
                    uint8_t qy);
 
+/* The same in two parts, for the build: the vertices' y codes depend only on the
+ * triangle and the texel row, so a run of texels along a row encodes them once
+ * (om__spsm_row_codes) and packs each texel with them (om__spsm_pack_row). */
+void om__spsm_row_codes(uint16_t vy[3], const om__rtri *t, int32_t y);
+void om__spsm_pack_row(om__spsm_texel *out, const om__rtri *t, int32_t x, int32_t y, uint8_t qx,
+                       uint8_t qy, const uint16_t vy[3]);
+
 #endif

@@ -152,14 +152,20 @@ void om__spsm_tangent_build(om__spsm_tangent lut[512])
 
 /* ---- packing (section 3.3, Figure 4) */
 
-void om__spsm_pack(om__spsm_texel *out, const om__rtri *t, int32_t x, int32_t y, uint8_t qx,
-                   uint8_t qy)
+void om__spsm_row_codes(uint16_t vy[3], const om__rtri *t, int32_t y)
+{
+    const int64_t cy = (int64_t)y * OM_SUBPIX + OM_SUBPIX / 2;
+    for (int i = 0; i < 3; i++) vy[i] = om__spsm_o16_encode(t->e.y[i] - cy);
+}
+
+void om__spsm_pack_row(om__spsm_texel *out, const om__rtri *t, int32_t x, int32_t y, uint8_t qx,
+                       uint8_t qy, const uint16_t vy[3])
 {
     const om__tri2 *e = &t->e;
     const int64_t cx = (int64_t)x * OM_SUBPIX + OM_SUBPIX / 2, cy = (int64_t)y * OM_SUBPIX + OM_SUBPIX / 2;
     for (int i = 0; i < 3; i++) {
         out->vx[i] = om__spsm_o16_encode(e->x[i] - cx);
-        out->vy[i] = om__spsm_o16_encode(e->y[i] - cy);
+        out->vy[i] = vy[i];
     }
     /* The plane at the centre, not clamped to the triangle's depth range: the lookup
      * extrapolates from here with the derivatives (Equation 1). */
@@ -168,4 +174,12 @@ void om__spsm_pack(om__spsm_texel *out, const om__rtri *t, int32_t x, int32_t y,
     out->z = (uint16_t)(s >= 0.0 ? (s > 65535.0 ? 65535.0 : s) : 0.0);   /* NaN: 0 */
     out->qx = qx;
     out->qy = qy;
+}
+
+void om__spsm_pack(om__spsm_texel *out, const om__rtri *t, int32_t x, int32_t y, uint8_t qx,
+                   uint8_t qy)
+{
+    uint16_t vy[3];
+    om__spsm_row_codes(vy, t, y);
+    om__spsm_pack_row(out, t, x, y, qx, qy, vy);
 }
