@@ -368,6 +368,7 @@ static void boundary_build(boundary *b, const dtri *const occ[9], int nocc)
             int64_t dx = b->x[j] - b->x[i], dy = b->y[j] - b->y[i];
             if (dx < 0) dx = -dx;
             if (dy < 0) dy = -dy;
+            if (b->piece[j] == b->piece[i]) continue;   /* joined already: nothing to test */
             if (!(tri_of[i] & tri_of[j])) {
                 if (dx > OM_SPSM_LINK || dy > OM_SPSM_LINK) continue;
                 /* one surface: i's triangle's plane, carried to j, meets j's triangle

@@ -152,10 +152,18 @@ void om__spsm_tangent_build(om__spsm_tangent lut[512])
 
 /* ---- packing (section 3.3, Figure 4) */
 
+/* om__spsm_o16_encode with its exact range (|v| < 2048, e = 0) done in line: the
+ * offsets of a small triangle's vertices from the texels it covers are mostly there. */
+static uint16_t enc(int64_t v)
+{
+    if (v > -2048 && v < 2048) return (uint16_t)(v < 0 ? 0x8000u | (unsigned)-v : (unsigned)v);
+    return om__spsm_o16_encode(v);
+}
+
 void om__spsm_row_codes(uint16_t vy[3], const om__rtri *t, int32_t y)
 {
     const int64_t cy = (int64_t)y * OM_SUBPIX + OM_SUBPIX / 2;
-    for (int i = 0; i < 3; i++) vy[i] = om__spsm_o16_encode(t->e.y[i] - cy);
+    for (int i = 0; i < 3; i++) vy[i] = enc(t->e.y[i] - cy);
 }
 
 void om__spsm_pack_row(om__spsm_texel *out, const om__rtri *t, int32_t x, int32_t y, uint8_t qx,
@@ -164,7 +172,7 @@ void om__spsm_pack_row(om__spsm_texel *out, const om__rtri *t, int32_t x, int32_
     const om__tri2 *e = &t->e;
     const int64_t cx = (int64_t)x * OM_SUBPIX + OM_SUBPIX / 2, cy = (int64_t)y * OM_SUBPIX + OM_SUBPIX / 2;
     for (int i = 0; i < 3; i++) {
-        out->vx[i] = om__spsm_o16_encode(e->x[i] - cx);
+        out->vx[i] = enc(e->x[i] - cx);
         out->vy[i] = vy[i];
     }
     /* The plane at the centre, not clamped to the triangle's depth range: the lookup
