@@ -44,6 +44,8 @@ typedef struct dtri {
     int64_t rx[3], ry[3];        /* the vertices as decoded (e holds them reordered) */
     int64_t cx, cy;              /* this texel's centre */
     double z, gx, gy, ex, ey;    /* centre depth, slopes and their error bounds */
+    double cmin;                 /* consistent_min, once computed (have_cmin) */
+    bool have_cmin;
 } dtri;
 
 typedef struct spsm_state {
@@ -60,11 +62,13 @@ typedef struct spsm_state {
     uint32_t samples, lit, shadowed, uncertain, recovered;
     int last;                    /* how the last sample was decided (enum path) */
     /* The lookup's 3x3 of decoded texels. Consecutive samples mostly fall in the same
-     * texel, so t[4] (the sample's own texel, which depends on nothing but the map and
-     * its index) is kept from one sample to the next while `t4_at` names it; the build
-     * forgets it. The others are scratch. */
+     * texel, and the 3x3 around it depends on nothing but the map and that texel's
+     * index, so it is kept from one sample to the next while `t4_at` names the texel:
+     * bit k of `t_have` says t[k] is decoded (always in k order, as decode's sharing
+     * of edge setups expects). The build forgets it. */
     dtri t[9];
     size_t t4_at;
+    uint32_t t_have;
 } spsm_state;
 
 static bool size_ok(const om_method_cfg *c) { return c->map_size >= 1 && c->map_size <= OM_MAX_DIM; }
@@ -112,6 +116,7 @@ static om_status spsm_init(void **state, om_arena *a, const om_method_cfg *c, co
     if ((st = om_arena_alloc(a, n * sizeof(uint32_t), 16, &p, d))) return st;
     m->cdepth = (uint32_t *)p;
     m->t4_at = (size_t)-1;
+    m->t_have = 0;
     om__spsm_qtable_build(&m->q);
     om__spsm_tangent_build(m->lut);
     *state = m;
@@ -258,6 +263,7 @@ static void decode(const spsm_state *m, int64_t tx, int64_t ty, dtri t[9], int k
     o->gy = m->q.dec[r->qy] * u;
     o->ex = m->q.err[r->qx] * u;
     o->ey = m->q.err[r->qy] * u;
+    o->have_cmin = false;
 }
 
 /* Equation 1: the stored plane at grid point (px, py), and what it cannot resolve. */
@@ -539,7 +545,7 @@ static uint8_t lookup(spsm_state *m, const om_strip *st, size_t i)
      * That halves the uncertain samples at no measured cost in accuracy. */
     dtri *t = m->t;
     size_t at = (size_t)ty * m->size + (size_t)tx;
-    if (at != m->t4_at) { decode(m, tx, ty, t, 4); m->t4_at = at; }
+    if (at != m->t4_at) { decode(m, tx, ty, t, 4); m->t4_at = at; m->t_have = 1u << 4; }
     if (t[4].empty) { m->lit++; return 255; }
     if (t[4].ok) {
         double z = plane_at(&t[4], px, py), tol = tol_at(&t[4], px, py);
@@ -550,7 +556,7 @@ static uint8_t lookup(spsm_state *m, const om_strip *st, size_t i)
     /* 4.1 shadowed: Algorithm 1 on the 3x3 neighbourhood */
     for (int k = 0; k < 9; k++) {
         if (k == 4) continue;
-        decode(m, tx, ty, t, k);
+        if (!((m->t_have >> k) & 1u)) { decode(m, tx, ty, t, k); m->t_have |= 1u << k; }
         if (hits(&t[k], px, py, p.z)) { m->shadowed++; m->last = P_NEAR; return 0; }
     }
 
@@ -570,7 +576,8 @@ static uint8_t lookup(spsm_state *m, const om_strip *st, size_t i)
         if (t[k].empty || !(plane_at(&t[k], px, py) < p.z - pat_tol(&t[k], px, py))) continue;
         if (!have_rp) { rp = receiver_plane(m, smp); have_rp = true; }
         if (t[k].ok && behind_receiver(&t[k], &rp, px, py)) continue;
-        if (consistent_min(&t[k]) < p.z - pat_tol(&t[k], t[k].cx, t[k].cy)) pat |= 1u << k;
+        if (!t[k].have_cmin) { t[k].cmin = consistent_min(&t[k]); t[k].have_cmin = true; }
+        if (t[k].cmin < p.z - pat_tol(&t[k], t[k].cx, t[k].cy)) pat |= 1u << k;
     }
     const om__spsm_tangent *tg = &m->lut[pat];
     const dtri *occ[9];
