@@ -227,7 +227,7 @@ static tvert midpoint(const om__rtw *m, const tvert *a, const tvert *b)
  * than RTW_BEND texels. Where the warp is straight along an edge (a region of even
  * density, however magnified) splitting would move no texel, so it is not done. */
 #define RTW_BEND 0.25
-static bool too_long(const tess_ctx *x, const tvert *a, const tvert *b, tvert *mid)
+static bool must_split(const tess_ctx *x, const tvert *a, const tvert *b, tvert *mid)
 {
     double du = a->u - b->u, dv = a->v - b->v;
     if (!(du * du + dv * dv > x->limit2)) return false;
@@ -266,9 +266,9 @@ static void tess(tess_ctx *x, const tvert *a, const tvert *b, const tvert *c, in
     bool sab = false, sbc = false, sca = false;
     tvert mab, mbc, mca;
     if (x->limit2 > 0.0 && depth < 40 && x->drawn < x->cap) {
-        sab = too_long(x, a, b, &mab);
-        sbc = too_long(x, b, c, &mbc);
-        sca = too_long(x, c, a, &mca);
+        sab = must_split(x, a, b, &mab);
+        sbc = must_split(x, b, c, &mbc);
+        sca = must_split(x, c, a, &mca);
     }
     int n = (int)sab + (int)sbc + (int)sca;
     if (n == 0) { emit(x, a, b, c); return; }

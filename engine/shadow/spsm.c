@@ -220,7 +220,6 @@ static om_status spsm_build(void *state, om_diag *d)
 
 /* ---------------------------------------------------------------- lookup (4) */
 
-
 /* Decodes texel k of the 3x3 (k = (dy + 1) * 3 + dx + 1) into t[k]. Neighbours often
  * hold the same triangle: its edge setup is then copied from one decoded before
  * (the centre first, then in k order). */

@@ -7,14 +7,11 @@
 
 /* ---- o16 vertex offsets (section 3.3; our choice of code, see spsm.h) */
 
-uint16_t om__spsm_o16_encode(int64_t v)
+/* The code of |v| >= 2048 (e > 0), apart so that the exact range below stays small
+ * enough to be inlined into the pack, which runs for every texel written. */
+static uint16_t o16_wide(uint16_t sign, uint64_t a)
 {
-    uint16_t sign = 0;
-    uint64_t a;
-    if (v < 0) { sign = 0x8000u; a = (uint64_t)(-(v + 1)) + 1u; }
-    else a = (uint64_t)v;
-    if (a < 2048u) return (uint16_t)(sign | a);
-    /* e = bit length of a - 11, found in five steps: this runs for every texel written */
+    /* e = bit length of a - 11, found in five steps */
     unsigned len = 1;
     uint64_t x = a;
     if (x >> 32) { x >>= 32; len += 32; }
@@ -29,6 +26,13 @@ uint16_t om__spsm_o16_encode(int64_t v)
     if (m >= 4096u) { m >>= 1; e++; }
     if (e > 15) return (uint16_t)(sign | (15u << 11) | 2047u);   /* saturate */
     return (uint16_t)(sign | (e << 11) | (unsigned)(m - 2048u));
+}
+
+uint16_t om__spsm_o16_encode(int64_t v)
+{
+    /* offsets of a small triangle's vertices from the texels it covers: mostly exact */
+    if (v > -2048 && v < 2048) return (uint16_t)(v < 0 ? 0x8000u | (unsigned)-v : (unsigned)v);
+    return v < 0 ? o16_wide(0x8000u, (uint64_t)(-(v + 1)) + 1u) : o16_wide(0, (uint64_t)v);
 }
 
 int64_t om__spsm_o16_decode(uint16_t c)
@@ -152,18 +156,10 @@ void om__spsm_tangent_build(om__spsm_tangent lut[512])
 
 /* ---- packing (section 3.3, Figure 4) */
 
-/* om__spsm_o16_encode with its exact range (|v| < 2048, e = 0) done in line: the
- * offsets of a small triangle's vertices from the texels it covers are mostly there. */
-static uint16_t enc(int64_t v)
-{
-    if (v > -2048 && v < 2048) return (uint16_t)(v < 0 ? 0x8000u | (unsigned)-v : (unsigned)v);
-    return om__spsm_o16_encode(v);
-}
-
 void om__spsm_row_codes(uint16_t vy[3], const om__rtri *t, int32_t y)
 {
     const int64_t cy = (int64_t)y * OM_SUBPIX + OM_SUBPIX / 2;
-    for (int i = 0; i < 3; i++) vy[i] = enc(t->e.y[i] - cy);
+    for (int i = 0; i < 3; i++) vy[i] = om__spsm_o16_encode(t->e.y[i] - cy);
 }
 
 void om__spsm_pack_row(om__spsm_texel *out, const om__rtri *t, int32_t x, int32_t y, uint8_t qx,
@@ -172,7 +168,7 @@ void om__spsm_pack_row(om__spsm_texel *out, const om__rtri *t, int32_t x, int32_
     const om__tri2 *e = &t->e;
     const int64_t cx = (int64_t)x * OM_SUBPIX + OM_SUBPIX / 2, cy = (int64_t)y * OM_SUBPIX + OM_SUBPIX / 2;
     for (int i = 0; i < 3; i++) {
-        out->vx[i] = enc(e->x[i] - cx);
+        out->vx[i] = om__spsm_o16_encode(e->x[i] - cx);
         out->vy[i] = vy[i];
     }
     /* The plane at the centre, not clamped to the triangle's depth range: the lookup

@@ -47,14 +47,17 @@ for c in $configs; do
 '
         continue
     fi
+    ok=true
+    $runner "$out/$name" >"$out/$name.txt" 2>&1 || ok=false
     # A kernel built without 32-bit support cannot exec the i386 build: run it under
     # qemu-user then, which gives the same bits (it emulates the SSE arithmetic).
-    if [ -z "$runner" ] && ! "$out/$name" >"$out/$name.txt" 2>&1 &&
-       grep -q "Exec format error" "$out/$name.txt" && command -v qemu-i386 >/dev/null 2>&1; then
+    if ! $ok && [ -z "$runner" ] && grep -q "Exec format error" "$out/$name.txt" &&
+       command -v qemu-i386 >/dev/null 2>&1; then
         echo "cross: $name: this kernel does not run it natively, so under qemu-i386"
-        runner=qemu-i386
+        ok=true
+        qemu-i386 "$out/$name" >"$out/$name.txt" 2>&1 || ok=false
     fi
-    if ! $runner "$out/$name" >"$out/$name.txt" 2>&1; then
+    if ! $ok; then
         echo "cross: FAIL $name exits non-zero: $(head -c 400 "$out/$name.txt")"
         fail=$((fail + 1))
     elif [ -z "$ref" ]; then
