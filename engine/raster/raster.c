@@ -201,32 +201,56 @@ static bool bounds(om__rtri *t, const om_target *tg, bool conservative)
     return true;
 }
 
+/* The texels of one row, [minx + *lo, minx + *hi], where every edge function (value
+ * E[i] at the row's first texel, growing by step[i] per texel) is >= 0: the same
+ * texels the per-texel test accepts, found by solving each edge for its crossing, so
+ * the fill visits only the span and not the whole bounding box. False: none. */
+static bool row_span(const int64_t E[3], const int64_t step[3], int64_t w, int64_t *lo,
+                     int64_t *hi)
+{
+    int64_t l = 0, h = w;
+    for (int i = 0; i < 3; i++) {
+        if (step[i] > 0) {
+            if (E[i] < 0) {
+                int64_t k = (-E[i] + step[i] - 1) / step[i];   /* first texel with E >= 0 */
+                if (k > l) l = k;
+            }
+        } else if (E[i] < 0) {
+            return false;                                   /* never rises to 0 */
+        } else if (step[i] < 0) {
+            int64_t k = E[i] / -step[i];                     /* last texel with E >= 0 */
+            if (k < h) h = k;
+        }
+    }
+    *lo = l;
+    *hi = h;
+    return l <= h;
+}
+
 static void fill(const om_raster *r, const om__rtri *t, uint32_t id)
 {
     const om_target *tg = r->target;
     const om__tri2 *e = &t->e;
     const int64_t S = OM_SUBPIX, H = OM_SUBPIX / 2;
-    const int64_t sa0 = e->a[0] * S, sa1 = e->a[1] * S, sa2 = e->a[2] * S;
+    const int64_t step[3] = {e->a[0] * S, e->a[1] * S, e->a[2] * S};
     const bool with_id = r->mode == OM_RASTER_DEPTH_ID;
     for (int32_t y = t->miny; y <= t->maxy; y++) {
-        int64_t py = (int64_t)y * S + H, px = (int64_t)t->minx * S + H;
-        int64_t e0 = om__tri2_edge(e, 0, px, py);
-        int64_t e1 = om__tri2_edge(e, 1, px, py);
-        int64_t e2 = om__tri2_edge(e, 2, px, py);
+        int64_t py = (int64_t)y * S + H, px0 = (int64_t)t->minx * S + H, lo, hi;
+        const int64_t E[3] = {om__tri2_edge(e, 0, px0, py), om__tri2_edge(e, 1, px0, py),
+                              om__tri2_edge(e, 2, px0, py)};
+        if (!row_span(E, step, t->maxx - t->minx, &lo, &hi)) continue;
         double ztail = t->zy * (double)(py - e->y[0]);
         size_t row = (size_t)(y - (int32_t)tg->y0) * tg->width;
         uint32_t *dep = tg->depth + row;
-        for (int32_t x = t->minx; x <= t->maxx; x++, px += S) {
-            if ((e0 | e1 | e2) >= 0) {
-                double z = (t->z0 + t->zx * (double)(px - e->x[0])) + ztail;
-                z = z < t->zmin ? t->zmin : z > t->zmax ? t->zmax : z;
-                uint32_t d = (uint32_t)z;
-                if (d < dep[x]) {
-                    dep[x] = d;
-                    if (with_id) tg->id[row + (size_t)x] = id;
-                }
+        for (int32_t x = t->minx + (int32_t)lo; x <= t->minx + (int32_t)hi; x++) {
+            int64_t px = (int64_t)x * S + H;
+            double z = (t->z0 + t->zx * (double)(px - e->x[0])) + ztail;
+            z = z < t->zmin ? t->zmin : z > t->zmax ? t->zmax : z;
+            uint32_t d = (uint32_t)z;
+            if (d < dep[x]) {
+                dep[x] = d;
+                if (with_id) tg->id[row + (size_t)x] = id;
             }
-            e0 += sa0; e1 += sa1; e2 += sa2;
         }
     }
 }
@@ -235,19 +259,18 @@ static void fill_conservative(const om_raster *r, const om__rtri *t)
 {
     const om__tri2 *e = &t->e;
     const int64_t S = OM_SUBPIX, H = OM_SUBPIX / 2;
+    const int64_t step[3] = {e->a[0] * S, e->a[1] * S, e->a[2] * S};
     /* Largest value of each edge function over a pixel square, relative to its centre. */
     int64_t reach[3];
     for (int i = 0; i < 3; i++)
         reach[i] = ((e->a[i] < 0 ? -e->a[i] : e->a[i]) + (e->b[i] < 0 ? -e->b[i] : e->b[i])) * H;
     for (int32_t y = t->miny; y <= t->maxy; y++) {
-        int64_t py = (int64_t)y * S + H;
-        for (int32_t x = t->minx; x <= t->maxx; x++) {
-            int64_t px = (int64_t)x * S + H;
-            if (om__tri2_edge(e, 0, px, py) + reach[0] >= 0 &&
-                om__tri2_edge(e, 1, px, py) + reach[1] >= 0 &&
-                om__tri2_edge(e, 2, px, py) + reach[2] >= 0)
-                r->frag(r->user, x, y, t);
-        }
+        int64_t py = (int64_t)y * S + H, px0 = (int64_t)t->minx * S + H, lo, hi;
+        const int64_t E[3] = {om__tri2_edge(e, 0, px0, py) + reach[0],
+                              om__tri2_edge(e, 1, px0, py) + reach[1],
+                              om__tri2_edge(e, 2, px0, py) + reach[2]};
+        if (!row_span(E, step, t->maxx - t->minx, &lo, &hi)) continue;
+        for (int32_t x = t->minx + (int32_t)lo; x <= t->minx + (int32_t)hi; x++) r->frag(r->user, x, y, t);
     }
 }
 
