@@ -48,6 +48,19 @@ typedef struct dtri {
     bool have_cmin;
 } dtri;
 
+/* The recovered silhouette of an uncertain sample (4.2; boundary_build below). */
+typedef struct boundary {
+    int nv;
+    int64_t x[MAXV], y[MAXV];
+    uint8_t piece[MAXV];
+    /* the pieces' hulls, counter-clockwise without collinear points, one after another:
+     * hull h has the vertices [hoff[h], hoff[h + 1]) of hx, hy; pieces with no area
+     * (a point, a segment) have none */
+    int nh;
+    uint8_t hoff[MAXV + 1];
+    int64_t hx[MAXV], hy[MAXV];
+} boundary;
+
 typedef struct spsm_state {
     const om_scene *scene;
     om_method_cfg cfg;
@@ -69,6 +82,13 @@ typedef struct spsm_state {
     dtri t[9];
     size_t t4_at;
     uint32_t t_have;
+    /* The recovery's occluders (pointers into t) and outline for the pattern `bd_keep`
+     * of the texel t4_at, while bd_have. */
+    const dtri *occ[9];
+    int nocc;
+    boundary bd;
+    uint16_t bd_keep;
+    bool bd_have;
 } spsm_state;
 
 static bool size_ok(const om_method_cfg *c) { return c->map_size >= 1 && c->map_size <= OM_MAX_DIM; }
@@ -117,6 +137,7 @@ static om_status spsm_init(void **state, om_arena *a, const om_method_cfg *c, co
     m->cdepth = (uint32_t *)p;
     m->t4_at = (size_t)-1;
     m->t_have = 0;
+    m->bd_have = false;
     om__spsm_qtable_build(&m->q);
     om__spsm_tangent_build(m->lut);
     *state = m;
@@ -195,6 +216,7 @@ static om_status spsm_build(void *state, om_diag *d)
     const om_scene *s = m->scene;
     size_t n = (size_t)m->size * m->size;
     m->t4_at = (size_t)-1;   /* no texel index: the map is about to change */
+    m->bd_have = false;
     /* the plain map at texel centres, for the fallback of 4.2: the engine's own pass */
     om_target tc = {m->size, m->size, 0, m->size, m->cdepth, NULL};
     om__scene_raster(s, &m->view.light_vp, &tc, OM_RASTER_DEPTH);
@@ -330,7 +352,7 @@ static double consistent_min(const dtri *t)
     return zmin;
 }
 
-/* The recovered silhouette (section 4.2, Figure 10), built once per uncertain sample so
+/* The recovered silhouette (section 4.2, Figure 10), built once per texel and pattern so
  * that AA sub-samples reuse it (section 5). Its points are the vertices of the
  * occluders the pattern keeps. Two are linked when they belong to one stored triangle,
  * or lie within OM_SPSM_LINK of each other on one smooth surface (the plane of one's
@@ -342,17 +364,60 @@ static double consistent_min(const dtri *t)
  * tangent into phi and shadows everything beyond it, the hull also closes the piece
  * on its far side, so two thin occluders a texel or more apart (a fence) do not shadow
  * the gap between them (see README: the one-sided phi measured worse). */
-typedef struct boundary {
-    int nv;
-    int64_t x[MAXV], y[MAXV];
-    uint8_t piece[MAXV];
-} boundary;
 
 static int lowbit(uint32_t m)
 {
     int k = 0;
     while (!((m >> k) & 1u)) k++;
     return k;
+}
+
+/* Twice the signed area of (o, a, b): > 0 when b lies left of o -> a. Exact: offsets
+ * stay below 2^27 (the o16 range), so the products stay below 2^55. */
+static int64_t turn(int64_t ox, int64_t oy, int64_t ax, int64_t ay, int64_t bx, int64_t by)
+{
+    return (ax - ox) * (by - oy) - (ay - oy) * (bx - ox);
+}
+
+/* Each piece's convex hull (Andrew's monotone chain on its points sorted by x, then
+ * y), built once per boundary so that every test point costs one pass over it. */
+static void hulls_build(boundary *b)
+{
+    b->nh = 0;
+    b->hoff[0] = 0;
+    int used = 0;
+    for (int pc = 0; pc < b->nv; pc++) {
+        if (b->piece[pc] != pc) continue;   /* a piece is labelled by its first vertex */
+        int64_t px[MAXV], py[MAXV];
+        int n = 0;
+        for (int i = 0; i < b->nv; i++) {
+            if (b->piece[i] != pc) continue;
+            int j = n++;
+            for (; j > 0 && (px[j - 1] > b->x[i] || (px[j - 1] == b->x[i] && py[j - 1] > b->y[i])); j--) {
+                px[j] = px[j - 1];
+                py[j] = py[j - 1];
+            }
+            px[j] = b->x[i];
+            py[j] = b->y[i];
+        }
+        if (n < 3) continue;
+        int64_t *hx = b->hx + used, *hy = b->hy + used;
+        int64_t cx[2 * MAXV], cy[2 * MAXV];   /* the chain; its last point repeats the first */
+        int k = 0;
+        for (int i = 0; i < n; i++) {         /* lower chain */
+            while (k >= 2 && turn(cx[k - 2], cy[k - 2], cx[k - 1], cy[k - 1], px[i], py[i]) <= 0) k--;
+            cx[k] = px[i]; cy[k] = py[i]; k++;
+        }
+        for (int i = n - 2, lo = k + 1; i >= 0; i--) {   /* upper chain */
+            while (k >= lo && turn(cx[k - 2], cy[k - 2], cx[k - 1], cy[k - 1], px[i], py[i]) <= 0) k--;
+            cx[k] = px[i]; cy[k] = py[i]; k++;
+        }
+        if (k - 1 < 3) continue;               /* all on one line: no inside */
+        for (int i = 0; i < k - 1; i++) { hx[i] = cx[i]; hy[i] = cy[i]; }
+        used += k - 1;
+        b->nh++;
+        b->hoff[b->nh] = (uint8_t)used;
+    }
 }
 
 static void boundary_build(boundary *b, const dtri *const occ[9], int nocc)
@@ -388,30 +453,20 @@ static void boundary_build(boundary *b, const dtri *const occ[9], int nocc)
             for (int k = 0; k < b->nv; k++)
                 if (b->piece[k] == from) b->piece[k] = to;
         }
+    hulls_build(b);
 }
 
-/* Strictly inside the hull of one piece: every line through the point and a vertex of
- * the piece has vertices of the piece strictly on both sides. Exact: offsets stay
- * below 2^27 (the o16 range), so the cross products stay below 2^55. */
+/* Strictly inside the hull of one piece: strictly left of each of its edges. */
 static bool inside_hull(const boundary *b, int64_t px, int64_t py)
 {
-    for (int pc = 0; pc < b->nv; pc++) {
-        if (b->piece[pc] != pc) continue;   /* a piece is labelled by its first vertex */
-        bool any = false, ok = true;
-        for (int i = 0; i < b->nv && ok; i++) {
-            if (b->piece[i] != pc) continue;
-            any = true;
-            int64_t ax = b->x[i] - px, ay = b->y[i] - py;
-            bool pos = false, neg = false;
-            for (int j = 0; j < b->nv; j++) {
-                if (b->piece[j] != pc) continue;
-                int64_t c = ax * (b->y[j] - py) - ay * (b->x[j] - px);
-                pos |= c > 0;
-                neg |= c < 0;
-            }
-            ok = pos && neg;
+    for (int h = 0; h < b->nh; h++) {
+        int a = b->hoff[h], e = b->hoff[h + 1];
+        bool in = true;
+        for (int i = a; i < e && in; i++) {
+            int j = i + 1 == e ? a : i + 1;
+            in = turn(b->hx[i], b->hy[i], b->hx[j], b->hy[j], px, py) > 0;
         }
-        if (any && ok) return true;
+        if (in) return true;
     }
     return false;
 }
@@ -544,7 +599,12 @@ static uint8_t lookup(spsm_state *m, const om_strip *st, size_t i)
      * That halves the uncertain samples at no measured cost in accuracy. */
     dtri *t = m->t;
     size_t at = (size_t)ty * m->size + (size_t)tx;
-    if (at != m->t4_at) { decode(m, tx, ty, t, 4); m->t4_at = at; m->t_have = 1u << 4; }
+    if (at != m->t4_at) {
+        decode(m, tx, ty, t, 4);
+        m->t4_at = at;
+        m->t_have = 1u << 4;
+        m->bd_have = false;
+    }
     if (t[4].empty) { m->lit++; return 255; }
     if (t[4].ok) {
         double z = plane_at(&t[4], px, py), tol = tol_at(&t[4], px, py);
@@ -579,19 +639,27 @@ static uint8_t lookup(spsm_state *m, const om_strip *st, size_t i)
         if (t[k].cmin < p.z - pat_tol(&t[k], t[k].cx, t[k].cy)) pat |= 1u << k;
     }
     const om__spsm_tangent *tg = &m->lut[pat];
-    const dtri *occ[9];
-    int nocc = 0;
-    for (int k = 0; k < 9; k++) {
-        if (!((tg->keep >> k) & 1u) || !t[k].ok) continue;
-        bool dup = false;   /* neighbours often hold the same triangle */
-        for (int j = 0; j < nocc && !dup; j++)
-            dup = !memcmp(occ[j]->e.x, t[k].e.x, sizeof t[k].e.x) &&
-                  !memcmp(occ[j]->e.y, t[k].e.y, sizeof t[k].e.y);
-        if (!dup) occ[nocc++] = &t[k];
+    /* The occluders the pattern keeps and their outline depend on nothing but the texel
+     * and `keep`: the next uncertain sample in this texel with the same pattern reuses
+     * them. */
+    if (!m->bd_have || m->bd_keep != tg->keep) {
+        m->nocc = 0;
+        for (int k = 0; k < 9; k++) {
+            if (!((tg->keep >> k) & 1u) || !t[k].ok) continue;
+            bool dup = false;   /* neighbours often hold the same triangle */
+            for (int j = 0; j < m->nocc && !dup; j++)
+                dup = !memcmp(m->occ[j]->e.x, t[k].e.x, sizeof t[k].e.x) &&
+                      !memcmp(m->occ[j]->e.y, t[k].e.y, sizeof t[k].e.y);
+            if (!dup) m->occ[m->nocc++] = &t[k];
+        }
+        m->bd.nv = m->bd.nh = 0;
+        if (m->nocc > 1) boundary_build(&m->bd, m->occ, m->nocc);   /* one triangle's hull is itself */
+        m->bd_keep = tg->keep;
+        m->bd_have = true;
     }
-    boundary bd;
-    bd.nv = 0;
-    if (nocc > 1) boundary_build(&bd, occ, nocc);   /* one triangle's hull is itself */
+    const dtri *const *occ = m->occ;
+    const int nocc = m->nocc;
+    const boundary *bd = &m->bd;
 
     /* The decision at one point of the pixel. */
     uint32_t K = m->cfg.spsm_aa > 1 ? m->cfg.spsm_aa : 1, nlit = 0;
@@ -614,7 +682,7 @@ static uint8_t lookup(spsm_state *m, const om_strip *st, size_t i)
         }
         bool shadow = false;
         for (int k = 0; k < nocc && !shadow; k++) shadow = hits(occ[k], qx, qy, q.z);
-        if (!shadow && bd.nv) shadow = inside_hull(&bd, qx, qy);
+        if (!shadow && bd->nh) shadow = inside_hull(bd, qx, qy);
         if (!shadow && tg->keep == 511) shadow = centre_test(m, &rp, tx, ty, px, py);   /* rp set */
         nlit += !shadow;
     }
