@@ -274,6 +274,19 @@ static void fill_conservative(const om_raster *r, const om__rtri *t)
     }
 }
 
+bool om__raster_snapped(const om_raster *r, const int64_t x[3], const int64_t y[3], const double z[3],
+                        uint32_t id)
+{
+    const bool cons = r->mode == OM_RASTER_CONSERVATIVE;
+    om__rtri t;
+    if (!om__tri2_setup(&t.e, x, y, !cons)) return false;
+    if (!bounds(&t, r->target, cons)) return false;
+    om__rtri_plane(&t, z);
+    if (cons) fill_conservative(r, &t);
+    else fill(r, &t, id);
+    return true;
+}
+
 int om__raster_tri(const om_raster *r, const om_vec4 clip[3], uint32_t id)
 {
     const om_target *tg = r->target;
@@ -284,18 +297,11 @@ int om__raster_tri(const om_raster *r, const om_vec4 clip[3], uint32_t id)
             !om__finite(clip[i].w))
             return 0;
     int n = om__clip_project(clip, tg->width, tg->height, gx, gy, gz);
-    const bool cons = r->mode == OM_RASTER_CONSERVATIVE;
     int filled = 0;
     for (int k = 1; k + 1 < n; k++) {
         int64_t tx[3] = {gx[0], gx[k], gx[k + 1]}, ty[3] = {gy[0], gy[k], gy[k + 1]};
         double tz[3] = {gz[0], gz[k], gz[k + 1]};
-        om__rtri t;
-        if (!om__tri2_setup(&t.e, tx, ty, !cons)) continue;
-        if (!bounds(&t, tg, cons)) continue;
-        om__rtri_plane(&t, tz);
-        if (cons) fill_conservative(r, &t);
-        else fill(r, &t, id);
-        filled++;
+        filled += om__raster_snapped(r, tx, ty, tz, id);
     }
     return filled;
 }

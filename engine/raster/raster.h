@@ -111,6 +111,12 @@ typedef struct om_raster {
  * are rejected: they cover nothing. Returns the number of sub-triangles filled. */
 int om__raster_tri(const om_raster *r, const om_vec4 clip[3], uint32_t id);
 
+/* Rasterizes one triangle already on the sub-pixel grid (coordinates within the
+ * guard band, OM_TRI2_MAX_COORD) with depths z/w * 2^32: what om__raster_tri does
+ * after clipping, for a caller that places vertices itself. False: nothing to fill. */
+bool om__raster_snapped(const om_raster *r, const int64_t x[3], const int64_t y[3], const double z[3],
+                        uint32_t id);
+
 /* Which of the six clip planes (near, far, four guard-band sides) a vertex is outside
  * of, as a bit mask; 0 means it needs no clipping. */
 unsigned om__outcode(const om_vec4 *v, uint32_t width, uint32_t height);

@@ -238,18 +238,22 @@ static bool must_split(const tess_ctx *x, const tvert *a, const tvert *b, tvert 
 
 static void emit(tess_ctx *x, const tvert *a, const tvert *b, const tvert *c)
 {
-    /* Back to clip coordinates with the warped x/w and y/w and the same z and w, so
-     * the depth stays z/w (section 4.3; the lead's note on warping after the divide). */
+    /* Straight onto the map's sub-texel grid: the warped x/w and y/w are u and v, the
+     * depth stays z/w (section 4.3; the lead's note on warping after the divide). The
+     * triangle is clipped already (clip_tri), so the rasterizer's clipping is skipped. */
     const tvert *t[3] = {a, b, c};
-    om_vec4 o[3];
+    const double s = (double)x->m->size * OM_SUBPIX, lim = (double)(1ll << 26);
+    int64_t gx[3], gy[3];
+    double gz[3];
     for (int k = 0; k < 3; k++) {
-        double w = (double)t[k]->c.w;
-        o[k].x = (float)((2.0 * t[k]->u - 1.0) * w);
-        o[k].y = (float)((1.0 - 2.0 * t[k]->v) * w);
-        o[k].z = t[k]->c.z;
-        o[k].w = t[k]->c.w;
+        double X = floor(t[k]->u * s + 0.5), Y = floor(t[k]->v * s + 0.5);
+        double Z = (double)t[k]->c.z * (1.0 / (double)t[k]->c.w) * 4294967296.0;
+        if (!(X > -lim && X < lim && Y > -lim && Y < lim)) return;
+        gx[k] = (int64_t)X;
+        gy[k] = (int64_t)Y;
+        gz[k] = Z < 0.0 ? 0.0 : Z > 4294967295.0 ? 4294967295.0 : Z;
     }
-    om__raster_tri(&x->r, o, x->tri);
+    om__raster_snapped(&x->r, gx, gy, gz, x->tri);
     x->drawn++;
 }
 
