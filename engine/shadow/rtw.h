@@ -98,7 +98,8 @@ void om__rtw_importance_finish(om__rtw *m);
 /* The 1-D tables of this frame's importance map: collapse, blur, warp (section 4.2). */
 void om__rtw_build_tables(om__rtw *m);
 
-/* Gives the method a clock for its per-stage times (stats counters in microseconds). */
+/* Gives the method a clock for its per-stage times (stats counters 4-7, in
+ * microseconds; without a clock the stats stop at counter 3). */
 void om__rtw_set_clock(void *state, om_clock_fn clock, void *user);
 
 /* Renders the warped shadow map of this frame's tables (rtw.c; called by build). */
