@@ -46,6 +46,8 @@ typedef struct dtri {
     double z, gx, gy, ex, ey;    /* centre depth, slopes and their error bounds */
     double cmin;                 /* consistent_min, once computed (have_cmin) */
     bool have_cmin;
+    double vz[3], vtol[3];       /* plane and pat_tol at the vertices e.x, e.y (have_vz) */
+    bool have_vz;
 } dtri;
 
 /* The recovered silhouette of an uncertain sample (4.2; boundary_build below). */
@@ -285,6 +287,7 @@ static void decode(const spsm_state *m, int64_t tx, int64_t ty, dtri t[9], int k
     o->ex = m->q.err[r->qx] * u;
     o->ey = m->q.err[r->qy] * u;
     o->have_cmin = false;
+    o->have_vz = false;
 }
 
 /* Equation 1: the stored plane at grid point (px, py), and what it cannot resolve. */
@@ -524,13 +527,19 @@ static receiver receiver_plane(const spsm_state *m, const om_sample *smp)
 /* A stored triangle lying wholly on or behind the sample's own plane (seen from the
  * light) cannot block it: the way to the light leaves on the plane's front side. On a
  * curved receiver its neighbouring triangles are such. */
-static bool behind_receiver(const dtri *t, const receiver *r, int64_t px, int64_t py)
+static bool behind_receiver(dtri *t, const receiver *r, int64_t px, int64_t py)
 {
     if (!r->ok) return false;
+    if (!t->have_vz) {   /* the texel's own part, the same for every sample */
+        for (int i = 0; i < 3; i++) {
+            t->vz[i] = plane_at(t, t->e.x[i], t->e.y[i]);
+            t->vtol[i] = pat_tol(t, t->e.x[i], t->e.y[i]);
+        }
+        t->have_vz = true;
+    }
     for (int i = 0; i < 3; i++) {
-        int64_t vx = t->e.x[i], vy = t->e.y[i];
-        double zr = r->z + r->gx * (double)(vx - px) + r->gy * (double)(vy - py);
-        if (plane_at(t, vx, vy) < zr - pat_tol(t, vx, vy)) return false;
+        double zr = r->z + r->gx * (double)(t->e.x[i] - px) + r->gy * (double)(t->e.y[i] - py);
+        if (t->vz[i] < zr - t->vtol[i]) return false;
     }
     return true;
 }
