@@ -1,7 +1,8 @@
 /* test_raster.c — the fixed-point rasterizer: hand-checked masks, both windings, the
  * top-left rule, watertightness of shared edges (fans, grids, random triangulations,
  * sub-pixel vertices), clipping at the near and far planes, coordinates that would
- * overflow 32-bit setup, conservative coverage, and the point-in-triangle test. */
+ * overflow 32-bit setup, conservative coverage, the point-in-triangle test, and the
+ * entry for triangles already on the grid. */
 #include "test.h"
 #include "../engine/raster/raster.h"
 #include "../engine/core/core.h"
@@ -372,6 +373,36 @@ static void covers_matches_fill(void)
     CHECK(!om__tri2_setup(&ta, big, ay, true));
 }
 
+/* om__raster_snapped is what om__raster_tri does once a triangle is on the grid: the
+ * same depths and ids for triangles given either way (partly off the image too). */
+static void snapped_matches_clipped(void)
+{
+    static uint32_t d0[TW * TH], i0[TW * TH];
+    rng_state = 123;
+    int bad = 0;
+    for (int k = 0; k < 300; k++) {
+        int64_t x[3], y[3];
+        double z[3];
+        om_vec4 c[3];
+        for (int i = 0; i < 3; i++) {
+            x[i] = (int64_t)(rnd() % (2 * TW * 256)) - TW * 128;
+            y[i] = (int64_t)(rnd() % (2 * TH * 256)) - TH * 128;
+            c[i] = at((double)x[i], (double)y[i], TW, TH, (float)(rnd() % 1000) / 1000.0f);
+            z[i] = (double)c[i].z * 4294967296.0;
+        }
+        om_target t = target(TW, TH);
+        om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL};
+        om__target_clear(&t);
+        om__raster_tri(&r, c, 5);
+        memcpy(d0, depth_buf, sizeof d0);
+        memcpy(i0, id_buf, sizeof i0);
+        om__target_clear(&t);
+        om__raster_snapped(&r, x, y, z, 5);
+        bad += memcmp(d0, depth_buf, sizeof d0) != 0 || memcmp(i0, id_buf, sizeof i0) != 0;
+    }
+    CHECK_EQ_U(bad, 0);
+}
+
 typedef struct cons_ctx { int *count; uint32_t w; } cons_ctx;
 static void cons_frag(void *user, int32_t x, int32_t y, const om__rtri *t)
 {
@@ -453,6 +484,7 @@ void suite_raster(void)
     RUN(clipping_near_far);
     RUN(overflow_cases);
     RUN(covers_matches_fill);
+    RUN(snapped_matches_clipped);
     RUN(conservative_superset);
     RUN(strips_match_whole);
 }
