@@ -5,6 +5,8 @@
 #define OM_SUITES \
     X(suite_core) \
     X(suite_scene) \
+    X(suite_obj) \
+    X(suite_scene_fuzz) \
     X(suite_raster) \
     X(suite_frame) \
     X(suite_platform) \

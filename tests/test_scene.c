@@ -1,62 +1,16 @@
-/* test_scene.c — the scene text format, procedural shapes, OBJ meshes and paths:
- * values and defaults as parsed, exact byte queries, closed outward-wound shapes,
- * errors with the right status, line and column, meshes through a loader, om_scene_at,
- * the default scene, and random mutations of it that must never crash. */
+/* test_scene.c — the scene text format, procedural shapes and paths: values and
+ * defaults as parsed, exact byte queries, closed outward-wound shapes, errors with the
+ * right status, line and column, om_scene_at and the default scene. OBJ meshes are in
+ * test_obj.c, random mutations in test_scene_fuzz.c, shared helpers in scene_util.c. */
 #include "test.h"
-#include "../engine/scene/scene.h"
+#include "scene_util.h"
 
 #include <math.h>
 #include <stdlib.h>
 
 /* ---------------------------------------------------------------- helpers */
 
-typedef struct parsed {
-    om_scene s;
-    void *mem;
-    size_t bytes;
-    om_diag d;
-    om_status st;
-} parsed;
-
-/* The text in a heap block of exactly its length, no NUL after it: under ASan any read
- * past `len` is caught. */
-static char *exact_copy(const char *text, size_t len)
-{
-    char *c = (char *)malloc(len ? len : 1);
-    if (len) memcpy(c, text, len);
-    return c;
-}
-
-/* Bytes query, then a parse into a heap buffer of exactly that many bytes (so ASan
- * sees any write past it); checks that the arena ends exactly full. */
-static om_status parse_ld(const char *text, size_t len, const om_loader *ld, parsed *p)
-{
-    memset(p, 0, sizeof *p);
-    char *t = text ? exact_copy(text, len) : NULL;
-    p->st = om_scene_bytes(t, len, ld, &p->bytes, &p->d);
-    if (p->st == OM_OK) {
-        p->mem = malloc(p->bytes ? p->bytes : 1);
-        om_arena a;
-        om_arena_init(&a, p->mem, p->bytes, "scene");
-        p->st = om_scene_parse(t, len, ld, &a, &p->s, &p->d);
-        if (p->st == OM_OK) CHECK_EQ_U(a.used, p->bytes);
-    }
-    free(t);
-    return p->st;
-}
-
-static om_status parse(const char *text, parsed *p) { return parse_ld(text, strlen(text), NULL, p); }
-static void done(parsed *p) { free(p->mem); p->mem = NULL; }
-
 static bool feq(float a, float b, float tol) { return fabsf(a - b) <= tol; }
-static bool veq(om_vec3 a, float x, float y, float z) { return a.x == x && a.y == y && a.z == z; }
-
-static om_vec3 tri_normal(const om_scene *s, uint32_t t)
-{
-    const uint32_t *i = s->idx + 3 * t;
-    om_vec3 a = s->verts[i[0]], b = s->verts[i[1]], c = s->verts[i[2]];
-    return om__cross(om__sub(b, a), om__sub(c, a));
-}
 
 static om_vec3 tri_centroid(const om_scene *s, uint32_t t)
 {
@@ -699,179 +653,6 @@ static void parse_errors(void)
     CHECK(om_scene_parse("box", 3, NULL, NULL, &s, NULL) == OM_E_INVALID);
 }
 
-/* ---------------------------------------------------------------- OBJ and meshes */
-
-typedef struct memfile { const char *name, *data; } memfile;
-
-static om_status mem_load(void *user, const char *name, const char **data, size_t *len)
-{
-    for (const memfile *f = (const memfile *)user; f->name; f++)
-        if (strcmp(f->name, name) == 0) {
-            *data = f->data;
-            *len = strlen(f->data);
-            return OM_OK;
-        }
-    return OM_E_NOTFOUND;
-}
-
-static void obj_count(void)
-{
-    uint32_t nv, nt;
-    om_diag d;
-    const char *obj =
-        "# a comment\n"
-        "mtllib x.mtl\n"
-        "o thing\n"
-        "v 0 0 0\n"
-        "v 1 0 0 1.0\n"              /* w is ignored */
-        "v 1 1 0\n"
-        "v 0 1 0 0.5 0.5 0.5\n"      /* vertex colours too */
-        "v 0.5 2 0\r\n"
-        "vt 0 0\nvn 0 0 1\ng grp\ns off\nusemtl m\nl 1 2\n"
-        "f 1 2 3\n"                  /* 1 */
-        "f 1/1 3/2 4/3\n"            /* 1 */
-        "f 1//1 2//1 3//1 4//1\n"    /* quad: 2 */
-        "f -5/1/1 -4/2/2 -3/3/3 -1/1/1 -2/2/2\n";   /* pentagon: 3 */
-    CHECK_OK(om_obj_count(obj, strlen(obj), &nv, &nt, &d));
-    CHECK_EQ_U(nv, 5);
-    CHECK_EQ_U(nt, 7);
-    CHECK_OK(om_obj_count("", 0, &nv, &nt, NULL));
-    CHECK(nv == 0 && nt == 0);
-    CHECK_OK(om_obj_count("v 1e20 0 0\n", 11, &nv, &nt, NULL));   /* no scene limit here */
-
-    static const struct { const char *text; uint32_t line, col; const char *msg; } bad[] = {
-        {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n", 4, 7, "vertex index 4 is out of range (3 vertices so far)"},
-        {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", 4, 3, "vertex index 0"},
-        {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -4\n", 4, 7, "vertex index -4 is out of range"},
-        {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\n", 4, 1, "at least 3 vertices, this one has 2"},
-        {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3/\n", 4, 7, "malformed vertex reference '3/'"},
-        {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3/1/\n", 4, 7, "malformed vertex reference"},
-        {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x\n", 4, 7, "malformed vertex reference 'x'"},
-        {"f 1 2 3\nv 0 0 0\nv 1 0 0\nv 0 1 0\n", 1, 3, "out of range (0 vertices so far)"},
-        {"v 0 0\n", 1, 6, "expected 3 numbers after 'v'"},
-        {"\n\nv 0 0 0x1\n", 3, 7, "malformed number '0x1'"},
-        {"v 0 nan 0\n", 1, 5, "malformed number 'nan'"},
-        {"v 0 1e999 0\n", 1, 5, "is not finite"},
-        {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\0\n", 4, 7, "malformed vertex reference"},
-    };
-    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
-        size_t len = strlen(bad[i].text);
-        if (i == sizeof bad / sizeof bad[0] - 1) len = 33;   /* the one with a NUL byte */
-        char *t = exact_copy(bad[i].text, len);
-        om_status st = om_obj_count(t, len, &nv, &nt, &d);
-        free(t);
-        CHECK_MSG(st == OM_E_PARSE && d.line == bad[i].line && d.col == bad[i].col,
-                  "obj case %zu: %s %u:%u (%s)", i, om_status_str(st), d.line, d.col, d.msg);
-        CHECK_MSG(strstr(d.msg, bad[i].msg) != NULL, "obj case %zu: '%s'", i, d.msg);
-        CHECK(strncmp(d.msg, "obj: line ", 10) == 0);
-    }
-    /* bytes after the length are never read; junk in skipped statements is fine */
-    CHECK_OK(om_obj_count("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3 99", 31, &nv, &nt, &d));
-    CHECK_EQ_U(nt, 1);
-    static const char junk[] = "vt \x01\x02\0\xff\nusemtl \0\n";
-    CHECK_OK(om_obj_count(junk, sizeof junk - 1, &nv, &nt, &d));
-}
-
-static void mesh_lines(void)
-{
-    static const memfile files[] = {
-        {"tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"},
-        {"quad.obj", "v 0 0 0\nv 1 0 0\nv 1 0 -1\nv 0 0 -1\nf 1/1/1 2/2/2 3/3/3 4/4/4\n"},
-        {"bad.obj", "v 0 0 0\nv 1 0 0\n\nf 1 2 3\n"},
-        {"far.obj", "v 0 0 0\nv 1 0 0\nv 9e6 1 0\nf 1 2 3\n"},
-        {"neg.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\nv 5 5 5\nf -1/1 -3/2 -4/3 2//1\n"},
-        {NULL, NULL},
-    };
-    om_loader ld = {mem_load, (void *)files};
-    parsed p;
-    const char *text =
-        "box\n"
-        "mesh quad.obj scale 2 translate 0 1 0 albedo 1 0 0\n"
-        "mesh tri.obj rotate 0 0 90\n"
-        "mesh quad.obj scale -1 1 1\n";
-    CHECK_OK(parse_ld(text, strlen(text), &ld, &p));
-    CHECK_EQ_U(p.s.nverts, 8 + 4 + 3 + 4);
-    CHECK_EQ_U(p.s.ntris, 12 + 2 + 1 + 2);
-    /* the quad: fan (1 2 3) (1 3 4), moved after the box's 8 vertices, scaled, lifted */
-    CHECK(p.s.idx[36] == 8 && p.s.idx[37] == 9 && p.s.idx[38] == 10);
-    CHECK(p.s.idx[39] == 8 && p.s.idx[40] == 10 && p.s.idx[41] == 11);
-    CHECK(veq(p.s.verts[10], 2, 1, -2));
-    CHECK(p.s.tri_mat[12] == 1 && p.s.mats[1].r == 1.0f && p.s.mats[1].g == 0.0f);
-    CHECK(tri_normal(&p.s, 12).y > 0);
-    /* rotated 90 degrees about z: (1,0,0) -> (0,1,0) */
-    CHECK(veq(p.s.verts[13], 0, 1, 0));
-    CHECK(p.s.idx[42] == 12 && p.s.idx[43] == 13 && p.s.idx[44] == 14);
-    /* mirrored: winding swapped, so the normal still points up */
-    CHECK(tri_normal(&p.s, 15).y > 0 && tri_normal(&p.s, 16).y > 0);
-    CHECK(veq(p.s.hi, 2, 1, 0.5f) && veq(p.s.lo, -1, -0.5f, -2));
-    done(&p);
-
-    /* negative indices count back from the last vertex read so far */
-    CHECK_OK(parse_ld("box\nmesh neg.obj\n", 17, &ld, &p));
-    CHECK_EQ_U(p.s.ntris, 12 + 1 + 2);
-    static const uint32_t want[9] = {8, 9, 10, 11, 9, 8, 11, 8, 9};   /* +8: after the box */
-    for (int i = 0; i < 9 && p.s.ntris == 15; i++) CHECK_EQ_U(p.s.idx[36 + i], want[i]);
-    done(&p);
-
-    /* errors: inside the OBJ (its own line and column, the file and the scene line named) */
-    om_diag d;
-    size_t bytes;
-    text = "box\nmesh bad.obj\n";
-    CHECK(om_scene_bytes(text, strlen(text), &ld, &bytes, &d) == OM_E_PARSE);
-    CHECK(d.line == 4 && d.col == 7);
-    CHECK_MSG(strcmp(d.msg, "bad.obj: line 4, col 7: vertex index 3 is out of range (2 vertices "
-                            "so far) (mesh on scene line 2)") == 0, "%s", d.msg);
-    /* a missing file: the loader's status, the file and the scene's line and column */
-    text = "box\n\nmesh  nothere.obj scale 2\n";
-    CHECK(om_scene_bytes(text, strlen(text), &ld, &bytes, &d) == OM_E_NOTFOUND);
-    CHECK(d.line == 3 && d.col == 7 && d.status == OM_E_NOTFOUND);
-    CHECK_MSG(strstr(d.msg, "line 3, col 7: cannot load mesh 'nothere.obj'") != NULL, "%s", d.msg);
-    /* no loader at all */
-    CHECK(om_scene_bytes(text, strlen(text), NULL, &bytes, &d) == OM_E_NOTFOUND);
-    CHECK(d.line == 3 && d.col == 7 && strstr(d.msg, "nothere.obj") != NULL);
-    om_loader none = {NULL, NULL};
-    CHECK(om_scene_bytes(text, strlen(text), &none, &bytes, &d) == OM_E_NOTFOUND);
-    /* beyond 1e7 once transformed */
-    text = "mesh far.obj translate 2e6 0 0\n";
-    CHECK(om_scene_bytes(text, strlen(text), &ld, &bytes, &d) == OM_E_RANGE);
-    CHECK(d.line == 1 && d.col == 1 && strstr(d.msg, "far.obj") && strstr(d.msg, "OBJ line 3"));
-    CHECK_OK(om_scene_bytes("mesh far.obj", 12, &ld, &bytes, &d));
-    /* an unknown parameter after the file name */
-    text = "mesh tri.obj colour 1\n";
-    CHECK(om_scene_bytes(text, strlen(text), &ld, &bytes, &d) == OM_E_PARSE);
-    CHECK(d.line == 1 && d.col == 14);
-}
-
-/* A loader whose file grows between the two passes: the parse must notice, not overrun. */
-static om_status growing_load(void *user, const char *name, const char **data, size_t *len)
-{
-    int *calls = (int *)user;
-    (void)name;
-    static const char small[] = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
-    static const char big[] = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 2 4\nf 1 3 4\n";
-    *data = (*calls)++ == 0 ? small : big;
-    *len = strlen(*data);
-    return OM_OK;
-}
-
-static void mesh_changing(void)
-{
-    int calls = 0;
-    om_loader ld = {growing_load, &calls};
-    size_t bytes;
-    CHECK_OK(om_scene_bytes("mesh a.obj", 10, &ld, &bytes, NULL));
-    unsigned char *buf = (unsigned char *)malloc(bytes);
-    om_arena a;
-    om_scene s;
-    om_diag d;
-    om_arena_init(&a, buf, bytes, "scene");
-    calls = 0;
-    CHECK(om_scene_parse("mesh a.obj", 10, &ld, &a, &s, &d) == OM_E_INVALID);
-    CHECK(strstr(d.msg, "changed") != NULL);
-    CHECK_EQ_U(a.used, 0);
-    free(buf);
-}
-
 /* ---------------------------------------------------------------- paths */
 
 static void scene_at(void)
@@ -971,118 +752,6 @@ static void default_scene(void)
     done(&p);
 }
 
-/* ---------------------------------------------------------------- fuzz */
-
-static uint64_t rng_next(uint64_t *s)
-{
-    *s = *s * 6364136223846793005ull + 1442695040888963407ull;
-    return *s >> 33;
-}
-
-static unsigned char fuzz_mem[4 << 20];
-
-static void fuzz_mutations(void)
-{
-    const char *base = om_scene_default_text();
-    size_t blen = strlen(base), cap = blen + 4096;
-    char *t = (char *)malloc(cap);
-    static const char *snippets[] = {
-        "1e999", "nan", "-", "\n", "#", "\r\n", " 0 ", "4096", "1e30", "\0", "box", "material",
-        "key camera 0 eye 0 0 0 target 0 0 0\n", "mesh a.obj", "scale", "-1e7", "9999999999999999999999",
-        "triangles count 20000 ", "sphere segments 4096 ", ".", "\t", "\xff",
-    };
-    uint64_t seed = 12345;
-    uint32_t ok = 0, errs[OM_E_COUNT_] = {0};
-    for (int it = 0; it < 2000; it++) {
-        memcpy(t, base, blen);
-        size_t len = blen;
-        int edits = 1 + (int)(rng_next(&seed) % 6);
-        for (int e = 0; e < edits; e++) {
-            size_t at = len ? (size_t)(rng_next(&seed) % len) : 0;
-            switch (rng_next(&seed) % 6) {
-            case 0: /* flip a byte */
-                if (len) t[at] = (char)rng_next(&seed);
-                break;
-            case 1: /* delete a run */
-            {
-                size_t n = rng_next(&seed) % 40;
-                if (n > len - at) n = len - at;
-                memmove(t + at, t + at + n, len - at - n);
-                len -= n;
-                break;
-            }
-            case 2: /* insert a snippet */
-            {
-                const char *sn = snippets[rng_next(&seed) % (sizeof snippets / sizeof snippets[0])];
-                size_t n = sn[0] ? strlen(sn) : 1;
-                if (len + n > cap) break;
-                memmove(t + at + n, t + at, len - at);
-                memcpy(t + at, sn, n);
-                len += n;
-                break;
-            }
-            case 3: /* cut the text short */
-                len = at;
-                break;
-            case 4: /* replace a digit */
-                if (len && t[at] >= '0' && t[at] <= '9') t[at] = (char)('0' + rng_next(&seed) % 10);
-                else if (len) t[at] = ' ';
-                break;
-            default: /* duplicate a chunk */
-            {
-                size_t n = rng_next(&seed) % 80, from = len ? (size_t)(rng_next(&seed) % len) : 0;
-                if (n > len - from) n = len - from;
-                if (len + n > cap) break;
-                memmove(t + at + n, t + at, len - at);
-                memmove(t + at, t + (from < at ? from : from + n), n);
-                len += n;
-                break;
-            }
-            }
-        }
-        size_t bytes = 0;
-        om_diag d1, d2;
-        char *x = exact_copy(t, len);
-        om_status s1 = om_scene_bytes(x, len, NULL, &bytes, &d1);
-        om_arena a;
-        om_scene s;
-        om_arena_init(&a, fuzz_mem, sizeof fuzz_mem, "scene");
-        om_status s2 = om_scene_parse(x, len, NULL, &a, &s, &d2);
-        free(x);
-        CHECK((unsigned)s1 < OM_E_COUNT_ && (unsigned)s2 < OM_E_COUNT_);
-        CHECK(memchr(d1.msg, '\0', sizeof d1.msg) != NULL);
-        if (s1 != OM_OK) {
-            CHECK(s2 == s1 && d1.line == d2.line && d1.col == d2.col);
-            CHECK(d1.msg[0] != '\0');
-            if (s1 == OM_E_PARSE) CHECK(d1.line >= 1 && d1.col >= 1);
-            errs[s1]++;
-            continue;
-        }
-        if (s2 == OM_E_BUDGET) {
-            CHECK(bytes > sizeof fuzz_mem);
-            errs[OM_E_BUDGET]++;
-            continue;
-        }
-        CHECK(s2 == OM_OK && a.used == bytes);
-        if (s2 != OM_OK) continue;
-        ok++;
-        uint32_t badidx = 0, badmat = 0;
-        for (uint32_t i = 0; i < 3 * s.ntris; i++) badidx += s.idx[i] >= s.nverts;
-        for (uint32_t i = 0; i < s.ntris; i++) badmat += s.tri_mat[i] >= s.nmats;
-        CHECK(badidx == 0 && badmat == 0);
-        for (uint32_t i = 0; i < s.nverts; i++) {
-            om_vec3 v = s.verts[i];
-            CHECK(om__finite3(v) && fabsf(v.x) <= 1e7f && fabsf(v.y) <= 1e7f && fabsf(v.z) <= 1e7f);
-        }
-        om_camera c;
-        om_light l;
-        om_scene_at(&s, (float)(rng_next(&seed) % 50) * 0.1f - 0.5f, &c, &l);
-        CHECK(om__finite3(c.eye) && om__finite3(l.pos));
-    }
-    CHECK_MSG(ok > 100 && errs[OM_E_PARSE] > 100, "fuzz: %u ok, %u parse errors", ok, errs[OM_E_PARSE]);
-    free(t);
-}
-
 void suite_scene(void)
 {
     RUN(numbers);
@@ -1095,10 +764,6 @@ void suite_scene(void)
     RUN(shapes_closed);
     RUN(random_triangles);
     RUN(parse_errors);
-    RUN(obj_count);
-    RUN(mesh_lines);
-    RUN(mesh_changing);
     RUN(scene_at);
     RUN(default_scene);
-    RUN(fuzz_mutations);
 }
