@@ -191,7 +191,11 @@ static void frag(void *user, int32_t x, int32_t y, const om__rtri *t)
     if (!(z >= t->zmin)) z = t->zmin;
     uint32_t dz = (uint32_t)z;
     size_t i = (size_t)y * m->size + (size_t)x;
-    if (dz >= m->depth[i]) return;
+    /* Ties are most often the two halves of one flat quad (a fence bar's face, the
+     * floor along its diagonals): the texels of a checkerboard take the first one
+     * drawn, the others the last, so a 3x3 neighbourhood sees both and recovery links
+     * them into the quad (first-drawn everywhere loses the other half's outline). */
+    if (dz > m->depth[i] || (dz == m->depth[i] && !((x ^ y) & 1))) return;
     m->depth[i] = dz;
     if (!b->have || t->zx != b->zx || t->zy != b->zy) {
         /* derivatives in depth steps per texel, scaled (spsm.h) */
