@@ -7,8 +7,9 @@
  * (every texel whose square it touches); the depth test uses the minimum conservative
  * depth over the texel (the plane's minimum over the square, never nearer than the
  * triangle's nearest vertex), kept in a 32-bit buffer beside the texels, and the
- * winner's record (section 3.3) is written to the texel. A second 32-bit buffer keeps
- * the plain map's depth at texel centres for the one case recovery cannot decide.
+ * winner's record (section 3.3) is written to the texel; near ties alternate in a
+ * checkerboard (frag, below). A second 32-bit buffer keeps the plain map's depth at
+ * texel centres for the one case recovery cannot decide.
  *
  * Lookup (section 4): each exposed sample is projected with the light's matrix, as the
  * conventional map does, onto the sub-texel grid. Then
@@ -30,6 +31,7 @@
 #include "spsm.h"
 
 #define LINK_DZ (32.0 * STEP)    /* planes of one smooth surface agree this well */
+#define TIE_DZ (LINK_DZ / 2)     /* the build's near tie: one surface to recovery */
 #define MAXV 27                  /* boundary vertices: 9 triangles x 3 */
 #define STEP 65536.0             /* one 16-bit depth step in raw units */
 #define TOL0 (1.5 * STEP)
@@ -191,12 +193,15 @@ static void frag(void *user, int32_t x, int32_t y, const om__rtri *t)
     if (!(z >= t->zmin)) z = t->zmin;
     uint32_t dz = (uint32_t)z;
     size_t i = (size_t)y * m->size + (size_t)x;
-    /* Ties are most often the two halves of one flat quad (a fence bar's face, the
-     * floor along its diagonals): the texels of a checkerboard take the first one
-     * drawn, the others the last, so a 3x3 neighbourhood sees both and recovery links
-     * them into the quad (first-drawn everywhere loses the other half's outline). */
-    if (dz > m->depth[i] || (dz == m->depth[i] && !((x ^ y) & 1))) return;
-    m->depth[i] = dz;
+    /* Near ties (within TIE_DZ, what recovery takes for one surface) are most often
+     * the halves of one flat quad or the faces of one thin part (a fence bar): the
+     * texels of a checkerboard keep the first one drawn, the others the last, so a
+     * 3x3 neighbourhood holds both and recovery links them into one outline (keeping
+     * the first everywhere loses the other's). The depth buffer keeps the nearer. */
+    uint32_t o = m->depth[i];
+    bool tie = o != 0xFFFFFFFFu && (dz >= o ? dz - o : o - dz) <= (uint32_t)TIE_DZ;
+    if (tie ? !((x ^ y) & 1) : dz > o) return;
+    if (dz < o) m->depth[i] = dz;
     if (!b->have || t->zx != b->zx || t->zy != b->zy) {
         /* derivatives in depth steps per texel, scaled (spsm.h) */
         const double k = (double)OM_SUBPIX / STEP / OM_SPSM_DSCALE;
@@ -606,7 +611,8 @@ static uint8_t lookup(spsm_state *m, const om_strip *st, size_t i)
     const int64_t px = p.x - ox, py = p.y - oy;
 
     /* 4.1 lit: the sample lies on the stored triangle. Nothing touching the texel was
-     * nearer than it over the texel (conservative rasterization and depth). We also
+     * nearer than it over the texel (conservative rasterization and depth; but for a
+     * near tie, which is one surface with it). We also
      * accept a stored triangle that does not cover the sample but lies in its plane
      * (the other half of a floor quad): it too was the nearest thing in the texel.
      * That halves the uncertain samples at no measured cost in accuracy. */
