@@ -2,7 +2,8 @@
  * top-left rule, watertightness of shared edges (fans, grids, random triangulations,
  * sub-pixel vertices), clipping at the near and far planes, coordinates that would
  * overflow 32-bit setup, conservative coverage, the point-in-triangle test, and the
- * entry for triangles already on the grid. */
+ * entry for triangles already on the grid, and the plain depth pass made alongside a
+ * conservative one. */
 #include "test.h"
 #include "../engine/raster/raster.h"
 #include "../engine/core/core.h"
@@ -41,7 +42,7 @@ static void add_coverage(const om_vec4 c[3], uint32_t w, uint32_t h)
 {
     om_target t = target(w, h);
     om__target_clear(&t);
-    om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL};
+    om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL, NULL};
     om__raster_tri(&r, c, 7);
     for (uint32_t i = 0; i < w * h; i++) count_buf[i] += id_buf[i] == 7;
 }
@@ -310,7 +311,7 @@ static void huge_ground(float half)
     for (int i = 0; i < 4; i++) c[i] = om__mat_apply(&vp, q[i]);
     om_target t = target(W, H);
     om__target_clear(&t);
-    om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL};
+    om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL, NULL};
     om_vec4 t1[3] = {c[0], c[1], c[2]}, t2[3] = {c[0], c[2], c[3]};
     om__raster_tri(&r, t1, 1);
     om__raster_tri(&r, t2, 2);
@@ -391,7 +392,7 @@ static void snapped_matches_clipped(void)
             z[i] = (double)c[i].z * 4294967296.0;
         }
         om_target t = target(TW, TH);
-        om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL};
+        om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL, NULL};
         om__target_clear(&t);
         om__raster_tri(&r, c, 5);
         memcpy(d0, depth_buf, sizeof d0);
@@ -430,7 +431,7 @@ static void conservative_superset(void)
         memset(cons, 0, sizeof cons);
         om_target t = target(TW, TH);
         cons_ctx ctx = {cons, TW};
-        om_raster r = {&t, OM_RASTER_CONSERVATIVE, cons_frag, &ctx};
+        om_raster r = {&t, OM_RASTER_CONSERVATIVE, cons_frag, &ctx, NULL};
         om__raster_tri(&r, c, 1);
         for (int i = 0; i < TW * TH; i++) {
             if (count_buf[i] && !cons[i]) missing++;
@@ -446,6 +447,50 @@ static void conservative_superset(void)
     CHECK_EQ_U(dup, 0);
 }
 
+static void no_frag(void *user, int32_t x, int32_t y, const om__rtri *t)
+{
+    (void)user; (void)x; (void)y; (void)t;
+}
+
+/* A conservative pass with `centres` leaves there the very depths a plain depth pass
+ * over the same triangles writes (random overlapping triangles, partly off the image,
+ * half with their vertices on texel centres, some degenerate). */
+static void conservative_centres_match_depth_pass(void)
+{
+    static uint32_t plain[TW * TH], alongside[TW * TH];
+    rng_state = 77;
+    om_vec4 c[60][3];
+    for (int k = 0; k < 60; k++) {
+        int64_t x[3], y[3];
+        for (int i = 0; i < 3; i++) {
+            x[i] = (int64_t)(rnd() % (2 * TW * 256)) - TW * 128;
+            y[i] = (int64_t)(rnd() % (2 * TH * 256)) - TH * 128;
+            if (k & 1) {   /* on texel centres: edges through centres test the fill rule */
+                x[i] = x[i] / 256 * 256 + 128;
+                y[i] = y[i] / 256 * 256 + 128;
+            }
+        }
+        if (k % 10 == 9) { x[2] = x[0] + (x[1] - x[0]) * 2; y[2] = y[0] + (y[1] - y[0]) * 2; }   /* no area */
+        for (int i = 0; i < 3; i++) c[k][i] = at((double)x[i], (double)y[i], TW, TH, (float)(rnd() % 1000) / 1000.0f);
+    }
+    om_target t = target(TW, TH);
+    om_raster r = {&t, OM_RASTER_DEPTH, NULL, NULL, NULL};
+    om__target_clear(&t);
+    for (int k = 0; k < 60; k++) om__raster_tri(&r, c[k], (uint32_t)k);
+    memcpy(plain, depth_buf, sizeof plain);
+    om_target ct = {TW, TH, 0, TH, alongside, NULL}, scratch = target(TW, TH);
+    om__target_clear(&ct);
+    om_raster rc = {&scratch, OM_RASTER_CONSERVATIVE, no_frag, NULL, &ct};
+    for (int k = 0; k < 60; k++) om__raster_tri(&rc, c[k], (uint32_t)k);
+    int differ = 0, written = 0;
+    for (int i = 0; i < TW * TH; i++) {
+        differ += plain[i] != alongside[i];
+        written += plain[i] != 0xFFFFFFFFu;
+    }
+    CHECK_EQ_U(differ, 0);
+    CHECK(written > TW * TH / 2);
+}
+
 static void strips_match_whole(void)
 {
     /* The same triangles rendered whole and through strips of 5 rows agree exactly,
@@ -459,7 +504,7 @@ static void strips_match_whole(void)
                             TW, TH, (float)(rnd() % 1000) / 1000.0f);
     om_target t = target(TW, TH);
     om__target_clear(&t);
-    om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL};
+    om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL, NULL};
     for (int k = 0; k < 40; k++) om__raster_tri(&r, tris[k], (uint32_t)k);
     memcpy(whole_d, depth_buf, sizeof whole_d);
     memcpy(whole_i, id_buf, sizeof whole_i);
@@ -486,5 +531,6 @@ void suite_raster(void)
     RUN(covers_matches_fill);
     RUN(snapped_matches_clipped);
     RUN(conservative_superset);
+    RUN(conservative_centres_match_depth_pass);
     RUN(strips_match_whole);
 }

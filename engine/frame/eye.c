@@ -70,6 +70,7 @@ void om__scene_raster(const om_scene *s, const om_mat4 *vp, const om_target *tg,
     r.mode = mode;
     r.frag = NULL;
     r.user = NULL;
+    r.centres = NULL;
     om__target_clear(tg);
     for (uint32_t t = 0; t < s->ntris; t++) {
         om_vec4 c[3];

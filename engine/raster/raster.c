@@ -227,6 +227,28 @@ static bool row_span(const int64_t E[3], const int64_t step[3], int64_t w, int64
     return l <= h;
 }
 
+/* The depth test along row y from texel x0 to x1, writing id too when `id_row` is
+ * given (that row of the id buffer). */
+static void depth_row(const om__rtri *t, const om_target *tg, int32_t y, int32_t x0, int32_t x1,
+                      uint32_t *id_row, uint32_t id)
+{
+    const om__tri2 *e = &t->e;
+    const int64_t S = OM_SUBPIX, H = OM_SUBPIX / 2;
+    int64_t py = (int64_t)y * S + H;
+    double ztail = t->zy * (double)(py - e->y[0]);
+    uint32_t *dep = tg->depth + (size_t)(y - (int32_t)tg->y0) * tg->width;
+    for (int32_t x = x0; x <= x1; x++) {
+        int64_t px = (int64_t)x * S + H;
+        double z = (t->z0 + t->zx * (double)(px - e->x[0])) + ztail;
+        z = z < t->zmin ? t->zmin : z > t->zmax ? t->zmax : z;
+        uint32_t d = (uint32_t)z;
+        if (d < dep[x]) {
+            dep[x] = d;
+            if (id_row) id_row[x] = id;
+        }
+    }
+}
+
 static void fill(const om_raster *r, const om__rtri *t, uint32_t id)
 {
     const om_target *tg = r->target;
@@ -239,19 +261,8 @@ static void fill(const om_raster *r, const om__rtri *t, uint32_t id)
         const int64_t E[3] = {om__tri2_edge(e, 0, px0, py), om__tri2_edge(e, 1, px0, py),
                               om__tri2_edge(e, 2, px0, py)};
         if (!row_span(E, step, t->maxx - t->minx, &lo, &hi)) continue;
-        double ztail = t->zy * (double)(py - e->y[0]);
-        size_t row = (size_t)(y - (int32_t)tg->y0) * tg->width;
-        uint32_t *dep = tg->depth + row;
-        for (int32_t x = t->minx + (int32_t)lo; x <= t->minx + (int32_t)hi; x++) {
-            int64_t px = (int64_t)x * S + H;
-            double z = (t->z0 + t->zx * (double)(px - e->x[0])) + ztail;
-            z = z < t->zmin ? t->zmin : z > t->zmax ? t->zmax : z;
-            uint32_t d = (uint32_t)z;
-            if (d < dep[x]) {
-                dep[x] = d;
-                if (with_id) tg->id[row + (size_t)x] = id;
-            }
-        }
+        uint32_t *id_row = with_id ? tg->id + (size_t)(y - (int32_t)tg->y0) * tg->width : NULL;
+        depth_row(t, tg, y, t->minx + (int32_t)lo, t->minx + (int32_t)hi, id_row, id);
     }
 }
 
@@ -264,13 +275,21 @@ static void fill_conservative(const om_raster *r, const om__rtri *t)
     int64_t reach[3];
     for (int i = 0; i < 3; i++)
         reach[i] = ((e->a[i] < 0 ? -e->a[i] : e->a[i]) + (e->b[i] < 0 ? -e->b[i] : e->b[i])) * H;
+    /* The plain pass alongside: the fill rule's edges are these less the top-left bias
+     * (om__tri2_setup), and a triangle with no area covers no centre. */
+    const om_target *ct = e->area2 > 0 ? r->centres : NULL;
+    int64_t bias[3];
+    for (int i = 0; i < 3; i++) bias[i] = (e->a[i] > 0 || (e->a[i] == 0 && e->b[i] > 0)) ? 0 : 1;
     for (int32_t y = t->miny; y <= t->maxy; y++) {
         int64_t py = (int64_t)y * S + H, px0 = (int64_t)t->minx * S + H, lo, hi;
-        const int64_t E[3] = {om__tri2_edge(e, 0, px0, py) + reach[0],
-                              om__tri2_edge(e, 1, px0, py) + reach[1],
-                              om__tri2_edge(e, 2, px0, py) + reach[2]};
-        if (!row_span(E, step, t->maxx - t->minx, &lo, &hi)) continue;
+        const int64_t E[3] = {om__tri2_edge(e, 0, px0, py), om__tri2_edge(e, 1, px0, py),
+                              om__tri2_edge(e, 2, px0, py)};
+        const int64_t R[3] = {E[0] + reach[0], E[1] + reach[1], E[2] + reach[2]};
+        if (!row_span(R, step, t->maxx - t->minx, &lo, &hi)) continue;
         for (int32_t x = t->minx + (int32_t)lo; x <= t->minx + (int32_t)hi; x++) r->frag(r->user, x, y, t);
+        const int64_t B[3] = {E[0] - bias[0], E[1] - bias[1], E[2] - bias[2]};
+        if (ct && row_span(B, step, t->maxx - t->minx, &lo, &hi))
+            depth_row(t, ct, y, t->minx + (int32_t)lo, t->minx + (int32_t)hi, NULL, 0);
     }
 }
 

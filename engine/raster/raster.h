@@ -105,6 +105,10 @@ typedef struct om_raster {
     om_raster_mode mode;
     om__frag_fn frag;      /* conservative mode */
     void *user;
+    /* Conservative mode, may be NULL: also the plain depth test (OM_RASTER_DEPTH) into
+     * this target of the same size, at the texel centres the fill rule covers; the
+     * same depths as a separate depth pass over the same triangles, in one pass. */
+    const om_target *centres;
 } om_raster;
 
 /* Rasterizes one triangle given in clip space (clipping it first). Non-finite vertices

@@ -363,6 +363,7 @@ void om__rtw_render_map(om__rtw *m)
     x.r.mode = OM_RASTER_DEPTH;
     x.r.frag = NULL;
     x.r.user = NULL;
+    x.r.centres = NULL;
     x.limit2 = m->limit * m->limit;
     x.bend2 = (RTW_BEND / (double)m->size) * (RTW_BEND / (double)m->size);
     x.drawn = 0;

@@ -228,9 +228,10 @@ static om_status spsm_build(void *state, om_diag *d)
     size_t n = (size_t)m->size * m->size;
     m->t4_at = (size_t)-1;   /* no texel index: the map is about to change */
     m->bd_have = false;
-    /* the plain map at texel centres, for the fallback of 4.2: the engine's own pass */
+    /* the plain map at texel centres, for the fallback of 4.2: the rasterizer's own
+     * depth pass, made alongside the conservative one */
     om_target tc = {m->size, m->size, 0, m->size, m->cdepth, NULL};
-    om__scene_raster(s, &m->view.light_vp, &tc, OM_RASTER_DEPTH);
+    om__target_clear(&tc);
     memset(m->depth, 0xFF, n * sizeof(uint32_t));
     /* texels are not cleared: one whose depth is still the far plane's is empty */
     om_target tg = {m->size, m->size, 0, m->size, m->depth, NULL};
@@ -242,6 +243,7 @@ static om_status spsm_build(void *state, om_diag *d)
     r.mode = OM_RASTER_CONSERVATIVE;
     r.frag = frag;
     r.user = &b;
+    r.centres = &tc;
     for (uint32_t t = 0; t < s->ntris; t++) {
         const uint32_t *ix = s->idx + (size_t)t * 3;
         om_vec4 c[3];
