@@ -7,24 +7,34 @@
 
 /* ---- o16 vertex offsets (section 3.3; our choice of code, see spsm.h) */
 
-/* The code of |v| >= 2048 (e > 0), apart so that the exact range below stays small
- * enough to be inlined into the pack, which runs for every texel written. */
-static uint16_t o16_wide(uint16_t sign, uint64_t a)
+/* Bits in x > 0: one instruction where the compiler offers it (the pack runs per
+ * texel written, and far vertices are the wide case), else five steps. */
+static unsigned bit_length(uint32_t x)
 {
-    /* e = bit length of a - 11, found in five steps */
+#if defined(__GNUC__) || defined(__clang__)
+    return 32u - (unsigned)__builtin_clz(x);
+#else
     unsigned len = 1;
-    uint64_t x = a;
-    if (x >> 32) { x >>= 32; len += 32; }
     if (x >> 16) { x >>= 16; len += 16; }
     if (x >> 8) { x >>= 8; len += 8; }
     if (x >> 4) { x >>= 4; len += 4; }
     if (x >> 2) { x >>= 2; len += 2; }
     if (x >> 1) len += 1;
-    unsigned e = len - 11;
+    return len;
+#endif
+}
+
+/* The code of |v| >= 2048 (e > 0), apart so that the exact range below stays small
+ * enough to be inlined into the pack, which runs for every texel written. */
+static uint16_t o16_wide(uint16_t sign, uint64_t a)
+{
+    const uint16_t top = (uint16_t)(sign | (15u << 11) | 2047u);
+    if (a >> 32) return top;   /* far beyond the largest code (about 2^26) */
+    unsigned e = bit_length((uint32_t)a) - 11;
     /* round half up to the step 2^(e-1); a carry moves to the next exponent */
     uint64_t m = e == 1 ? a : (a + (1ull << (e - 2))) >> (e - 1);
     if (m >= 4096u) { m >>= 1; e++; }
-    if (e > 15) return (uint16_t)(sign | (15u << 11) | 2047u);   /* saturate */
+    if (e > 15) return top;   /* saturate */
     return (uint16_t)(sign | (e << 11) | (unsigned)(m - 2048u));
 }
 
