@@ -38,11 +38,17 @@ static uint16_t o16_wide(uint16_t sign, uint64_t a)
     return (uint16_t)(sign | (e << 11) | (unsigned)(m - 2048u));
 }
 
-uint16_t om__spsm_o16_encode(int64_t v)
+/* In line in the pack, which runs for every texel written. */
+static inline uint16_t o16_encode(int64_t v)
 {
     /* offsets of a small triangle's vertices from the texels it covers: mostly exact */
     if (v > -2048 && v < 2048) return (uint16_t)(v < 0 ? 0x8000u | (unsigned)-v : (unsigned)v);
     return v < 0 ? o16_wide(0x8000u, (uint64_t)(-(v + 1)) + 1u) : o16_wide(0, (uint64_t)v);
+}
+
+uint16_t om__spsm_o16_encode(int64_t v)
+{
+    return o16_encode(v);
 }
 
 int64_t om__spsm_o16_decode(uint16_t c)
@@ -169,7 +175,7 @@ void om__spsm_tangent_build(om__spsm_tangent lut[512])
 void om__spsm_row_codes(uint16_t vy[3], const om__rtri *t, int32_t y)
 {
     const int64_t cy = (int64_t)y * OM_SUBPIX + OM_SUBPIX / 2;
-    for (int i = 0; i < 3; i++) vy[i] = om__spsm_o16_encode(t->e.y[i] - cy);
+    for (int i = 0; i < 3; i++) vy[i] = o16_encode(t->e.y[i] - cy);
 }
 
 void om__spsm_pack_row(om__spsm_texel *out, const om__rtri *t, int32_t x, int32_t y, uint8_t qx,
@@ -178,7 +184,7 @@ void om__spsm_pack_row(om__spsm_texel *out, const om__rtri *t, int32_t x, int32_
     const om__tri2 *e = &t->e;
     const int64_t cx = (int64_t)x * OM_SUBPIX + OM_SUBPIX / 2, cy = (int64_t)y * OM_SUBPIX + OM_SUBPIX / 2;
     for (int i = 0; i < 3; i++) {
-        out->vx[i] = om__spsm_o16_encode(e->x[i] - cx);
+        out->vx[i] = o16_encode(e->x[i] - cx);
         out->vy[i] = vy[i];
     }
     /* The plane at the centre, not clamped to the triangle's depth range: the lookup
