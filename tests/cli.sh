@@ -45,6 +45,8 @@ if [ "$size" -eq $((15 + 160 * 120 * 3)) ]; then ok; else bad "ppm size $size"; 
 hash_whole=$(grep '^hash:' "$dir/out")
 
 # Strips and a tight budget give the very same frame.
+expect 0 "quiet render" -- "$OMBRA" render --size 16x16 -q --out "$dir/q.ppm"
+if [ -s "$dir/out" ]; then bad "-q printed: $(head -c 200 "$dir/out")"; else ok; fi
 expect 0 "strip render" -- "$OMBRA" render --size 160x120 --strip 7 --out "$dir/b.ppm"
 if [ "$(grep '^hash:' "$dir/out")" = "$hash_whole" ]; then ok; else bad "strips changed the frame"; fi
 cmp -s "$dir/a.ppm" "$dir/b.ppm" && ok || bad "strip PPM differs from whole PPM"

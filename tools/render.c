@@ -29,7 +29,7 @@ static const char render_help[] =
     "  --slope S         short for --set slope=S (slope-scaled bias, texels)\n"
     "  --offset O        short for --set offset=O (normal offset, texels)\n"
     "  --pcf K           short for --set pcf=K (K x K percentage-closer filtering)\n"
-    "  --quiet           print nothing but errors\n";
+    "  -q, --quiet       print nothing but errors\n";
 
 /* One method's memory and state for a frame. */
 typedef struct run {
@@ -149,7 +149,7 @@ int cmd_render(int argc, char **argv)
         const char *a = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) { fputs(render_help, stdout); return 0; }
-        if (!strcmp(a, "--quiet")) { quiet = true; continue; }
+        if (!strcmp(a, "--quiet") || !strcmp(a, "-q")) { quiet = true; continue; }
         static const char *const valued[] = {"--method", "--against", "--out", "--mask", "--diff",
             "--size", "--strip", "--budget", "--time", "--format", "--set", "--map", "--pcf",
             "--bias", "--slope", "--offset"};
