@@ -12,6 +12,14 @@ static int64_t floordiv(int64_t a, int64_t b)   /* b > 0 */
     return (a % b != 0 && a < 0) ? q - 1 : q;
 }
 
+/* The top-left rule for the edge with coefficients a (of x) and b (of y), area2 > 0 in
+ * a y-down image: a top edge runs in +x (a = 0, b > 0) and a left edge runs upwards
+ * (a > 0); points exactly on any other edge are outside. */
+static bool top_left(int64_t a, int64_t b)
+{
+    return a > 0 || (a == 0 && b > 0);
+}
+
 bool om__tri2_setup(om__tri2 *t, const int64_t x[3], const int64_t y[3], bool biased)
 {
     int p[3] = {0, 1, 2};
@@ -35,10 +43,7 @@ bool om__tri2_setup(om__tri2 *t, const int64_t x[3], const int64_t y[3], bool bi
         t->a[i] = -dy;
         t->b[i] = dx;
         t->c[i] = dy * t->x[i] - dx * t->y[i];
-        /* With area2 > 0 in a y-down image, a top edge runs in +x and a left edge runs
-         * upwards; points exactly on any other edge are outside. */
-        bool top_left = (dy == 0 && dx > 0) || dy < 0;
-        if (biased && !top_left) t->c[i] -= 1;
+        if (biased && !top_left(t->a[i], t->b[i])) t->c[i] -= 1;
     }
     t->area2 = area2;
     return true;
@@ -279,7 +284,7 @@ static void fill_conservative(const om_raster *r, const om__rtri *t)
      * (om__tri2_setup), and a triangle with no area covers no centre. */
     const om_target *ct = e->area2 > 0 ? r->centres : NULL;
     int64_t bias[3];
-    for (int i = 0; i < 3; i++) bias[i] = (e->a[i] > 0 || (e->a[i] == 0 && e->b[i] > 0)) ? 0 : 1;
+    for (int i = 0; i < 3; i++) bias[i] = top_left(e->a[i], e->b[i]) ? 0 : 1;
     for (int32_t y = t->miny; y <= t->maxy; y++) {
         int64_t py = (int64_t)y * S + H, px0 = (int64_t)t->minx * S + H, lo, hi;
         const int64_t E[3] = {om__tri2_edge(e, 0, px0, py), om__tri2_edge(e, 1, px0, py),
