@@ -366,19 +366,6 @@ static double consistent_min(const dtri *t)
     return zmin;
 }
 
-/* The recovered silhouette (section 4.2, Figure 10), built once per texel and pattern so
- * that AA sub-samples reuse it (section 5). Its points are the vertices of the
- * occluders the pattern keeps. Two are linked when they belong to one stored triangle,
- * or lie within OM_SPSM_LINK of each other on one smooth surface (the plane of one's
- * triangle, carried to the other, meets the other's within LINK_DZ): a gap that narrow
- * is taken for geometry the map could not keep, as a dense mesh keeps one small
- * triangle per texel (Figure 10a), while a cloud of separate small triangles does not
- * line up and stays apart. Links join the points into pieces; a piece's outline is the
- * convex hull of its points. Where the paper links the lit-side vertices along the
- * tangent into phi and shadows everything beyond it, the hull also closes the piece
- * on its far side, so two thin occluders a texel or more apart (a fence) do not shadow
- * the gap between them (see README: the one-sided phi measured worse). */
-
 static int lowbit(uint32_t m)
 {
     int k = 0;
@@ -434,6 +421,18 @@ static void hulls_build(boundary *b)
     }
 }
 
+/* The recovered silhouette (section 4.2, Figure 10), built once per texel and pattern so
+ * that AA sub-samples reuse it (section 5). Its points are the vertices of the
+ * occluders the pattern keeps. Two are linked when they belong to one stored triangle,
+ * or lie within OM_SPSM_LINK of each other on one smooth surface (the plane of one's
+ * triangle, carried to the other, meets the other's within LINK_DZ): a gap that narrow
+ * is taken for geometry the map could not keep, as a dense mesh keeps one small
+ * triangle per texel (Figure 10a), while a cloud of separate small triangles does not
+ * line up and stays apart. Links join the points into pieces; a piece's outline is the
+ * convex hull of its points. Where the paper links the lit-side vertices along the
+ * tangent into phi and shadows everything beyond it, the hull also closes the piece
+ * on its far side, so two thin occluders a texel or more apart (a fence) do not shadow
+ * the gap between them (see README: the one-sided phi measured worse). */
 static void boundary_build(boundary *b, const dtri *const occ[9], int nocc)
 {
     uint32_t tri_of[MAXV];       /* bit k: a vertex of occluder k */
