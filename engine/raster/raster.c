@@ -85,21 +85,25 @@ unsigned om__outcode(const om_vec4 *v, uint32_t width, uint32_t height)
     return mask;
 }
 
+bool om__snap(double x, double y, double z, int64_t *gx, int64_t *gy, double *gz)
+{
+    const double lim = (double)(1ll << 26);
+    double X = floor(x + 0.5), Y = floor(y + 0.5);
+    if (!(X > -lim && X < lim && Y > -lim && Y < lim)) return false;
+    *gx = (int64_t)X;
+    *gy = (int64_t)Y;
+    *gz = z < 0.0 ? 0.0 : z > 4294967295.0 ? 4294967295.0 : z;
+    return true;
+}
+
 bool om__project(const om_vec4 *v, uint32_t width, uint32_t height, int64_t *gx, int64_t *gy,
                  double *gz)
 {
     const double sx = (double)width * (OM_SUBPIX / 2), sy = (double)height * (OM_SUBPIX / 2);
-    const double lim = (double)(1ll << 26);
     if (!(v->w > 0.0f)) return false;
     double iw = 1.0 / (double)v->w;
-    double X = floor(((double)v->x * iw + 1.0) * sx + 0.5);
-    double Y = floor((1.0 - (double)v->y * iw) * sy + 0.5);
-    double Z = (double)v->z * iw * 4294967296.0;
-    if (!(X > -lim && X < lim && Y > -lim && Y < lim)) return false;
-    *gx = (int64_t)X;
-    *gy = (int64_t)Y;
-    *gz = Z < 0.0 ? 0.0 : Z > 4294967295.0 ? 4294967295.0 : Z;
-    return true;
+    return om__snap(((double)v->x * iw + 1.0) * sx, (1.0 - (double)v->y * iw) * sy,
+                    (double)v->z * iw * 4294967296.0, gx, gy, gz);
 }
 
 /* The intersection is always computed from the inside vertex towards the outside one,

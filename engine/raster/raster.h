@@ -130,6 +130,12 @@ unsigned om__outcode(const om_vec4 *v, uint32_t width, uint32_t height);
 bool om__project(const om_vec4 *v, uint32_t width, uint32_t height, int64_t *gx, int64_t *gy,
                  double *gz);
 
+/* Snaps a point given in sub-pixel grid units (x, y) with depth z/w * 2^32 (z) to the
+ * grid: rounded to the nearest grid point, the depth clamped to [0, 2^32 - 1]; false
+ * beyond 2^26 grid units (or NaN). om__project ends here, and so may a caller that
+ * places vertices itself (rtw's warped map). */
+bool om__snap(double x, double y, double z, int64_t *gx, int64_t *gy, double *gz);
+
 /* Clips a triangle against the near, far and guard-band planes of a width x height
  * viewport and projects it: up to 9 vertices of a convex polygon in sub-pixel grid
  * coordinates with depth z/w * 2^32. Returns the vertex count (0: nothing left). */

@@ -242,17 +242,13 @@ static void emit(tess_ctx *x, const tvert *a, const tvert *b, const tvert *c)
      * depth stays z/w (section 4.3; the lead's note on warping after the divide). The
      * triangle is clipped already (clip_tri), so the rasterizer's clipping is skipped. */
     const tvert *t[3] = {a, b, c};
-    const double s = (double)x->m->size * OM_SUBPIX, lim = (double)(1ll << 26);
+    const double s = (double)x->m->size * OM_SUBPIX;
     int64_t gx[3], gy[3];
     double gz[3];
-    for (int k = 0; k < 3; k++) {
-        double X = floor(t[k]->u * s + 0.5), Y = floor(t[k]->v * s + 0.5);
-        double Z = (double)t[k]->c.z * (1.0 / (double)t[k]->c.w) * 4294967296.0;
-        if (!(X > -lim && X < lim && Y > -lim && Y < lim)) return;
-        gx[k] = (int64_t)X;
-        gy[k] = (int64_t)Y;
-        gz[k] = Z < 0.0 ? 0.0 : Z > 4294967295.0 ? 4294967295.0 : Z;
-    }
+    for (int k = 0; k < 3; k++)
+        if (!om__snap(t[k]->u * s, t[k]->v * s, (double)t[k]->c.z * (1.0 / (double)t[k]->c.w) * 4294967296.0,
+                      &gx[k], &gy[k], &gz[k]))
+            return;
     om__raster_snapped(&x->r, gx, gy, gz, x->tri);
     x->drawn++;
 }

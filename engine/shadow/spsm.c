@@ -613,10 +613,10 @@ static uint8_t lookup(spsm_state *m, const om_strip *st, size_t i)
 
     /* 4.1 lit: the sample lies on the stored triangle. Nothing touching the texel was
      * nearer than it over the texel (conservative rasterization and depth; but for a
-     * near tie, which is one surface with it). We also
-     * accept a stored triangle that does not cover the sample but lies in its plane
-     * (the other half of a floor quad): it too was the nearest thing in the texel.
-     * That halves the uncertain samples at no measured cost in accuracy. */
+     * near tie, which is one surface with it). We also accept a stored triangle that
+     * does not cover the sample but lies in its plane (the other half of a floor quad):
+     * it too was the nearest thing in the texel. That halves the uncertain samples at
+     * no measured cost in accuracy. */
     dtri *t = m->t;
     size_t at = (size_t)ty * m->size + (size_t)tx;
     if (at != m->t4_at) {

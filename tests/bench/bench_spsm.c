@@ -1,10 +1,11 @@
 /* bench_spsm.c — Sub-Pixel Shadow Maps against the conventional map at 1024x768, for
  * the default scene and the 10K and 100K random-triangle scenes, at map sizes 512 to
- * 4096: build and lookup time (medians of 5 interleaved runs), SPSM's overhead over the map (build plus
- * lookup, the stages the two differ in; the paper's Table 2 measured 81, 56, 44 and
- * 27%, on frames that include rendering the scene: our "frame" figure adds the eye
- * pass to both), each one's mismatch share against the reference, and SPSM's classification
- * shares (lit, shadowed, uncertain; and the uncertain share that recovery shadowed). */
+ * 4096: build and lookup time (medians of 5 interleaved runs), SPSM's overhead over
+ * the map (build plus lookup, the stages the two differ in; the paper's Table 2
+ * measured 81, 56, 44 and 27%, on frames that include rendering the scene: our
+ * "frame" figure adds the eye pass to both), each one's mismatch share against the
+ * reference, and SPSM's classification shares (lit, shadowed, uncertain; and the
+ * uncertain share that recovery shadowed). */
 #include "bench.h"
 
 enum { N = 5 };   /* runs per method and size */
