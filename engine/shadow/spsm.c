@@ -23,7 +23,9 @@
  *    outline is a hull, see boundary below); with spsm.aa = K > 1, K positions in
  *    the eye pixel are tested against the same outline (section 5). When every texel
  *    around holds an occluder there is no outline to find, and the plain map's test at
- *    the texel centre decides (the paper assumes shadow there).
+ *    the texel centre decides (the paper assumes shadow there). A point the outline
+ *    leaves lit is still shadowed when the plain map finds an occluder at all four
+ *    texel centres around it (centres_shadow: not in the paper).
  * The depth tolerance is what the record cannot resolve: half a 16-bit depth step for
  * rounding, one step of margin, and the derivative code's error bound times the
  * distance from the texel centre. No bias setting is used. */
@@ -566,6 +568,25 @@ static bool centre_test(const spsm_state *m, const receiver *r, int64_t tx, int6
     return (double)c < z - TOL0;
 }
 
+/* The plain map around a point of the pixel at grid offset (qx, qy) from the centre of
+ * texel (tx, ty): whether the four texel centres nearest to it all hold something
+ * nearer than the sample's plane carried there, the sample itself being at (px, py).
+ * The point then lies inside a shadow wider than a texel, whatever outline recovery
+ * found: a record keeps one triangle per texel, and across a thin bar or along a
+ * finely tessellated rim the 3x3 can miss the triangles that reach the point. */
+static bool centres_shadow(const spsm_state *m, const receiver *r, int64_t tx, int64_t ty,
+                           int64_t px, int64_t py, int64_t qx, int64_t qy)
+{
+    const int64_t ax = floordiv(qx, OM_SUBPIX), ay = floordiv(qy, OM_SUBPIX);
+    for (int64_t j = ay; j <= ay + 1; j++)
+        for (int64_t i = ax; i <= ax + 1; i++) {
+            int64_t x = tx + i, y = ty + j;
+            if (x < 0 || y < 0 || x >= (int64_t)m->size || y >= (int64_t)m->size) return false;
+            if (!centre_test(m, r, x, y, px - i * OM_SUBPIX, py - j * OM_SUBPIX)) return false;
+        }
+    return true;
+}
+
 static sample_pt project(const spsm_state *m, om_vec3 p)
 {
     sample_pt s;
@@ -647,8 +668,7 @@ static uint8_t lookup(spsm_state *m, const om_strip *st, size_t i)
      * neighbours, near its terminator) cannot block the way to the light. */
     m->uncertain++;
     unsigned pat = 0;
-    receiver rp;
-    rp.ok = false;
+    receiver rp = {0.0, 0.0, 0.0, false};
     bool have_rp = false;
     for (int k = 0; k < 9; k++) {
         /* cheapest test first; the receiver's plane only when a texel needs it */
@@ -704,6 +724,10 @@ static uint8_t lookup(spsm_state *m, const om_strip *st, size_t i)
         for (int k = 0; k < nocc && !shadow; k++) shadow = hits(occ[k], qx, qy, q.z);
         if (!shadow && bd->nh) shadow = inside_hull(bd, qx, qy);
         if (!shadow && tg->keep == 511) shadow = centre_test(m, &rp, tx, ty, px, py);   /* rp set */
+        if (!shadow) {
+            if (!have_rp) { rp = receiver_plane(m, smp); have_rp = true; }
+            shadow = centres_shadow(m, &rp, tx, ty, px, py, qx, qy);
+        }
         nlit += !shadow;
     }
     m->last = nlit == K ? P_REC_LIT : P_REC_SHADOW;
