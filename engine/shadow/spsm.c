@@ -7,9 +7,9 @@
  * (every texel whose square it touches); the depth test uses the minimum conservative
  * depth over the texel (the plane's minimum over the square, never nearer than the
  * triangle's nearest vertex), kept in a 32-bit buffer beside the texels, and the
- * winner's record (section 3.3) is written to the texel; near ties alternate in a
- * checkerboard (frag, below). A second 32-bit buffer keeps the plain map's depth at
- * texel centres for the one case recovery cannot decide.
+ * winner's record (section 3.3) is written to the texel; near ties share the texels
+ * out in a fixed pattern (frag, below). A second 32-bit buffer keeps the plain map's
+ * depth at texel centres for the cases recovery cannot decide.
  *
  * Lookup (section 4): each exposed sample is projected with the light's matrix, as the
  * conventional map does, onto the sub-texel grid. Then
@@ -34,6 +34,7 @@
 
 #define LINK_DZ (32.0 * STEP)    /* planes of one smooth surface agree this well */
 #define TIE_DZ (LINK_DZ / 2)     /* the build's near tie: one surface to recovery */
+#define TIES 0xFFu               /* the depth buffer's low bits: ties counted (frag) */
 #define MAXV 27                  /* boundary vertices: 9 triangles x 3 */
 #define STEP 65536.0             /* one 16-bit depth step in raw units */
 #define TOL0 (1.5 * STEP)
@@ -72,7 +73,8 @@ typedef struct spsm_state {
     om_method_cfg cfg;
     uint32_t size;
     om__spsm_texel *tex;
-    uint32_t *depth;             /* minimum conservative depth: the build's depth test */
+    uint32_t *depth;             /* minimum conservative depth: the build's depth test
+                                  * (low 8 bits: ties so far; all ones: empty) */
     uint32_t *cdepth;            /* nearest depth at each texel centre (fallback) */
     om_view view;
     om__spsm_qtable q;
@@ -193,17 +195,24 @@ static void frag(void *user, int32_t x, int32_t y, const om__rtri *t)
      * but never nearer than the triangle itself reaches. */
     double z = t->z0 + t->zx * cx + t->zy * cy - (fabs(t->zx) + fabs(t->zy)) * H;
     if (!(z >= t->zmin)) z = t->zmin;
-    uint32_t dz = (uint32_t)z;
+    uint32_t dz = (uint32_t)z & ~TIES;
     size_t i = (size_t)y * m->size + (size_t)x;
     /* Near ties (within TIE_DZ, what recovery takes for one surface) are most often
-     * the halves of one flat quad or the faces of one thin part (a fence bar): the
-     * texels of a checkerboard keep the first one drawn, the others the last, so a
-     * 3x3 neighbourhood holds both and recovery links them into one outline (keeping
-     * the first everywhere loses the other's). The depth buffer keeps the nearer. */
-    uint32_t o = m->depth[i];
-    bool tie = o != 0xFFFFFFFFu && (dz >= o ? dz - o : o - dz) <= (uint32_t)TIE_DZ;
-    if (tie ? !((x ^ y) & 1) : dz > o) return;
-    if (dz < o) m->depth[i] = dz;
+     * the halves of one flat quad, the faces of one thin part (a fence bar, a pole)
+     * or the small triangles of a fine mesh. The k-th triangle to tie for a texel
+     * takes it where (x + (k - 1) y) mod k = k - 1 (k = nt): the second on a checkerboard, the
+     * third on one texel of each row and column of a 3x3, and so on, so that the
+     * neighbourhood recovery reads holds as many of them as it can (keeping the first
+     * everywhere loses the rest of the outline). The depth keeps the nearer. */
+    uint32_t o = m->depth[i], od = o & ~TIES, nt = o & TIES;
+    if (o != 0xFFFFFFFFu && (dz >= od ? dz - od : od - dz) <= (uint32_t)TIE_DZ) {
+        if (nt < TIES - 1) nt++;
+        m->depth[i] = (dz < od ? dz : od) | nt;
+        if (((uint32_t)x + (nt - 1) * (uint32_t)y) % nt != nt - 1) return;
+    } else {
+        if (dz > od) return;
+        m->depth[i] = dz | 1u;
+    }
     if (!b->have || t->zx != b->zx || t->zy != b->zy) {
         /* derivatives in depth steps per texel, scaled (spsm.h) */
         const double k = (double)OM_SUBPIX / STEP / OM_SPSM_DSCALE;
