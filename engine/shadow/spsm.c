@@ -5,11 +5,11 @@
  *
  * Build (section 3.2): every triangle is rasterized conservatively from the light
  * (every texel whose square it touches); the depth test uses the minimum conservative
- * depth over the texel (the plane's minimum over the square, never nearer than the
- * triangle's nearest vertex), kept in a 32-bit buffer beside the texels, and the
- * winner's record (section 3.3) is written to the texel; near ties share the texels
- * out in a fixed pattern (frag, below). A second 32-bit buffer keeps the plain map's
- * depth at texel centres for the cases recovery cannot decide.
+ * depth over the texel (the least depth the triangle reaches inside the square), kept
+ * in a 32-bit buffer beside the texels, and the winner's record (section 3.3) is
+ * written to the texel; near ties share the texels out in a fixed pattern (frag,
+ * below). A second 32-bit buffer keeps the plain map's depth at texel centres for the
+ * cases recovery cannot decide.
  *
  * Lookup (section 4): each exposed sample is projected with the light's matrix, as the
  * conventional map does, onto the sub-texel grid. Then
@@ -167,6 +167,51 @@ static om_status spsm_observe(void *state, const om_strip *st, om_diag *d)
     return OM_OK;
 }
 
+/* A depth plane: z at grid point (ox, oy), slopes gx, gy per grid unit. */
+typedef struct zplane { double z, gx, gy; int64_t ox, oy; } zplane;
+
+/* The least depth of plane p over the triangle (X, Y) clipped to the square
+ * [x0, x0 + side] x [y0, y0 + side]: a linear function's least value on a convex
+ * polygon is at one of its vertices. HUGE_VAL when the two do not overlap. */
+static double clipped_min(const int64_t X[3], const int64_t Y[3], int64_t x0, int64_t y0, int64_t side,
+                          const zplane *p)
+{
+    double buf[2][10][2];
+    double (*src)[2] = buf[0], (*dst)[2] = buf[1];
+    int n = 3;
+    for (int i = 0; i < 3; i++) { src[i][0] = (double)X[i]; src[i][1] = (double)Y[i]; }
+    const double lim[4] = {(double)x0, (double)(x0 + side), (double)y0, (double)(y0 + side)};
+    for (int c = 0; c < 4 && n > 0; c++) {
+        const int axis = c >> 1;
+        const double sgn = (c & 1) ? -1.0 : 1.0;
+        bool cuts = false;   /* a side no vertex lies beyond changes nothing */
+        for (int i = 0; i < n && !cuts; i++) cuts = (src[i][axis] - lim[c]) * sgn < 0;
+        if (!cuts) continue;
+        int k = 0;
+        for (int i = 0; i < n; i++) {
+            const double *a = src[i], *b = src[i + 1 == n ? 0 : i + 1];
+            double da = (a[axis] - lim[c]) * sgn, db = (b[axis] - lim[c]) * sgn;
+            if (da >= 0) { dst[k][0] = a[0]; dst[k][1] = a[1]; k++; }
+            if ((da >= 0) != (db >= 0)) {
+                double s = da / (da - db);
+                dst[k][0] = a[0] + s * (b[0] - a[0]);
+                dst[k][1] = a[1] + s * (b[1] - a[1]);
+                k++;
+            }
+        }
+        n = k;
+        double (*t)[2] = src;
+        src = dst;
+        dst = t;
+    }
+    double zmin = HUGE_VAL;
+    for (int i = 0; i < n; i++) {
+        double z = p->z + p->gx * (src[i][0] - (double)p->ox) + p->gy * (src[i][1] - (double)p->oy);
+        if (z < zmin) zmin = z;
+    }
+    return zmin;
+}
+
 /* ---------------------------------------------------------------- build (3.2) */
 
 typedef struct build_ctx {
@@ -190,10 +235,23 @@ static void frag(void *user, int32_t x, int32_t y, const om__rtri *t)
     const double H = OM_SUBPIX / 2;
     double cx = (double)((int64_t)x * OM_SUBPIX) + H - (double)e->x[0];
     double cy = (double)((int64_t)y * OM_SUBPIX) + H - (double)e->y[0];
-    /* Minimum conservative depth (Hasselgren et al., as section 3.2 uses it): the
-     * plane's least value over the texel square, at the corner its slopes point to,
-     * but never nearer than the triangle itself reaches. */
+    /* Minimum conservative depth (section 3.2): the least depth the triangle reaches
+     * inside the texel's square. That is the plane's least value over the square, at
+     * the corner its slopes point to, when the triangle covers that corner; otherwise
+     * it is on the triangle clipped to the square. (The paper takes the plane's value
+     * at the corner even there, nearer than the triangle reaches: a steep triangle
+     * behind an occluder then takes its texels.) A long sliver, a fence bar's face,
+     * so competes with its depth in this texel, not with its nearest end's. */
     double z = t->z0 + t->zx * cx + t->zy * cy - (fabs(t->zx) + fabs(t->zy)) * H;
+    const int64_t kx = (int64_t)x * OM_SUBPIX, ky = (int64_t)y * OM_SUBPIX;
+    /* a triangle touching this texel alone lies inside it: its nearest vertex is the
+     * answer (at the map's edge the bounds are clamped, and zmin stays a lower bound) */
+    const bool alone = t->minx == t->maxx && t->miny == t->maxy;
+    if (!alone && !om__tri2_covers(e, kx + (t->zx > 0 ? 0 : OM_SUBPIX), ky + (t->zy > 0 ? 0 : OM_SUBPIX))) {
+        const zplane p = {t->z0, t->zx, t->zy, e->x[0], e->y[0]};
+        double zc = clipped_min(e->x, e->y, kx, ky, OM_SUBPIX, &p);
+        if (zc > z && zc != HUGE_VAL) z = zc;   /* (no overlap: only touching) */
+    }
     if (!(z >= t->zmin)) z = t->zmin;
     uint32_t dz = (uint32_t)z & ~TIES;
     size_t i = (size_t)y * m->size + (size_t)x;
@@ -346,35 +404,8 @@ static double consistent_min(const dtri *t)
     const int64_t H = OM_SUBPIX / 2;
     int64_t kx = t->cx + (t->gx > 0 ? -H : H), ky = t->cy + (t->gy > 0 ? -H : H);
     if (om__tri2_covers(&t->e, kx, ky)) return plane_at(t, kx, ky);
-    double px[10][2], qx[10][2];
-    int n = 3;
-    for (int i = 0; i < 3; i++) { px[i][0] = (double)t->e.x[i]; px[i][1] = (double)t->e.y[i]; }
-    const double lim[4] = {(double)(t->cx - H), (double)(t->cx + H), (double)(t->cy - H), (double)(t->cy + H)};
-    for (int p = 0; p < 4 && n > 0; p++) {
-        int axis = p >> 1;
-        double sgn = (p & 1) ? -1.0 : 1.0;
-        int k = 0;
-        for (int i = 0; i < n; i++) {
-            const double *a = px[i], *b = px[i + 1 == n ? 0 : i + 1];
-            double da = (a[axis] - lim[p]) * sgn, db = (b[axis] - lim[p]) * sgn;
-            if (da >= 0) { qx[k][0] = a[0]; qx[k][1] = a[1]; k++; }
-            if ((da >= 0) != (db >= 0)) {
-                double s = da / (da - db);
-                qx[k][0] = a[0] + s * (b[0] - a[0]);
-                qx[k][1] = a[1] + s * (b[1] - a[1]);
-                k++;
-            }
-        }
-        n = k;
-        memcpy(px, qx, sizeof px);
-    }
-    if (n == 0) return HUGE_VAL;
-    double zmin = HUGE_VAL;
-    for (int i = 0; i < n; i++) {
-        double z = t->z + t->gx * (px[i][0] - (double)t->cx) + t->gy * (px[i][1] - (double)t->cy);
-        if (z < zmin) zmin = z;
-    }
-    return zmin;
+    const zplane p = {t->z, t->gx, t->gy, t->cx, t->cy};
+    return clipped_min(t->e.x, t->e.y, t->cx - H, t->cy - H, OM_SUBPIX, &p);
 }
 
 static int lowbit(uint32_t m)
