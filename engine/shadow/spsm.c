@@ -171,45 +171,35 @@ static om_status spsm_observe(void *state, const om_strip *st, om_diag *d)
 typedef struct zplane { double z, gx, gy; int64_t ox, oy; } zplane;
 
 /* The least depth of plane p over the triangle (X, Y) clipped to the square
- * [x0, x0 + side] x [y0, y0 + side]: a linear function's least value on a convex
- * polygon is at one of its vertices. HUGE_VAL when the two do not overlap. */
+ * [x0, x0 + side] x [y0, y0 + side], for a square whose corner the slopes point to
+ * (the plane's least value over the square) lies outside the triangle: the least
+ * value over the two's overlap is then on the triangle's boundary, at an end of one
+ * of its edges clipped to the square (Liang-Barsky), whichever the slope along the
+ * edge points to. HUGE_VAL when no edge crosses the square. */
 static double clipped_min(const int64_t X[3], const int64_t Y[3], int64_t x0, int64_t y0, int64_t side,
                           const zplane *p)
 {
-    double buf[2][10][2];
-    double (*src)[2] = buf[0], (*dst)[2] = buf[1];
-    int n = 3;
-    for (int i = 0; i < 3; i++) { src[i][0] = (double)X[i]; src[i][1] = (double)Y[i]; }
-    const double lim[4] = {(double)x0, (double)(x0 + side), (double)y0, (double)(y0 + side)};
-    for (int c = 0; c < 4 && n > 0; c++) {
-        const int axis = c >> 1;
-        const double sgn = (c & 1) ? -1.0 : 1.0;
-        bool cuts = false;   /* a side no vertex lies beyond changes nothing */
-        for (int i = 0; i < n && !cuts; i++) cuts = (src[i][axis] - lim[c]) * sgn < 0;
-        if (!cuts) continue;
-        int k = 0;
-        for (int i = 0; i < n; i++) {
-            const double *a = src[i], *b = src[i + 1 == n ? 0 : i + 1];
-            double da = (a[axis] - lim[c]) * sgn, db = (b[axis] - lim[c]) * sgn;
-            if (da >= 0) { dst[k][0] = a[0]; dst[k][1] = a[1]; k++; }
-            if ((da >= 0) != (db >= 0)) {
-                double s = da / (da - db);
-                dst[k][0] = a[0] + s * (b[0] - a[0]);
-                dst[k][1] = a[1] + s * (b[1] - a[1]);
-                k++;
-            }
+    const double lo[2] = {(double)x0, (double)y0}, hi[2] = {(double)(x0 + side), (double)(y0 + side)};
+    double best = HUGE_VAL;
+    for (int i = 0; i < 3; i++) {
+        const int j = i == 2 ? 0 : i + 1;
+        const double a[2] = {(double)X[i], (double)Y[i]}, d[2] = {(double)(X[j] - X[i]), (double)(Y[j] - Y[i])};
+        double t0 = 0.0, t1 = 1.0;
+        bool in = true;
+        for (int k = 0; k < 2 && in; k++) {
+            if (d[k] == 0.0) { in = a[k] >= lo[k] && a[k] <= hi[k]; continue; }
+            double inv = 1.0 / d[k], ta = (lo[k] - a[k]) * inv, tb = (hi[k] - a[k]) * inv;
+            if (ta > tb) { double s = ta; ta = tb; tb = s; }
+            if (ta > t0) t0 = ta;
+            if (tb < t1) t1 = tb;
+            in = t0 <= t1;
         }
-        n = k;
-        double (*t)[2] = src;
-        src = dst;
-        dst = t;
+        if (!in) continue;
+        double t = p->gx * d[0] + p->gy * d[1] < 0.0 ? t1 : t0;
+        double z = p->z + p->gx * (a[0] + t * d[0] - (double)p->ox) + p->gy * (a[1] + t * d[1] - (double)p->oy);
+        if (z < best) best = z;
     }
-    double zmin = HUGE_VAL;
-    for (int i = 0; i < n; i++) {
-        double z = p->z + p->gx * (src[i][0] - (double)p->ox) + p->gy * (src[i][1] - (double)p->oy);
-        if (z < zmin) zmin = z;
-    }
-    return zmin;
+    return best;
 }
 
 /* ---------------------------------------------------------------- build (3.2) */
