@@ -49,8 +49,21 @@ bool om__rtw_table(const double *I, uint32_t n, int32_t *P);
 /* warp(k) = P(k) - k/n, both in OM_RTW_ONE units (k/n rounded to nearest). */
 int32_t om__rtw_warp_at(const int32_t *P, uint32_t n, uint32_t k);
 /* Warps one coordinate; *density (if not NULL): warped length per unwarped length
- * there (1 outside [0, 1]). */
-double om__rtw_apply(const int32_t *P, uint32_t n, double u, double *density);
+ * there (1 outside [0, 1]). Inline: every lookup and every warped vertex runs it. */
+static inline double om__rtw_apply(const int32_t *P, uint32_t n, double u, double *density)
+{
+    if (!(u > 0.0 && u < 1.0)) {   /* outside the map (and NaN): left alone */
+        if (density) *density = 1.0;
+        return u;
+    }
+    double t = u * (double)n;
+    uint32_t k = (uint32_t)t;
+    if (k > n - 1) k = n - 1;
+    double f = t - (double)k, a = (double)P[k], b = (double)P[k + 1];
+    if (density) *density = (b - a) * (double)n / (double)OM_RTW_ONE;
+    return (a + f * (b - a)) / (double)OM_RTW_ONE;
+}
+
 /* Largest warped length of a super-cell, times n: the densest super-cell's
  * magnification (the maximum effective resolution is map_size times it). */
 double om__rtw_max_density(const int32_t *P, uint32_t n);

@@ -87,20 +87,6 @@ int32_t om__rtw_warp_at(const int32_t *P, uint32_t n, uint32_t k)
     return P[k] - identity_at(n, k);
 }
 
-double om__rtw_apply(const int32_t *P, uint32_t n, double u, double *density)
-{
-    if (!(u > 0.0 && u < 1.0)) {   /* outside the map (and NaN): left alone */
-        if (density) *density = 1.0;
-        return u;
-    }
-    double t = u * (double)n;
-    uint32_t k = (uint32_t)t;
-    if (k > n - 1) k = n - 1;
-    double f = t - (double)k, a = (double)P[k], b = (double)P[k + 1];
-    if (density) *density = (b - a) * (double)n / (double)OM_RTW_ONE;
-    return (a + f * (b - a)) / (double)OM_RTW_ONE;
-}
-
 double om__rtw_max_density(const int32_t *P, uint32_t n)
 {
     int32_t best = 0;
