@@ -247,9 +247,9 @@ static void frag(void *user, int32_t x, int32_t y, const om__rtri *t)
     size_t i = (size_t)y * m->size + (size_t)x;
     /* Near ties (within TIE_DZ, what recovery takes for one surface) are most often
      * the halves of one flat quad, the faces of one thin part (a fence bar, a pole)
-     * or the small triangles of a fine mesh. The k-th triangle to tie for a texel
-     * takes it where (x + (k - 1) y) mod k = k - 1 (k = nt): the second on a checkerboard, the
-     * third on one texel of each row and column of a 3x3, and so on, so that the
+     * or the small triangles of a fine mesh. The k-th triangle to tie for a texel (k
+     * = nt) takes it where (x + (k - 1) y) mod k = k - 1: the second on a checkerboard,
+     * the third on one texel of each row and column of a 3x3, and so on, so that the
      * neighbourhood recovery reads holds as many of them as it can (keeping the first
      * everywhere loses the rest of the outline). The depth keeps the nearer. */
     uint32_t o = m->depth[i], od = o & ~TIES, nt = o & TIES;
