@@ -81,7 +81,6 @@ typedef struct spsm_state {
     om__spsm_tangent lut[512];
     /* per frame */
     uint32_t samples, lit, shadowed, uncertain, recovered;
-    int last;                    /* how the last sample was decided (enum path) */
     /* The lookup's 3x3 of decoded texels. Consecutive samples mostly fall in the same
      * texel, and the 3x3 around it depends on nothing but the map and that texel's
      * index, so it is kept from one sample to the next while `t4_at` names the texel:
@@ -642,8 +641,6 @@ static om_vec3 pixel_step(const om_strip *st, size_t i, int axis)
     return om__scale(om__v3(o->p[0] - s->p[0], o->p[1] - s->p[1], o->p[2] - s->p[2]), sign);
 }
 
-enum path { P_EMPTY, P_ON, P_UNDER, P_NEAR, P_REC_LIT, P_REC_SHADOW };
-
 /* The whole lookup of one sample; returns the term value (255 lit, 0 shadowed, partial
  * with AA). */
 static uint8_t lookup(spsm_state *m, const om_strip *st, size_t i)
@@ -651,7 +648,6 @@ static uint8_t lookup(spsm_state *m, const om_strip *st, size_t i)
     const om_sample *smp = &st->samples[i];
     om_vec3 pw = om__v3(smp->p[0], smp->p[1], smp->p[2]);
     sample_pt p = project(m, pw);
-    m->last = P_EMPTY;
     if (!p.ok) { m->lit++; return 255; }
     int64_t tx = floordiv(p.x, OM_SUBPIX), ty = floordiv(p.y, OM_SUBPIX);
     if (tx < 0) tx = 0;
@@ -680,14 +676,14 @@ static uint8_t lookup(spsm_state *m, const om_strip *st, size_t i)
     if (t[4].ok) {
         double z = plane_at(&t[4], px, py), tol = tol_at(&t[4], px, py);
         bool cov = om__tri2_covers(&t[4].e, px, py);
-        if (cov && z < p.z - tol) { m->shadowed++; m->last = P_UNDER; return 0; }
-        if (z >= p.z - tol && z <= p.z + tol && tol <= TOL0 + LIT_CAP) { m->lit++; m->last = P_ON; return 255; }
+        if (cov && z < p.z - tol) { m->shadowed++; return 0; }
+        if (z >= p.z - tol && z <= p.z + tol && tol <= TOL0 + LIT_CAP) { m->lit++; return 255; }
     }
     /* 4.1 shadowed: Algorithm 1 on the 3x3 neighbourhood */
     for (int k = 0; k < 9; k++) {
         if (k == 4) continue;
         if (!((m->t_have >> k) & 1u)) { decode(m, tx, ty, t, k); m->t_have |= 1u << k; }
-        if (hits(&t[k], px, py, p.z)) { m->shadowed++; m->last = P_NEAR; return 0; }
+        if (hits(&t[k], px, py, p.z)) { m->shadowed++; return 0; }
     }
 
     /* 4.2 uncertain: the silhouette from partial geometry. Consistent depth tests give
@@ -760,7 +756,6 @@ static uint8_t lookup(spsm_state *m, const om_strip *st, size_t i)
         }
         nlit += !shadow;
     }
-    m->last = nlit == K ? P_REC_LIT : P_REC_SHADOW;
     if (nlit == K) return 255;
     m->recovered++;
     uint8_t v = (uint8_t)((255 * nlit + K / 2) / K);
