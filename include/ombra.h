@@ -274,6 +274,8 @@ typedef struct om_method_cfg {
     float rtw_tess;           /* longest warped edge as a fraction of the map, 0 = off */
     /* spsm */
     uint32_t spsm_aa;      /* sub-samples at uncertain samples, 0 or 1 = off */
+    uint32_t spsm_all;     /* 1: make every texel's record, not only those the view
+                              reads (the paper's build; the same frames, slower) */
 } om_method_cfg;
 
 /* One settable field of om_method_cfg. */

@@ -42,7 +42,7 @@ static void add_coverage(const om_vec4 c[3], uint32_t w, uint32_t h)
 {
     om_target t = target(w, h);
     om__target_clear(&t);
-    om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL, NULL};
+    om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL, NULL, NULL, 0};
     om__raster_tri(&r, c, 7);
     for (uint32_t i = 0; i < w * h; i++) count_buf[i] += id_buf[i] == 7;
 }
@@ -311,7 +311,7 @@ static void huge_ground(float half)
     for (int i = 0; i < 4; i++) c[i] = om__mat_apply(&vp, q[i]);
     om_target t = target(W, H);
     om__target_clear(&t);
-    om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL, NULL};
+    om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL, NULL, NULL, 0};
     om_vec4 t1[3] = {c[0], c[1], c[2]}, t2[3] = {c[0], c[2], c[3]};
     om__raster_tri(&r, t1, 1);
     om__raster_tri(&r, t2, 2);
@@ -392,7 +392,7 @@ static void snapped_matches_clipped(void)
             z[i] = (double)c[i].z * 4294967296.0;
         }
         om_target t = target(TW, TH);
-        om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL, NULL};
+        om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL, NULL, NULL, 0};
         om__target_clear(&t);
         om__raster_tri(&r, c, 5);
         memcpy(d0, depth_buf, sizeof d0);
@@ -405,11 +405,11 @@ static void snapped_matches_clipped(void)
 }
 
 typedef struct cons_ctx { int *count; uint32_t w; } cons_ctx;
-static void cons_frag(void *user, int32_t x, int32_t y, const om__rtri *t)
+static void cons_span(void *user, int32_t y, int32_t x0, int32_t x1, const om__rtri *t)
 {
     cons_ctx *c = (cons_ctx *)user;
     (void)t;
-    c->count[y * (int32_t)c->w + x]++;
+    for (int32_t x = x0; x <= x1; x++) c->count[y * (int32_t)c->w + x]++;
 }
 
 static void conservative_superset(void)
@@ -431,7 +431,7 @@ static void conservative_superset(void)
         memset(cons, 0, sizeof cons);
         om_target t = target(TW, TH);
         cons_ctx ctx = {cons, TW};
-        om_raster r = {&t, OM_RASTER_CONSERVATIVE, cons_frag, &ctx, NULL};
+        om_raster r = {&t, OM_RASTER_CONSERVATIVE, cons_span, &ctx, NULL, NULL, 0};
         om__raster_tri(&r, c, 1);
         for (int i = 0; i < TW * TH; i++) {
             if (count_buf[i] && !cons[i]) missing++;
@@ -447,9 +447,9 @@ static void conservative_superset(void)
     CHECK_EQ_U(dup, 0);
 }
 
-static void no_frag(void *user, int32_t x, int32_t y, const om__rtri *t)
+static void no_span(void *user, int32_t y, int32_t x0, int32_t x1, const om__rtri *t)
 {
-    (void)user; (void)x; (void)y; (void)t;
+    (void)user; (void)y; (void)x0; (void)x1; (void)t;
 }
 
 /* A conservative pass with `centres` leaves there the very depths a plain depth pass
@@ -474,13 +474,13 @@ static void conservative_centres_match_depth_pass(void)
         for (int i = 0; i < 3; i++) c[k][i] = at((double)x[i], (double)y[i], TW, TH, (float)(rnd() % 1000) / 1000.0f);
     }
     om_target t = target(TW, TH);
-    om_raster r = {&t, OM_RASTER_DEPTH, NULL, NULL, NULL};
+    om_raster r = {&t, OM_RASTER_DEPTH, NULL, NULL, NULL, NULL, 0};
     om__target_clear(&t);
     for (int k = 0; k < 60; k++) om__raster_tri(&r, c[k], (uint32_t)k);
     memcpy(plain, depth_buf, sizeof plain);
     om_target ct = {TW, TH, 0, TH, alongside, NULL}, scratch = target(TW, TH);
     om__target_clear(&ct);
-    om_raster rc = {&scratch, OM_RASTER_CONSERVATIVE, no_frag, NULL, &ct};
+    om_raster rc = {&scratch, OM_RASTER_CONSERVATIVE, no_span, NULL, &ct, NULL, 0};
     for (int k = 0; k < 60; k++) om__raster_tri(&rc, c[k], (uint32_t)k);
     int differ = 0, written = 0;
     for (int i = 0; i < TW * TH; i++) {
@@ -489,6 +489,25 @@ static void conservative_centres_match_depth_pass(void)
     }
     CHECK_EQ_U(differ, 0);
     CHECK(written > TW * TH / 2);
+    /* With a mask, the same depths at the pixels it holds and nothing elsewhere: runs
+     * of set and clear bits of every length, whole clear words among them. */
+    enum { MW = (TW + 31) / 32 };
+    static uint32_t mask[MW * TH];
+    for (int i = 0; i < MW * TH; i++) mask[i] = i % 5 == 0 ? 0 : rnd() & rnd();
+    om__target_clear(&ct);
+    rc.centre_mask = mask;
+    rc.mask_words = MW;
+    for (int k = 0; k < 60; k++) om__raster_tri(&rc, c[k], (uint32_t)k);
+    int wrong = 0, held = 0;
+    for (int y = 0; y < TH; y++)
+        for (int x = 0; x < TW; x++) {
+            const bool in = (mask[y * MW + x / 32] >> (x % 32)) & 1u;
+            const size_t i = (size_t)y * TW + (size_t)x;
+            wrong += alongside[i] != (in ? plain[i] : 0xFFFFFFFFu);
+            held += in && plain[i] != 0xFFFFFFFFu;
+        }
+    CHECK_EQ_U(wrong, 0);
+    CHECK(held > TW * TH / 8);
 }
 
 static void strips_match_whole(void)
@@ -504,7 +523,7 @@ static void strips_match_whole(void)
                             TW, TH, (float)(rnd() % 1000) / 1000.0f);
     om_target t = target(TW, TH);
     om__target_clear(&t);
-    om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL, NULL};
+    om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL, NULL, NULL, 0};
     for (int k = 0; k < 40; k++) om__raster_tri(&r, tris[k], (uint32_t)k);
     memcpy(whole_d, depth_buf, sizeof whole_d);
     memcpy(whole_i, id_buf, sizeof whole_i);

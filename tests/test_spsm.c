@@ -23,10 +23,10 @@ static uint32_t rnd(void)
 #define CW 24
 typedef struct cov { int hits[CW * CW]; } cov;
 
-static void cov_frag(void *user, int32_t x, int32_t y, const om__rtri *t)
+static void cov_span(void *user, int32_t y, int32_t x0, int32_t x1, const om__rtri *t)
 {
     (void)t;
-    ((cov *)user)->hits[y * CW + x]++;
+    for (int32_t x = x0; x <= x1; x++) ((cov *)user)->hits[y * CW + x]++;
 }
 
 /* Exact overlap of the snapped triangle with the closed square of texel (x, y), by
@@ -79,7 +79,7 @@ static void conservative_is_exact_overlap(void)
         cov cv;
         memset(&cv, 0, sizeof cv);
         om_target t = {CW, CW, 0, CW, depth, NULL};
-        om_raster r = {&t, OM_RASTER_CONSERVATIVE, cov_frag, &cv, NULL};
+        om_raster r = {&t, OM_RASTER_CONSERVATIVE, cov_span, &cv, NULL, NULL, 0};
         om__raster_tri(&r, c, 0);
         /* normal coverage: the top-left rule at texel centres */
         om__tri2 e;
@@ -303,6 +303,32 @@ static void identical_runs_identical_frames(void)
     h_scene_free(&hs);
 }
 
+/* The build makes only the records the lookup reads (the 3x3 around each exposed
+ * sample's texel); spsm.all = 1 makes every one. The frames must not differ, at a map
+ * coarser and one finer than the image, with AA and through strips. */
+static void records_made_where_read(void)
+{
+    h_scene hs;
+    if (!h_scene_parse(&hs, om_scene_default_text())) return;
+    om_method_cfg c;
+    om_method_cfg_default(&c);
+    int differ = 0, runs = 0;
+    for (uint32_t map = 128; map <= 2048; map *= 16)
+        for (uint32_t aa = 0; aa <= 4; aa += 4)
+            for (uint32_t strip = 0; strip <= 7; strip += 7) {
+                c.map_size = map;
+                c.spsm_aa = aa;
+                c.spsm_all = 0;
+                CHECK_OK(h_render(&hs.s, "spsm", &c, 320, 240, 0, strip, msk, terms, NULL));
+                c.spsm_all = 1;
+                CHECK_OK(h_render(&hs.s, "spsm", &c, 320, 240, 0, strip, msk2, terms2, NULL));
+                differ += memcmp(terms, terms2, sizeof(om_term) * 320 * 240) != 0;
+                runs++;
+            }
+    CHECK_MSG(differ == 0, "%d of %d frames differ", differ, runs);
+    h_scene_free(&hs);
+}
+
 static void aa_only_at_uncertain_samples(void)
 {
     h_scene hs;
@@ -381,6 +407,9 @@ static void stats_and_budget(void)
               s.counters[0]);
     CHECK(s.counters[0] > 10000 && s.counters[3] > 0 && s.counters[4] <= s.counters[3]);
     CHECK(s.bytes_used == mn);
+    /* records are made where the lookup reads: here 2/3 of the map is never read */
+    CHECK(s.ncounters >= 8);
+    CHECK_MSG(s.counters[7] > 1000 && s.counters[7] < 300u * 300u / 3, "%u texels needed", s.counters[7]);
     /* settings out of range are refused cleanly */
     c.map_size = 0;
     CHECK(m->bytes(&c, &hs.s, 160, 120, &mn, &full) == OM_E_INVALID);
@@ -427,6 +456,7 @@ void suite_spsm(void)
     RUN(default_scene_accuracy);
     RUN(dense_mesh_stays_ahead);
     RUN(identical_runs_identical_frames);
+    RUN(records_made_where_read);
     RUN(aa_only_at_uncertain_samples);
     RUN(stats_and_budget);
     RUN(odd_inputs);

@@ -25,6 +25,20 @@ om__str om__diag_begin(om_diag *d, om_status st, char *scratch, size_t scratch_c
  * `who` and the minimum. Inits call it with their bytes query's figure. */
 om_status om__need(om_arena *a, size_t need, const char *who, om_diag *d);
 
+/* ---- bits */
+/* Index of the lowest set bit of x != 0: one instruction where the compiler offers it
+ * (bit masks are scanned per texel), else a loop. */
+static inline int om__ctz32(uint32_t x)
+{
+#if defined(__GNUC__) || defined(__clang__)
+    return __builtin_ctz(x);
+#else
+    int k = 0;
+    while (!((x >> k) & 1u)) k++;
+    return k;
+#endif
+}
+
 /* ---- vectors */
 static inline om_vec3 om__v3(float x, float y, float z) { om_vec3 v; v.x = x; v.y = y; v.z = z; return v; }
 static inline om_vec3 om__add(om_vec3 a, om_vec3 b) { return om__v3(a.x + b.x, a.y + b.y, a.z + b.z); }
@@ -42,7 +56,17 @@ static inline bool om__finite(float f) { return f == f && f - f == 0.0f; }
 /* ---- matrices (row-major, v' = M v) */
 om_mat4 om__mat_identity(void);
 om_mat4 om__mat_mul(const om_mat4 *a, const om_mat4 *b);
-om_vec4 om__mat_apply(const om_mat4 *m, om_vec3 p);        /* w = 1 */
+/* w = 1; in line: every lookup of every sample runs it */
+static inline om_vec4 om__mat_apply(const om_mat4 *m, om_vec3 p)
+{
+    const float *a = m->m;
+    om_vec4 r;
+    r.x = a[0] * p.x + a[1] * p.y + a[2] * p.z + a[3];
+    r.y = a[4] * p.x + a[5] * p.y + a[6] * p.z + a[7];
+    r.z = a[8] * p.x + a[9] * p.y + a[10] * p.z + a[11];
+    r.w = a[12] * p.x + a[13] * p.y + a[14] * p.z + a[15];
+    return r;
+}
 om_vec3 om__mat_apply_dir(const om_mat4 *m, om_vec3 d);    /* w = 0 */
 /* View matrix looking from eye to target; fails (false) when degenerate. */
 bool om__mat_look_at(om_mat4 *out, om_vec3 eye, om_vec3 target, om_vec3 up);

@@ -35,17 +35,6 @@ om_mat4 om__mat_mul(const om_mat4 *a, const om_mat4 *b)
     return r;
 }
 
-om_vec4 om__mat_apply(const om_mat4 *m, om_vec3 p)
-{
-    const float *a = m->m;
-    om_vec4 r;
-    r.x = a[0] * p.x + a[1] * p.y + a[2] * p.z + a[3];
-    r.y = a[4] * p.x + a[5] * p.y + a[6] * p.z + a[7];
-    r.z = a[8] * p.x + a[9] * p.y + a[10] * p.z + a[11];
-    r.w = a[12] * p.x + a[13] * p.y + a[14] * p.z + a[15];
-    return r;
-}
-
 om_vec3 om__mat_apply_dir(const om_mat4 *m, om_vec3 d)
 {
     const float *a = m->m;

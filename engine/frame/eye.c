@@ -68,9 +68,11 @@ void om__scene_raster(const om_scene *s, const om_mat4 *vp, const om_target *tg,
     om_raster r;
     r.target = tg;
     r.mode = mode;
-    r.frag = NULL;
+    r.span = NULL;
     r.user = NULL;
     r.centres = NULL;
+    r.centre_mask = NULL;
+    r.mask_words = 0;
     om__target_clear(tg);
     for (uint32_t t = 0; t < s->ntris; t++) {
         om_vec4 c[3];

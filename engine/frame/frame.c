@@ -88,6 +88,7 @@ om_status om_render_frame(const om_frame_desc *fd, om_arena *fa, om_frame_stats 
     const bool observes = (m->flags & OM_METHOD_OBSERVES) != 0;
     const bool fit = view.light.kind == OM_LIGHT_DIRECTIONAL;
     bool have_samples = false;   /* strip.samples hold the whole frame already */
+    bool have_terms = false;     /* and strip.terms their exposure (mark_exposed) */
     uint64_t t0;
 
 #define EYE(y)                                                                   \
@@ -121,6 +122,7 @@ om_status om_render_frame(const om_frame_desc *fd, om_arena *fa, om_frame_stats 
             if (st != OM_OK) goto done;
         }
         have_samples = single;
+        have_terms = single;   /* observe leaves the strip as marked */
     }
     t0 = now(fd);
     st = m->build(fd->method_state, d);
@@ -128,7 +130,7 @@ om_status om_render_frame(const om_frame_desc *fd, om_arena *fa, om_frame_stats 
     if (st != OM_OK) goto done;
     for (uint32_t y = 0; y < H; y += rows) {
         if (!have_samples) EYE(y);
-        mark_exposed(&view, &strip);
+        if (!have_terms) mark_exposed(&view, &strip);
         t0 = now(fd);
         st = m->resolve(fd->method_state, &strip, d);
         fs->ns_resolve += now(fd) - t0;

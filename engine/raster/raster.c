@@ -85,27 +85,6 @@ unsigned om__outcode(const om_vec4 *v, uint32_t width, uint32_t height)
     return mask;
 }
 
-bool om__snap(double x, double y, double z, int64_t *gx, int64_t *gy, double *gz)
-{
-    const double lim = (double)(1ll << 26);
-    double X = floor(x + 0.5), Y = floor(y + 0.5);
-    if (!(X > -lim && X < lim && Y > -lim && Y < lim)) return false;
-    *gx = (int64_t)X;
-    *gy = (int64_t)Y;
-    *gz = z < 0.0 ? 0.0 : z > 4294967295.0 ? 4294967295.0 : z;
-    return true;
-}
-
-bool om__project(const om_vec4 *v, uint32_t width, uint32_t height, int64_t *gx, int64_t *gy,
-                 double *gz)
-{
-    const double sx = (double)width * (OM_SUBPIX / 2), sy = (double)height * (OM_SUBPIX / 2);
-    if (!(v->w > 0.0f)) return false;
-    double iw = 1.0 / (double)v->w;
-    return om__snap(((double)v->x * iw + 1.0) * sx, (1.0 - (double)v->y * iw) * sy,
-                    (double)v->z * iw * 4294967296.0, gx, gy, gz);
-}
-
 /* The intersection is always computed from the inside vertex towards the outside one,
  * so an edge shared by two triangles is cut at the same point in both: no cracks. */
 static cvert cut(const cvert *in, const cvert *out, float din, float dout)
@@ -275,6 +254,23 @@ static void fill(const om_raster *r, const om__rtri *t, uint32_t id)
     }
 }
 
+/* depth_row over the pixels of x0..x1 whose bit is set in `mask` (one row's words):
+ * runs of clear bits are passed over, a word at a time where they fill it. */
+static void depth_row_masked(const om__rtri *t, const om_target *tg, int32_t y, int32_t x0, int32_t x1,
+                             const uint32_t *mask)
+{
+    for (int32_t x = x0; x <= x1;) {
+        const uint32_t w = mask[x >> 5] >> (x & 31);
+        if (!w) { x = (x | 31) + 1; continue; }
+        x += om__ctz32(w);
+        if (x > x1) break;
+        int32_t e = x;   /* the run of set bits from x */
+        while (e < x1 && ((mask[(e + 1) >> 5] >> ((e + 1) & 31)) & 1u)) e++;
+        depth_row(t, tg, y, x, e, NULL, 0);
+        x = e + 1;
+    }
+}
+
 static void fill_conservative(const om_raster *r, const om__rtri *t)
 {
     const om__tri2 *e = &t->e;
@@ -295,10 +291,15 @@ static void fill_conservative(const om_raster *r, const om__rtri *t)
                               om__tri2_edge(e, 2, px0, py)};
         const int64_t R[3] = {E[0] + reach[0], E[1] + reach[1], E[2] + reach[2]};
         if (!row_span(R, step, t->maxx - t->minx, &lo, &hi)) continue;
-        for (int32_t x = t->minx + (int32_t)lo; x <= t->minx + (int32_t)hi; x++) r->frag(r->user, x, y, t);
+        r->span(r->user, y, t->minx + (int32_t)lo, t->minx + (int32_t)hi, t);
         const int64_t B[3] = {E[0] - bias[0], E[1] - bias[1], E[2] - bias[2]};
-        if (ct && row_span(B, step, t->maxx - t->minx, &lo, &hi))
-            depth_row(t, ct, y, t->minx + (int32_t)lo, t->minx + (int32_t)hi, NULL, 0);
+        if (ct && row_span(B, step, t->maxx - t->minx, &lo, &hi)) {
+            if (r->centre_mask)
+                depth_row_masked(t, ct, y, t->minx + (int32_t)lo, t->minx + (int32_t)hi,
+                                 r->centre_mask + (size_t)(y - (int32_t)ct->y0) * r->mask_words);
+            else
+                depth_row(t, ct, y, t->minx + (int32_t)lo, t->minx + (int32_t)hi, NULL, 0);
+        }
     }
 }
 

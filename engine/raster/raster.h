@@ -27,6 +27,8 @@
 
 #include "ombra.h"
 
+#include <math.h>
+
 #define OM_SUBPIX_BITS 8
 #define OM_SUBPIX (1 << OM_SUBPIX_BITS)
 #define OM_GUARD_PX 8192
@@ -95,20 +97,26 @@ static inline double om__rtri_depth(const om__rtri *t, int64_t px, int64_t py)
 typedef enum om_raster_mode {
     OM_RASTER_DEPTH,       /* depth test and write (shadow maps) */
     OM_RASTER_DEPTH_ID,    /* depth test, write depth and triangle id (eye pass) */
-    OM_RASTER_CONSERVATIVE /* call `frag` for every touched pixel; no buffers written */
+    OM_RASTER_CONSERVATIVE /* call `span` for every run of touched pixels; no buffers written */
 } om_raster_mode;
 
-typedef void (*om__frag_fn)(void *user, int32_t x, int32_t y, const om__rtri *t);
+/* Conservative mode's output: pixels x0..x1 (inclusive) of row y, all touched by t. One
+ * call per row and triangle, so that the caller's per-pixel loop is its own. */
+typedef void (*om__span_fn)(void *user, int32_t y, int32_t x0, int32_t x1, const om__rtri *t);
 
 typedef struct om_raster {
     const om_target *target;
     om_raster_mode mode;
-    om__frag_fn frag;      /* conservative mode */
+    om__span_fn span;      /* conservative mode */
     void *user;
     /* Conservative mode, may be NULL: also the plain depth test (OM_RASTER_DEPTH) into
      * this target of the same size, at the texel centres the fill rule covers; the
      * same depths as a separate depth pass over the same triangles, in one pass. */
     const om_target *centres;
+    /* With centres, may be NULL: the plain test only at pixels whose bit is set here
+     * (bit x & 31 of word x >> 5 of a row; mask_words words per row of the image). */
+    const uint32_t *centre_mask;
+    uint32_t mask_words;
 } om_raster;
 
 /* Rasterizes one triangle given in clip space (clipping it first). Non-finite vertices
@@ -124,17 +132,48 @@ bool om__raster_snapped(const om_raster *r, const int64_t x[3], const int64_t y[
 /* Which of the six clip planes (near, far, four guard-band sides) a vertex is outside
  * of, as a bit mask; 0 means it needs no clipping. */
 unsigned om__outcode(const om_vec4 *v, uint32_t width, uint32_t height);
-/* Projects one clip-space vertex to the sub-pixel grid of a width x height image, with
- * depth z/w * 2^32 (clamped to [0, 2^32 - 1]); false when w <= 0 or it lands beyond
- * 2^26 grid units. Clipping uses exactly this, so a vertex projects the same alone. */
-bool om__project(const om_vec4 *v, uint32_t width, uint32_t height, int64_t *gx, int64_t *gy,
-                 double *gz);
-
 /* Snaps a point given in sub-pixel grid units (x, y) with depth z/w * 2^32 (z) to the
  * grid: rounded to the nearest grid point, the depth clamped to [0, 2^32 - 1]; false
  * beyond 2^26 grid units (or NaN). om__project ends here, and so may a caller that
- * places vertices itself (rtw's warped map). */
-bool om__snap(double x, double y, double z, int64_t *gx, int64_t *gy, double *gz);
+ * places vertices itself (rtw's warped map). In line, as om__project: the lookups
+ * run them for every sample. */
+static inline bool om__snap_xy(double x, double y, int64_t *gx, int64_t *gy)
+{
+    const double lim = (double)(1ll << 26);
+    double X = floor(x + 0.5), Y = floor(y + 0.5);
+    if (!(X > -lim && X < lim && Y > -lim && Y < lim)) return false;
+    *gx = (int64_t)X;
+    *gy = (int64_t)Y;
+    return true;
+}
+
+static inline bool om__snap(double x, double y, double z, int64_t *gx, int64_t *gy, double *gz)
+{
+    if (!om__snap_xy(x, y, gx, gy)) return false;
+    *gz = z < 0.0 ? 0.0 : z > 4294967295.0 ? 4294967295.0 : z;
+    return true;
+}
+
+/* Projects one clip-space vertex to the sub-pixel grid of a width x height image, with
+ * depth z/w * 2^32 (clamped to [0, 2^32 - 1]); false when w <= 0 or it lands beyond
+ * 2^26 grid units. Clipping uses exactly this, so a vertex projects the same alone.
+ * om__project_xy is its grid position alone (the same, without the depth). */
+static inline bool om__project_xy(const om_vec4 *v, uint32_t width, uint32_t height, int64_t *gx, int64_t *gy)
+{
+    const double sx = (double)width * (OM_SUBPIX / 2), sy = (double)height * (OM_SUBPIX / 2);
+    if (!(v->w > 0.0f)) return false;
+    double iw = 1.0 / (double)v->w;
+    return om__snap_xy(((double)v->x * iw + 1.0) * sx, (1.0 - (double)v->y * iw) * sy, gx, gy);
+}
+
+static inline bool om__project(const om_vec4 *v, uint32_t width, uint32_t height, int64_t *gx, int64_t *gy,
+                               double *gz)
+{
+    if (!om__project_xy(v, width, height, gx, gy)) return false;
+    double z = (double)v->z * (1.0 / (double)v->w) * 4294967296.0;
+    *gz = z < 0.0 ? 0.0 : z > 4294967295.0 ? 4294967295.0 : z;
+    return true;
+}
 
 /* Clips a triangle against the near, far and guard-band planes of a width x height
  * viewport and projects it: up to 9 vertices of a convex polygon in sub-pixel grid

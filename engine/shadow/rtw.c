@@ -357,9 +357,11 @@ void om__rtw_render_map(om__rtw *m)
     x.m = m;
     x.r.target = &tg;
     x.r.mode = OM_RASTER_DEPTH;
-    x.r.frag = NULL;
+    x.r.span = NULL;
     x.r.user = NULL;
     x.r.centres = NULL;
+    x.r.centre_mask = NULL;
+    x.r.mask_words = 0;
     x.limit2 = m->limit * m->limit;
     x.bend2 = (RTW_BEND / (double)m->size) * (RTW_BEND / (double)m->size);
     x.drawn = 0;

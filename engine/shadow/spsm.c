@@ -3,11 +3,16 @@
  * rebuilt below texel size. The texel format, the derivative code and the tangent
  * table are in spsm_texel.c (spsm.h); this file owns the method: build and lookup.
  *
+ * Observe (not in the paper): each exposed sample marks its texel. The lookup reads the
+ * records of the 3x3 around a sample's texel and no others, so the build writes only
+ * those (the marks grown by one texel); a record nobody reads is not made. The frames
+ * are the same as with every record made; the build's work follows the view's needs.
+ *
  * Build (section 3.2): every triangle is rasterized conservatively from the light
  * (every texel whose square it touches); the depth test uses the minimum conservative
  * depth over the texel (the least depth the triangle reaches inside the square), kept
  * in a 32-bit buffer beside the texels, and the winner's record (section 3.3) is
- * written to the texel; near ties share the texels out in a fixed pattern (frag,
+ * written to the texel; near ties share the texels out in a fixed pattern (texel,
  * below). A second 32-bit buffer keeps the plain map's depth at texel centres for the
  * cases recovery cannot decide.
  *
@@ -34,7 +39,7 @@
 
 #define LINK_DZ (32.0 * STEP)    /* planes of one smooth surface agree this well */
 #define TIE_DZ (LINK_DZ / 2)     /* the build's near tie: one surface to recovery */
-#define TIES 0xFFu               /* the depth buffer's low bits: ties counted (frag) */
+#define TIES 0xFFu               /* the depth buffer's low bits: ties counted (texel) */
 #define MAXV 27                  /* boundary vertices: 9 triangles x 3 */
 #define STEP 65536.0             /* one 16-bit depth step in raw units */
 #define TOL0 (1.5 * STEP)
@@ -76,11 +81,15 @@ typedef struct spsm_state {
     uint32_t *depth;             /* minimum conservative depth: the build's depth test
                                   * (low 8 bits: ties so far; all ones: empty) */
     uint32_t *cdepth;            /* nearest depth at each texel centre (fallback) */
+    /* Texels the lookup will read, one bit each, `words` 32-bit words per row: `seen`
+     * (the samples' texels, from observe) grown by one texel into `need` (build). */
+    uint32_t *seen, *need;
+    uint32_t words;
     om_view view;
     om__spsm_qtable q;
     om__spsm_tangent lut[512];
     /* per frame */
-    uint32_t samples, lit, shadowed, uncertain, recovered;
+    uint32_t samples, lit, shadowed, uncertain, recovered, needed;
     /* The lookup's 3x3 of decoded texels. Consecutive samples mostly fall in the same
      * texel, and the 3x3 around it depends on nothing but the map and that texel's
      * index, so it is kept from one sample to the next while `t4_at` names the texel:
@@ -100,16 +109,19 @@ typedef struct spsm_state {
 
 static bool size_ok(const om_method_cfg *c) { return c->map_size >= 1 && c->map_size <= OM_MAX_DIM; }
 
+static uint32_t row_words(uint32_t size) { return (size + 31) / 32; }
+
 static size_t spsm_need(const om_method_cfg *c)
 {
-    size_t n = (size_t)c->map_size * c->map_size;
+    size_t n = (size_t)c->map_size * c->map_size, bits = (size_t)c->map_size * row_words(c->map_size);
     return om_arena_need(sizeof(spsm_state), 16) + om_arena_need(n * sizeof(om__spsm_texel), 16) +
-           om_arena_need(n * sizeof(uint32_t), 16) * 2;
+           om_arena_need(n * sizeof(uint32_t), 16) * 2 + om_arena_need(bits * sizeof(uint32_t), 16) * 2;
 }
 
 static size_t map_bytes(const spsm_state *m)
 {
-    return (size_t)m->size * m->size * (sizeof(om__spsm_texel) + 2 * sizeof(uint32_t));
+    return (size_t)m->size * m->size * (sizeof(om__spsm_texel) + 2 * sizeof(uint32_t)) +
+           (size_t)m->size * m->words * 2 * sizeof(uint32_t);
 }
 
 static om_status spsm_bytes(const om_method_cfg *c, const om_scene *s, uint32_t w, uint32_t h,
@@ -142,6 +154,12 @@ static om_status spsm_init(void **state, om_arena *a, const om_method_cfg *c, co
     m->depth = (uint32_t *)p;
     if ((st = om_arena_alloc(a, n * sizeof(uint32_t), 16, &p, d))) return st;
     m->cdepth = (uint32_t *)p;
+    m->words = row_words(m->size);
+    const size_t bits = (size_t)m->size * m->words;
+    if ((st = om_arena_alloc(a, bits * sizeof(uint32_t), 16, &p, d))) return st;
+    m->seen = (uint32_t *)p;
+    if ((st = om_arena_alloc(a, bits * sizeof(uint32_t), 16, &p, d))) return st;
+    m->need = (uint32_t *)p;
     m->t4_at = (size_t)-1;
     m->t_have = 0;
     m->bd_have = false;
@@ -156,14 +174,90 @@ static om_status spsm_begin(void *state, const om_view *v, om_diag *d)
     (void)d;
     spsm_state *m = (spsm_state *)state;
     m->view = *v;
-    m->samples = m->lit = m->shadowed = m->uncertain = m->recovered = 0;
+    m->samples = m->lit = m->shadowed = m->uncertain = m->recovered = m->needed = 0;
+    memset(m->seen, 0, (size_t)m->size * m->words * sizeof(uint32_t));
     return OM_OK;
+}
+
+typedef struct sample_pt { int64_t x, y; double z; bool ok; } sample_pt;
+
+static sample_pt project(const spsm_state *m, om_vec3 p)
+{
+    sample_pt s;
+    om_vec4 q = om__mat_apply(&m->view.light_vp, p);
+    s.ok = om__project(&q, m->size, m->size, &s.x, &s.y, &s.z);
+    return s;
+}
+
+static int64_t floordiv(int64_t a, int64_t b)
+{
+    int64_t q = a / b;
+    return (a % b != 0 && a < 0) ? q - 1 : q;
+}
+
+/* The texel holding grid position (x, y), clamped to the map (so negative positions
+ * need no floor division: they clamp to 0). */
+static int64_t texel_of(const spsm_state *m, int64_t g)
+{
+    const int64_t t = g < 0 ? 0 : g / OM_SUBPIX, last = (int64_t)m->size - 1;
+    return t > last ? last : t;
+}
+
+/* For observe: the texel a sample's lookup will centre on, false when the sample does
+ * not project. The lookup projects with om__project, whose position is this
+ * om__project_xy's: the two agree on every sample. */
+static bool sample_texel(const spsm_state *m, const om_sample *smp, int64_t *tx, int64_t *ty)
+{
+    int64_t x, y;
+    om_vec4 q = om__mat_apply(&m->view.light_vp, om__v3(smp->p[0], smp->p[1], smp->p[2]));
+    if (!om__project_xy(&q, m->size, m->size, &x, &y)) return false;
+    *tx = texel_of(m, x);
+    *ty = texel_of(m, y);
+    return true;
 }
 
 static om_status spsm_observe(void *state, const om_strip *st, om_diag *d)
 {
-    (void)state; (void)st; (void)d;
+    (void)d;
+    spsm_state *m = (spsm_state *)state;
+    size_t n = (size_t)st->rows * st->width;
+    if (m->cfg.spsm_all) return OM_OK;   /* every record is made */
+    for (size_t i = 0; i < n; i++) {
+        if (!(st->terms[i].flags & OM_TERM_EXPOSED)) continue;
+        int64_t tx, ty;
+        if (!sample_texel(m, &st->samples[i], &tx, &ty)) continue;
+        m->seen[(size_t)ty * m->words + (size_t)(tx >> 5)] |= 1u << (tx & 31);
+    }
     return OM_OK;
+}
+
+/* need = seen grown by one texel each way (the 3x3 the lookup decodes); returns the
+ * number of texels in it. Bits past the map's width in a row's last word may be set:
+ * no texel reads them. */
+static uint32_t grow_needs(spsm_state *m)
+{
+    const uint32_t W = m->words, S = m->size;
+    uint32_t count = 0;
+    if (m->cfg.spsm_all) {
+        memset(m->need, 0xFF, (size_t)S * W * sizeof(uint32_t));
+        return S * S;
+    }
+    for (uint32_t y = 0; y < S; y++) {
+        uint32_t *out = m->need + (size_t)y * W;
+        for (uint32_t j = 0; j < W; j++) {
+            uint32_t v = 0;   /* the three rows' words, each grown sideways */
+            for (uint32_t r = y ? y - 1 : 0; r <= y + 1 && r < S; r++) {
+                const uint32_t *row = m->seen + (size_t)r * W;
+                uint32_t w = row[j];
+                v |= w | w << 1 | w >> 1;
+                if (j) v |= row[j - 1] >> 31;
+                if (j + 1 < W) v |= row[j + 1] << 31;
+            }
+            out[j] = v;
+            for (uint32_t b = v; b; b &= b - 1) count++;
+        }
+    }
+    return count;
 }
 
 /* A depth plane: z at grid point (ox, oy), slopes gx, gy per grid unit. */
@@ -216,9 +310,9 @@ typedef struct build_ctx {
     uint16_t vy[3];
 } build_ctx;
 
-static void frag(void *user, int32_t x, int32_t y, const om__rtri *t)
+/* One texel x of row y touched by t: the depth test and, for the winner, its record. */
+static void texel(build_ctx *b, int32_t x, int32_t y, const om__rtri *t)
 {
-    build_ctx *b = (build_ctx *)user;
     spsm_state *m = b->m;
     const om__tri2 *e = &t->e;
     const double H = OM_SUBPIX / 2;
@@ -278,19 +372,50 @@ static void frag(void *user, int32_t x, int32_t y, const om__rtri *t)
     om__spsm_pack_row(&m->tex[i], t, x, y, b->qx, b->qy, b->vy);
 }
 
+/* Sets a buffer to the far plane (empty) at the needed texels, a word of them at a time. */
+static void clear_needed(const spsm_state *m, uint32_t *buf)
+{
+    for (uint32_t y = 0; y < m->size; y++)
+        for (uint32_t j = 0; j < m->words; j++) {
+            if (!m->need[(size_t)y * m->words + j]) continue;
+            const uint32_t x0 = j * 32, x1 = x0 + 32 < m->size ? x0 + 32 : m->size;
+            for (uint32_t x = x0; x < x1; x++) buf[(size_t)y * m->size + x] = 0xFFFFFFFFu;
+        }
+}
+
+/* The texels of a span that the lookup will read (need): runs of 32 unneeded ones are
+ * passed over a word at a time. */
+static void span(void *user, int32_t y, int32_t x0, int32_t x1, const om__rtri *t)
+{
+    build_ctx *b = (build_ctx *)user;
+    const uint32_t *row = b->m->need + (size_t)y * b->m->words;
+    for (int32_t x = x0; x <= x1;) {
+        const uint32_t w = row[x >> 5] >> (x & 31);
+        if (!w) { x = (x | 31) + 1; continue; }
+        x += om__ctz32(w);
+        if (x > x1) break;
+        texel(b, x, y, t);
+        x++;
+    }
+}
+
 static om_status spsm_build(void *state, om_diag *d)
 {
     (void)d;
     spsm_state *m = (spsm_state *)state;
     const om_scene *s = m->scene;
-    size_t n = (size_t)m->size * m->size;
     m->t4_at = (size_t)-1;   /* no texel index: the map is about to change */
     m->bd_have = false;
-    /* the plain map at texel centres, for the fallback of 4.2: the rasterizer's own
-     * depth pass, made alongside the conservative one */
+    m->needed = grow_needs(m);
+    /* The plain map at texel centres, for the fallback of 4.2, is the rasterizer's own
+     * depth pass, made alongside the conservative one. Without AA the lookup reads it
+     * inside the 3x3 too, so both buffers are cleared and written at the needed texels
+     * only; sub-samples reach beyond, so with AA the plain map is made whole. */
+    const bool whole_plain = m->cfg.spsm_aa > 1;
     om_target tc = {m->size, m->size, 0, m->size, m->cdepth, NULL};
-    om__target_clear(&tc);
-    memset(m->depth, 0xFF, n * sizeof(uint32_t));
+    if (whole_plain) om__target_clear(&tc);
+    else clear_needed(m, m->cdepth);
+    clear_needed(m, m->depth);
     /* texels are not cleared: one whose depth is still the far plane's is empty */
     om_target tg = {m->size, m->size, 0, m->size, m->depth, NULL};
     build_ctx b;
@@ -299,9 +424,11 @@ static om_status spsm_build(void *state, om_diag *d)
     om_raster r;
     r.target = &tg;
     r.mode = OM_RASTER_CONSERVATIVE;
-    r.frag = frag;
+    r.span = span;
     r.user = &b;
     r.centres = &tc;
+    r.centre_mask = whole_plain ? NULL : m->need;
+    r.mask_words = m->words;
     for (uint32_t t = 0; t < s->ntris; t++) {
         const uint32_t *ix = s->idx + (size_t)t * 3;
         om_vec4 c[3];
@@ -397,13 +524,6 @@ static double consistent_min(const dtri *t)
     return clipped_min(t->e.x, t->e.y, t->cx - H, t->cy - H, OM_SUBPIX, &p);
 }
 
-static int lowbit(uint32_t m)
-{
-    int k = 0;
-    while (!((m >> k) & 1u)) k++;
-    return k;
-}
-
 /* Twice the signed area of (o, a, b): > 0 when b lies left of o -> a. Exact: offsets
  * stay below 2^27 (the o16 range), so the products stay below 2^55. */
 static int64_t turn(int64_t ox, int64_t oy, int64_t ax, int64_t ay, int64_t bx, int64_t by)
@@ -488,7 +608,7 @@ static void boundary_build(boundary *b, const dtri *const occ[9], int nocc)
                 /* one surface: i's triangle's plane, carried to j, meets j's triangle
                  * there (a smooth mesh bends little over a texel; a cloud of separate
                  * triangles does not line up) */
-                const dtri *a = occ[lowbit(tri_of[i])], *c = occ[lowbit(tri_of[j])];
+                const dtri *a = occ[om__ctz32(tri_of[i])], *c = occ[om__ctz32(tri_of[j])];
                 double za = plane_at(a, b->x[j], b->y[j]), zc = plane_at(c, b->x[j], b->y[j]);
                 if (fabs(za - zc) > tol_at(a, b->x[j], b->y[j]) + LINK_DZ) continue;
             }
@@ -514,14 +634,6 @@ static bool inside_hull(const boundary *b, int64_t px, int64_t py)
     }
     return false;
 }
-
-static int64_t floordiv(int64_t a, int64_t b)
-{
-    int64_t q = a / b;
-    return (a % b != 0 && a < 0) ? q - 1 : q;
-}
-
-typedef struct sample_pt { int64_t x, y; double z; bool ok; } sample_pt;
 
 /* Light depth (raw) and grid position of a world point, in double throughout. */
 static void project_d(const spsm_state *m, const double w[3], double *gx, double *gy, double *gz)
@@ -616,14 +728,6 @@ static bool centres_shadow(const spsm_state *m, const receiver *r, int64_t tx, i
     return true;
 }
 
-static sample_pt project(const spsm_state *m, om_vec3 p)
-{
-    sample_pt s;
-    om_vec4 q = om__mat_apply(&m->view.light_vp, p);
-    s.ok = om__project(&q, m->size, m->size, &s.x, &s.y, &s.z);
-    return s;
-}
-
 /* World-space step to the neighbouring eye pixel on the same triangle (for AA). */
 static om_vec3 pixel_step(const om_strip *st, size_t i, int axis)
 {
@@ -649,11 +753,7 @@ static uint8_t lookup(spsm_state *m, const om_strip *st, size_t i)
     om_vec3 pw = om__v3(smp->p[0], smp->p[1], smp->p[2]);
     sample_pt p = project(m, pw);
     if (!p.ok) { m->lit++; return 255; }
-    int64_t tx = floordiv(p.x, OM_SUBPIX), ty = floordiv(p.y, OM_SUBPIX);
-    if (tx < 0) tx = 0;
-    if (ty < 0) ty = 0;
-    if (tx >= (int64_t)m->size) tx = (int64_t)m->size - 1;
-    if (ty >= (int64_t)m->size) ty = (int64_t)m->size - 1;
+    const int64_t tx = texel_of(m, p.x), ty = texel_of(m, p.y);
     /* the sample relative to its texel's centre */
     const int64_t ox = tx * OM_SUBPIX + OM_SUBPIX / 2, oy = ty * OM_SUBPIX + OM_SUBPIX / 2;
     const int64_t px = p.x - ox, py = p.y - oy;
@@ -796,10 +896,12 @@ static void spsm_stats(const void *state, om_method_stats *out)
     out->counter_names[5] = "map size";
     out->counters[6] = (uint32_t)(map_bytes(m) > 0xFFFFFFFFu ? 0xFFFFFFFFu : map_bytes(m));
     out->counter_names[6] = "map bytes";
-    out->ncounters = 7;
+    out->counters[7] = m->needed;
+    out->counter_names[7] = "texels needed (records made only there)";
+    out->ncounters = 8;
 }
 
 const om_method om__method_spsm = {
     "spsm", "sub-pixel shadow map: 128-bit texels with the nearest triangle, silhouette recovery",
-    0, spsm_bytes, spsm_init, spsm_begin, spsm_observe, spsm_build, spsm_resolve, spsm_stats,
+    OM_METHOD_OBSERVES, spsm_bytes, spsm_init, spsm_begin, spsm_observe, spsm_build, spsm_resolve, spsm_stats,
 };

@@ -1,11 +1,13 @@
 /* bench_spsm.c — Sub-Pixel Shadow Maps against the conventional map at 1024x768, for
  * the default scene and the 10K and 100K random-triangle scenes, at map sizes 512 to
- * 4096: build and lookup time (medians of 5 interleaved runs), SPSM's overhead over
- * the map (build plus lookup, the stages the two differ in; the paper's Table 2
- * measured 81, 56, 44 and 27%, on frames that include rendering the scene: our
- * "frame" figure adds the eye pass to both), each one's mismatch share against the
- * reference, and SPSM's classification shares (lit, shadowed, uncertain; and the
- * uncertain share that recovery shadowed). */
+ * 4096: time per stage (medians of 5 interleaved runs; SPSM's observe marks the
+ * texels its lookup will read, and its build makes only their records), SPSM's
+ * overhead over the map (observe, build and lookup, the stages the two differ in; the
+ * paper's Table 2 measured 81, 56, 44 and 27%, on frames that include rendering the
+ * scene: our "frame" figure adds the eye pass to both), each one's mismatch share
+ * against the reference, SPSM's classification shares (lit, shadowed, uncertain; and
+ * the uncertain share that recovery shadowed) and the share of texels whose records
+ * it made. */
 #include "bench.h"
 
 enum { N = 5 };   /* runs per method and size */
@@ -16,13 +18,13 @@ static void one_scene(const bscene *b)
     uint8_t *ref = malloc((size_t)W * H), *mask = malloc((size_t)W * H);
     mrun r;
     if (bench_run(b, "ref", NULL, W, H, 0, ref, &r)) goto out;
-    printf("%-12s %ux%u, %u exposed samples; time = build + lookup, median of %d interleaved runs\n", b->name, W, H,
+    printf("%-12s %ux%u, %u exposed samples; time = [observe +] build + lookup, median of %d interleaved runs\n", b->name, W, H,
            r.stats.counters[0], N);
     for (uint32_t size = 512; size <= 4096; size *= 2) {
         /* the two methods' runs alternate, so that a busy spell of the machine slows
          * both alike and the overhead stays meaningful */
         const char *names[2] = {"sm", "spsm"};
-        double bu[2], lo[2], ey[2], miss[2], tb[2][N], tl[2][N], te[2][N];
+        double ob[2], bu[2], lo[2], ey[2], miss[2], to[2][N], tb[2][N], tl[2][N], te[2][N];
         mrun last;
         om_method_cfg c;
         om_method_cfg_default(&c);
@@ -30,6 +32,7 @@ static void one_scene(const bscene *b)
         for (int run = 0; run < N; run++)
             for (int k = 0; k < 2; k++) {
                 if (bench_run(b, names[k], &c, W, H, 0, mask, &last)) goto out;
+                to[k][run] = last.observe_ms;
                 tb[k][run] = last.build_ms;
                 tl[k][run] = last.resolve_ms;
                 te[k][run] = last.eye_ms;
@@ -40,18 +43,20 @@ static void one_scene(const bscene *b)
                 }
             }
         for (int k = 0; k < 2; k++) {
+            ob[k] = bench_median(to[k], N);
             bu[k] = bench_median(tb[k], N);
             lo[k] = bench_median(tl[k], N);
             ey[k] = bench_median(te[k], N);
         }
         const uint32_t *cn = last.stats.counters;   /* spsm's, from its last run */
         double n = cn[0] ? (double)cn[0] : 1.0;
-        printf("%-12s %4u  sm %7.2f + %6.2f ms, %.4f%% wrong | spsm %7.2f + %6.2f ms, %.4f%% wrong, "
-               "overhead %+5.0f%% (frame %+4.0f%%) | lit %.1f%% shadowed %.1f%% uncertain %.1f%% (recovered shadow %.1f%%)\n",
-               b->name, size, bu[0], lo[0], miss[0], bu[1], lo[1], miss[1],
-               100.0 * ((bu[1] + lo[1]) / (bu[0] + lo[0]) - 1.0),
-               100.0 * ((ey[1] + bu[1] + lo[1]) / (ey[0] + bu[0] + lo[0]) - 1.0), 100.0 * cn[1] / n, 100.0 * cn[2] / n,
-               100.0 * cn[3] / n, 100.0 * cn[4] / n);
+        const double sm = ob[0] + bu[0] + lo[0], sp = ob[1] + bu[1] + lo[1];
+        printf("%-12s %4u  sm %6.2f + %6.2f ms, %.4f%% wrong | spsm %5.2f + %6.2f + %6.2f ms, %.4f%% wrong, "
+               "overhead %+5.0f%% (frame %+4.0f%%) | lit %.1f%% shadowed %.1f%% uncertain %.1f%% (recovered shadow %.1f%%)"
+               " | records made %.1f%%\n",
+               b->name, size, bu[0], lo[0], miss[0], ob[1], bu[1], lo[1], miss[1], 100.0 * (sp / sm - 1.0),
+               100.0 * ((ey[1] + sp) / (ey[0] + sm) - 1.0), 100.0 * cn[1] / n, 100.0 * cn[2] / n,
+               100.0 * cn[3] / n, 100.0 * cn[4] / n, 100.0 * cn[7] / ((double)size * size));
     }
 out:
     free(ref);
