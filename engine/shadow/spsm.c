@@ -92,9 +92,9 @@ typedef struct spsm_state {
     uint32_t samples, lit, shadowed, uncertain, recovered, needed;
     /* The lookup's 3x3 of decoded texels. Consecutive samples mostly fall in the same
      * texel, and the 3x3 around it depends on nothing but the map and that texel's
-     * index, so it is kept from one sample to the next while `t4_at` names the texel:
-     * bit k of `t_have` says t[k] is decoded (always in k order, as decode's sharing
-     * of edge setups expects). The build forgets it. */
+     * index, so it is kept from one sample to the next while `t4_at` names the texel
+     * (and what it shares with the next texel's 3x3 is kept too: shift_window): bit k
+     * of `t_have` says t[k] is decoded. The build forgets it. */
     dtri t[9];
     size_t t4_at;
     uint32_t t_have;
@@ -441,8 +441,10 @@ static om_status spsm_build(void *state, om_diag *d)
 /* ---------------------------------------------------------------- lookup (4) */
 
 /* Decodes texel k of the 3x3 (k = (dy + 1) * 3 + dx + 1) into t[k]. Neighbours often
- * hold the same triangle: its edge setup is then copied from one decoded before
- * (the centre first, then in k order). */
+ * hold the same triangle: its edge setup is then copied from an entry before k or the
+ * centre holding the very same vertices. (An entry not marked decoded may be left
+ * from an earlier 3x3; the setup is a function of the vertices alone, so a match
+ * there is as good.) */
 static void decode(const spsm_state *m, int64_t tx, int64_t ty, dtri t[9], int k)
 {
     const int dx = k % 3 - 1, dy = k / 3 - 1;
@@ -486,6 +488,40 @@ static void decode(const spsm_state *m, int64_t tx, int64_t ty, dtri t[9], int k
     o->have_vz = false;
 }
 
+/* The sample's texel stepped to a neighbour, (dx, dy) texels away: the decoded texels
+ * the old and the new 3x3 share are kept, moved to their new places (in an order that
+ * reads each before it is overwritten) and made relative to the new centre. The shift
+ * is exact: vertices and centre move by whole texels and each edge constant by the
+ * matching integer, so an entry is what decoding it anew gives, with its plane values
+ * at the vertices and its consistent minimum (found in the texel's own coordinates). */
+static void shift_window(spsm_state *m, int dx, int dy)
+{
+    const int64_t sx = -(int64_t)dx * OM_SUBPIX, sy = -(int64_t)dy * OM_SUBPIX;
+    uint32_t have = 0;
+    for (int rr = 0; rr < 3; rr++) {
+        const int r = dy >= 0 ? rr : 2 - rr, orow = r + dy;
+        for (int cc = 0; cc < 3; cc++) {
+            const int c = dx >= 0 ? cc : 2 - cc, ocol = c + dx;
+            if (orow < 0 || orow > 2 || ocol < 0 || ocol > 2) continue;
+            const int from = orow * 3 + ocol, to = r * 3 + c;
+            if (!((m->t_have >> from) & 1u)) continue;
+            dtri *t = &m->t[to];
+            if (to != from) *t = m->t[from];
+            t->cx += sx;
+            t->cy += sy;
+            for (int i = 0; i < 3; i++) {
+                t->rx[i] += sx;
+                t->ry[i] += sy;
+                t->e.x[i] += sx;
+                t->e.y[i] += sy;
+                t->e.c[i] -= t->e.a[i] * sx + t->e.b[i] * sy;
+            }
+            have |= 1u << to;
+        }
+    }
+    m->t_have = have;
+}
+
 /* Equation 1: the stored plane at grid point (px, py), and what it cannot resolve. */
 static double plane_at(const dtri *t, int64_t px, int64_t py)
 {
@@ -501,7 +537,8 @@ static double tol_at(const dtri *t, int64_t px, int64_t py)
  * known loosely (a nearly edge-on triangle) is used at its decoded slope. */
 static double pat_tol(const dtri *t, int64_t px, int64_t py)
 {
-    return fmin(tol_at(t, px, py), TOL0 + PAT_CAP);
+    const double tol = tol_at(t, px, py);   /* finite: fmin's NaN rule is not needed */
+    return tol < TOL0 + PAT_CAP ? tol : TOL0 + PAT_CAP;
 }
 
 /* Algorithm 1: the stored triangle covers the point in 2-D and is nearer there. */
@@ -520,8 +557,12 @@ static double consistent_min(const dtri *t)
     const int64_t H = OM_SUBPIX / 2;
     int64_t kx = t->cx + (t->gx > 0 ? -H : H), ky = t->cy + (t->gy > 0 ? -H : H);
     if (om__tri2_covers(&t->e, kx, ky)) return plane_at(t, kx, ky);
-    const zplane p = {t->z, t->gx, t->gy, t->cx, t->cy};
-    return clipped_min(t->e.x, t->e.y, t->cx - H, t->cy - H, OM_SUBPIX, &p);
+    /* in the texel's own coordinates, so that the value does not depend on where the
+     * 3x3 is centred (shift_window keeps it) */
+    const int64_t X[3] = {t->e.x[0] - t->cx, t->e.x[1] - t->cx, t->e.x[2] - t->cx},
+                  Y[3] = {t->e.y[0] - t->cy, t->e.y[1] - t->cy, t->e.y[2] - t->cy};
+    const zplane p = {t->z, t->gx, t->gy, 0, 0};
+    return clipped_min(X, Y, -H, -H, OM_SUBPIX, &p);
 }
 
 /* Twice the signed area of (o, a, b): > 0 when b lies left of o -> a. Exact: offsets
@@ -767,9 +808,12 @@ static uint8_t lookup(spsm_state *m, const om_strip *st, size_t i)
     dtri *t = m->t;
     size_t at = (size_t)ty * m->size + (size_t)tx;
     if (at != m->t4_at) {
-        decode(m, tx, ty, t, 4);
+        const int64_t dx = m->t4_at == (size_t)-1 ? 9 : tx - (int64_t)(m->t4_at % m->size),
+                      dy = m->t4_at == (size_t)-1 ? 9 : ty - (int64_t)(m->t4_at / m->size);
+        if (dx >= -1 && dx <= 1 && dy >= -1 && dy <= 1) shift_window(m, (int)dx, (int)dy);
+        else m->t_have = 0;
+        if (!(m->t_have & (1u << 4))) { decode(m, tx, ty, t, 4); m->t_have |= 1u << 4; }
         m->t4_at = at;
-        m->t_have = 1u << 4;
         m->bd_have = false;
     }
     if (t[4].empty) { m->lit++; return 255; }

@@ -37,7 +37,13 @@ typedef char om__spsm_texel_is_16_bytes[sizeof(om__spsm_texel) == 16 ? 1 : -1];
  * is where larger offsets saturate. A far vertex so keeps the direction of its edges
  * near the texel, which a fixed-point window clamped at its border would not. */
 uint16_t om__spsm_o16_encode(int64_t v);
-int64_t om__spsm_o16_decode(uint16_t c);
+/* In line: the lookup decodes six per texel record it reads. */
+static inline int64_t om__spsm_o16_decode(uint16_t c)
+{
+    unsigned e = (c >> 11) & 15u, m = c & 2047u;
+    int64_t a = e == 0 ? (int64_t)m : (int64_t)(2048u + m) << (e - 1);
+    return (c & 0x8000u) ? -a : a;
+}
 
 /* The derivative code of section 3.4 (Equations 2-4) with n = 5:
  * Q(d) = round(127 * (1 + x^5)), x = (2/pi) atan(d), and its decoding table. */

@@ -51,13 +51,6 @@ uint16_t om__spsm_o16_encode(int64_t v)
     return o16_encode(v);
 }
 
-int64_t om__spsm_o16_decode(uint16_t c)
-{
-    unsigned e = (c >> 11) & 15u, m = c & 2047u;
-    int64_t a = e == 0 ? (int64_t)m : (int64_t)(2048u + m) << (e - 1);
-    return (c & 0x8000u) ? -a : a;
-}
-
 /* ---- derivative code (section 3.4) */
 
 uint8_t om__spsm_q_encode(double d)
