@@ -274,8 +274,11 @@ typedef struct om_method_cfg {
     float rtw_tess;           /* longest warped edge as a fraction of the map, 0 = off */
     /* spsm */
     uint32_t spsm_aa;      /* sub-samples at uncertain samples, 0 or 1 = off */
-    uint32_t spsm_all;     /* 1: make every texel's record, not only those the view
-                              reads (the paper's build; the same frames, slower) */
+    uint32_t spsm_records; /* which texel records the build makes: 1 every one (the
+                              paper's build), 2 only those the view reads (observe
+                              marks them), 0 = 2 when the map has more than twice as
+                              many texels as the image has pixels, else 1. The same
+                              frames either way; only the time differs. */
 } om_method_cfg;
 
 /* One settable field of om_method_cfg. */
@@ -327,6 +330,10 @@ typedef struct om_method {
     /* Writes st->terms for every sample of the strip (background samples get 255). */
     om_status (*resolve)(void *state, om_strip *st, om_diag *d);
     void (*stats)(const void *state, om_method_stats *out);
+    /* May be NULL. For an OBSERVES method: whether this state observes at all (its
+     * configuration may not need the samples first); when not, the frame skips the
+     * observe pass and, with strips, the eye pass it would run again for it. */
+    bool (*observes)(const void *state);
 } om_method;
 
 size_t om_method_count(void);

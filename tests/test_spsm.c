@@ -303,8 +303,8 @@ static void identical_runs_identical_frames(void)
     h_scene_free(&hs);
 }
 
-/* The build makes only the records the lookup reads (the 3x3 around each exposed
- * sample's texel); spsm.all = 1 makes every one. The frames must not differ, at a map
+/* spsm.records = 2 makes only the records the lookup reads (the 3x3 around each
+ * exposed sample's texel), 1 makes every one. The frames must not differ, at a map
  * coarser and one finer than the image, with AA and through strips. */
 static void records_made_where_read(void)
 {
@@ -318,14 +318,64 @@ static void records_made_where_read(void)
             for (uint32_t strip = 0; strip <= 7; strip += 7) {
                 c.map_size = map;
                 c.spsm_aa = aa;
-                c.spsm_all = 0;
+                c.spsm_records = 2;
                 CHECK_OK(h_render(&hs.s, "spsm", &c, 320, 240, 0, strip, msk, terms, NULL));
-                c.spsm_all = 1;
+                c.spsm_records = 1;
                 CHECK_OK(h_render(&hs.s, "spsm", &c, 320, 240, 0, strip, msk2, terms2, NULL));
                 differ += memcmp(terms, terms2, sizeof(om_term) * 320 * 240) != 0;
                 runs++;
             }
     CHECK_MSG(differ == 0, "%d of %d frames differ", differ, runs);
+    h_scene_free(&hs);
+}
+
+/* By default the texels are marked only when the map has more than twice as many
+ * texels as the image has pixels: then observe runs (with strips, the eye pass twice)
+ * and fewer records are made; otherwise neither. */
+static void marks_only_when_they_pay(void)
+{
+    h_scene hs;
+    if (!h_scene_parse(&hs, om_scene_default_text())) return;
+    const om_method *m = om_method_find("spsm");
+    static unsigned char mem[(1024 * 1024 * 25) + (1 << 16)], fm[1 << 22];
+    static uint8_t px[160 * 120 * 3];
+    for (uint32_t map = 128; map <= 1024; map *= 8) {
+        om_method_cfg c;
+        om_method_cfg_default(&c);
+        c.map_size = map;
+        size_t mn, full;
+        CHECK_OK(m->bytes(&c, &hs.s, 160, 120, &mn, &full));
+        CHECK(full <= sizeof mem);
+        if (full > sizeof mem) break;
+        om_arena a, fa;
+        om_arena_init(&a, mem, full, "method");
+        om_arena_init(&fa, fm, sizeof fm, "frame");
+        void *state;
+        om_diag d;
+        CHECK_OK(m->init(&state, &a, &c, &hs.s, 160, 120, &d));
+        om_camera cam;
+        om_light light;
+        om_view v;
+        om_scene_at(&hs.s, 0, &cam, &light);
+        cam.width = 160; cam.height = 120;
+        CHECK_OK(om_view_init(&v, &cam, &light, &hs.s, NULL));
+        om_framebuffer fb = {OM_RGB888, 160, 30, 160 * 3, px};
+        om_shade_cfg shade;
+        om_shade_cfg_default(&shade);
+        om_frame_desc fd;
+        memset(&fd, 0, sizeof fd);
+        fd.scene = &hs.s; fd.view = &v; fd.method = m; fd.method_state = state; fd.shade = &shade;
+        fd.fb = &fb; fd.strip_rows = 30;
+        om_frame_stats fs;
+        CHECK_OK(om_render_frame(&fd, &fa, &fs, &d));
+        om_method_stats s;
+        m->stats(state, &s);
+        const bool marks = map == 1024;
+        CHECK_EQ_U(fs.strips, 4);
+        CHECK_MSG(fs.eye_passes == (marks ? 8u : 4u), "map %u: %u eye passes", map, fs.eye_passes);
+        if (marks) CHECK_MSG(s.counters[7] < map * map / 4, "map %u: %u records", map, s.counters[7]);
+        else CHECK_EQ_U(s.counters[7], map * map);
+    }
     h_scene_free(&hs);
 }
 
@@ -417,6 +467,10 @@ static void stats_and_budget(void)
     c.spsm_aa = 65;
     om_arena_init(&a, buf + 32, mn, "method");
     CHECK(m->init(&state, &a, &c, &hs.s, 160, 120, &d) == OM_E_INVALID);
+    c.spsm_aa = 0;
+    c.spsm_records = 3;
+    om_arena_init(&a, buf + 32, mn, "method");
+    CHECK(m->init(&state, &a, &c, &hs.s, 160, 120, &d) == OM_E_INVALID);
     free(buf);
     h_scene_free(&hs);
 }
@@ -457,6 +511,7 @@ void suite_spsm(void)
     RUN(dense_mesh_stays_ahead);
     RUN(identical_runs_identical_frames);
     RUN(records_made_where_read);
+    RUN(marks_only_when_they_pay);
     RUN(aa_only_at_uncertain_samples);
     RUN(stats_and_budget);
     RUN(odd_inputs);

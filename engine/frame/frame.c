@@ -85,7 +85,7 @@ om_status om_render_frame(const om_frame_desc *fd, om_arena *fa, om_frame_stats 
 
     om_view view = *fd->view;
     const bool single = rows == H;
-    const bool observes = (m->flags & OM_METHOD_OBSERVES) != 0;
+    const bool observes = (m->flags & OM_METHOD_OBSERVES) && (!m->observes || m->observes(fd->method_state));
     const bool fit = view.light.kind == OM_LIGHT_DIRECTIONAL;
     bool have_samples = false;   /* strip.samples hold the whole frame already */
     bool have_terms = false;     /* and strip.terms their exposure (mark_exposed) */

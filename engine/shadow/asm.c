@@ -603,5 +603,5 @@ static void asm_stats(const void *state, om_method_stats *out)
 const om_method om__method_asm = {
     "asm", "adaptive shadow map: a tree of tiles refined where the eye needs it, within asm.cap",
     OM_METHOD_OBSERVES,
-    asm_bytes, asm_init, asm_begin, asm_observe, asm_build, asm_resolve, asm_stats,
+    asm_bytes, asm_init, asm_begin, asm_observe, asm_build, asm_resolve, asm_stats, NULL,
 };

@@ -386,5 +386,5 @@ static void izb_stats(const void *state, om_method_stats *out)
 const om_method om__method_izb = {
     "izb", "irregular z-buffer (alias-free shadow maps): exact, BSP over the visible samples",
     OM_METHOD_EXACT, izb_bytes, izb_init, izb_begin, izb_observe, izb_build, izb_resolve,
-    izb_stats,
+    izb_stats, NULL,
 };

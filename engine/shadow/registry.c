@@ -73,7 +73,7 @@ void om_method_cfg_default(om_method_cfg *c)
     c->rtw_sigma = 3.0f;
     c->rtw_tess = 0.025f;
     c->spsm_aa = 0;
-    c->spsm_all = 0;
+    c->spsm_records = 0;
 }
 
 #define F(name, kind, field, lo, hi, help) {name, help, kind, offsetof(om_method_cfg, field), lo, hi}
@@ -100,7 +100,7 @@ static const om_cfg_field fields[] = {
     F("rtw.sigma", 'f', rtw_sigma, 0, 64, "RTW blur sigma in super-cells"),
     F("rtw.tess", 'f', rtw_tess, 0, 1, "RTW longest warped edge / map width, 0 = off"),
     F("spsm.aa", 'u', spsm_aa, 0, 64, "SPSM sub-samples at uncertain samples, 0 = off"),
-    F("spsm.all", 'u', spsm_all, 0, 1, "SPSM: 1 = every texel's record, not only those read"),
+    F("spsm.records", 'u', spsm_records, 0, 2, "SPSM records made: 1 all, 2 those the view reads, 0 auto"),
 };
 
 #undef F

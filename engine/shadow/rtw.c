@@ -445,5 +445,5 @@ static void rtw_stats(const void *state, om_method_stats *out)
 const om_method om__method_rtw = {
     "rtw", "rectilinear texture warping: importance-warped shadow map with 1-D warp tables",
     OM_METHOD_OBSERVES,
-    rtw_bytes, rtw_init, rtw_begin, rtw_observe, rtw_build, rtw_resolve, rtw_stats,
+    rtw_bytes, rtw_init, rtw_begin, rtw_observe, rtw_build, rtw_resolve, rtw_stats, NULL,
 };

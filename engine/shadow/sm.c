@@ -118,5 +118,5 @@ static void sm_stats(const void *state, om_method_stats *out)
 
 const om_method om__method_sm = {
     "sm", "conventional shadow map: depth from the light, bias, optional PCF", 0,
-    sm_bytes, sm_init, sm_begin, sm_observe, sm_build, sm_resolve, sm_stats,
+    sm_bytes, sm_init, sm_begin, sm_observe, sm_build, sm_resolve, sm_stats, NULL,
 };
