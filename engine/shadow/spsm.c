@@ -631,6 +631,15 @@ static void hulls_build(boundary *b)
  * tangent into phi and shadows everything beyond it, the hull also closes the piece
  * on its far side, so two thin occluders a texel or more apart (a fence) do not shadow
  * the gap between them (see README: the one-sided phi measured worse). */
+/* Merges piece `from` into piece `to` (every vertex labelled `from` takes `to`), keeping
+ * a piece's label its first vertex's: the smaller index wins. */
+static void join(boundary *b, uint8_t from, uint8_t to)
+{
+    if (from < to) { uint8_t s = from; from = to; to = s; }
+    for (int k = 0; k < b->nv; k++)
+        if (b->piece[k] == from) b->piece[k] = to;
+}
+
 static void boundary_build(boundary *b, const dtri *const occ[9], int nocc)
 {
     uint32_t tri_of[MAXV];       /* bit k: a vertex of occluder k */
@@ -643,26 +652,28 @@ static void boundary_build(boundary *b, const dtri *const occ[9], int nocc)
             if (j == b->nv) { b->x[j] = x; b->y[j] = y; tri_of[j] = 0; b->nv++; }
             tri_of[j] |= 1u << k;
         }
-    for (int i = 0; i < b->nv; i++) b->piece[i] = (uint8_t)i;
+    /* A piece is labelled by its first vertex. Vertices of one triangle are one piece
+     * from the start: a vertex joins the piece of the first earlier vertex it shares a
+     * triangle with, and pieces that a shared vertex bridges are merged. */
+    for (int i = 0; i < b->nv; i++) {
+        b->piece[i] = (uint8_t)i;
+        for (int j = 0; j < i; j++) {
+            if (!(tri_of[i] & tri_of[j]) || b->piece[j] == b->piece[i]) continue;
+            join(b, b->piece[i], b->piece[j]);
+        }
+    }
     for (int i = 0; i < b->nv; i++)
         for (int j = i + 1; j < b->nv; j++) {
-            int64_t dx = b->x[j] - b->x[i], dy = b->y[j] - b->y[i];
-            if (dx < 0) dx = -dx;
-            if (dy < 0) dy = -dy;
             if (b->piece[j] == b->piece[i]) continue;   /* joined already: nothing to test */
-            if (!(tri_of[i] & tri_of[j])) {
-                if (dx > OM_SPSM_LINK || dy > OM_SPSM_LINK) continue;
-                /* one surface: i's triangle's plane, carried to j, meets j's triangle
-                 * there (a smooth mesh bends little over a texel; a cloud of separate
-                 * triangles does not line up) */
-                const dtri *a = occ[om__ctz32(tri_of[i])], *c = occ[om__ctz32(tri_of[j])];
-                double za = plane_at(a, b->x[j], b->y[j]), zc = plane_at(c, b->x[j], b->y[j]);
-                if (fabs(za - zc) > tol_at(a, b->x[j], b->y[j]) + LINK_DZ) continue;
-            }
-            uint8_t from = b->piece[j], to = b->piece[i];   /* join: relabel j's piece */
-            if (from == to) continue;
-            for (int k = 0; k < b->nv; k++)
-                if (b->piece[k] == from) b->piece[k] = to;
+            int64_t dx = b->x[j] - b->x[i], dy = b->y[j] - b->y[i];
+            if (dx > OM_SPSM_LINK || dx < -OM_SPSM_LINK || dy > OM_SPSM_LINK || dy < -OM_SPSM_LINK) continue;
+            /* one surface: i's triangle's plane, carried to j, meets j's triangle there
+             * (a smooth mesh bends little over a texel; a cloud of separate triangles
+             * does not line up) */
+            const dtri *a = occ[om__ctz32(tri_of[i])], *c = occ[om__ctz32(tri_of[j])];
+            double za = plane_at(a, b->x[j], b->y[j]), zc = plane_at(c, b->x[j], b->y[j]);
+            if (fabs(za - zc) > tol_at(a, b->x[j], b->y[j]) + LINK_DZ) continue;
+            join(b, b->piece[j], b->piece[i]);
         }
     hulls_build(b);
 }
