@@ -51,13 +51,14 @@
  * the centre of the sample's texel, plane in raw depth per grid unit. */
 typedef struct dtri {
     bool empty, ok;              /* ok: a 2-D triangle with area */
+    bool have_e;                 /* e is set up (edges(): most samples need only the plane) */
     om__tri2 e;
     int64_t rx[3], ry[3];        /* the vertices as decoded (e holds them reordered) */
     int64_t cx, cy;              /* this texel's centre */
     double z, gx, gy, ex, ey;    /* centre depth, slopes and their error bounds */
     double cmin;                 /* consistent_min, once computed (have_cmin) */
     bool have_cmin;
-    double vz[3], vtol[3];       /* plane and pat_tol at the vertices e.x, e.y (have_vz) */
+    double vz[3], vtol[3];       /* plane and pat_tol at the vertices rx, ry (have_vz) */
     bool have_vz;
 } dtri;
 
@@ -446,11 +447,8 @@ static om_status spsm_build(void *state, om_diag *d)
 
 /* ---------------------------------------------------------------- lookup (4) */
 
-/* Decodes texel k of the 3x3 (k = (dy + 1) * 3 + dx + 1) into t[k]. Neighbours often
- * hold the same triangle: its edge setup is then copied from an entry before k or the
- * centre holding the very same vertices. (An entry not marked decoded may be left
- * from an earlier 3x3; the setup is a function of the vertices alone, so a match
- * there is as good.) */
+/* Decodes texel k of the 3x3 (k = (dy + 1) * 3 + dx + 1) into t[k]: its vertices and
+ * plane; the edges are set up when a test first needs them (edges). */
 static void decode(const spsm_state *m, int64_t tx, int64_t ty, dtri t[9], int k)
 {
     const int dx = k % 3 - 1, dy = k / 3 - 1;
@@ -472,18 +470,10 @@ static void decode(const spsm_state *m, int64_t tx, int64_t ty, dtri t[9], int k
     }
     memcpy(o->rx, X, sizeof X);
     memcpy(o->ry, Y, sizeof Y);
-    int same = -1;
-    for (int j = 0; k != 4 && j <= k && same < 0; j++) {
-        int c = j == k ? 4 : j;   /* those before k, and the centre */
-        const dtri *q = &t[c];
-        if (!q->empty && !memcmp(q->rx, X, sizeof X) && !memcmp(q->ry, Y, sizeof Y)) same = c;
-    }
-    if (same >= 0) {
-        o->e = t[same].e;
-        o->ok = t[same].ok;
-    } else {
-        o->ok = om__tri2_setup(&o->e, X, Y, false) && o->e.area2 > 0;
-    }
+    /* the edge setup waits until a test needs it (edges); whether there is a triangle
+     * at all is its area, as the setup finds it (offsets stay far inside its range) */
+    o->ok = (X[1] - X[0]) * (Y[2] - Y[0]) - (X[2] - X[0]) * (Y[1] - Y[0]) != 0;
+    o->have_e = false;
     const double u = STEP * OM_SPSM_DSCALE / (double)OM_SUBPIX;   /* code -> raw per unit */
     o->z = (double)r->z * STEP;
     o->gx = m->q.dec[r->qx] * u;
@@ -518,6 +508,7 @@ static void shift_window(spsm_state *m, int dx, int dy)
             for (int i = 0; i < 3; i++) {
                 t->rx[i] += sx;
                 t->ry[i] += sy;
+                if (!t->have_e) continue;
                 t->e.x[i] += sx;
                 t->e.y[i] += sy;
                 t->e.c[i] -= t->e.a[i] * sx + t->e.b[i] * sy;
@@ -526,6 +517,25 @@ static void shift_window(spsm_state *m, int dx, int dy)
         }
     }
     m->t_have = have;
+}
+
+/* The entry's edge functions, set up on first use. Neighbours often hold the same
+ * triangle: its setup is then copied from another entry of the 3x3 with the very same
+ * vertices. (That entry may be left from an earlier 3x3; the setup is a function of
+ * the vertices alone, so a match there is as good.) */
+static const om__tri2 *edges(dtri t[9], int k)
+{
+    dtri *o = &t[k];
+    if (o->have_e) return &o->e;
+    int same = -1;
+    for (int j = 0; j < 9 && same < 0; j++)
+        if (j != k && t[j].have_e && !t[j].empty && t[j].rx[0] == o->rx[0] && t[j].ry[0] == o->ry[0] &&
+            !memcmp(t[j].rx, o->rx, sizeof o->rx) && !memcmp(t[j].ry, o->ry, sizeof o->ry))
+            same = j;
+    if (same >= 0) o->e = t[same].e;
+    else om__tri2_setup(&o->e, o->rx, o->ry, false);
+    o->have_e = true;
+    return &o->e;
 }
 
 /* Equation 1: the stored plane at grid point (px, py), and what it cannot resolve. */
@@ -547,7 +557,8 @@ static double pat_tol(const dtri *t, int64_t px, int64_t py)
     return tol < TOL0 + PAT_CAP ? tol : TOL0 + PAT_CAP;
 }
 
-/* Algorithm 1: the stored triangle covers the point in 2-D and is nearer there. */
+/* Algorithm 1: the stored triangle covers the point in 2-D and is nearer there (its
+ * edges set up: edges). */
 static bool hits(const dtri *t, int64_t px, int64_t py, double pz)
 {
     return t->ok && om__tri2_covers(&t->e, px, py) && plane_at(t, px, py) < pz - tol_at(t, px, py);
@@ -557,7 +568,7 @@ static bool hits(const dtri *t, int64_t px, int64_t py, double pz)
  * the paper finds it — at the square's corner that the slopes point to, when the
  * triangle covers it; otherwise on the triangle's part of the square, whose least depth
  * is at one of its corners, so we clip the triangle to the square. HUGE_VAL when the
- * (quantized) triangle misses the square. */
+ * (quantized) triangle misses the square. Its edges are set up (edges). */
 static double consistent_min(const dtri *t)
 {
     const int64_t H = OM_SUBPIX / 2;
@@ -743,13 +754,13 @@ static bool behind_receiver(dtri *t, const receiver *r, int64_t px, int64_t py)
     if (!r->ok) return false;
     if (!t->have_vz) {   /* the texel's own part, the same for every sample */
         for (int i = 0; i < 3; i++) {
-            t->vz[i] = plane_at(t, t->e.x[i], t->e.y[i]);
-            t->vtol[i] = pat_tol(t, t->e.x[i], t->e.y[i]);
+            t->vz[i] = plane_at(t, t->rx[i], t->ry[i]);
+            t->vtol[i] = pat_tol(t, t->rx[i], t->ry[i]);
         }
         t->have_vz = true;
     }
     for (int i = 0; i < 3; i++) {
-        double zr = r->z + r->gx * (double)(t->e.x[i] - px) + r->gy * (double)(t->e.y[i] - py);
+        double zr = r->z + r->gx * (double)(t->rx[i] - px) + r->gy * (double)(t->ry[i] - py);
         if (t->vz[i] < zr - t->vtol[i]) return false;
     }
     return true;
@@ -836,14 +847,18 @@ static uint8_t lookup(spsm_state *m, const om_strip *st, size_t i)
     if (t[4].empty) { m->lit++; return 255; }
     if (t[4].ok) {
         double z = plane_at(&t[4], px, py), tol = tol_at(&t[4], px, py);
-        bool cov = om__tri2_covers(&t[4].e, px, py);
-        if (cov && z < p.z - tol) { m->shadowed++; return 0; }
-        if (z >= p.z - tol && z <= p.z + tol && tol <= TOL0 + LIT_CAP) { m->lit++; return 255; }
+        if (z < p.z - tol) {
+            if (om__tri2_covers(edges(t, 4), px, py)) { m->shadowed++; return 0; }
+        } else if (z <= p.z + tol && tol <= TOL0 + LIT_CAP) {
+            m->lit++;
+            return 255;
+        }
     }
     /* 4.1 shadowed: Algorithm 1 on the 3x3 neighbourhood */
     for (int k = 0; k < 9; k++) {
         if (k == 4) continue;
         if (!((m->t_have >> k) & 1u)) { decode(m, tx, ty, t, k); m->t_have |= 1u << k; }
+        if (t[k].ok) edges(t, k);
         if (hits(&t[k], px, py, p.z)) { m->shadowed++; return 0; }
     }
 
@@ -862,7 +877,11 @@ static uint8_t lookup(spsm_state *m, const om_strip *st, size_t i)
         if (t[k].empty || !(plane_at(&t[k], px, py) < p.z - pat_tol(&t[k], px, py))) continue;
         if (!have_rp) { rp = receiver_plane(m, smp); have_rp = true; }
         if (t[k].ok && behind_receiver(&t[k], &rp, px, py)) continue;
-        if (!t[k].have_cmin) { t[k].cmin = consistent_min(&t[k]); t[k].have_cmin = true; }
+        if (!t[k].have_cmin) {
+            edges(t, k);
+            t[k].cmin = consistent_min(&t[k]);
+            t[k].have_cmin = true;
+        }
         if (t[k].cmin < p.z - pat_tol(&t[k], t[k].cx, t[k].cy)) pat |= 1u << k;
     }
     const om__spsm_tangent *tg = &m->lut[pat];
@@ -873,6 +892,7 @@ static uint8_t lookup(spsm_state *m, const om_strip *st, size_t i)
         m->nocc = 0;
         for (int k = 0; k < 9; k++) {
             if (!((tg->keep >> k) & 1u) || !t[k].ok) continue;
+            edges(t, k);
             bool dup = false;   /* neighbours often hold the same triangle */
             for (int j = 0; j < m->nocc && !dup; j++)
                 dup = !memcmp(m->occ[j]->e.x, t[k].e.x, sizeof t[k].e.x) &&
