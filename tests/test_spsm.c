@@ -329,6 +329,31 @@ static void records_made_where_read(void)
     h_scene_free(&hs);
 }
 
+/* `frames` frames of spsm's state at 160x120 on the scene's camera, in strips of
+ * `strip` rows (0: whole), through the public frame API; the last frame's stats in fs. */
+static void spsm_frames(const om_scene *s, void *state, uint32_t strip, int frames, om_frame_stats *fs)
+{
+    static unsigned char fm[1 << 22];
+    static uint8_t px[160 * 120 * 3];
+    om_arena fa;
+    om_arena_init(&fa, fm, sizeof fm, "frame");
+    om_camera cam;
+    om_light light;
+    om_view v;
+    om_scene_at(s, 0, &cam, &light);
+    cam.width = 160; cam.height = 120;
+    CHECK_OK(om_view_init(&v, &cam, &light, s, NULL));
+    om_framebuffer fb = {OM_RGB888, 160, strip ? strip : 120, 160 * 3, px};
+    om_shade_cfg shade;
+    om_shade_cfg_default(&shade);
+    om_frame_desc fd;
+    memset(&fd, 0, sizeof fd);
+    fd.scene = s; fd.view = &v; fd.method = om_method_find("spsm"); fd.method_state = state;
+    fd.shade = &shade; fd.fb = &fb; fd.strip_rows = strip;
+    om_diag d;
+    for (int f = 0; f < frames; f++) CHECK_OK(om_render_frame(&fd, &fa, fs, &d));
+}
+
 /* By default the texels are marked only when the map has more than twice as many
  * texels as the image has pixels: then observe runs (with strips, the eye pass twice)
  * and fewer records are made; otherwise neither. */
@@ -337,8 +362,7 @@ static void marks_only_when_they_pay(void)
     h_scene hs;
     if (!h_scene_parse(&hs, om_scene_default_text())) return;
     const om_method *m = om_method_find("spsm");
-    static unsigned char mem[(1024 * 1024 * 25) + (1 << 16)], fm[1 << 22];
-    static uint8_t px[160 * 120 * 3];
+    static unsigned char mem[(1024 * 1024 * 25) + (1 << 16)];
     for (uint32_t map = 128; map <= 1024; map *= 8) {
         om_method_cfg c;
         om_method_cfg_default(&c);
@@ -347,27 +371,13 @@ static void marks_only_when_they_pay(void)
         CHECK_OK(m->bytes(&c, &hs.s, 160, 120, &mn, &full));
         CHECK(full <= sizeof mem);
         if (full > sizeof mem) break;
-        om_arena a, fa;
+        om_arena a;
         om_arena_init(&a, mem, full, "method");
-        om_arena_init(&fa, fm, sizeof fm, "frame");
         void *state;
         om_diag d;
         CHECK_OK(m->init(&state, &a, &c, &hs.s, 160, 120, &d));
-        om_camera cam;
-        om_light light;
-        om_view v;
-        om_scene_at(&hs.s, 0, &cam, &light);
-        cam.width = 160; cam.height = 120;
-        CHECK_OK(om_view_init(&v, &cam, &light, &hs.s, NULL));
-        om_framebuffer fb = {OM_RGB888, 160, 30, 160 * 3, px};
-        om_shade_cfg shade;
-        om_shade_cfg_default(&shade);
-        om_frame_desc fd;
-        memset(&fd, 0, sizeof fd);
-        fd.scene = &hs.s; fd.view = &v; fd.method = m; fd.method_state = state; fd.shade = &shade;
-        fd.fb = &fb; fd.strip_rows = 30;
         om_frame_stats fs;
-        CHECK_OK(om_render_frame(&fd, &fa, &fs, &d));
+        spsm_frames(&hs.s, state, 30, 1, &fs);
         om_method_stats s;
         m->stats(state, &s);
         const bool marks = map == 1024;
@@ -428,23 +438,8 @@ static void stats_and_budget(void)
     CHECK_MSG(strstr(d.msg, num) != NULL, "'%s' does not name %s", d.msg, num);
     om_arena_init(&a, buf + 32, mn, "method");
     CHECK_OK(m->init(&state, &a, &c, &hs.s, 160, 120, &d));
-    om_camera cam;
-    om_light light;
-    om_view v;
-    om_scene_at(&hs.s, 0, &cam, &light);
-    cam.width = 160; cam.height = 120;
-    CHECK_OK(om_view_init(&v, &cam, &light, &hs.s, NULL));
-    static unsigned char fm[1 << 22];
-    om_arena fa;
-    om_arena_init(&fa, fm, sizeof fm, "frame");
-    static uint8_t px[160 * 120 * 3];
-    om_framebuffer fb = {OM_RGB888, 160, 120, 160 * 3, px};
-    om_shade_cfg shade;
-    om_shade_cfg_default(&shade);
-    om_frame_desc fd;
-    memset(&fd, 0, sizeof fd);
-    fd.scene = &hs.s; fd.view = &v; fd.method = m; fd.method_state = state; fd.shade = &shade; fd.fb = &fb;
-    for (int frame = 0; frame < 2; frame++) CHECK_OK(om_render_frame(&fd, &fa, NULL, &d));
+    om_frame_stats fs;
+    spsm_frames(&hs.s, state, 0, 2, &fs);
     CHECK(a.peak <= mn);
     int guard = 0;
     for (int i = 0; i < 32; i++) guard += buf[i] != 0xC3 || buf[32 + mn + i] != 0xC3;
