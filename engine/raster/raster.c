@@ -254,20 +254,16 @@ static void fill(const om_raster *r, const om__rtri *t, uint32_t id)
     }
 }
 
-/* depth_row over the pixels of x0..x1 whose bit is set in `mask` (one row's words):
- * runs of clear bits are passed over, a word at a time where they fill it. */
+/* depth_row over the runs of pixels of x0..x1 whose bit is set in `mask` (one row's
+ * words). */
 static void depth_row_masked(const om__rtri *t, const om_target *tg, int32_t y, int32_t x0, int32_t x1,
                              const uint32_t *mask)
 {
-    for (int32_t x = x0; x <= x1;) {
-        const uint32_t w = mask[x >> 5] >> (x & 31);
-        if (!w) { x = (x | 31) + 1; continue; }
-        x += om__ctz32(w);
-        if (x > x1) break;
+    for (int32_t x = om__mask_next(mask, x0, x1); x <= x1;) {
         int32_t e = x;   /* the run of set bits from x */
         while (e < x1 && ((mask[(e + 1) >> 5] >> ((e + 1) & 31)) & 1u)) e++;
         depth_row(t, tg, y, x, e, NULL, 0);
-        x = e + 1;
+        x = om__mask_next(mask, e + 1, x1);
     }
 }
 

@@ -26,6 +26,7 @@
 #define OM_RASTER_H
 
 #include "ombra.h"
+#include "../core/core.h"
 
 #include <math.h>
 
@@ -118,6 +119,21 @@ typedef struct om_raster {
     const uint32_t *centre_mask;
     uint32_t mask_words;
 } om_raster;
+
+/* The first pixel x..x1 whose bit is set in `row` (one row of such a mask), x1 + 1
+ * when none: clear words are passed over whole. */
+static inline int32_t om__mask_next(const uint32_t *row, int32_t x, int32_t x1)
+{
+    while (x <= x1) {
+        const uint32_t w = row[x >> 5] >> (x & 31);
+        if (w) {
+            x += om__ctz32(w);
+            return x <= x1 ? x : x1 + 1;
+        }
+        x = (x | 31) + 1;
+    }
+    return x1 + 1;
+}
 
 /* Rasterizes one triangle given in clip space (clipping it first). Non-finite vertices
  * are rejected: they cover nothing. Returns the number of sub-triangles filled. */

@@ -1,7 +1,8 @@
 /* spsm.c — Sub-Pixel Shadow Maps (paper 004, Lecocq et al., i3D 2014): a shadow map
  * whose texels keep a 128-bit record of the nearest triangle, so shadow edges are
  * rebuilt below texel size. The texel format, the derivative code and the tangent
- * table are in spsm_texel.c (spsm.h); this file owns the method: build and lookup.
+ * table are in spsm_texel.c (spsm.h), the recovered outline in spsm_outline.c
+ * (spsm_lookup.h); this file owns the method: observe, build and lookup.
  *
  * Observe (not in the paper; spsm.records, by default when the map is finer than the
  * image): each exposed sample marks its texel. The lookup reads the records of the
@@ -26,7 +27,7 @@
  *  - otherwise uncertain: the silhouette is recovered (section 4.2) from the 3x3
  *    pattern of consistent depth tests (Figure 9), pruned by the pattern table
  *    (Figures 7 and 8), and the outline of the occluders it keeps (Figure 10; our
- *    outline is a hull, see boundary below); with spsm.aa = K > 1, K positions in
+ *    outline is a hull: spsm_outline.c); with spsm.aa = K > 1, K positions in
  *    the eye pixel are tested against the same outline (section 5). When every texel
  *    around holds an occluder there is no outline to find, and the plain map's test at
  *    the texel centre decides (the paper assumes shadow there). A point the outline
@@ -36,44 +37,12 @@
  * rounding, one step of margin, and the derivative code's error bound times the
  * distance from the texel centre. No bias setting is used. */
 #include "shadow.h"
-#include "spsm.h"
+#include "spsm_lookup.h"
 
-#define LINK_DZ (32.0 * STEP)    /* planes of one smooth surface agree this well */
 #define TIE_DZ (LINK_DZ / 2)     /* the build's near tie: one surface to recovery */
 #define TIES 0xFFu               /* the depth buffer's low bits: ties counted (texel) */
-#define MAXV 27                  /* boundary vertices: 9 triangles x 3 */
-#define STEP 65536.0             /* one 16-bit depth step in raw units */
-#define TOL0 (1.5 * STEP)
 #define LIT_CAP (64.0 * STEP)    /* a plane known this loosely proves nothing lit */
 #define PAT_CAP (16.0 * STEP)    /* the pattern's tests use at most this much slack */
-
-/* A texel's record decoded around the sample's texel: grid coordinates relative to
- * the centre of the sample's texel, plane in raw depth per grid unit. */
-typedef struct dtri {
-    bool empty, ok;              /* ok: a 2-D triangle with area */
-    bool have_e;                 /* e is set up (edges(): most samples need only the plane) */
-    om__tri2 e;
-    int64_t rx[3], ry[3];        /* the vertices as decoded (e holds them reordered) */
-    int64_t cx, cy;              /* this texel's centre */
-    double z, gx, gy, ex, ey;    /* centre depth, slopes and their error bounds */
-    double cmin;                 /* consistent_min, once computed (have_cmin) */
-    bool have_cmin;
-    double vz[3], vtol[3];       /* plane and pat_tol at the vertices rx, ry (have_vz) */
-    bool have_vz;
-} dtri;
-
-/* The recovered silhouette of an uncertain sample (4.2; boundary_build below). */
-typedef struct boundary {
-    int nv;
-    int64_t x[MAXV], y[MAXV];
-    uint8_t piece[MAXV];
-    /* the pieces' hulls, counter-clockwise without collinear points, one after another:
-     * hull h has the vertices [hoff[h], hoff[h + 1]) of hx, hy; pieces with no area
-     * (a point, a segment) have none */
-    int nh;
-    uint8_t hoff[MAXV + 1];
-    int64_t hx[MAXV], hy[MAXV];
-} boundary;
 
 typedef struct spsm_state {
     const om_scene *scene;
@@ -390,20 +359,12 @@ static void clear_needed(const spsm_state *m, uint32_t *buf)
         }
 }
 
-/* The texels of a span that the lookup will read (need): runs of 32 unneeded ones are
- * passed over a word at a time. */
+/* The texels of a span that the lookup will read (need). */
 static void span(void *user, int32_t y, int32_t x0, int32_t x1, const om__rtri *t)
 {
     build_ctx *b = (build_ctx *)user;
     const uint32_t *row = b->m->need + (size_t)y * b->m->words;
-    for (int32_t x = x0; x <= x1;) {
-        const uint32_t w = row[x >> 5] >> (x & 31);
-        if (!w) { x = (x | 31) + 1; continue; }
-        x += om__ctz32(w);
-        if (x > x1) break;
-        texel(b, x, y, t);
-        x++;
-    }
+    for (int32_t x = om__mask_next(row, x0, x1); x <= x1; x = om__mask_next(row, x + 1, x1)) texel(b, x, y, t);
 }
 
 static om_status spsm_build(void *state, om_diag *d)
@@ -538,17 +499,6 @@ static const om__tri2 *edges(dtri t[9], int k)
     return &o->e;
 }
 
-/* Equation 1: the stored plane at grid point (px, py), and what it cannot resolve. */
-static double plane_at(const dtri *t, int64_t px, int64_t py)
-{
-    return t->z + t->gx * (double)(px - t->cx) + t->gy * (double)(py - t->cy);
-}
-
-static double tol_at(const dtri *t, int64_t px, int64_t py)
-{
-    return TOL0 + t->ex * fabs((double)(px - t->cx)) + t->ey * fabs((double)(py - t->cy));
-}
-
 /* The slack of the pattern's tests (4.2): they only orient the silhouette, so a plane
  * known loosely (a nearly edge-on triangle) is used at its decoded slope. */
 static double pat_tol(const dtri *t, int64_t px, int64_t py)
@@ -580,128 +530,6 @@ static double consistent_min(const dtri *t)
                   Y[3] = {t->e.y[0] - t->cy, t->e.y[1] - t->cy, t->e.y[2] - t->cy};
     const zplane p = {t->z, t->gx, t->gy, 0, 0};
     return clipped_min(X, Y, -H, -H, OM_SUBPIX, &p);
-}
-
-/* Twice the signed area of (o, a, b): > 0 when b lies left of o -> a. Exact: offsets
- * stay below 2^27 (the o16 range), so the products stay below 2^55. */
-static int64_t turn(int64_t ox, int64_t oy, int64_t ax, int64_t ay, int64_t bx, int64_t by)
-{
-    return (ax - ox) * (by - oy) - (ay - oy) * (bx - ox);
-}
-
-/* Each piece's convex hull (Andrew's monotone chain on its points sorted by x, then
- * y), built once per boundary so that every test point costs one pass over it. */
-static void hulls_build(boundary *b)
-{
-    b->nh = 0;
-    b->hoff[0] = 0;
-    int used = 0;
-    for (int pc = 0; pc < b->nv; pc++) {
-        if (b->piece[pc] != pc) continue;   /* a piece is labelled by its first vertex */
-        int64_t px[MAXV], py[MAXV];
-        int n = 0;
-        for (int i = 0; i < b->nv; i++) {
-            if (b->piece[i] != pc) continue;
-            int j = n++;
-            for (; j > 0 && (px[j - 1] > b->x[i] || (px[j - 1] == b->x[i] && py[j - 1] > b->y[i])); j--) {
-                px[j] = px[j - 1];
-                py[j] = py[j - 1];
-            }
-            px[j] = b->x[i];
-            py[j] = b->y[i];
-        }
-        if (n < 3) continue;
-        int64_t *hx = b->hx + used, *hy = b->hy + used;
-        int64_t cx[2 * MAXV], cy[2 * MAXV];   /* the chain; its last point repeats the first */
-        int k = 0;
-        for (int i = 0; i < n; i++) {         /* lower chain */
-            while (k >= 2 && turn(cx[k - 2], cy[k - 2], cx[k - 1], cy[k - 1], px[i], py[i]) <= 0) k--;
-            cx[k] = px[i]; cy[k] = py[i]; k++;
-        }
-        for (int i = n - 2, lo = k + 1; i >= 0; i--) {   /* upper chain */
-            while (k >= lo && turn(cx[k - 2], cy[k - 2], cx[k - 1], cy[k - 1], px[i], py[i]) <= 0) k--;
-            cx[k] = px[i]; cy[k] = py[i]; k++;
-        }
-        if (k - 1 < 3) continue;               /* all on one line: no inside */
-        for (int i = 0; i < k - 1; i++) { hx[i] = cx[i]; hy[i] = cy[i]; }
-        used += k - 1;
-        b->nh++;
-        b->hoff[b->nh] = (uint8_t)used;
-    }
-}
-
-/* The recovered silhouette (section 4.2, Figure 10), built once per texel and pattern so
- * that AA sub-samples reuse it (section 5). Its points are the vertices of the
- * occluders the pattern keeps. Two are linked when they belong to one stored triangle,
- * or lie within OM_SPSM_LINK of each other on one smooth surface (the plane of one's
- * triangle, carried to the other, meets the other's within LINK_DZ): a gap that narrow
- * is taken for geometry the map could not keep, as a dense mesh keeps one small
- * triangle per texel (Figure 10a), while a cloud of separate small triangles does not
- * line up and stays apart. Links join the points into pieces; a piece's outline is the
- * convex hull of its points. Where the paper links the lit-side vertices along the
- * tangent into phi and shadows everything beyond it, the hull also closes the piece
- * on its far side, so two thin occluders a texel or more apart (a fence) do not shadow
- * the gap between them (see README: the one-sided phi measured worse). */
-/* Merges piece `from` into piece `to` (every vertex labelled `from` takes `to`), keeping
- * a piece's label its first vertex's: the smaller index wins. */
-static void join(boundary *b, uint8_t from, uint8_t to)
-{
-    if (from < to) { uint8_t s = from; from = to; to = s; }
-    for (int k = 0; k < b->nv; k++)
-        if (b->piece[k] == from) b->piece[k] = to;
-}
-
-static void boundary_build(boundary *b, const dtri *const occ[9], int nocc)
-{
-    uint32_t tri_of[MAXV];       /* bit k: a vertex of occluder k */
-    b->nv = 0;
-    for (int k = 0; k < nocc; k++)
-        for (int i = 0; i < 3; i++) {
-            int64_t x = occ[k]->e.x[i], y = occ[k]->e.y[i];
-            int j = 0;
-            while (j < b->nv && (b->x[j] != x || b->y[j] != y)) j++;
-            if (j == b->nv) { b->x[j] = x; b->y[j] = y; tri_of[j] = 0; b->nv++; }
-            tri_of[j] |= 1u << k;
-        }
-    /* A piece is labelled by its first vertex. Vertices of one triangle are one piece
-     * from the start: a vertex joins the piece of the first earlier vertex it shares a
-     * triangle with, and pieces that a shared vertex bridges are merged. */
-    for (int i = 0; i < b->nv; i++) {
-        b->piece[i] = (uint8_t)i;
-        for (int j = 0; j < i; j++) {
-            if (!(tri_of[i] & tri_of[j]) || b->piece[j] == b->piece[i]) continue;
-            join(b, b->piece[i], b->piece[j]);
-        }
-    }
-    for (int i = 0; i < b->nv; i++)
-        for (int j = i + 1; j < b->nv; j++) {
-            if (b->piece[j] == b->piece[i]) continue;   /* joined already: nothing to test */
-            int64_t dx = b->x[j] - b->x[i], dy = b->y[j] - b->y[i];
-            if (dx > OM_SPSM_LINK || dx < -OM_SPSM_LINK || dy > OM_SPSM_LINK || dy < -OM_SPSM_LINK) continue;
-            /* one surface: i's triangle's plane, carried to j, meets j's triangle there
-             * (a smooth mesh bends little over a texel; a cloud of separate triangles
-             * does not line up) */
-            const dtri *a = occ[om__ctz32(tri_of[i])], *c = occ[om__ctz32(tri_of[j])];
-            double za = plane_at(a, b->x[j], b->y[j]), zc = plane_at(c, b->x[j], b->y[j]);
-            if (fabs(za - zc) > tol_at(a, b->x[j], b->y[j]) + LINK_DZ) continue;
-            join(b, b->piece[j], b->piece[i]);
-        }
-    hulls_build(b);
-}
-
-/* Strictly inside the hull of one piece: strictly left of each of its edges. */
-static bool inside_hull(const boundary *b, int64_t px, int64_t py)
-{
-    for (int h = 0; h < b->nh; h++) {
-        int a = b->hoff[h], e = b->hoff[h + 1];
-        bool in = true;
-        for (int i = a; i < e && in; i++) {
-            int j = i + 1 == e ? a : i + 1;
-            in = turn(b->hx[i], b->hy[i], b->hx[j], b->hy[j], px, py) > 0;
-        }
-        if (in) return true;
-    }
-    return false;
 }
 
 /* Light depth (raw) and grid position of a world point, in double throughout. */
@@ -900,7 +728,7 @@ static uint8_t lookup(spsm_state *m, const om_strip *st, size_t i)
             if (!dup) m->occ[m->nocc++] = &t[k];
         }
         m->bd.nv = m->bd.nh = 0;
-        if (m->nocc > 1) boundary_build(&m->bd, m->occ, m->nocc);   /* one triangle's hull is itself */
+        if (m->nocc > 1) om__spsm_outline_build(&m->bd, m->occ, m->nocc);   /* one triangle's hull is itself */
         m->bd_keep = tg->keep;
         m->bd_have = true;
     }
@@ -929,7 +757,7 @@ static uint8_t lookup(spsm_state *m, const om_strip *st, size_t i)
         }
         bool shadow = false;
         for (int k = 0; k < nocc && !shadow; k++) shadow = hits(occ[k], qx, qy, q.z);
-        if (!shadow && bd->nh) shadow = inside_hull(bd, qx, qy);
+        if (!shadow && bd->nh) shadow = om__spsm_outline_inside(bd, qx, qy);
         if (!shadow && tg->keep == 511) shadow = centre_test(m, &rp, tx, ty, px, py);   /* rp set */
         if (!shadow) {
             if (!have_rp) { rp = receiver_plane(m, smp); have_rp = true; }

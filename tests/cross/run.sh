@@ -125,7 +125,7 @@ if command -v arm-none-eabi-gcc >/dev/null 2>&1; then
     echo "cross: .text bytes for Cortex-M3 at -Os:"
     for part in core raster scene frame measure shadow/occlude shadow/bvh shadow/smlookup shadow/registry \
                 $(ls engine/shadow/*.c | sed -n 's|engine/shadow/\([a-z]*\)\.c|\1|p' | \
-                  grep -v -x -e occlude -e bvh -e registry -e smlookup -e asm_tree -e rtw_warp -e spsm_texel); do
+                  grep -v -x -e occlude -e bvh -e registry -e smlookup -e asm_tree -e rtw_warp -e spsm_texel -e spsm_outline); do
         case $part in
             core|raster|scene|frame|measure) files=$(ls engine/$part/*.c) ;;
             shadow/*) files=engine/$part.c ;;

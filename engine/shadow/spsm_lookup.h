@@ -1,0 +1,60 @@
+/* spsm_lookup.h — what the SPSM lookup (spsm.c) and its silhouette outline
+ * (spsm_outline.c, section 4.2 and Figure 10) share: a texel record decoded around the
+ * sample's texel, its plane (Equation 1), and the outline built from the occluders the
+ * depth-test pattern keeps. Units as in spsm.h: grid units of 1/256 texel, raw depth. */
+#ifndef OM_SPSM_LOOKUP_H
+#define OM_SPSM_LOOKUP_H
+
+#include "spsm.h"
+
+#define STEP 65536.0             /* one 16-bit depth step in raw units */
+#define TOL0 (1.5 * STEP)        /* what a record's depth cannot resolve at its centre */
+#define LINK_DZ (32.0 * STEP)    /* planes of one smooth surface agree this well */
+#define MAXV 27                  /* outline vertices: 9 triangles x 3 */
+
+/* A texel's record decoded around the sample's texel: grid coordinates relative to
+ * the centre of the sample's texel, plane in raw depth per grid unit. */
+typedef struct dtri {
+    bool empty, ok;              /* ok: a 2-D triangle with area */
+    bool have_e;                 /* e is set up (edges(): most samples need only the plane) */
+    om__tri2 e;
+    int64_t rx[3], ry[3];        /* the vertices as decoded (e holds them reordered) */
+    int64_t cx, cy;              /* this texel's centre */
+    double z, gx, gy, ex, ey;    /* centre depth, slopes and their error bounds */
+    double cmin;                 /* consistent_min, once computed (have_cmin) */
+    bool have_cmin;
+    double vz[3], vtol[3];       /* plane and pat_tol at the vertices rx, ry (have_vz) */
+    bool have_vz;
+} dtri;
+
+/* The recovered silhouette of an uncertain sample (4.2; spsm_outline.c). */
+typedef struct boundary {
+    int nv;
+    int64_t x[MAXV], y[MAXV];
+    uint8_t piece[MAXV];
+    /* the pieces' hulls, counter-clockwise without collinear points, one after another:
+     * hull h has the vertices [hoff[h], hoff[h + 1]) of hx, hy; pieces with no area
+     * (a point, a segment) have none */
+    int nh;
+    uint8_t hoff[MAXV + 1];
+    int64_t hx[MAXV], hy[MAXV];
+} boundary;
+
+/* Equation 1: the stored plane at grid point (px, py), and what it cannot resolve. */
+static inline double plane_at(const dtri *t, int64_t px, int64_t py)
+{
+    return t->z + t->gx * (double)(px - t->cx) + t->gy * (double)(py - t->cy);
+}
+
+static inline double tol_at(const dtri *t, int64_t px, int64_t py)
+{
+    return TOL0 + t->ex * fabs((double)(px - t->cx)) + t->ey * fabs((double)(py - t->cy));
+}
+
+/* Builds the outline of the occluders occ[0..nocc) (distinct triangles, their edges
+ * set up): their vertices, linked into pieces, and each piece's convex hull. */
+void om__spsm_outline_build(boundary *b, const dtri *const occ[9], int nocc);
+/* Whether (px, py) lies strictly inside one of the outline's hulls. */
+bool om__spsm_outline_inside(const boundary *b, int64_t px, int64_t py);
+
+#endif

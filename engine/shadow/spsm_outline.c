@@ -1,0 +1,129 @@
+/* spsm_outline.c — the silhouette that SPSM's recovery (paper 004, section 4.2,
+ * Figure 10) rebuilds for an uncertain sample from the occluders its depth-test
+ * pattern keeps: their vertices, linked into pieces where they lie on one surface, and
+ * each piece's convex hull, against which the sample (and each AA sub-sample) is
+ * tested. The pattern, the occluders and the decisions around it are in spsm.c. */
+#include "spsm_lookup.h"
+
+/* Twice the signed area of (o, a, b): > 0 when b lies left of o -> a. Exact: offsets
+ * stay below 2^27 (the o16 range), so the products stay below 2^55. */
+static int64_t turn(int64_t ox, int64_t oy, int64_t ax, int64_t ay, int64_t bx, int64_t by)
+{
+    return (ax - ox) * (by - oy) - (ay - oy) * (bx - ox);
+}
+
+/* Each piece's convex hull (Andrew's monotone chain on its points sorted by x, then
+ * y), built once per boundary so that every test point costs one pass over it. */
+static void hulls_build(boundary *b)
+{
+    b->nh = 0;
+    b->hoff[0] = 0;
+    int used = 0;
+    for (int pc = 0; pc < b->nv; pc++) {
+        if (b->piece[pc] != pc) continue;   /* a piece is labelled by its first vertex */
+        int64_t px[MAXV], py[MAXV];
+        int n = 0;
+        for (int i = 0; i < b->nv; i++) {
+            if (b->piece[i] != pc) continue;
+            int j = n++;
+            for (; j > 0 && (px[j - 1] > b->x[i] || (px[j - 1] == b->x[i] && py[j - 1] > b->y[i])); j--) {
+                px[j] = px[j - 1];
+                py[j] = py[j - 1];
+            }
+            px[j] = b->x[i];
+            py[j] = b->y[i];
+        }
+        if (n < 3) continue;
+        int64_t *hx = b->hx + used, *hy = b->hy + used;
+        int64_t cx[2 * MAXV], cy[2 * MAXV];   /* the chain; its last point repeats the first */
+        int k = 0;
+        for (int i = 0; i < n; i++) {         /* lower chain */
+            while (k >= 2 && turn(cx[k - 2], cy[k - 2], cx[k - 1], cy[k - 1], px[i], py[i]) <= 0) k--;
+            cx[k] = px[i]; cy[k] = py[i]; k++;
+        }
+        for (int i = n - 2, lo = k + 1; i >= 0; i--) {   /* upper chain */
+            while (k >= lo && turn(cx[k - 2], cy[k - 2], cx[k - 1], cy[k - 1], px[i], py[i]) <= 0) k--;
+            cx[k] = px[i]; cy[k] = py[i]; k++;
+        }
+        if (k - 1 < 3) continue;               /* all on one line: no inside */
+        for (int i = 0; i < k - 1; i++) { hx[i] = cx[i]; hy[i] = cy[i]; }
+        used += k - 1;
+        b->nh++;
+        b->hoff[b->nh] = (uint8_t)used;
+    }
+}
+
+/* The recovered silhouette (section 4.2, Figure 10), built once per texel and pattern so
+ * that AA sub-samples reuse it (section 5). Its points are the vertices of the
+ * occluders the pattern keeps. Two are linked when they belong to one stored triangle,
+ * or lie within OM_SPSM_LINK of each other on one smooth surface (the plane of one's
+ * triangle, carried to the other, meets the other's within LINK_DZ): a gap that narrow
+ * is taken for geometry the map could not keep, as a dense mesh keeps one small
+ * triangle per texel (Figure 10a), while a cloud of separate small triangles does not
+ * line up and stays apart. Links join the points into pieces; a piece's outline is the
+ * convex hull of its points. Where the paper links the lit-side vertices along the
+ * tangent into phi and shadows everything beyond it, the hull also closes the piece
+ * on its far side, so two thin occluders a texel or more apart (a fence) do not shadow
+ * the gap between them (see README: the one-sided phi measured worse). */
+/* Merges piece `from` into piece `to` (every vertex labelled `from` takes `to`), keeping
+ * a piece's label its first vertex's: the smaller index wins. */
+static void join(boundary *b, uint8_t from, uint8_t to)
+{
+    if (from < to) { uint8_t s = from; from = to; to = s; }
+    for (int k = 0; k < b->nv; k++)
+        if (b->piece[k] == from) b->piece[k] = to;
+}
+
+void om__spsm_outline_build(boundary *b, const dtri *const occ[9], int nocc)
+{
+    uint32_t tri_of[MAXV];       /* bit k: a vertex of occluder k */
+    b->nv = 0;
+    for (int k = 0; k < nocc; k++)
+        for (int i = 0; i < 3; i++) {
+            int64_t x = occ[k]->e.x[i], y = occ[k]->e.y[i];
+            int j = 0;
+            while (j < b->nv && (b->x[j] != x || b->y[j] != y)) j++;
+            if (j == b->nv) { b->x[j] = x; b->y[j] = y; tri_of[j] = 0; b->nv++; }
+            tri_of[j] |= 1u << k;
+        }
+    /* A piece is labelled by its first vertex. Vertices of one triangle are one piece
+     * from the start: a vertex joins the piece of the first earlier vertex it shares a
+     * triangle with, and pieces that a shared vertex bridges are merged. */
+    for (int i = 0; i < b->nv; i++) {
+        b->piece[i] = (uint8_t)i;
+        for (int j = 0; j < i; j++) {
+            if (!(tri_of[i] & tri_of[j]) || b->piece[j] == b->piece[i]) continue;
+            join(b, b->piece[i], b->piece[j]);
+        }
+    }
+    for (int i = 0; i < b->nv; i++)
+        for (int j = i + 1; j < b->nv; j++) {
+            if (b->piece[j] == b->piece[i]) continue;   /* joined already: nothing to test */
+            int64_t dx = b->x[j] - b->x[i], dy = b->y[j] - b->y[i];
+            if (dx > OM_SPSM_LINK || dx < -OM_SPSM_LINK || dy > OM_SPSM_LINK || dy < -OM_SPSM_LINK) continue;
+            /* one surface: i's triangle's plane, carried to j, meets j's triangle there
+             * (a smooth mesh bends little over a texel; a cloud of separate triangles
+             * does not line up) */
+            const dtri *a = occ[om__ctz32(tri_of[i])], *c = occ[om__ctz32(tri_of[j])];
+            double za = plane_at(a, b->x[j], b->y[j]), zc = plane_at(c, b->x[j], b->y[j]);
+            if (fabs(za - zc) > tol_at(a, b->x[j], b->y[j]) + LINK_DZ) continue;
+            join(b, b->piece[j], b->piece[i]);
+        }
+    hulls_build(b);
+}
+
+/* Strictly inside the hull of one piece: strictly left of each of its edges. */
+bool om__spsm_outline_inside(const boundary *b, int64_t px, int64_t py)
+{
+    for (int h = 0; h < b->nh; h++) {
+        int a = b->hoff[h], e = b->hoff[h + 1];
+        bool in = true;
+        for (int i = a; i < e && in; i++) {
+            int j = i + 1 == e ? a : i + 1;
+            in = turn(b->hx[i], b->hy[i], b->hx[j], b->hy[j], px, py) > 0;
+        }
+        if (in) return true;
+    }
+    return false;
+}
+
