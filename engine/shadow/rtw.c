@@ -401,15 +401,7 @@ static om_status rtw_resolve(void *state, om_strip *st, om_diag *d)
     (void)d;
     om__rtw *m = (om__rtw *)state;
     uint64_t t0 = now(m);
-    size_t n = (size_t)st->rows * st->width;
-    for (size_t i = 0; i < n; i++) {
-        om_term *t = &st->terms[i];
-        t->r = t->g = t->b = 255;
-        if (!(t->flags & OM_TERM_EXPOSED)) continue;
-        m->samples++;
-        om__smlook_term(&m->look, &st->samples[i], t);
-        if (t->r != 255) m->shadowed++;
-    }
+    om__smlook_strip(&m->look, st, &m->samples, &m->shadowed);
     m->ns[3] += now(m) - t0;
     return OM_OK;
 }

@@ -90,15 +90,7 @@ static om_status sm_resolve(void *state, om_strip *st, om_diag *d)
 {
     (void)d;
     sm_state *m = (sm_state *)state;
-    size_t n = (size_t)st->rows * st->width;
-    for (size_t i = 0; i < n; i++) {
-        om_term *t = &st->terms[i];
-        t->r = t->g = t->b = 255;
-        if (!(t->flags & OM_TERM_EXPOSED)) continue;
-        m->samples++;
-        om__smlook_term(&m->look, &st->samples[i], t);
-        if (t->r != 255) m->shadowed++;
-    }
+    om__smlook_strip(&m->look, st, &m->samples, &m->shadowed);
     return OM_OK;
 }
 

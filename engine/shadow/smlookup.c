@@ -25,7 +25,12 @@ static float texel_world(const om__smlook *L, float dist)
     return span / (float)L->size;
 }
 
-void om__smlook_term(const om__smlook *L, const om_sample *smp, om_term *t)
+/* Where one sample's test looks: its biased depth and the texel under it (before the
+ * clamp to the map). */
+typedef struct tap { double z; int64_t cx, cy; } tap;
+
+/* All of the test's arithmetic; false when the sample is behind the light. */
+static bool locate(const om__smlook *L, const om_sample *smp, tap *out)
 {
     const om_view *v = L->view;
     om_vec3 p = om__v3(smp->p[0], smp->p[1], smp->p[2]);
@@ -40,7 +45,7 @@ void om__smlook_term(const om__smlook *L, const om_sample *smp, om_term *t)
         /* A warped texel covers 1/density of an unwarped one: where the warp stretches
          * the map, texels are smaller in the world and the bias shrinks with them. */
         q0 = om__mat_apply(&v->light_vp, p);
-        if (!(q0.w > 0.0f)) return;
+        if (!(q0.w > 0.0f)) return false;
         double iw0 = 1.0 / (double)q0.w, dens = 1.0;
         u0 = ((double)q0.x * iw0 + 1.0) * 0.5;
         v0 = (1.0 - (double)q0.y * iw0) * 0.5;
@@ -56,7 +61,7 @@ void om__smlook_term(const om__smlook *L, const om_sample *smp, om_term *t)
     } else {
         p = om__add(p, om__scale(n, L->normal_offset * texel));
         q = om__mat_apply(&v->light_vp, p);
-        if (!(q.w > 0.0f)) return;
+        if (!(q.w > 0.0f)) return false;
     }
     double iw = 1.0 / (double)q.w;
     double u, w;
@@ -82,9 +87,18 @@ void om__smlook_term(const om__smlook *L, const om_sample *smp, om_term *t)
     } else {
         dz = 4294967296.0 * fabs((double)v->light_proj.m[10]);
     }
-    z -= (double)bias * dz;
+    out->z = z - (double)bias * dz;
+    out->cx = (int64_t)floor(u);
+    out->cy = (int64_t)floor(w);
+    return true;
+}
+
+/* The map loads: k x k taps around the texel, each clamped to the map. */
+static uint8_t test(const om__smlook *L, const tap *tp)
+{
+    const double z = tp->z;
+    const int64_t cx = tp->cx, cy = tp->cy;
     int k = (int)L->pcf, half = k / 2, lit = 0;
-    int64_t cx = (int64_t)floor(u), cy = (int64_t)floor(w);
     for (int dy = -half; dy < k - half; dy++)
         for (int dx = -half; dx < k - half; dx++) {
             int64_t x = cx + dx, y = cy + dy;
@@ -96,5 +110,33 @@ void om__smlook_term(const om__smlook *L, const om_sample *smp, om_term *t)
         }
     uint8_t val = (uint8_t)((255 * lit + k * k / 2) / (k * k));
     if (lit < k * k && val == 255) val = 254;   /* partly shadowed is never "lit" */
-    t->r = t->g = t->b = val;
+    return val;
+}
+
+/* Locating a block of samples first and testing them after keeps the test loop short
+ * and its loads independent, so that many of them are in flight at once: a warped map
+ * spreads the view over the whole map, and its loads miss the cache. The terms are
+ * the same as testing sample by sample. */
+#define SMLOOK_BLOCK 32
+void om__smlook_strip(const om__smlook *L, om_strip *st, uint32_t *samples, uint32_t *shadowed)
+{
+    const size_t n = (size_t)st->rows * st->width;
+    tap taps[SMLOOK_BLOCK];
+    uint32_t at[SMLOOK_BLOCK];   /* strip index of each located sample */
+    for (size_t i = 0; i < n;) {
+        int got = 0;
+        for (; i < n && got < SMLOOK_BLOCK; i++) {
+            om_term *t = &st->terms[i];
+            t->r = t->g = t->b = 255;
+            if (!(t->flags & OM_TERM_EXPOSED)) continue;
+            ++*samples;
+            if (locate(L, &st->samples[i], &taps[got])) at[got++] = (uint32_t)i;
+        }
+        for (int j = 0; j < got; j++) {
+            uint8_t val = test(L, &taps[j]);
+            om_term *t = &st->terms[at[j]];
+            t->r = t->g = t->b = val;
+            *shadowed += val != 255;
+        }
+    }
 }

@@ -29,8 +29,10 @@ typedef struct om__smlook {
 
 /* Fills the frame-dependent part (view, span) for this frame's light. */
 void om__smlook_begin(om__smlook *L, const om_view *v);
-/* The term of one exposed sample: 255 lit, 0 shadowed, between for partial PCF (never
- * 255 unless every tap is lit). Leaves *t alone when the sample is behind the light. */
-void om__smlook_term(const om__smlook *L, const om_sample *smp, om_term *t);
+/* The terms of a strip. Each exposed sample's is 255 lit, 0 shadowed, between for
+ * partial PCF (never 255 unless every tap is lit); 255 where the sample is not exposed
+ * or lies behind the light. Counts the exposed samples and the shadowed ones (term
+ * below 255) into *samples, *shadowed. */
+void om__smlook_strip(const om__smlook *L, om_strip *st, uint32_t *samples, uint32_t *shadowed);
 
 #endif
