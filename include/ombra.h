@@ -133,6 +133,12 @@ typedef struct om_light {
 typedef struct om_camera_key { float t; om_vec3 eye, target; } om_camera_key;
 typedef struct om_light_key { float t; om_vec3 pos, target, dir; } om_light_key;
 
+/* A closed shape: triangles [first, first + count) form a closed surface wound
+ * counter-clockwise seen from outside, inside the box lo..hi. Seen from a point
+ * outside it, the nearest surface along any ray faces that point, so a depth map may
+ * skip the triangles facing away. */
+typedef struct om_solid { uint32_t first, count; om_vec3 lo, hi; } om_solid;
+
 /* A scene: indexed triangles with a material per triangle, one camera, one light and
  * optional keyframed paths. All arrays live in the arena the scene was parsed into. */
 typedef struct om_scene {
@@ -146,6 +152,8 @@ typedef struct om_scene {
     om_camera_key *cam_keys;   /* sorted by t */
     om_light_key *light_keys;  /* sorted by t */
     om_vec3 lo, hi;        /* bounds of all vertices */
+    uint32_t nsolids;      /* closed shapes (box, sphere, cylinder), by first triangle; */
+    om_solid *solids;      /* 0 and NULL in a hand-made scene: nothing is skipped */
 } om_scene;
 
 /* The host reads files named in a scene (`mesh FILE.obj`); the engine never does.

@@ -404,6 +404,7 @@ static void bytes_exact(void)
             CHECK_EQ_U(a.used, bytes);
             CHECK(((uintptr_t)s.verts & 3) == 0 && ((uintptr_t)s.idx & 3) == 0);
             CHECK(((uintptr_t)s.tri_mat & 1) == 0 && ((uintptr_t)s.mats & 3) == 0);
+            CHECK(((uintptr_t)s.solids & 3) == 0);
             if (bytes == 0) continue;
             om_arena_init(&a, buf + off, bytes - 1, "scene");
             CHECK(om_scene_parse(text, strlen(text), NULL, &a, &s, &d) == OM_E_BUDGET);
@@ -417,19 +418,19 @@ static void bytes_exact(void)
     /* the count is what the arrays take, plus alignment slack */
     size_t bytes;
     CHECK_OK(om_scene_bytes("box", 3, NULL, &bytes, NULL));
-    size_t arrays = 8 * sizeof(om_vec3) + 12 * 3 * 4 + 12 * 2 + sizeof(om_material);
-    CHECK(bytes >= arrays && bytes <= arrays + 4 * 8);
+    size_t arrays = 8 * sizeof(om_vec3) + 12 * 3 * 4 + 12 * 2 + sizeof(om_material) + sizeof(om_solid);
+    CHECK(bytes >= arrays && bytes <= arrays + 5 * 8);
     /* fault injection: a carve failing in the middle leaves the arena as it was */
     static unsigned char buf[1 << 16];
-    const char *five = "box\nkey camera 0 eye 0 0 1 target 0 0 0";   /* five arrays */
-    for (uint32_t k = 1; k <= 6; k++) {
+    const char *six = "box\nkey camera 0 eye 0 0 1 target 0 0 0";   /* six arrays, a solid */
+    for (uint32_t k = 1; k <= 7; k++) {
         om_arena a;
         om_scene s;
         om_arena_init(&a, buf, sizeof buf, "scene");
         a.fail_at = k;
-        om_status st = om_scene_parse(five, strlen(five), NULL, &a, &s, NULL);
-        CHECK(st == (k <= 5 ? OM_E_BUDGET : OM_OK));
-        if (k <= 5) CHECK_EQ_U(a.used, 0);
+        om_status st = om_scene_parse(six, strlen(six), NULL, &a, &s, NULL);
+        CHECK(st == (k <= 6 ? OM_E_BUDGET : OM_OK));
+        if (k <= 6) CHECK_EQ_U(a.used, 0);
     }
 }
 

@@ -4,6 +4,7 @@
 #include "test.h"
 #include "harness.h"
 #include "../engine/shadow/occlude.h"
+#include "../engine/frame/frame.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -317,6 +318,92 @@ static void ref_small_equals_fast(void)
     h_scene_free(&hs);
 }
 
+/* Back-face culling of a light's depth map (om__cull): the scene records its closed
+ * shapes, and on them the map is the same bits with and without culling, wherever the
+ * light is; a solid that holds the light or that the near plane cuts is not culled
+ * (culling it would lose its nearest, back-facing, surface). */
+static void light_cull_keeps_the_map(void)
+{
+    enum { N = 512 };
+    static uint32_t full[N * N], culled[N * N];
+    h_scene hs;
+    if (!h_scene_parse(&hs, "camera eye 0 6 9 target 0 0 0 fov 60 size 160 120 near 0.1 far 100\n"
+                            "light spot pos 6 8 5 target 0 0 0 fov 70 near 0.5 far 40\n"
+                            "plane size 20 20 divisions 4\n"
+                            "box size 2 1 3 rotate 10 20 30 translate -3 0.8 0\n"
+                            "sphere radius 1 segments 24 rings 12 scale 1 0.5 2 rotate 0 40 0 translate 0 1 -3\n"
+                            "triangles count 60 seed 1 area 4 in -5 0 -5 5 3 5\n"
+                            "box size 1 1 1 scale -1 2 1 rotate 0 30 0 translate 3 0.5 2\n"
+                            "cylinder radius 0.5 height 2 segments 20 rotate 90 0 0 translate 2 1 -2\n"
+                            "box size 4 4 4 translate 8 2 8\n"))
+        return;
+    const om_scene *s = &hs.s;
+    /* the three boxes, the sphere and the cylinder, in scene order; not the plane or
+     * the triangle cloud */
+    static const uint32_t counts[5] = {12, 2 * 24 * 11, 12, 4 * 20, 12};
+    CHECK_EQ_U(s->nsolids, 5);
+    uint32_t first[5] = {32, 32 + 12, 32 + 12 + 2 * 24 * 11 + 60, 0, 0};
+    first[3] = first[2] + 12;
+    first[4] = first[3] + 80;
+    for (uint32_t k = 0; k < s->nsolids && k < 5; k++) {
+        const om_solid *o = &s->solids[k];
+        CHECK_EQ_U(o->first, first[k]);
+        CHECK_EQ_U(o->count, counts[k]);
+        for (uint32_t t = o->first; t < o->first + o->count; t++)
+            for (int c = 0; c < 3; c++) {
+                om_vec3 v = s->verts[s->idx[3 * t + c]];
+                CHECK(v.x >= o->lo.x && v.y >= o->lo.y && v.z >= o->lo.z);
+                CHECK(v.x <= o->hi.x && v.y <= o->hi.y && v.z <= o->hi.z);
+            }
+    }
+    CHECK_EQ_U(first[4] + 12, s->ntris);
+    /* lights: above, grazing, inside the last box, with a near plane through the
+     * first box, and a directional light */
+    static const float lights[5][8] = {
+        {6, 8, 5, 0, 0, 0, 0.5f, 40}, {-9, 2, -7, 0, 0.5f, 0, 0.5f, 40},
+        {8, 2, 8, 0, 0, 0, 0.2f, 40}, {-3, 3.5f, 0, -3, 0, 0, 2.6f, 20}, {0, 0, 0, 0, 0, 0, 0, 0}};
+    for (int k = 0; k < 5; k++) {
+        om_camera cam;
+        om_light light;
+        om_scene_at(s, 0, &cam, &light);
+        const float *l = lights[k];
+        if (k == 4) {
+            light.kind = OM_LIGHT_DIRECTIONAL;
+            light.dir = om__v3(0.3f, -1.0f, 0.2f);
+        } else {
+            light.pos = om__v3(l[0], l[1], l[2]);
+            light.target = om__v3(l[3], l[4], l[5]);
+            light.znear = l[6];
+            light.zfar = l[7];
+        }
+        om_view v;
+        CHECK_OK(om_view_init(&v, &cam, &light, s, NULL));
+        om_target tf = {N, N, 0, N, full, NULL}, tc = {N, N, 0, N, culled, NULL};
+        om__scene_raster(s, &v.light_vp, &tf, OM_RASTER_DEPTH, false);
+        om__scene_raster(s, &v.light_vp, &tc, OM_RASTER_DEPTH, true);
+        uint32_t diff = 0, covered = 0;
+        for (uint32_t i = 0; i < N * N; i++) {
+            diff += full[i] != culled[i];
+            covered += full[i] != UINT32_MAX;
+        }
+        CHECK_MSG(diff == 0, "light %d: %u of %u covered texels differ", k, diff, covered);
+        CHECK(covered > N * N / 8);
+        /* which solids were culled */
+        om__cull cl;
+        om__cull_begin(&cl, s, &v.light_vp);
+        unsigned on = 0;
+        for (uint32_t t = 0; t < s->ntris; t++)
+            if (om__cull_next(&cl, t))
+                for (unsigned j = 0; j < 5; j++)
+                    if (t == first[j]) on |= 1u << j;
+        /* light 0 has the last box behind it and light 2 inside it; light 3's near
+         * plane (y = 0.9) cuts every solid, though the light is inside none */
+        unsigned want = k == 0 || k == 2 ? 0x0Fu : k == 3 ? 0u : 0x1Fu;
+        CHECK_MSG(on == want, "light %d: solids culled %#x, expected %#x", k, on, want);
+    }
+    h_scene_free(&hs);
+}
+
 void suite_shadow(void)
 {
     RUN(square_under_sun);
@@ -328,4 +415,5 @@ void suite_shadow(void)
     RUN(budgets_name_the_minimum);
     RUN(odd_lights);
     RUN(ref_small_equals_fast);
+    RUN(light_cull_keeps_the_map);
 }

@@ -62,8 +62,47 @@ static void resolve_pixel(const om__persp_tri *c, double sx, double sy, om_sampl
     out->tri = c->tri;
 }
 
+/* A margin in front of the near plane, in clip z over w: the vertices are inside the
+ * box, but their clip coordinates are rounded on their own. */
+#define CULL_MARGIN 1e-4f
+
+static bool solid_in_front(const om_solid *o, const om_mat4 *vp)
+{
+    for (int i = 0; i < 8; i++) {
+        om_vec3 p = om__v3(i & 1 ? o->hi.x : o->lo.x, i & 2 ? o->hi.y : o->lo.y, i & 4 ? o->hi.z : o->lo.z);
+        om_vec4 q = om__mat_apply(vp, p);
+        if (!(q.w > 0.0f && q.z >= CULL_MARGIN * q.w)) return false;
+    }
+    return true;
+}
+
+void om__cull_begin(om__cull *c, const om_scene *s, const om_mat4 *vp)
+{
+    c->s = s;
+    c->vp = vp;
+    c->k = 0;
+    c->seen = UINT32_MAX;
+    c->on = false;
+}
+
+bool om__cull_next(om__cull *c, uint32_t t)
+{
+    const om_scene *s = c->s;
+    if (!s->solids) return false;
+    /* solids are in triangle order; a hand-made list out of order only culls less */
+    while (c->k < s->nsolids && (uint64_t)s->solids[c->k].first + s->solids[c->k].count <= t) c->k++;
+    if (c->k >= s->nsolids) return false;
+    const om_solid *o = &s->solids[c->k];
+    if (t < o->first || (uint64_t)o->first + o->count > s->ntris) return false;
+    if (c->seen != c->k) {
+        c->seen = c->k;
+        c->on = solid_in_front(o, c->vp);
+    }
+    return c->on;
+}
+
 void om__scene_raster(const om_scene *s, const om_mat4 *vp, const om_target *tg,
-                      om_raster_mode mode)
+                      om_raster_mode mode, bool cull)
 {
     om_raster r;
     r.target = tg;
@@ -73,17 +112,21 @@ void om__scene_raster(const om_scene *s, const om_mat4 *vp, const om_target *tg,
     r.centres = NULL;
     r.centre_mask = NULL;
     r.mask_words = 0;
+    r.cull_back = false;
+    om__cull cl;
+    om__cull_begin(&cl, s, vp);
     om__target_clear(tg);
     for (uint32_t t = 0; t < s->ntris; t++) {
         om_vec4 c[3];
         clip_tri(s, vp, t, c);
+        r.cull_back = cull && om__cull_next(&cl, t);
         om__raster_tri(&r, c, t);
     }
 }
 
 void om__eye_pass(const om_scene *s, const om_view *v, const om_target *tg, om_strip *st)
 {
-    om__scene_raster(s, &v->cam_vp, tg, OM_RASTER_DEPTH_ID);
+    om__scene_raster(s, &v->cam_vp, tg, OM_RASTER_DEPTH_ID, false);
     om__persp_tri cache;
     memset(&cache, 0, sizeof cache);
     cache.tri = OM_NO_TRI;

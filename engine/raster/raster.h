@@ -118,6 +118,10 @@ typedef struct om_raster {
      * (bit x & 31 of word x >> 5 of a row; mask_words words per row of the image). */
     const uint32_t *centre_mask;
     uint32_t mask_words;
+    /* Skip the triangle when it faces away: clockwise on the target (y down), that is
+     * counter-clockwise-from-outside seen from behind. The caller sets it per triangle,
+     * for closed shapes only (om__cull_next), in the depth modes only. */
+    bool cull_back;
 } om_raster;
 
 /* The first pixel x..x1 whose bit is set in `row` (one row of such a mask), x1 + 1

@@ -431,6 +431,24 @@ static om_status do_mesh(parser *p, const om__tok *file, const char *name, const
     return OM_OK;
 }
 
+/* Second pass: records the closed shape just generated, triangles [first, first + nt),
+ * with the box of its vertices (the shape's own, base .. nv of the sink). */
+static void add_solid(parser *p, uint64_t first, uint64_t nt)
+{
+    const om__sink *k = &p->out;
+    om_scene *s = p->s;
+    if (p->nsolids >= s->nsolids || k->overflow || k->nv > k->vcap || k->base >= k->nv) return;
+    om_solid *o = &s->solids[p->nsolids];
+    o->first = (uint32_t)first;
+    o->count = (uint32_t)nt;
+    o->lo = o->hi = k->verts[k->base];
+    for (uint64_t i = k->base + 1; i < k->nv; i++) {
+        om_vec3 v = k->verts[i];
+        o->lo = om__v3(fminf(o->lo.x, v.x), fminf(o->lo.y, v.y), fminf(o->lo.z, v.z));
+        o->hi = om__v3(fmaxf(o->hi.x, v.x), fmaxf(o->hi.y, v.y), fmaxf(o->hi.z, v.z));
+    }
+}
+
 static om_status do_object(parser *p, int cmd)
 {
     static const struct { const uint8_t *ids; size_t n; } sets[C_N_] = {
@@ -472,9 +490,12 @@ static om_status do_object(parser *p, int cmd)
     uint64_t nv, nt;
     shape_counts(cmd, pl, &nv, &nt);
     if ((st = check_totals(p, nv, nt)) != OM_OK) return st;
+    const bool closed = cmd == C_BOX || cmd == C_SPHERE || cmd == C_CYLINDER;
     if (p->fill) {
         om__sink_begin(&p->out, &xf, mat);
+        uint64_t first = p->out.nt;
         shape_gen(&p->out, cmd, pl);
+        if (closed) add_solid(p, first, nt);
     } else {
         double lo[3], hi[3];
         shape_box(cmd, pl, lo, hi);
@@ -489,6 +510,7 @@ static om_status do_object(parser *p, int cmd)
     }
     p->nv += nv;
     p->nt += nt;
+    p->nsolids += closed;
     return OM_OK;
 }
 
@@ -647,8 +669,9 @@ typedef struct al_u16 { char c; uint16_t x; } al_u16;
 typedef struct al_mat { char c; om_material x; } al_mat;
 typedef struct al_ck { char c; om_camera_key x; } al_ck;
 typedef struct al_lk { char c; om_light_key x; } al_lk;
+typedef struct al_so { char c; om_solid x; } al_so;
 
-enum { A_VERTS, A_IDX, A_TRIMAT, A_MATS, A_CKEYS, A_LKEYS, A_N_ };
+enum { A_VERTS, A_IDX, A_TRIMAT, A_MATS, A_CKEYS, A_LKEYS, A_SOLIDS, A_N_ };
 
 /* Each array's size and alignment, from the first pass's counts. */
 static void layout(const parser *p, uint64_t size[A_N_], size_t align[A_N_])
@@ -660,6 +683,7 @@ static void layout(const parser *p, uint64_t size[A_N_], size_t align[A_N_])
     align[A_MATS] = offsetof(al_mat, x);
     size[A_CKEYS] = (uint64_t)p->ncam * sizeof(om_camera_key);   align[A_CKEYS] = offsetof(al_ck, x);
     size[A_LKEYS] = (uint64_t)p->nlight * sizeof(om_light_key);  align[A_LKEYS] = offsetof(al_lk, x);
+    size[A_SOLIDS] = (uint64_t)p->nsolids * sizeof(om_solid);    align[A_SOLIDS] = offsetof(al_so, x);
 }
 
 /* Bytes of one array: om_arena_need's worst case, or nothing for an empty array. */
@@ -764,11 +788,13 @@ om_status om_scene_parse(const char *text, size_t len, const om_loader *ld, om_a
     s->mats = (om_material *)arr[A_MATS];
     s->cam_keys = (om_camera_key *)arr[A_CKEYS];
     s->light_keys = (om_light_key *)arr[A_LKEYS];
+    s->nsolids = p.nsolids;
+    s->solids = (om_solid *)arr[A_SOLIDS];
     s->mats[0].r = s->mats[0].g = s->mats[0].b = 0.8f;
     s->mats[0].opacity = 1.0f;
 
     /* The second pass reuses the parser: one on the stack is enough for small targets. */
-    uint32_t named = p.nnamed, inline_ = p.ninline;
+    uint32_t named = p.nnamed, inline_ = p.ninline, solids = p.nsolids;
     parser_init(&p, text, len, ld, d);
     p.fill = true;
     p.nnamed_total = named;
@@ -783,7 +809,8 @@ om_status om_scene_parse(const char *text, size_t len, const om_loader *ld, om_a
     /* Only a mesh file that changed between the two loads can make the passes differ. */
     if (st == OM_OK && (p.out.overflow || p.out.nv != s->nverts || p.out.nt != s->ntris ||
                         p.nv != s->nverts || p.nt != s->ntris || p.nnamed != named ||
-                        p.ninline != inline_ || p.ncam != s->ncam_keys || p.nlight != s->nlight_keys))
+                        p.ninline != inline_ || p.ncam != s->ncam_keys || p.nlight != s->nlight_keys ||
+                        p.nsolids != solids))
         st = om__fail(d, OM_E_INVALID, "a mesh file changed between the counting and filling passes");
     if (st != OM_OK) {
         om_arena_rewind(a, mark);

@@ -42,6 +42,7 @@ typedef struct parser {
     bool fill;             /* second pass: write into the scene */
     uint64_t nv, nt;       /* vertices and triangles so far */
     uint32_t nnamed, ninline, ncam, nlight;
+    uint32_t nsolids;      /* closed shapes so far (om_solid) */
     uint32_t nnamed_total; /* second pass: named materials in the whole text */
     bool have_cam, have_light;
     uint32_t cam_line, light_line;

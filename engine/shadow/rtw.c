@@ -362,6 +362,8 @@ void om__rtw_render_map(om__rtw *m)
     x.r.centres = NULL;
     x.r.centre_mask = NULL;
     x.r.mask_words = 0;
+    om__cull cl;
+    om__cull_begin(&cl, s, &m->view.light_vp);
     x.limit2 = m->limit * m->limit;
     x.bend2 = (RTW_BEND / (double)m->size) * (RTW_BEND / (double)m->size);
     x.drawn = 0;
@@ -374,6 +376,9 @@ void om__rtw_render_map(om__rtw *m)
     const float g = 1.0f + 4.0f / (float)m->size;
     for (uint32_t t = 0; t < s->ntris; t++) {
         const uint32_t *ix = s->idx + (size_t)t * 3;
+        /* Each warped piece is culled by its own orientation on the map: warped and
+         * split alike along shared edges, a closed shape stays closed. */
+        x.r.cull_back = om__cull_next(&cl, t);
         om_vec4 c[3], poly[9];
         bool ok = true;
         for (int k = 0; k < 3; k++) {

@@ -397,6 +397,7 @@ static om_status spsm_build(void *state, om_diag *d)
     r.centres = &tc;
     r.centre_mask = whole_plain ? NULL : m->need;
     r.mask_words = m->words;
+    r.cull_back = false;   /* the record is the nearest of all that touch a texel */
     for (uint32_t t = 0; t < s->ntris; t++) {
         const uint32_t *ix = s->idx + (size_t)t * 3;
         om_vec4 c[3];

@@ -22,7 +22,7 @@ static void bench_eye(const bscene *b, uint32_t W, uint32_t H)
     size_t covered = 0;
     for (int r = 0; r < RUNS; r++) {
         uint64_t t0 = om_clock_ns(NULL);
-        om__scene_raster(&b->s, &v.cam_vp, &tg, OM_RASTER_DEPTH_ID);
+        om__scene_raster(&b->s, &v.cam_vp, &tg, OM_RASTER_DEPTH_ID, false);
         uint64_t t1 = om_clock_ns(NULL);
         om__eye_pass(&b->s, &v, &tg, &st);
         uint64_t t2 = om_clock_ns(NULL);
@@ -51,7 +51,7 @@ static void bench_light(const bscene *b, uint32_t size)
     uint64_t t[RUNS];
     for (int r = 0; r < RUNS; r++) {
         uint64_t t0 = om_clock_ns(NULL);
-        om__scene_raster(&b->s, &v.light_vp, &tg, OM_RASTER_DEPTH);
+        om__scene_raster(&b->s, &v.light_vp, &tg, OM_RASTER_DEPTH, true);
         t[r] = om_clock_ns(NULL) - t0;
     }
     size_t written = 0;
