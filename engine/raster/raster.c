@@ -307,7 +307,7 @@ bool om__raster_snapped(const om_raster *r, const int64_t x[3], const int64_t y[
      * closed surface, every texel centre a back face covers is then also covered by a
      * front face (the signed covers of a closed surface cancel), and nearer, since a
      * ray from outside enters before it leaves. */
-    if (r->cull_back && !cons && (x[1] - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[1] - y[0]) > 0)
+    if (r->cull_back && (x[1] - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[1] - y[0]) > 0)
         return false;
     om__rtri t;
     if (!om__tri2_setup(&t.e, x, y, !cons)) return false;

@@ -120,7 +120,7 @@ typedef struct om_raster {
     uint32_t mask_words;
     /* Skip the triangle when it faces away: clockwise on the target (y down), that is
      * counter-clockwise-from-outside seen from behind. The caller sets it per triangle,
-     * for closed shapes only (om__cull_next), in the depth modes only. */
+     * for closed shapes only (om__cull_next). */
     bool cull_back;
 } om_raster;
 

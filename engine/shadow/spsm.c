@@ -397,8 +397,15 @@ static om_status spsm_build(void *state, om_diag *d)
     r.centres = &tc;
     r.centre_mask = whole_plain ? NULL : m->need;
     r.mask_words = m->words;
-    r.cull_back = false;   /* the record is the nearest of all that touch a texel */
+    /* A light ray that meets a closed shape's back face has met a front face before
+     * it, so a back face is never the occluder a record should describe: culled, the
+     * record of a rim texel is more often the grazing front face the ray really hits
+     * (default scene, mismatches at maps 512 / 1024 / 2048 / 4096: 5,838 / 1,278 /
+     * 458 / 163 -> 5,789 / 1,268 / 328 / 133). The plain depth is the same. */
+    om__cull cl;
+    om__cull_begin(&cl, s, &m->view.light_vp);
     for (uint32_t t = 0; t < s->ntris; t++) {
+        r.cull_back = om__cull_next(&cl, t);
         const uint32_t *ix = s->idx + (size_t)t * 3;
         om_vec4 c[3];
         for (int k = 0; k < 3; k++) c[k] = om__mat_apply(&m->view.light_vp, s->verts[ix[k]]);
