@@ -401,6 +401,28 @@ static void light_cull_keeps_the_map(void)
         unsigned want = k == 0 || k == 2 ? 0x0Fu : k == 3 ? 0u : 0x1Fu;
         CHECK_MSG(on == want, "light %d: solids culled %#x, expected %#x", k, on, want);
     }
+    /* the eye pass culls too: the same depths and visible triangles from the scene's
+     * camera, from one inside the last box and from one whose near plane cuts it */
+    static const float eyes[3][7] = {{0, 6, 9, 0, 0, 0, 0.1f}, {8, 2, 8, 0, 0, 0, 0.1f},
+                                     {8, 2, 11, 8, 2, 0, 1.5f}};
+    static uint32_t ids_full[N * N], ids_culled[N * N];
+    for (int k = 0; k < 3; k++) {
+        om_camera cam;
+        om_light light;
+        om_scene_at(s, 0, &cam, &light);
+        const float *e = eyes[k];
+        cam.eye = om__v3(e[0], e[1], e[2]);
+        cam.target = om__v3(e[3], e[4], e[5]);
+        cam.znear = e[6];
+        om_view v;
+        CHECK_OK(om_view_init(&v, &cam, &light, s, NULL));
+        om_target tf = {N, N, 0, N, full, ids_full}, tc = {N, N, 0, N, culled, ids_culled};
+        om__scene_raster(s, &v.cam_vp, &tf, OM_RASTER_DEPTH_ID, false);
+        om__scene_raster(s, &v.cam_vp, &tc, OM_RASTER_DEPTH_ID, true);
+        uint32_t diff = 0;
+        for (uint32_t i = 0; i < N * N; i++) diff += full[i] != culled[i] || ids_full[i] != ids_culled[i];
+        CHECK_MSG(diff == 0, "eye %d: %u texels differ", k, diff);
+    }
     h_scene_free(&hs);
 }
 

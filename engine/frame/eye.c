@@ -126,7 +126,9 @@ void om__scene_raster(const om_scene *s, const om_mat4 *vp, const om_target *tg,
 
 void om__eye_pass(const om_scene *s, const om_view *v, const om_target *tg, om_strip *st)
 {
-    om__scene_raster(s, &v->cam_vp, tg, OM_RASTER_DEPTH_ID, false);
+    /* Culling is exact here too: the visible point of a pixel is the nearest, and the
+     * nearest surface of a closed shape the camera is outside of faces the camera. */
+    om__scene_raster(s, &v->cam_vp, tg, OM_RASTER_DEPTH_ID, true);
     om__persp_tri cache;
     memset(&cache, 0, sizeof cache);
     cache.tri = OM_NO_TRI;
