@@ -266,6 +266,10 @@ static void render(asm_state *m, uint32_t level, uint32_t ox, uint32_t oy, uint3
     om_target tg = {T, T, 0, T, m->sdepth, m->sid};
     om__target_clear(&tg);
     om_raster r = {&tg, OM_RASTER_DEPTH_ID, NULL, NULL, NULL, NULL, 0, false};
+    /* back faces of closed shapes skipped, as in every light map (om__cull); the
+     * window scales x and y by s_ > 0, so windings stay */
+    om__cull cl;
+    om__cull_begin(&cl, s, &m->view.light_vp);
     if (m->lean) {
         /* The same triangles in the same order as the fast path below, so the same tile:
          * projections and bounds are made per tile instead of kept per frame. */
@@ -275,7 +279,9 @@ static void render(asm_state *m, uint32_t level, uint32_t ox, uint32_t oy, uint3
             float b[4];
             for (int i = 0; i < 3; i++) q[i] = dapply(&m->view.light_vp, s->verts[ix[i]]);
             tri_box(q, T, b);
-            if (box_meets(b, u0, v0, u1, v1)) render_tri(&r, q, s_, kx, ky, t);
+            if (!box_meets(b, u0, v0, u1, v1)) continue;
+            r.cull_back = om__cull_next(&cl, t);
+            render_tri(&r, q, s_, kx, ky, t);
         }
     } else {
         /* Gather first, without branches (most triangles miss a deep node's region). */
@@ -288,6 +294,7 @@ static void render(asm_state *m, uint32_t level, uint32_t ox, uint32_t oy, uint3
             const uint32_t t = m->cull[k];
             const uint32_t *ix = s->idx + (size_t)t * 3;
             const asm_dvec q[3] = {m->vclip[ix[0]], m->vclip[ix[1]], m->vclip[ix[2]]};
+            r.cull_back = om__cull_next(&cl, t);
             render_tri(&r, q, s_, kx, ky, t);
         }
     }
