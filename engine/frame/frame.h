@@ -9,17 +9,18 @@
 #include <string.h>
 #include <math.h>
 
-/* Back-face culling of a depth map, exact for closed shapes: walking the triangles in
- * order, om__cull_next(c, t) says whether triangle t may skip its back face, that is
- * whether it belongs to a solid (om_solid) whose box lies wholly in front of the
- * viewpoint's near plane (z >= 0 in vp's clip space, w > 0). Then the viewpoint is
- * outside the solid and the near plane cuts nothing of it, so the nearest surface
- * under every texel faces the viewpoint: the map is the same without the back faces. */
+/* Back-face culling of a depth pass, exact for closed shapes: walking the triangles in
+ * order, om__cull_next(c, t) says whether triangle t may be skipped when it faces
+ * away, that is whether it belongs to a solid (om_solid) whose box lies wholly in
+ * front of the viewpoint's near plane (z >= 1e-4 w in vp's clip space, w > 0). Then
+ * the viewpoint is outside the solid and the near plane cuts nothing of it, so the
+ * nearest surface under every texel faces the viewpoint: the map is the same without
+ * the back faces. */
 typedef struct om__cull {
     const om_scene *s;
     const om_mat4 *vp;
     uint32_t k;            /* the first solid that may still hold t */
-    uint32_t seen;         /* solids before this one are decided */
+    uint32_t seen;         /* the solid `on` was decided for (UINT32_MAX: none yet) */
     bool on;               /* solid k may cull */
 } om__cull;
 
@@ -27,8 +28,8 @@ void om__cull_begin(om__cull *c, const om_scene *s, const om_mat4 *vp);
 bool om__cull_next(om__cull *c, uint32_t t);
 
 /* Clears `tg` and rasterizes every triangle of the scene through `vp` into it: the
- * eye pass (OM_RASTER_DEPTH_ID) and every light depth pass (OM_RASTER_DEPTH, with
- * `cull` skipping the back faces of closed shapes, om__cull). */
+ * eye pass (OM_RASTER_DEPTH_ID) and the light depth passes (OM_RASTER_DEPTH); with
+ * `cull`, the back faces of closed shapes are skipped (om__cull). */
 void om__scene_raster(const om_scene *s, const om_mat4 *vp, const om_target *tg,
                       om_raster_mode mode, bool cull);
 
