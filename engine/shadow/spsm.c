@@ -459,6 +459,33 @@ static void decode(const spsm_state *m, int64_t tx, int64_t ty, dtri t[9], int k
  * is exact: vertices and centre move by whole texels and each edge constant by the
  * matching integer, so an entry is what decoding it anew gives, with its plane values
  * at the vertices and its consistent minimum (found in the texel's own coordinates). */
+/* *to = *from, but for the parts set up only on demand (the edges, the plane at the
+ * vertices) when they are not: most entries never need them, and the window moves
+ * at almost every texel step. Every field of dtri is here. */
+static void move_entry(dtri *to, const dtri *from)
+{
+    to->empty = from->empty;
+    to->ok = from->ok;
+    to->have_e = from->have_e;
+    if (from->have_e) to->e = from->e;
+    memcpy(to->rx, from->rx, sizeof to->rx);
+    memcpy(to->ry, from->ry, sizeof to->ry);
+    to->cx = from->cx;
+    to->cy = from->cy;
+    to->z = from->z;
+    to->gx = from->gx;
+    to->gy = from->gy;
+    to->ex = from->ex;
+    to->ey = from->ey;
+    to->cmin = from->cmin;
+    to->have_cmin = from->have_cmin;
+    to->have_vz = from->have_vz;
+    if (from->have_vz) {
+        memcpy(to->vz, from->vz, sizeof to->vz);
+        memcpy(to->vtol, from->vtol, sizeof to->vtol);
+    }
+}
+
 static void shift_window(spsm_state *m, int dx, int dy)
 {
     const int64_t sx = -(int64_t)dx * OM_SUBPIX, sy = -(int64_t)dy * OM_SUBPIX;
@@ -471,7 +498,7 @@ static void shift_window(spsm_state *m, int dx, int dy)
             const int from = orow * 3 + ocol, to = r * 3 + c;
             if (!((m->t_have >> from) & 1u)) continue;
             dtri *t = &m->t[to];
-            if (to != from) *t = m->t[from];
+            if (to != from) move_entry(t, &m->t[from]);
             t->cx += sx;
             t->cy += sy;
             for (int i = 0; i < 3; i++) {
