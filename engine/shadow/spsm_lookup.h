@@ -25,7 +25,7 @@ typedef struct dtri {
     bool have_cmin;
     double vz[3], vtol[3];       /* plane and pat_tol at the vertices rx, ry (have_vz) */
     bool have_vz;
-} dtri;
+} dtri;   /* a new field is moved in spsm.c's move_entry too */
 
 /* The recovered silhouette of an uncertain sample (4.2; spsm_outline.c). */
 typedef struct boundary {
