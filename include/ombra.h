@@ -280,6 +280,9 @@ typedef struct om_method_cfg {
                                  4 shadow edge, 8 surface normal */
     float rtw_sigma;          /* Gaussian blur, in super-cells */
     float rtw_tess;           /* longest warped edge as a fraction of the map, 0 = off */
+    uint32_t rtw_exact;       /* 1: each texel samples the scene at its inverse-warped
+                                 centre (exact; no tessellation needed); 0: warped
+                                 vertices, straight edges, rtw_tess (the paper's) */
     /* spsm */
     uint32_t spsm_aa;      /* sub-samples at uncertain samples, 0 or 1 = off */
     uint32_t spsm_records; /* which texel records the build makes: 1 every one (the

@@ -42,7 +42,7 @@ static void add_coverage(const om_vec4 c[3], uint32_t w, uint32_t h)
 {
     om_target t = target(w, h);
     om__target_clear(&t);
-    om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL, NULL, NULL, 0, false};
+    om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL, NULL, NULL, 0, false, NULL, NULL};
     om__raster_tri(&r, c, 7);
     for (uint32_t i = 0; i < w * h; i++) count_buf[i] += id_buf[i] == 7;
 }
@@ -311,7 +311,7 @@ static void huge_ground(float half)
     for (int i = 0; i < 4; i++) c[i] = om__mat_apply(&vp, q[i]);
     om_target t = target(W, H);
     om__target_clear(&t);
-    om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL, NULL, NULL, 0, false};
+    om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL, NULL, NULL, 0, false, NULL, NULL};
     om_vec4 t1[3] = {c[0], c[1], c[2]}, t2[3] = {c[0], c[2], c[3]};
     om__raster_tri(&r, t1, 1);
     om__raster_tri(&r, t2, 2);
@@ -392,7 +392,7 @@ static void snapped_matches_clipped(void)
             z[i] = (double)c[i].z * 4294967296.0;
         }
         om_target t = target(TW, TH);
-        om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL, NULL, NULL, 0, false};
+        om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL, NULL, NULL, 0, false, NULL, NULL};
         om__target_clear(&t);
         om__raster_tri(&r, c, 5);
         memcpy(d0, depth_buf, sizeof d0);
@@ -431,7 +431,7 @@ static void conservative_superset(void)
         memset(cons, 0, sizeof cons);
         om_target t = target(TW, TH);
         cons_ctx ctx = {cons, TW};
-        om_raster r = {&t, OM_RASTER_CONSERVATIVE, cons_span, &ctx, NULL, NULL, 0, false};
+        om_raster r = {&t, OM_RASTER_CONSERVATIVE, cons_span, &ctx, NULL, NULL, 0, false, NULL, NULL};
         om__raster_tri(&r, c, 1);
         for (int i = 0; i < TW * TH; i++) {
             if (count_buf[i] && !cons[i]) missing++;
@@ -474,13 +474,13 @@ static void conservative_centres_match_depth_pass(void)
         for (int i = 0; i < 3; i++) c[k][i] = at((double)x[i], (double)y[i], TW, TH, (float)(rnd() % 1000) / 1000.0f);
     }
     om_target t = target(TW, TH);
-    om_raster r = {&t, OM_RASTER_DEPTH, NULL, NULL, NULL, NULL, 0, false};
+    om_raster r = {&t, OM_RASTER_DEPTH, NULL, NULL, NULL, NULL, 0, false, NULL, NULL};
     om__target_clear(&t);
     for (int k = 0; k < 60; k++) om__raster_tri(&r, c[k], (uint32_t)k);
     memcpy(plain, depth_buf, sizeof plain);
     om_target ct = {TW, TH, 0, TH, alongside, NULL}, scratch = target(TW, TH);
     om__target_clear(&ct);
-    om_raster rc = {&scratch, OM_RASTER_CONSERVATIVE, no_span, NULL, &ct, NULL, 0, false};
+    om_raster rc = {&scratch, OM_RASTER_CONSERVATIVE, no_span, NULL, &ct, NULL, 0, false, NULL, NULL};
     for (int k = 0; k < 60; k++) om__raster_tri(&rc, c[k], (uint32_t)k);
     int differ = 0, written = 0;
     for (int i = 0; i < TW * TH; i++) {
@@ -523,7 +523,7 @@ static void strips_match_whole(void)
                             TW, TH, (float)(rnd() % 1000) / 1000.0f);
     om_target t = target(TW, TH);
     om__target_clear(&t);
-    om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL, NULL, NULL, 0, false};
+    om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL, NULL, NULL, 0, false, NULL, NULL};
     for (int k = 0; k < 40; k++) om__raster_tri(&r, tris[k], (uint32_t)k);
     memcpy(whole_d, depth_buf, sizeof whole_d);
     memcpy(whole_i, id_buf, sizeof whole_i);

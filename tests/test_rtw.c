@@ -1,11 +1,13 @@
 /* test_rtw.c — Rectilinear Texture Warping: the warp tables' properties (identity for
  * uniform importance, monotonic with fixed ends, a single important cell widening, no
  * division by an all-zero map), shared edges staying closed in the warped map, the
- * paper's accuracy claim on the default scene, tessellation helping, budgets and
- * determinism. */
+ * exact map holding the occlusion predicate's depths at its texels' points, the paper's
+ * accuracy claim on the default scene, tessellation helping the warped-vertex map,
+ * budgets and determinism. */
 #include "test.h"
 #include "harness.h"
 #include "../engine/shadow/rtw.h"
+#include "../engine/shadow/occlude.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -228,23 +230,99 @@ static void warped_map_has_no_cracks(void)
         "plane size 80 80 divisions 5\n"
         "sphere radius 1 segments 24 rings 12 translate 0 1 0\n",
     };
-    static const float tess[] = {0.0f, 0.05f, 0.025f, 0.01f};
+    /* the warped-vertex map at four tessellations, then the exact map */
+    static const float tess[] = {0.0f, 0.05f, 0.025f, 0.01f, 0.0f};
     for (int k = 0; k < 2; k++) {
         h_scene hs;
         if (!h_scene_parse(&hs, scenes[k])) return;
-        for (int t = 0; t < 4; t++) {
+        for (int t = 0; t < 5; t++) {
             om_method_cfg c;
             om_method_cfg_default(&c);
             c.map_size = 256;
             c.rtw_importance = 128;
             c.rtw_tess = tess[t];
+            c.rtw_exact = t == 4;
             crack_probe p;
             memset(&p, 0, sizeof p);
             CHECK_OK(run_rtw(&hs.s, &c, 160, 120, 0, NULL, count_holes, &p));
-            CHECK_MSG(p.holes == 0, "scene %d tess %g: %u empty texels", k, tess[t], p.holes);
+            CHECK_MSG(p.holes == 0, "scene %d tess %g exact %u: %u empty texels", k, tess[t], c.rtw_exact, p.holes);
             CHECK_MSG(p.dens > 2.0, "scene %d: the warp is too weak to test (%g)", k, p.dens);
-            if (t > 0) CHECK(p.drawn > hs.s.ntris);
+            if (t > 0 && t < 4) CHECK(p.drawn > hs.s.ntris);
         }
+        h_scene_free(&hs);
+    }
+}
+
+/* The exact map, texel by texel, against the occlusion predicate's own triangles: the
+ * nearest depth of any triangle covering the texel's point (gridx[x], gridy[y]) on the
+ * light's grid, by the same edge functions, tie rule and plane. Back faces of closed
+ * shapes count too: culling them must change no texel. */
+typedef struct exact_probe { uint64_t texels, wrong, covered; uint32_t distinct_x; } exact_probe;
+
+static void check_exact(const om__rtw *m, void *user)
+{
+    exact_probe *p = (exact_probe *)user;
+    om__lspace ls;
+    om__lspace_init_lean(&ls, m->scene);
+    om__lspace_begin(&ls, &m->view);
+    static uint32_t want[128 * 128];
+    const uint32_t S = m->size;
+    if (S > 128) { CHECK(S <= 128); return; }
+    for (uint32_t i = 0; i < S * S; i++) want[i] = 0xFFFFFFFFu;
+    for (uint32_t t = 0; t < m->scene->ntris; t++) {
+        om__ltri lt;
+        if (!om__lspace_tri(&ls, t, &lt)) continue;
+        for (uint32_t y = 0; y < S; y++)
+            for (uint32_t x = 0; x < S; x++)
+                for (int k = 0; k < lt.n; k++)
+                    if (om__tri2_covers(&lt.sub[k].e, m->gridx[x], m->gridy[y])) {
+                        uint32_t d = (uint32_t)om__rtri_depth(&lt.sub[k], m->gridx[x], m->gridy[y]);
+                        if (d < want[y * S + x]) want[y * S + x] = d;
+                        break;
+                    }
+    }
+    for (uint32_t i = 0; i < S * S; i++) {
+        p->texels++;
+        p->wrong += m->depth[i] != want[i];
+        p->covered += want[i] != 0xFFFFFFFFu;
+    }
+    p->distinct_x = 1;
+    for (uint32_t x = 1; x < S; x++) {
+        CHECK(m->gridx[x] >= m->gridx[x - 1] && m->gridy[x] >= m->gridy[x - 1]);
+        p->distinct_x += m->gridx[x] != m->gridx[x - 1];
+    }
+}
+
+static void exact_map_is_the_predicate(void)
+{
+    static const char *scenes[] = {
+        /* a box and a sphere on a floor: closed shapes (culled), shared edges, a strong
+         * warp towards the camera */
+        "camera eye 1 2 6 target 0 0 -2 fov 70 size 160 120 near 0.1 far 100\n"
+        "light spot pos 3 12 4 target 0 0 0 fov 60 near 1 far 60\n"
+        "plane size 30 30 divisions 3\n"
+        "box size 1 2 1 translate 1 1 -1\n"
+        "sphere radius 1 segments 16 rings 8 translate -1 1 0\n",
+        /* a directional light and random triangles, some off the map */
+        "camera eye 0 4 9 target 0 0 0 fov 50 size 160 120 near 0.1 far 100\n"
+        "light directional dir 0.2 -1 -0.3\n"
+        "plane size 12 12\n"
+        "triangles count 300 seed 3 area 20 in -7 0.2 -7 7 3 7\n",
+    };
+    for (int k = 0; k < 2; k++) {
+        h_scene hs;
+        if (!h_scene_parse(&hs, scenes[k])) return;
+        om_method_cfg c;
+        om_method_cfg_default(&c);
+        c.map_size = 128;
+        c.rtw_importance = 64;
+        exact_probe p;
+        memset(&p, 0, sizeof p);
+        CHECK_OK(run_rtw(&hs.s, &c, 160, 120, 0, NULL, check_exact, &p));
+        CHECK_MSG(p.wrong == 0, "scene %d: %llu of %llu texels differ from the predicate", k,
+                  (unsigned long long)p.wrong, (unsigned long long)p.texels);
+        CHECK_MSG(p.covered > p.texels / 2, "scene %d: only %llu texels covered", k, (unsigned long long)p.covered);
+        CHECK_MSG(p.distinct_x > 100, "scene %d: texel points coincide (%u distinct)", k, p.distinct_x);
         h_scene_free(&hs);
     }
 }
@@ -268,7 +346,8 @@ static uint64_t miss_of(const h_scene *hs, const char *name, const om_method_cfg
 static uint8_t claim_ref[1024 * 768], claim_m[1024 * 768];
 
 /* The paper's claim (Figure 1): a 512 x 512 RTW map is as accurate as a 2048 x 2048
- * conventional one; and tessellation at 2.5% beats none (Figure 7). */
+ * conventional one; for the warped-vertex map, tessellation at 2.5% beats none (Figure
+ * 7), and the exact map beats both. */
 static void rtw512_matches_sm2048(void)
 {
     enum { w = 640, h = 480 };
@@ -283,12 +362,22 @@ static void rtw512_matches_sm2048(void)
     c.map_size = 512;
     uint64_t sm512 = miss_of(&hs, "sm", &c, w, h, ref, m);
     uint64_t rtw = miss_of(&hs, "rtw", &c, w, h, ref, m);
+    c.rtw_exact = 0;
+    uint64_t rtw_tess = miss_of(&hs, "rtw", &c, w, h, ref, m);
     c.rtw_tess = 0.0f;
     uint64_t rtw_flat = miss_of(&hs, "rtw", &c, w, h, ref, m);
     CHECK_MSG(rtw <= sm2048, "rtw 512: %llu mismatches, sm 2048: %llu", (unsigned long long)rtw,
               (unsigned long long)sm2048);
-    CHECK_MSG(rtw < rtw_flat, "tessellated %llu, not fewer than untessellated %llu",
-              (unsigned long long)rtw, (unsigned long long)rtw_flat);
+    CHECK_MSG(rtw_tess <= sm2048, "rtw 512 warped vertices, 2.5%%: %llu mismatches, sm 2048: %llu",
+              (unsigned long long)rtw_tess, (unsigned long long)sm2048);
+    CHECK_MSG(rtw_tess < rtw_flat, "tessellated %llu, not fewer than untessellated %llu",
+              (unsigned long long)rtw_tess, (unsigned long long)rtw_flat);
+    /* the exact map needs no tessellation: far better than the untessellated warped
+     * vertices, about as good as tessellating them */
+    CHECK_MSG(rtw * 4 < rtw_flat, "exact %llu, untessellated warped vertices %llu", (unsigned long long)rtw,
+              (unsigned long long)rtw_flat);
+    CHECK_MSG(rtw * 20 < rtw_tess * 21, "exact %llu, warped vertices at 2.5%% %llu", (unsigned long long)rtw,
+              (unsigned long long)rtw_tess);
     CHECK(rtw * 2 < sm512);
 
     /* The same claim at the benchmark's 1024x768, where the view asks more of the map:
@@ -395,8 +484,9 @@ static void budget_and_determinism(void)
     om_method_cfg c;
     om_method_cfg_default(&c);
     c.map_size = 512;
-    for (uint32_t analysis = 0; analysis < 3; analysis++) {
-        c.rtw_analysis = analysis;
+    for (uint32_t k = 0; k < 6; k++) {
+        c.rtw_analysis = k % 3;
+        c.rtw_exact = k / 3;
         c.rtw_funcs = 15;
         CHECK_OK(run_rtw(&hs.s, &c, w, h, 0, t1, NULL, NULL));
         CHECK_OK(run_rtw(&hs.s, &c, w, h, 0, t2, NULL, NULL));
@@ -414,6 +504,9 @@ static void budget_and_determinism(void)
     c.rtw_sigma = 3.0f;
     c.rtw_analysis = 3;
     CHECK(m->init(&state, &a, &c, &hs.s, w, h, NULL) == OM_E_INVALID);
+    c.rtw_analysis = 0;
+    c.rtw_exact = 2;
+    CHECK(m->init(&state, &a, &c, &hs.s, w, h, NULL) == OM_E_INVALID);
     h_scene_free(&hs);
 }
 
@@ -425,6 +518,7 @@ void suite_rtw(void)
     RUN(all_zero_is_safe);
     RUN(collapse_by_maximum);
     RUN(warped_map_has_no_cracks);
+    RUN(exact_map_is_the_predicate);
     RUN(rtw512_matches_sm2048);
     RUN(analyses_and_functions);
     RUN(budget_and_determinism);

@@ -111,6 +111,7 @@ void om__scene_raster(const om_scene *s, const om_mat4 *vp, const om_target *tg,
     r.user = NULL;
     r.centres = NULL;
     r.centre_mask = NULL;
+    r.grid_x = r.grid_y = NULL;
     r.mask_words = 0;
     r.cull_back = false;
     om__cull cl;

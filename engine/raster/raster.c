@@ -299,6 +299,78 @@ static void fill_conservative(const om_raster *r, const om__rtri *t)
     }
 }
 
+/* ---- rectilinear grids (om_raster.grid_x, grid_y) */
+
+/* The first i in [lo, hi] where g[i] >= v; hi + 1 when none (g non-decreasing). */
+static int32_t grid_first(const int64_t *g, int32_t lo, int32_t hi, int64_t v)
+{
+    while (lo <= hi) {
+        int32_t mid = lo + (hi - lo) / 2;
+        if (g[mid] >= v) hi = mid - 1;
+        else lo = mid + 1;
+    }
+    return lo;
+}
+
+/* The first i in [lo, hi] past the crossing of a * g[i] + k = 0 (a != 0): where it is
+ * >= 0 when it rises (a > 0), where it is < 0 when it falls; hi + 1 when none. */
+static int32_t grid_cross(const int64_t *g, int32_t lo, int32_t hi, int64_t a, int64_t k)
+{
+    while (lo <= hi) {
+        int32_t mid = lo + (hi - lo) / 2;
+        if ((a * g[mid] + k >= 0) == (a > 0)) hi = mid - 1;
+        else lo = mid + 1;
+    }
+    return lo;
+}
+
+/* The pixels whose grid point lies in the triangle's bounding box. */
+static bool bounds_grid(om__rtri *t, const om_raster *r)
+{
+    const om_target *tg = r->target;
+    const om__tri2 *e = &t->e;
+    int64_t minX = e->x[0], maxX = e->x[0], minY = e->y[0], maxY = e->y[0];
+    for (int i = 1; i < 3; i++) {
+        if (e->x[i] < minX) minX = e->x[i];
+        if (e->x[i] > maxX) maxX = e->x[i];
+        if (e->y[i] < minY) minY = e->y[i];
+        if (e->y[i] > maxY) maxY = e->y[i];
+    }
+    const int32_t xe = (int32_t)tg->width - 1, ye = (int32_t)(tg->y0 + tg->rows) - 1;
+    t->minx = grid_first(r->grid_x, 0, xe, minX);
+    t->maxx = grid_first(r->grid_x, t->minx, xe, maxX + 1) - 1;
+    t->miny = grid_first(r->grid_y, (int32_t)tg->y0, ye, minY);
+    t->maxy = grid_first(r->grid_y, t->miny, ye, maxY + 1) - 1;
+    return t->minx <= t->maxx && t->miny <= t->maxy;
+}
+
+/* fill at grid points: along a row every edge function is monotonic in x (the grid
+ * is), so the covered pixels are one run, found by bisection at each edge. */
+static void fill_grid(const om_raster *r, const om__rtri *t)
+{
+    const om_target *tg = r->target;
+    const om__tri2 *e = &t->e;
+    const int64_t *gx = r->grid_x;
+    for (int32_t y = t->miny; y <= t->maxy; y++) {
+        const int64_t py = r->grid_y[y];
+        int32_t lo = t->minx, hi = t->maxx;
+        for (int i = 0; i < 3 && lo <= hi; i++) {
+            const int64_t a = e->a[i], k = e->b[i] * py + e->c[i];
+            if (a > 0) lo = grid_cross(gx, lo, hi, a, k);
+            else if (a < 0) hi = grid_cross(gx, lo, hi, a, k) - 1;
+            else if (k < 0) hi = lo - 1;
+        }
+        const double ztail = t->zy * (double)(py - e->y[0]);
+        uint32_t *dep = tg->depth + (size_t)(y - (int32_t)tg->y0) * tg->width;
+        for (int32_t x = lo; x <= hi; x++) {
+            double z = (t->z0 + t->zx * (double)(gx[x] - e->x[0])) + ztail;
+            z = z < t->zmin ? t->zmin : z > t->zmax ? t->zmax : z;
+            uint32_t d = (uint32_t)z;
+            if (d < dep[x]) dep[x] = d;
+        }
+    }
+}
+
 bool om__raster_snapped(const om_raster *r, const int64_t x[3], const int64_t y[3], const double z[3],
                         uint32_t id)
 {
@@ -311,6 +383,12 @@ bool om__raster_snapped(const om_raster *r, const int64_t x[3], const int64_t y[
         return false;
     om__rtri t;
     if (!om__tri2_setup(&t.e, x, y, !cons)) return false;
+    if (r->grid_x) {
+        if (!bounds_grid(&t, r)) return false;
+        om__rtri_plane(&t, z);
+        fill_grid(r, &t);
+        return true;
+    }
     if (!bounds(&t, r->target, cons)) return false;
     om__rtri_plane(&t, z);
     if (cons) fill_conservative(r, &t);
@@ -320,14 +398,19 @@ bool om__raster_snapped(const om_raster *r, const int64_t x[3], const int64_t y[
 
 int om__raster_tri(const om_raster *r, const om_vec4 clip[3], uint32_t id)
 {
-    const om_target *tg = r->target;
+    return om__raster_tri_on(r, clip, id, r->target->width, r->target->height);
+}
+
+int om__raster_tri_on(const om_raster *r, const om_vec4 clip[3], uint32_t id, uint32_t width,
+                      uint32_t height)
+{
     int64_t gx[9], gy[9];
     double gz[9];
     for (int i = 0; i < 3; i++)
         if (!om__finite(clip[i].x) || !om__finite(clip[i].y) || !om__finite(clip[i].z) ||
             !om__finite(clip[i].w))
             return 0;
-    int n = om__clip_project(clip, tg->width, tg->height, gx, gy, gz);
+    int n = om__clip_project(clip, width, height, gx, gy, gz);
     int filled = 0;
     for (int k = 1; k + 1 < n; k++) {
         int64_t tx[3] = {gx[0], gx[k], gx[k + 1]}, ty[3] = {gy[0], gy[k], gy[k + 1]};

@@ -21,6 +21,9 @@
  *    strict (<): among equal depths the first triangle drawn wins.
  *  - Conservative mode reports every pixel whose closed square the snapped triangle
  *    touches at all (an exact separating-axis test: bounding boxes and three edges).
+ *  - A depth pass may sample a rectilinear grid instead of pixel centres (om_raster's
+ *    grid_x, grid_y): the same rule at other points, so a pixel holds exactly what the
+ *    triangles cover at its grid point.
  */
 #ifndef OM_RASTER_H
 #define OM_RASTER_H
@@ -122,6 +125,13 @@ typedef struct om_raster {
      * counter-clockwise-from-outside seen from behind. The caller sets it per triangle,
      * for closed shapes only (om__cull_next). */
     bool cull_back;
+    /* May be NULL (then pixel centres, the rule above): a rectilinear grid of sample
+     * positions, for OM_RASTER_DEPTH only. Pixel (x, y) of the target samples the
+     * triangle at grid point (grid_x[x], grid_y[y]) (sub-pixel units of whatever image
+     * the triangle was snapped on), with the same edge functions, tie rule and depth
+     * plane; both tables non-decreasing, grid_y indexed by image row. A warped map
+     * (rtw) samples the unwarped light image at its texels' inverse-warped centres. */
+    const int64_t *grid_x, *grid_y;
 } om_raster;
 
 /* The first pixel x..x1 whose bit is set in `row` (one row of such a mask), x1 + 1
@@ -142,6 +152,10 @@ static inline int32_t om__mask_next(const uint32_t *row, int32_t x, int32_t x1)
 /* Rasterizes one triangle given in clip space (clipping it first). Non-finite vertices
  * are rejected: they cover nothing. Returns the number of sub-triangles filled. */
 int om__raster_tri(const om_raster *r, const om_vec4 clip[3], uint32_t id);
+/* The same, projected and clipped on the grid of a width x height image rather than
+ * the target's: for a rectilinear grid (om_raster.grid_x) on that image. */
+int om__raster_tri_on(const om_raster *r, const om_vec4 clip[3], uint32_t id, uint32_t width,
+                      uint32_t height);
 
 /* Rasterizes one triangle already on the sub-pixel grid (coordinates within the
  * guard band, OM_TRI2_MAX_COORD) with depths z/w * 2^32: what om__raster_tri does

@@ -18,7 +18,7 @@ static const struct { const char *name, *sweep; } sweeps[] = {
     {"sm", "map=256,512,1024,2048,4096,8192"},
     {"izb", "izb.pool=0,65536,16384"},
     {"asm", "asm.cap=1048576,4194304,8388608,16777216"},
-    {"rtw", "map=512,1024,2048 rtw.tess=0,0.05,0.025"},
+    {"rtw", "map=512,1024,2048 rtw.exact=1,0"},
     {"spsm", "map=512,1024,2048,4096"},
 };
 
@@ -72,6 +72,7 @@ void om_method_cfg_default(om_method_cfg *c)
     c->rtw_funcs = 1 | 2 | 8;
     c->rtw_sigma = 3.0f;
     c->rtw_tess = 0.025f;
+    c->rtw_exact = 1;
     c->spsm_aa = 0;
     c->spsm_records = 0;
 }
@@ -99,6 +100,7 @@ static const om_cfg_field fields[] = {
     F("rtw.funcs", 'u', rtw_funcs, 0, 15, "RTW importance: 1 view, 2 distance, 4 edge, 8 normal"),
     F("rtw.sigma", 'f', rtw_sigma, 0, 64, "RTW blur sigma in super-cells"),
     F("rtw.tess", 'f', rtw_tess, 0, 1, "RTW longest warped edge / map width, 0 = off"),
+    F("rtw.exact", 'u', rtw_exact, 0, 1, "RTW map: 1 texels sample at inverse-warped centres, 0 warped vertices"),
     F("spsm.aa", 'u', spsm_aa, 0, 64, "SPSM sub-samples at uncertain samples, 0 = off"),
     F("spsm.records", 'u', spsm_records, 0, 2, "SPSM records made: 1 all, 2 those the view reads, 0 auto"),
 };

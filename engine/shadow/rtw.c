@@ -6,14 +6,18 @@
  *   observe  (a) backward analysis: every exposed visible sample raises the importance
  *            of its cell (rtw_warp.c)
  *   build    (a) forward analysis, if asked; (b) collapse, blur, warp tables
- *            (rtw_warp.c); (c) render the warped map: vertices are warped after the
- *            perspective divide (4.3), long edges tessellated first (6.1)
+ *            (rtw_warp.c); (c) render the warped map. By default (rtw_exact) every
+ *            texel samples the unwarped scene at the point its centre warps from, so
+ *            edges need no tessellation (not in the paper: a GPU can only draw warped
+ *            vertices). With rtw_exact 0, the paper's way: vertices are warped after
+ *            the perspective divide (4.3), long edges tessellated first (6.1)
  *   resolve  (d) lookup: the sample's light coordinates are warped (4.4) and tested
  *            with the conventional map's bias rules, in warped texels (smlookup.c)
  * All state lives in the method's arena; nothing persists between frames but the
  * buffers. */
 #include "shadow.h"
 #include "rtw.h"
+#include "occlude.h"   /* OM_LIGHT_GRID */
 
 /* ---------------------------------------------------------------- sizes */
 
@@ -26,6 +30,7 @@ static size_t rtw_need(const om_method_cfg *c)
                om_arena_need((n + 1) * sizeof(int32_t), 16) * 2 +
                om_arena_need(s * s * sizeof(uint32_t), 16);
     if (c->rtw_analysis != OM_RTW_BACKWARD) b += om_arena_need(nn * sizeof(uint32_t), 16) * 2;
+    if (c->rtw_exact) b += om_arena_need(s * sizeof(int64_t), 16) * 2;
     return b;
 }
 
@@ -38,6 +43,7 @@ static const char *check_cfg(const om_method_cfg *c)
     if (c->rtw_funcs > 15) return "rtw: importance functions are a mask of 1, 2, 4, 8";
     if (!(c->rtw_sigma >= 0.0f && c->rtw_sigma <= 64.0f)) return "rtw: sigma must be 0..64";
     if (!(c->rtw_tess >= 0.0f && c->rtw_tess <= 1.0f)) return "rtw: tessellation must be 0..1";
+    if (c->rtw_exact > 1) return "rtw: exact must be 0 (warped vertices) or 1 (inverse-warped texel centres)";
     return NULL;
 }
 
@@ -103,6 +109,13 @@ static om_status rtw_init(void **state, om_arena *a, const om_method_cfg *c, con
     m->py = (int32_t *)p;
     if ((st = carve(a, (size_t)m->size * m->size * sizeof(uint32_t), &p, d))) return st;
     m->depth = (uint32_t *)p;
+    m->gridx = m->gridy = NULL;
+    if (c->rtw_exact) {
+        if ((st = carve(a, (size_t)m->size * sizeof(int64_t), &p, d))) return st;
+        m->gridx = (int64_t *)p;
+        if ((st = carve(a, (size_t)m->size * sizeof(int64_t), &p, d))) return st;
+        m->gridy = (int64_t *)p;
+    }
     if (c->rtw_analysis != OM_RTW_BACKWARD) {
         if ((st = carve(a, nn * sizeof(uint32_t), &p, d))) return st;
         m->fdepth = (uint32_t *)p;
@@ -348,6 +361,33 @@ static int clip_tri(const om_vec4 in[3], float g, om_vec4 *out)
     return n < 3 ? 0 : n;
 }
 
+/* The exact warped map (rtw_exact): texel (x, y) holds the nearest depth of the
+ * unwarped light image at the point its centre warps from, (gridx[x], gridy[y]) on the
+ * occlusion predicate's grid. The warp is separable and monotonic, so those points form
+ * a rectilinear grid and the rasterizer samples it directly (om_raster.grid_x): edges
+ * stay straight where they are straight, in the unwarped image, and no triangle needs
+ * splitting. The map is what a conventional map as fine as the warp would hold at
+ * those points, and the lookup reads the texel whose centre is nearest in warped
+ * coordinates, as before. */
+static void render_exact(om__rtw *m, om_raster *r, om__cull *cl)
+{
+    const om_scene *s = m->scene;
+    const double steps = (double)OM_LIGHT_GRID * OM_SUBPIX;
+    om__rtw_unwarp_grid(m->px, m->n, m->size, steps, m->gridx);
+    om__rtw_unwarp_grid(m->py, m->n, m->size, steps, m->gridy);
+    r->grid_x = m->gridx;
+    r->grid_y = m->gridy;
+    uint32_t drawn = 0;
+    for (uint32_t t = 0; t < s->ntris; t++) {
+        const uint32_t *ix = s->idx + (size_t)t * 3;
+        om_vec4 c[3];
+        for (int k = 0; k < 3; k++) c[k] = om__mat_apply(&m->view.light_vp, s->verts[ix[k]]);
+        r->cull_back = om__cull_next(cl, t);
+        drawn += (uint32_t)om__raster_tri_on(r, c, t, OM_LIGHT_GRID, OM_LIGHT_GRID);
+    }
+    m->tris_drawn = drawn;
+}
+
 void om__rtw_render_map(om__rtw *m)
 {
     const om_scene *s = m->scene;
@@ -362,8 +402,13 @@ void om__rtw_render_map(om__rtw *m)
     x.r.centres = NULL;
     x.r.centre_mask = NULL;
     x.r.mask_words = 0;
+    x.r.grid_x = x.r.grid_y = NULL;
     om__cull cl;
     om__cull_begin(&cl, s, &m->view.light_vp);
+    if (m->cfg.rtw_exact) {
+        render_exact(m, &x.r, &cl);
+        return;
+    }
     x.limit2 = m->limit * m->limit;
     x.bend2 = (RTW_BEND / (double)m->size) * (RTW_BEND / (double)m->size);
     x.drawn = 0;

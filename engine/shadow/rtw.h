@@ -64,6 +64,12 @@ static inline double om__rtw_apply(const int32_t *P, uint32_t n, double u, doubl
     return (a + f * (b - a)) / (double)OM_RTW_ONE;
 }
 
+/* The inverse warp at the centres of a warped map's `size` texels: g[x] is where the
+ * centre of texel x, (x + 0.5) / size warped, comes from, on a grid of `steps` units
+ * across [0, 1] (rounded to nearest); non-decreasing. A collapsed super-cell is
+ * stepped over: no texel centre comes from it. */
+void om__rtw_unwarp_grid(const int32_t *P, uint32_t n, uint32_t size, double steps, int64_t *g);
+
 /* Largest warped length of a super-cell, times n: the densest super-cell's
  * magnification (the maximum effective resolution is map_size times it). */
 double om__rtw_max_density(const int32_t *P, uint32_t n);
@@ -89,6 +95,7 @@ typedef struct om__rtw {
     double *cols, *rows, *scratch, *kernel;
     int32_t *px, *py;          /* warp tables, n + 1 each */
     uint32_t *depth;           /* size * size warped shadow map */
+    int64_t *gridx, *gridy;    /* rtw_exact: each texel's sample point on the light grid */
     om_view view;
     om__smlook look;
     double limit;              /* tessellation: longest warped edge in [0, 1] units; 0 = off */

@@ -82,6 +82,21 @@ bool om__rtw_table(const double *I, uint32_t n, int32_t *P)
     return true;
 }
 
+void om__rtw_unwarp_grid(const int32_t *P, uint32_t n, uint32_t size, double steps, int64_t *g)
+{
+    uint32_t k = 0;
+    for (uint32_t x = 0; x < size; x++) {
+        /* the texel centre in OM_RTW_ONE units, and the super-cell it lands in: the
+         * last k with P[k] <= c (centres rise, so k only moves on) */
+        const double c = ((double)x + 0.5) / (double)size * (double)OM_RTW_ONE;
+        while (k + 1 < n && (double)P[k + 1] <= c) k++;
+        const double a = (double)P[k], b = (double)P[k + 1];
+        double f = b > a ? (c - a) / (b - a) : 0.0;
+        f = f < 0.0 ? 0.0 : f > 1.0 ? 1.0 : f;
+        g[x] = (int64_t)floor(((double)k + f) / (double)n * steps + 0.5);
+    }
+}
+
 int32_t om__rtw_warp_at(const int32_t *P, uint32_t n, uint32_t k)
 {
     return P[k] - identity_at(n, k);

@@ -396,6 +396,7 @@ static om_status spsm_build(void *state, om_diag *d)
     r.user = &b;
     r.centres = &tc;
     r.centre_mask = whole_plain ? NULL : m->need;
+    r.grid_x = r.grid_y = NULL;
     r.mask_words = m->words;
     /* A light ray that meets a closed shape's back face has met a front face before
      * it, so a back face is never the occluder a record should describe: culled, the
