@@ -312,13 +312,20 @@ static int32_t grid_first(const int64_t *g, int32_t lo, int32_t hi, int64_t v)
     return lo;
 }
 
-/* The first i in [lo, hi] past the crossing of a * g[i] + k = 0 (a != 0): where it is
- * >= 0 when it rises (a > 0), where it is < 0 when it falls; hi + 1 when none. */
+/* Whether grid index x lies past the crossing of edge (a, k), a != 0: a * g[x] + k >= 0
+ * when the edge function rises along the row (a > 0), < 0 when it falls. False, then
+ * true, along a row. */
+static inline bool grid_past(const int64_t *g, int32_t x, int64_t a, int64_t k)
+{
+    return (a * g[x] + k >= 0) == (a > 0);
+}
+
+/* The first i in [lo, hi] past the crossing; hi + 1 when none. */
 static int32_t grid_cross(const int64_t *g, int32_t lo, int32_t hi, int64_t a, int64_t k)
 {
     while (lo <= hi) {
         int32_t mid = lo + (hi - lo) / 2;
-        if ((a * g[mid] + k >= 0) == (a > 0)) hi = mid - 1;
+        if (grid_past(g, mid, a, k)) hi = mid - 1;
         else lo = mid + 1;
     }
     return lo;
@@ -345,21 +352,37 @@ static bool bounds_grid(om__rtri *t, const om_raster *r)
 }
 
 /* fill at grid points: along a row every edge function is monotonic in x (the grid
- * is), so the covered pixels are one run, found by bisection at each edge. */
+ * is), so the covered pixels are one run, bounded by each edge's crossing. The first
+ * row finds the crossings by bisection; each next row walks from the row before's,
+ * since a straight edge moves little from row to row. */
 static void fill_grid(const om_raster *r, const om__rtri *t)
 {
     const om_target *tg = r->target;
     const om__tri2 *e = &t->e;
     const int64_t *gx = r->grid_x;
+    const int32_t x0 = t->minx, x1 = t->maxx;
+    int32_t cross[3] = {x0, x0, x0};   /* per edge: the first index past its crossing */
     for (int32_t y = t->miny; y <= t->maxy; y++) {
         const int64_t py = r->grid_y[y];
-        int32_t lo = t->minx, hi = t->maxx;
-        for (int i = 0; i < 3 && lo <= hi; i++) {
+        int32_t lo = x0, hi = x1;
+        for (int i = 0; i < 3; i++) {
             const int64_t a = e->a[i], k = e->b[i] * py + e->c[i];
-            if (a > 0) lo = grid_cross(gx, lo, hi, a, k);
-            else if (a < 0) hi = grid_cross(gx, lo, hi, a, k) - 1;
-            else if (k < 0) hi = lo - 1;
+            if (a == 0) {
+                if (k < 0) hi = lo - 1;
+                continue;
+            }
+            int32_t x = cross[i];
+            if (y == t->miny) {
+                x = grid_cross(gx, x0, x1, a, k);
+            } else {
+                while (x > x0 && grid_past(gx, x - 1, a, k)) x--;
+                while (x <= x1 && !grid_past(gx, x, a, k)) x++;
+            }
+            cross[i] = x;
+            if (a > 0) { if (x > lo) lo = x; }
+            else if (x - 1 < hi) hi = x - 1;
         }
+        if (lo > hi) continue;
         const double ztail = t->zy * (double)(py - e->y[0]);
         uint32_t *dep = tg->depth + (size_t)(y - (int32_t)tg->y0) * tg->width;
         for (int32_t x = lo; x <= hi; x++) {

@@ -61,20 +61,6 @@ static om_status carve(om_arena *a, size_t bytes, void **out, om_diag *d)
     return om_arena_alloc(a, bytes, 16, out, d);
 }
 
-/* The warp as smlookup.c's coordinate mapping. The density is the smaller axis's (the
- * bias then covers the larger warped texel), kept above a sliver: a sample in a
- * collapsed super-cell (possible only just outside what the analysis saw) must not
- * get an infinite bias. */
-static void warp_uv(const void *user, double *u, double *v, double *density)
-{
-    const om__rtw *m = (const om__rtw *)user;
-    double dx, dy;
-    *u = om__rtw_apply(m->px, m->n, *u, &dx);
-    *v = om__rtw_apply(m->py, m->n, *v, &dy);
-    double dmin = dx < dy ? dx : dy;
-    *density = dmin > 1.0 / 64.0 ? dmin : 1.0 / 64.0;
-}
-
 static om_status rtw_init(void **state, om_arena *a, const om_method_cfg *c, const om_scene *s,
                           uint32_t w, uint32_t h, om_diag *d)
 {
@@ -132,8 +118,9 @@ static om_status rtw_init(void **state, om_arena *a, const om_method_cfg *c, con
     m->look.bias_slope = c->bias_slope;
     m->look.normal_offset = c->normal_offset;
     m->look.pcf = c->pcf;
-    m->look.warp = warp_uv;
-    m->look.warp_user = m;
+    m->look.warp_x = m->px;
+    m->look.warp_y = m->py;
+    m->look.warp_n = m->n;
     for (uint32_t k = 0; k <= m->n; k++) m->px[k] = m->py[k] = (int32_t)(((int64_t)k * OM_RTW_ONE + m->n / 2) / m->n);
     *state = m;
     return OM_OK;

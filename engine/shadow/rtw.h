@@ -22,7 +22,6 @@
 
 #include "smlookup.h"
 
-#define OM_RTW_ONE (1 << 30)       /* 1.0 in the warp tables' fixed point */
 #define OM_RTW_ALPHA 0.001f        /* shadow-edge function away from edges (section 5.3) */
 #define OM_RTW_BETA 2.0f           /* surface-normal bonus (section 5.4) */
 /* Visible samples' cells keep at least this share of the largest importance, so that a
@@ -48,21 +47,7 @@ void om__rtw_blur(double *I, uint32_t n, float sigma, double *scratch, double *k
 bool om__rtw_table(const double *I, uint32_t n, int32_t *P);
 /* warp(k) = P(k) - k/n, both in OM_RTW_ONE units (k/n rounded to nearest). */
 int32_t om__rtw_warp_at(const int32_t *P, uint32_t n, uint32_t k);
-/* Warps one coordinate; *density (if not NULL): warped length per unwarped length
- * there (1 outside [0, 1]). Inline: every lookup and every warped vertex runs it. */
-static inline double om__rtw_apply(const int32_t *P, uint32_t n, double u, double *density)
-{
-    if (!(u > 0.0 && u < 1.0)) {   /* outside the map (and NaN): left alone */
-        if (density) *density = 1.0;
-        return u;
-    }
-    double t = u * (double)n;
-    uint32_t k = (uint32_t)t;
-    if (k > n - 1) k = n - 1;
-    double f = t - (double)k, a = (double)P[k], b = (double)P[k + 1];
-    if (density) *density = (b - a) * (double)n / (double)OM_RTW_ONE;
-    return (a + f * (b - a)) / (double)OM_RTW_ONE;
-}
+/* om__rtw_apply, which warps one coordinate, is in smlookup.h: the lookup runs it. */
 
 /* The inverse warp at the centres of a warped map's `size` texels: g[x] is where the
  * centre of texel x, (x + 0.5) / size warped, comes from, on a grid of `steps` units

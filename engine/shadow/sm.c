@@ -56,7 +56,8 @@ static om_status sm_init(void **state, om_arena *a, const om_method_cfg *c, cons
     m->look.bias_slope = c->bias_slope;
     m->look.normal_offset = c->normal_offset;
     m->look.pcf = c->pcf;
-    m->look.warp = NULL;
+    m->look.warp_x = m->look.warp_y = NULL;
+    m->look.warp_n = 0;
     *state = m;
     return OM_OK;
 }

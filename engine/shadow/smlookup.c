@@ -1,5 +1,5 @@
 /* smlookup.c — the biased shadow-map depth test (see smlookup.h), moved out of sm.c so
- * that the RTW map uses the very same rules; for the conventional map (warp == NULL)
+ * that the RTW map uses the very same rules; for the conventional map (warp_x == NULL)
  * every operation is the one sm.c always did, so its frames are unchanged.
  *
  * The bias is given in world units along the light ray and converted to depth units at
@@ -25,6 +25,20 @@ static float texel_world(const om__smlook *L, float dist)
     return span / (float)L->size;
 }
 
+/* Warps (u, v) in place; *density: warped texels per unwarped texel there, the
+ * smaller axis's (the bias then covers the larger warped texel), kept above a sliver:
+ * a sample in a collapsed super-cell (possible only just outside what the analysis
+ * saw) must not get an infinite bias. In line, with the tables in the struct rather
+ * than behind a callback: every sample of a warped map runs it. */
+static inline void warp(const om__smlook *L, double *u, double *v, double *density)
+{
+    double dx, dy;
+    *u = om__rtw_apply(L->warp_x, L->warp_n, *u, &dx);
+    *v = om__rtw_apply(L->warp_y, L->warp_n, *v, &dy);
+    double dmin = dx < dy ? dx : dy;
+    *density = dmin > 1.0 / 64.0 ? dmin : 1.0 / 64.0;
+}
+
 /* Where one sample's test looks: its biased depth and the texel under it (before the
  * clamp to the map). */
 typedef struct tap { double z; int64_t cx, cy; } tap;
@@ -41,7 +55,7 @@ static bool locate(const om__smlook *L, const om_sample *smp, tap *out)
     float texel = texel_world(L, dist);
     double u0 = 0.0, v0 = 0.0;
     om_vec4 q0 = {0.0f, 0.0f, 0.0f, 0.0f};
-    if (L->warp) {
+    if (L->warp_x) {
         /* A warped texel covers 1/density of an unwarped one: where the warp stretches
          * the map, texels are smaller in the world and the bias shrinks with them. */
         q0 = om__mat_apply(&v->light_vp, p);
@@ -49,14 +63,14 @@ static bool locate(const om__smlook *L, const om_sample *smp, tap *out)
         double iw0 = 1.0 / (double)q0.w, dens = 1.0;
         u0 = ((double)q0.x * iw0 + 1.0) * 0.5;
         v0 = (1.0 - (double)q0.y * iw0) * 0.5;
-        L->warp(L->warp_user, &u0, &v0, &dens);
+        warp(L, &u0, &v0, &dens);
         texel = (float)((double)texel / dens);
     }
     float cosang = om__dot(n, l);
     float tanang = cosang > 0.0995f ? sqrtf(1.0f - cosang * cosang) / cosang : 10.0f;
     float bias = L->bias_const + L->bias_slope * texel * tanang;
     om_vec4 q;
-    if (L->warp && L->normal_offset == 0.0f) {
+    if (L->warp_x && L->normal_offset == 0.0f) {
         q = q0;   /* the point did not move: its projection and warp are done */
     } else {
         p = om__add(p, om__scale(n, L->normal_offset * texel));
@@ -65,12 +79,12 @@ static bool locate(const om__smlook *L, const om_sample *smp, tap *out)
     }
     double iw = 1.0 / (double)q.w;
     double u, w;
-    if (L->warp) {
+    if (L->warp_x) {
         if (L->normal_offset != 0.0f) {   /* the point moved: warp it anew */
             double dens;
             u0 = ((double)q.x * iw + 1.0) * 0.5;
             v0 = (1.0 - (double)q.y * iw) * 0.5;
-            L->warp(L->warp_user, &u0, &v0, &dens);
+            warp(L, &u0, &v0, &dens);
         }
         u = u0 * L->size;
         w = v0 * L->size;

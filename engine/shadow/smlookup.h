@@ -4,17 +4,34 @@
  *
  * A map is a size x size uint32 depth image in the rasterizer's depth format (z/w *
  * 2^32, sampled at texel centres) over the light's image plane. A warped map (RTW) adds
- * a coordinate mapping: it moves normalized light-image coordinates (u right, v down,
- * [0, 1] across the map) to the warped map's, and reports how many warped texels one
- * unwarped texel spans there, so that "a texel" in the bias rules is a warped texel. */
+ * a coordinate mapping, two 1-D tables: it moves normalized light-image coordinates (u
+ * right, v down, [0, 1] across the map) to the warped map's, and tells how many warped
+ * texels one unwarped texel spans there, so that "a texel" in the bias rules is a
+ * warped texel. */
 #ifndef OM_SMLOOKUP_H
 #define OM_SMLOOKUP_H
 
 #include "../frame/frame.h"
 
-/* Maps (u, v) in place; *density: warped texels per unwarped texel at (u, v) (the
- * smaller of the two axes', so the bias stays on the safe side). */
-typedef void (*om__smwarp_fn)(const void *user, double *u, double *v, double *density);
+/* A warped map's coordinate mapping (rtw.h): one 1-D table per axis of n + 1
+ * fixed-point super-cell edge positions, 1.0 = OM_RTW_ONE, interpolated linearly. */
+#define OM_RTW_ONE (1 << 30)
+
+/* Warps one coordinate; *density (if not NULL): warped length per unwarped length
+ * there (1 outside [0, 1]). Inline: every lookup and every warped vertex runs it. */
+static inline double om__rtw_apply(const int32_t *P, uint32_t n, double u, double *density)
+{
+    if (!(u > 0.0 && u < 1.0)) {   /* outside the map (and NaN): left alone */
+        if (density) *density = 1.0;
+        return u;
+    }
+    double t = u * (double)n;
+    uint32_t k = (uint32_t)t;
+    if (k > n - 1) k = n - 1;
+    double f = t - (double)k, a = (double)P[k], b = (double)P[k + 1];
+    if (density) *density = (b - a) * (double)n / (double)OM_RTW_ONE;
+    return (a + f * (b - a)) / (double)OM_RTW_ONE;
+}
 
 typedef struct om__smlook {
     const om_view *view;
@@ -23,8 +40,10 @@ typedef struct om__smlook {
     float bias_const, bias_slope, normal_offset;
     uint32_t pcf;              /* k for k x k, 1 = a single tap */
     float span_per_dist;       /* spot: frustum width per unit of distance */
-    om__smwarp_fn warp;        /* NULL: the conventional map */
-    const void *warp_user;
+    /* A warped map's tables (n + 1 entries each), NULL for the conventional map: u
+     * and v are warped by them, and "a texel" in the bias rules is a warped one. */
+    const int32_t *warp_x, *warp_y;
+    uint32_t warp_n;
 } om__smlook;
 
 /* Fills the frame-dependent part (view, span) for this frame's light. */
