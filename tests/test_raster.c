@@ -2,8 +2,8 @@
  * top-left rule, watertightness of shared edges (fans, grids, random triangulations,
  * sub-pixel vertices), clipping at the near and far planes, coordinates that would
  * overflow 32-bit setup, conservative coverage, the point-in-triangle test, and the
- * entry for triangles already on the grid, and the plain depth pass made alongside a
- * conservative one. */
+ * entry for triangles already on the grid, the plain depth pass made alongside a
+ * conservative one, and depth passes on rectilinear grids. */
 #include "test.h"
 #include "../engine/raster/raster.h"
 #include "../engine/core/core.h"
@@ -404,6 +404,59 @@ static void snapped_matches_clipped(void)
     CHECK_EQ_U(bad, 0);
 }
 
+/* A depth pass on a rectilinear grid (om_raster.grid_x, grid_y) gives every pixel the
+ * nearest depth of the triangles covering its grid point, by the point-in-triangle test
+ * and the plane: random non-decreasing grids with repeated points, points on vertices
+ * and edges, triangles partly off the grid, both windings, 40 triangles layered. */
+static void grid_matches_point_tests(void)
+{
+    enum { GW = 48, GH = 40, NT = 40 };
+    static int64_t gx[GW], gy[GH];
+    static om__rtri tris[NT];
+    rng_state = 77;
+    int bad = 0, covered = 0;
+    for (int round = 0; round < 20; round++) {
+        /* steps of 0..600 grid units: some points repeat, some lie far apart */
+        int64_t g = (int64_t)(rnd() % 500);
+        for (int i = 0; i < GW; i++) { gx[i] = g; g += (int64_t)(rnd() % 4 ? rnd() % 600 : 0); }
+        g = (int64_t)(rnd() % 500);
+        for (int i = 0; i < GH; i++) { gy[i] = g; g += (int64_t)(rnd() % 4 ? rnd() % 600 : 0); }
+        om_target t = target(GW, GH);
+        t.id = NULL;
+        om_raster r = {&t, OM_RASTER_DEPTH, NULL, NULL, NULL, NULL, 0, false, gx, gy};
+        om__target_clear(&t);
+        int nt = 0;
+        for (int k = 0; k < NT; k++) {
+            int64_t x[3], y[3];
+            double z[3];
+            for (int i = 0; i < 3; i++) {
+                /* a third of the vertices exactly on grid points */
+                x[i] = rnd() % 3 ? (int64_t)(rnd() % 30000) - 2000 : gx[rnd() % GW];
+                y[i] = rnd() % 3 ? (int64_t)(rnd() % 26000) - 2000 : gy[rnd() % GH];
+                z[i] = (double)(rnd() % 1000000) * 4000.0;
+            }
+            if (om__raster_snapped(&r, x, y, z, 0)) {
+                CHECK(om__tri2_setup(&tris[nt].e, x, y, true));
+                om__rtri_plane(&tris[nt], z);
+                nt++;
+            }
+        }
+        for (int j = 0; j < GH; j++)
+            for (int i = 0; i < GW; i++) {
+                uint32_t d = 0xFFFFFFFFu;
+                for (int k = 0; k < nt; k++)
+                    if (om__tri2_covers(&tris[k].e, gx[i], gy[j])) {
+                        uint32_t z = (uint32_t)om__rtri_depth(&tris[k], gx[i], gy[j]);
+                        if (z < d) d = z;
+                    }
+                covered += d != 0xFFFFFFFFu;
+                bad += depth_buf[j * GW + i] != d;
+            }
+    }
+    CHECK_EQ_U(bad, 0);
+    CHECK(covered > 20 * GW * GH / 4);
+}
+
 typedef struct cons_ctx { int *count; uint32_t w; } cons_ctx;
 static void cons_span(void *user, int32_t y, int32_t x0, int32_t x1, const om__rtri *t)
 {
@@ -549,6 +602,7 @@ void suite_raster(void)
     RUN(overflow_cases);
     RUN(covers_matches_fill);
     RUN(snapped_matches_clipped);
+    RUN(grid_matches_point_tests);
     RUN(conservative_superset);
     RUN(conservative_centres_match_depth_pass);
     RUN(strips_match_whole);

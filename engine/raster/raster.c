@@ -301,34 +301,27 @@ static void fill_conservative(const om_raster *r, const om__rtri *t)
 
 /* ---- rectilinear grids (om_raster.grid_x, grid_y) */
 
-/* The first i in [lo, hi] where g[i] >= v; hi + 1 when none (g non-decreasing). */
-static int32_t grid_first(const int64_t *g, int32_t lo, int32_t hi, int64_t v)
-{
-    while (lo <= hi) {
-        int32_t mid = lo + (hi - lo) / 2;
-        if (g[mid] >= v) hi = mid - 1;
-        else lo = mid + 1;
-    }
-    return lo;
-}
-
 /* Whether grid index x lies past the crossing of edge (a, k), a != 0: a * g[x] + k >= 0
  * when the edge function rises along the row (a > 0), < 0 when it falls. False, then
- * true, along a row. */
+ * true, along a row (g is non-decreasing). */
 static inline bool grid_past(const int64_t *g, int32_t x, int64_t a, int64_t k)
 {
     return (a * g[x] + k >= 0) == (a > 0);
 }
 
-/* The first i in [lo, hi] past the crossing; hi + 1 when none. */
+/* The first i in [lo, hi] past the crossing; hi + 1 when none. Bisection without
+ * branches on the data (the choice is a conditional move): small triangles land
+ * anywhere on the map, and a mispredicted step costs more than the step. */
 static int32_t grid_cross(const int64_t *g, int32_t lo, int32_t hi, int64_t a, int64_t k)
 {
-    while (lo <= hi) {
-        int32_t mid = lo + (hi - lo) / 2;
-        if (grid_past(g, mid, a, k)) hi = mid - 1;
-        else lo = mid + 1;
+    if (lo > hi) return lo;
+    int32_t b = lo, n = hi - lo + 1;
+    while (n > 1) {
+        const int32_t half = n / 2;
+        b = grid_past(g, b + half - 1, a, k) ? b : b + half;
+        n -= half;
     }
-    return lo;
+    return b + !grid_past(g, b, a, k);
 }
 
 /* The pixels whose grid point lies in the triangle's bounding box. */
@@ -344,10 +337,11 @@ static bool bounds_grid(om__rtri *t, const om_raster *r)
         if (e->y[i] > maxY) maxY = e->y[i];
     }
     const int32_t xe = (int32_t)tg->width - 1, ye = (int32_t)(tg->y0 + tg->rows) - 1;
-    t->minx = grid_first(r->grid_x, 0, xe, minX);
-    t->maxx = grid_first(r->grid_x, t->minx, xe, maxX + 1) - 1;
-    t->miny = grid_first(r->grid_y, (int32_t)tg->y0, ye, minY);
-    t->maxy = grid_first(r->grid_y, t->miny, ye, maxY + 1) - 1;
+    /* the first grid point at or past each side: the edge 1 * g - side */
+    t->minx = grid_cross(r->grid_x, 0, xe, 1, -minX);
+    t->maxx = grid_cross(r->grid_x, t->minx, xe, 1, -(maxX + 1)) - 1;
+    t->miny = grid_cross(r->grid_y, (int32_t)tg->y0, ye, 1, -minY);
+    t->maxy = grid_cross(r->grid_y, t->miny, ye, 1, -(maxY + 1)) - 1;
     return t->minx <= t->maxx && t->miny <= t->maxy;
 }
 
