@@ -160,16 +160,24 @@ void om__rtri_plane(om__rtri *t, const double z[3])
     t->zmax = fmax(z0, fmax(z1, z2));
 }
 
+/* The snapped triangle's bounding box on the grid. */
+static void tri_box(const om__tri2 *e, int64_t *minX, int64_t *maxX, int64_t *minY, int64_t *maxY)
+{
+    *minX = *maxX = e->x[0];
+    *minY = *maxY = e->y[0];
+    for (int i = 1; i < 3; i++) {
+        if (e->x[i] < *minX) *minX = e->x[i];
+        if (e->x[i] > *maxX) *maxX = e->x[i];
+        if (e->y[i] < *minY) *minY = e->y[i];
+        if (e->y[i] > *maxY) *maxY = e->y[i];
+    }
+}
+
 static bool bounds(om__rtri *t, const om_target *tg, bool conservative)
 {
     const om__tri2 *e = &t->e;
-    int64_t minX = e->x[0], maxX = e->x[0], minY = e->y[0], maxY = e->y[0];
-    for (int i = 1; i < 3; i++) {
-        if (e->x[i] < minX) minX = e->x[i];
-        if (e->x[i] > maxX) maxX = e->x[i];
-        if (e->y[i] < minY) minY = e->y[i];
-        if (e->y[i] > maxY) maxY = e->y[i];
-    }
+    int64_t minX, maxX, minY, maxY;
+    tri_box(e, &minX, &maxX, &minY, &maxY);
     int64_t x0, x1, y0, y1;
     if (conservative) {       /* pixels whose closed square meets the bounding box */
         x0 = floordiv(minX - 1, OM_SUBPIX); x1 = floordiv(maxX, OM_SUBPIX);
@@ -329,13 +337,8 @@ static bool bounds_grid(om__rtri *t, const om_raster *r)
 {
     const om_target *tg = r->target;
     const om__tri2 *e = &t->e;
-    int64_t minX = e->x[0], maxX = e->x[0], minY = e->y[0], maxY = e->y[0];
-    for (int i = 1; i < 3; i++) {
-        if (e->x[i] < minX) minX = e->x[i];
-        if (e->x[i] > maxX) maxX = e->x[i];
-        if (e->y[i] < minY) minY = e->y[i];
-        if (e->y[i] > maxY) maxY = e->y[i];
-    }
+    int64_t minX, maxX, minY, maxY;
+    tri_box(e, &minX, &maxX, &minY, &maxY);
     const int32_t xe = (int32_t)tg->width - 1, ye = (int32_t)(tg->y0 + tg->rows) - 1;
     /* the first grid point at or past each side: the edge 1 * g - side */
     t->minx = grid_cross(r->grid_x, 0, xe, 1, -minX);
