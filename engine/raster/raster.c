@@ -382,6 +382,9 @@ static void fill_grid(const om_raster *r, const om__rtri *t)
         if (lo > hi) continue;
         const double ztail = t->zy * (double)(py - e->y[0]);
         uint32_t *dep = tg->depth + (size_t)(y - (int32_t)tg->y0) * tg->width;
+#if defined(__GNUC__) || defined(__clang__)
+        if (y < t->maxy) __builtin_prefetch(dep + tg->width + lo, 1);
+#endif
         for (int32_t x = lo; x <= hi; x++) {
             double z = (t->z0 + t->zx * (double)(gx[x] - e->x[0])) + ztail;
             z = z < t->zmin ? t->zmin : z > t->zmax ? t->zmax : z;
