@@ -457,6 +457,59 @@ static void grid_matches_point_tests(void)
     CHECK(covered > 20 * GW * GH / 4);
 }
 
+/* The plain fill (depth and id, as the eye pass) gives every pixel the nearest depth
+ * of the triangles covering its centre, by the point-in-triangle test and the plane,
+ * and the id of the first triangle drawn at that depth: random layered triangles whose
+ * depths span [0, 2^32) and cross 2^31 inside rows, and flat ones at depths where the
+ * conversion to uint32 is easiest to get wrong (just below and above 2^31 and integers,
+ * the far end). Wide spans run four pixels at a time where the compiler has SSE2. */
+static void fill_matches_point_tests(void)
+{
+    enum { W = 61, H = 37, NT = 30 };
+    static om__rtri tris[NT];
+    static uint32_t ids[NT];
+    static const double flat[] = {2147483647.0, 2147483647.5, 2147483647.9999998, 2147483648.0,
+                                  2147483648.5, 4294967294.75, 4294967295.0, 0.25, 1.0};
+    rng_state = 31;
+    int bad = 0, covered = 0;
+    for (int round = 0; round < 30; round++) {
+        om_target t = target(W, H);
+        om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL, NULL, NULL, 0, false, NULL, NULL};
+        om__target_clear(&t);
+        int nt = 0;
+        for (int k = 0; k < NT; k++) {
+            int64_t x[3], y[3];
+            double z[3];
+            const bool is_flat = k % 3 == 0;
+            const double zf = flat[(size_t)(rnd() % (sizeof flat / sizeof flat[0]))];
+            for (int i = 0; i < 3; i++) {
+                x[i] = (int64_t)(rnd() % (W * 256 + 2000)) - 1000;
+                y[i] = (int64_t)(rnd() % (H * 256 + 2000)) - 1000;
+                z[i] = is_flat ? zf : (double)(rnd() % 4294967) * 1000.0 + (double)(rnd() % 1000) * 0.001;
+            }
+            if (om__raster_snapped(&r, x, y, z, (uint32_t)k)) {
+                CHECK(om__tri2_setup(&tris[nt].e, x, y, true));
+                om__rtri_plane(&tris[nt], z);
+                ids[nt++] = (uint32_t)k;
+            }
+        }
+        for (int j = 0; j < H; j++)
+            for (int i = 0; i < W; i++) {
+                const int64_t px = i * 256 + 128, py = j * 256 + 128;
+                uint32_t d = 0xFFFFFFFFu, id = OM_NO_TRI;
+                for (int k = 0; k < nt; k++)
+                    if (om__tri2_covers(&tris[k].e, px, py)) {
+                        uint32_t z = (uint32_t)om__rtri_depth(&tris[k], px, py);
+                        if (z < d) { d = z; id = ids[k]; }
+                    }
+                covered += id != OM_NO_TRI;
+                bad += depth_buf[j * W + i] != d || id_buf[j * W + i] != id;
+            }
+    }
+    CHECK_EQ_U(bad, 0);
+    CHECK(covered > 30 * W * H / 2);
+}
+
 typedef struct cons_ctx { int *count; uint32_t w; } cons_ctx;
 static void cons_span(void *user, int32_t y, int32_t x0, int32_t x1, const om__rtri *t)
 {
@@ -603,6 +656,7 @@ void suite_raster(void)
     RUN(covers_matches_fill);
     RUN(snapped_matches_clipped);
     RUN(grid_matches_point_tests);
+    RUN(fill_matches_point_tests);
     RUN(conservative_superset);
     RUN(conservative_centres_match_depth_pass);
     RUN(strips_match_whole);

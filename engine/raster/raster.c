@@ -6,6 +6,11 @@
 
 #include <math.h>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#define OM_RASTER_SSE2 1
+#endif
+
 static int64_t floordiv(int64_t a, int64_t b)   /* b > 0 */
 {
     int64_t q = a / b;
@@ -223,6 +228,65 @@ static bool row_span(const int64_t E[3], const int64_t step[3], int64_t w, int64
     return l <= h;
 }
 
+/* The depth of one pixel whose grid point lies g units (along x) from the plane's
+ * origin, on a row whose y term is ztail: the rule of raster.h, evaluated alike by
+ * every fill. */
+static inline uint32_t depth_at(const om__rtri *t, int64_t g, double ztail)
+{
+    double z = (t->z0 + t->zx * (double)g) + ztail;
+    z = z < t->zmin ? t->zmin : z > t->zmax ? t->zmax : z;
+    return (uint32_t)z;
+}
+
+#ifdef OM_RASTER_SSE2
+/* Four pixels at once with SSE2, where the compiler has it (every x86-64): each lane
+ * is the very value depth_at gives. The same double operations in the same order; the
+ * clamp as max then min (the bounds are the triangle's vertex depths, z is never NaN,
+ * and where the two could differ, in the sign of a zero, the integer is the same); and
+ * the truncation to uint32 in two exact halves, since SSE2 converts to int32 only:
+ * z < 2^31 directly, z >= 2^31 as z - 2^31 (exact there) with the top bit put back. */
+typedef struct zlanes { __m128d z0, zx, ztail, zmin, zmax, two31; __m128i top; } zlanes;
+
+static inline zlanes zlanes_of(const om__rtri *t, double ztail)
+{
+    zlanes k;
+    k.z0 = _mm_set1_pd(t->z0);
+    k.zx = _mm_set1_pd(t->zx);
+    k.ztail = _mm_set1_pd(ztail);
+    k.zmin = _mm_set1_pd(t->zmin);
+    k.zmax = _mm_set1_pd(t->zmax);
+    k.two31 = _mm_set1_pd(2147483648.0);
+    k.top = _mm_set1_epi32((int32_t)0x80000000u);
+    return k;
+}
+
+/* The depth test of dep[0..3] (and ids, when idr is given) for pixels whose offsets g
+ * are ga (pixels 0, 1) and gb (2, 3), as doubles. */
+static inline void depth4(const zlanes *k, __m128d ga, __m128d gb, uint32_t *dep, uint32_t *idr, uint32_t id)
+{
+    __m128d za = _mm_add_pd(_mm_add_pd(k->z0, _mm_mul_pd(k->zx, ga)), k->ztail);
+    __m128d zb = _mm_add_pd(_mm_add_pd(k->z0, _mm_mul_pd(k->zx, gb)), k->ztail);
+    za = _mm_min_pd(_mm_max_pd(za, k->zmin), k->zmax);
+    zb = _mm_min_pd(_mm_max_pd(zb, k->zmin), k->zmax);
+    const __m128i lo = _mm_unpacklo_epi64(_mm_cvttpd_epi32(za), _mm_cvttpd_epi32(zb));
+    const __m128i hi = _mm_xor_si128(_mm_unpacklo_epi64(_mm_cvttpd_epi32(_mm_sub_pd(za, k->two31)),
+                                                        _mm_cvttpd_epi32(_mm_sub_pd(zb, k->two31))),
+                                     k->top);
+    const __m128i ma = _mm_shuffle_epi32(_mm_castpd_si128(_mm_cmpge_pd(za, k->two31)), _MM_SHUFFLE(2, 0, 2, 0));
+    const __m128i mb = _mm_shuffle_epi32(_mm_castpd_si128(_mm_cmpge_pd(zb, k->two31)), _MM_SHUFFLE(2, 0, 2, 0));
+    const __m128i m = _mm_unpacklo_epi64(ma, mb);
+    const __m128i d = _mm_or_si128(_mm_andnot_si128(m, lo), _mm_and_si128(m, hi));
+    /* d < old, unsigned: compare with the top bits flipped */
+    const __m128i old = _mm_loadu_si128((const __m128i *)dep);
+    const __m128i win = _mm_cmpgt_epi32(_mm_xor_si128(old, k->top), _mm_xor_si128(d, k->top));
+    _mm_storeu_si128((__m128i *)dep, _mm_or_si128(_mm_andnot_si128(win, old), _mm_and_si128(win, d)));
+    if (idr) {
+        const __m128i oid = _mm_loadu_si128((const __m128i *)idr);
+        _mm_storeu_si128((__m128i *)idr, _mm_or_si128(_mm_andnot_si128(win, oid), _mm_and_si128(win, _mm_set1_epi32((int32_t)id))));
+    }
+}
+#endif
+
 /* The depth test along row y from texel x0 to x1, writing id too when `id_row` is
  * given (that row of the id buffer). */
 static void depth_row(const om__rtri *t, const om_target *tg, int32_t y, int32_t x0, int32_t x1,
@@ -233,11 +297,23 @@ static void depth_row(const om__rtri *t, const om_target *tg, int32_t y, int32_t
     int64_t py = (int64_t)y * S + H;
     double ztail = t->zy * (double)(py - e->y[0]);
     uint32_t *dep = tg->depth + (size_t)(y - (int32_t)tg->y0) * tg->width;
-    for (int32_t x = x0; x <= x1; x++) {
-        int64_t px = (int64_t)x * S + H;
-        double z = (t->z0 + t->zx * (double)(px - e->x[0])) + ztail;
-        z = z < t->zmin ? t->zmin : z > t->zmax ? t->zmax : z;
-        uint32_t d = (uint32_t)z;
+    int32_t x = x0;
+#ifdef OM_RASTER_SSE2
+    if (x1 - x0 >= 3) {
+        /* offsets fit in int32: pixel centres lie below 2^21, vertices within 2^29 */
+        const zlanes k = zlanes_of(t, ztail);
+        __m128i g = _mm_add_epi32(_mm_set1_epi32((int32_t)((int64_t)x0 * S + H - e->x[0])),
+                                  _mm_setr_epi32(0, (int32_t)S, 2 * (int32_t)S, 3 * (int32_t)S));
+        const __m128i step = _mm_set1_epi32(4 * (int32_t)S);
+        for (; x + 3 <= x1; x += 4) {
+            depth4(&k, _mm_cvtepi32_pd(g), _mm_cvtepi32_pd(_mm_shuffle_epi32(g, _MM_SHUFFLE(3, 2, 3, 2))), dep + x,
+                   id_row ? id_row + x : NULL, id);
+            g = _mm_add_epi32(g, step);
+        }
+    }
+#endif
+    for (; x <= x1; x++) {
+        uint32_t d = depth_at(t, (int64_t)x * S + H - e->x[0], ztail);
         if (d < dep[x]) {
             dep[x] = d;
             if (id_row) id_row[x] = id;
@@ -385,10 +461,23 @@ static void fill_grid(const om_raster *r, const om__rtri *t)
 #if defined(__GNUC__) || defined(__clang__)
         if (y < t->maxy) __builtin_prefetch(dep + tg->width + lo, 1);
 #endif
-        for (int32_t x = lo; x <= hi; x++) {
-            double z = (t->z0 + t->zx * (double)(gx[x] - e->x[0])) + ztail;
-            z = z < t->zmin ? t->zmin : z > t->zmax ? t->zmax : z;
-            uint32_t d = (uint32_t)z;
+        int32_t x = lo;
+#ifdef OM_RASTER_SSE2
+        /* four at a time where the offsets fit in int32 (the grid rises, so its ends
+         * decide) */
+        if (hi - lo >= 3 && gx[lo] - e->x[0] >= INT32_MIN && gx[hi] - e->x[0] <= INT32_MAX) {
+            const zlanes k = zlanes_of(t, ztail);
+            const __m128i origin = _mm_set1_epi64x(e->x[0]);
+            for (; x + 3 <= hi; x += 4) {
+                const __m128i g01 = _mm_sub_epi64(_mm_loadu_si128((const __m128i *)(gx + x)), origin);
+                const __m128i g23 = _mm_sub_epi64(_mm_loadu_si128((const __m128i *)(gx + x + 2)), origin);
+                depth4(&k, _mm_cvtepi32_pd(_mm_shuffle_epi32(g01, _MM_SHUFFLE(2, 0, 2, 0))),
+                       _mm_cvtepi32_pd(_mm_shuffle_epi32(g23, _MM_SHUFFLE(2, 0, 2, 0))), dep + x, NULL, 0);
+            }
+        }
+#endif
+        for (; x <= hi; x++) {
+            uint32_t d = depth_at(t, gx[x] - e->x[0], ztail);
             if (d < dep[x]) dep[x] = d;
         }
     }
