@@ -112,29 +112,55 @@ double om__rtw_max_density(const int32_t *P, uint32_t n)
 
 /* ---------------------------------------------------------------- importance */
 
-float om__rtw_point_importance(const om_view *v, unsigned funcs, om_vec3 p, om_vec3 nrm)
+/* What the importance functions need of the view, taken once per frame: the view
+ * matrix's depth row, the camera's near and far planes and the eye. */
+typedef struct imp_ctx {
+    unsigned funcs;
+    float row[4];
+    double nn, ff, span;   /* span = ff - nn */
+    om_vec3 eye;
+} imp_ctx;
+
+static imp_ctx imp_ctx_of(const om_view *v, unsigned funcs)
+{
+    imp_ctx k;
+    k.funcs = funcs;
+    for (int i = 0; i < 4; i++) k.row[i] = v->cam_view.m[8 + i];
+    k.nn = v->cam.znear;
+    k.ff = v->cam.zfar;
+    k.span = k.ff - k.nn;
+    k.eye = v->cam.eye;
+    return k;
+}
+
+/* In line: the backward analysis runs it for every exposed sample. */
+static inline float point_importance(const imp_ctx *k, om_vec3 p, om_vec3 nrm)
 {
     float imp = 1.0f;
-    if (funcs & OM_RTW_DIST) {
+    if (k->funcs & OM_RTW_DIST) {
         /* Section 5.2: 1 - (the desired view's depth), which falls as 1/q with the
          * distance q from the eye. Our depth is z/w in [0, 1], and 1 - z/w is
          * near (far - q) / (q (far - near)) for a point at view depth q. Only the view
          * matrix's depth row is needed. */
-        const float *a = v->cam_view.m;
-        double d = -(double)(a[8] * p.x + a[9] * p.y + a[10] * p.z + a[11]);
-        double nn = v->cam.znear, ff = v->cam.zfar;
-        double id = d > nn ? nn * (ff - d) / (d * (ff - nn)) : 1.0;
+        double d = -(double)(k->row[0] * p.x + k->row[1] * p.y + k->row[2] * p.z + k->row[3]);
+        double id = d > k->nn ? k->nn * (k->ff - d) / (d * k->span) : 1.0;
         imp *= (float)(id > 0.0 ? id : 0.0);
     }
-    if (funcs & OM_RTW_NORMAL) {
+    if (k->funcs & OM_RTW_NORMAL) {
         /* Section 5.4: 1 + beta clamp(-normal . view direction, 0, 1), with the normal
          * turned to the camera (the side the camera sees), so only the angle counts. */
-        om_vec3 e = om__sub(p, v->cam.eye);
+        om_vec3 e = om__sub(p, k->eye);
         float l2 = om__dot(e, e), c = om__dot(nrm, e);
         c = l2 > 0.0f ? fabsf(c) / sqrtf(l2) : 0.0f;
         imp *= 1.0f + OM_RTW_BETA * (c > 1.0f ? 1.0f : c);
     }
     return imp;
+}
+
+float om__rtw_point_importance(const om_view *v, unsigned funcs, om_vec3 p, om_vec3 nrm)
+{
+    const imp_ctx k = imp_ctx_of(v, funcs);
+    return point_importance(&k, p, nrm);
 }
 
 void om__rtw_importance_begin(om__rtw *m)
@@ -162,6 +188,7 @@ void om__rtw_observe_strip(om__rtw *m, const om_strip *st)
      * needs to know which cells hold a sample (for the floor). */
     unsigned funcs = m->cfg.rtw_analysis == OM_RTW_FORWARD ? 0u
                                                            : m->cfg.rtw_funcs & (OM_RTW_DIST | OM_RTW_NORMAL);
+    const imp_ctx k = imp_ctx_of(v, funcs);
     size_t count = (size_t)st->rows * st->width;
     for (size_t i = 0; i < count; i++) {
         if (!(st->terms[i].flags & OM_TERM_EXPOSED)) continue;
@@ -177,7 +204,7 @@ void om__rtw_observe_strip(om__rtw *m, const om_strip *st)
         double u = ((double)qx * iw + 1.0) * 0.5, w = (1.0 - (double)qy * iw) * 0.5;
         if (!(u >= 0.0 && u <= 1.0 && w >= 0.0 && w <= 1.0)) continue;
         size_t c = cell_of(m, u, w);
-        float val = om__rtw_point_importance(v, funcs, p, om__v3(smp->n[0], smp->n[1], smp->n[2]));
+        float val = point_importance(&k, p, om__v3(smp->n[0], smp->n[1], smp->n[2]));
         m->seen[c >> 3] |= (uint8_t)(1u << (c & 7));
         /* "only keeping the highest value point" (section 6.3) */
         if (val > m->imp[c]) m->imp[c] = val;
