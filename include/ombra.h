@@ -283,6 +283,11 @@ typedef struct om_method_cfg {
     uint32_t rtw_exact;       /* 1: each texel samples the scene at its inverse-warped
                                  centre (exact; no tessellation needed); 0: warped
                                  vertices, straight edges, rtw_tess (the paper's) */
+    uint32_t rtw_footprint;   /* PCF taps (pcf > 1): 0 one warped texel apart (the
+                                 filter follows the map's local resolution: anti-
+                                 aliasing), 1 one texel of a conventional map of the
+                                 same size apart, warped at the last moment (constant
+                                 area in the light's image: soft shadows; section 6.2) */
     /* spsm */
     uint32_t spsm_aa;      /* sub-samples at uncertain samples, 0 or 1 = off */
     uint32_t spsm_records; /* which texel records the build makes: 1 every one (the

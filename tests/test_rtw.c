@@ -507,6 +507,52 @@ static void budget_and_determinism(void)
     c.rtw_analysis = 0;
     c.rtw_exact = 2;
     CHECK(m->init(&state, &a, &c, &hs.s, w, h, NULL) == OM_E_INVALID);
+    c.rtw_exact = 1;
+    c.rtw_footprint = 2;
+    CHECK(m->init(&state, &a, &c, &hs.s, w, h, NULL) == OM_E_INVALID);
+    h_scene_free(&hs);
+}
+
+/* Section 6.2: PCF taps one warped texel apart follow the map's local resolution (a
+ * narrow filter where the warp magnifies), taps one unwarped texel apart keep the
+ * filter's area in the light's image, that of a conventional map of the same size.
+ * Counted in partly lit samples (0 < term < 255) on the default scene: the unwarped
+ * footprint's penumbrae are as wide as sm's (within 20%), the warped one's less than
+ * half as wide; with a single tap the footprint changes nothing. */
+static om_term pcf_terms[3][320 * 240];
+
+static uint32_t partly_lit(const om_term *t, size_t n)
+{
+    uint32_t k = 0;
+    for (size_t i = 0; i < n; i++) k += (t[i].flags & OM_TERM_EXPOSED) && t[i].r > 0 && t[i].r < 255;
+    return k;
+}
+
+static void pcf_footprints(void)
+{
+    enum { w = 320, h = 240 };
+    h_scene hs;
+    if (!h_scene_parse(&hs, om_scene_default_text())) return;
+    om_method_cfg c;
+    om_method_cfg_default(&c);
+    c.map_size = 1024;
+    c.pcf = 1;
+    c.rtw_footprint = 1;
+    CHECK_OK(run_rtw(&hs.s, &c, w, h, 0, pcf_terms[0], NULL, NULL));
+    c.rtw_footprint = 0;
+    CHECK_OK(run_rtw(&hs.s, &c, w, h, 0, pcf_terms[1], NULL, NULL));
+    CHECK(memcmp(pcf_terms[0], pcf_terms[1], sizeof pcf_terms[0]) == 0);
+    c.pcf = 3;
+    CHECK_OK(run_rtw(&hs.s, &c, w, h, 0, pcf_terms[0], NULL, NULL));
+    c.rtw_footprint = 1;
+    CHECK_OK(run_rtw(&hs.s, &c, w, h, 0, pcf_terms[1], NULL, NULL));
+    CHECK_OK(h_render(&hs.s, "sm", &c, w, h, 0, 0, NULL, pcf_terms[2], NULL));
+    uint32_t warped = partly_lit(pcf_terms[0], w * h), unwarped = partly_lit(pcf_terms[1], w * h),
+             sm = partly_lit(pcf_terms[2], w * h);
+    /* measured: 830, 2,364 and 2,473 */
+    CHECK_MSG(unwarped > 2 * warped, "unwarped taps: %u partly lit samples, warped: %u", unwarped, warped);
+    CHECK_MSG(10 * unwarped > 8 * sm && 10 * unwarped < 12 * sm, "unwarped taps: %u partly lit samples, sm: %u",
+              unwarped, sm);
     h_scene_free(&hs);
 }
 
@@ -522,4 +568,5 @@ void suite_rtw(void)
     RUN(rtw512_matches_sm2048);
     RUN(analyses_and_functions);
     RUN(budget_and_determinism);
+    RUN(pcf_footprints);
 }

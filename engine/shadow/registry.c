@@ -73,6 +73,7 @@ void om_method_cfg_default(om_method_cfg *c)
     c->rtw_sigma = 3.0f;
     c->rtw_tess = 0.025f;
     c->rtw_exact = 1;
+    c->rtw_footprint = 0;
     c->spsm_aa = 0;
     c->spsm_records = 0;
 }
@@ -101,6 +102,7 @@ static const om_cfg_field fields[] = {
     F("rtw.sigma", 'f', rtw_sigma, 0, 64, "RTW blur sigma in super-cells"),
     F("rtw.tess", 'f', rtw_tess, 0, 1, "RTW longest warped edge / map width, 0 = off"),
     F("rtw.exact", 'u', rtw_exact, 0, 1, "RTW map: 1 texels sample at inverse-warped centres, 0 warped vertices"),
+    F("rtw.footprint", 'u', rtw_footprint, 0, 1, "RTW PCF taps: 0 a warped texel apart, 1 an unwarped one"),
     F("spsm.aa", 'u', spsm_aa, 0, 64, "SPSM sub-samples at uncertain samples, 0 = off"),
     F("spsm.records", 'u', spsm_records, 0, 2, "SPSM records made: 1 all, 2 those the view reads, 0 auto"),
 };

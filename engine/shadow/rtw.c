@@ -44,6 +44,7 @@ static const char *check_cfg(const om_method_cfg *c)
     if (!(c->rtw_sigma >= 0.0f && c->rtw_sigma <= 64.0f)) return "rtw: sigma must be 0..64";
     if (!(c->rtw_tess >= 0.0f && c->rtw_tess <= 1.0f)) return "rtw: tessellation must be 0..1";
     if (c->rtw_exact > 1) return "rtw: exact must be 0 (warped vertices) or 1 (inverse-warped texel centres)";
+    if (c->rtw_footprint > 1) return "rtw: footprint must be 0 (PCF taps a warped texel apart) or 1 (an unwarped one)";
     return NULL;
 }
 
@@ -121,6 +122,7 @@ static om_status rtw_init(void **state, om_arena *a, const om_method_cfg *c, con
     m->look.warp_x = m->px;
     m->look.warp_y = m->py;
     m->look.warp_n = m->n;
+    m->look.unwarped_pcf = c->rtw_footprint == 1;
     for (uint32_t k = 0; k <= m->n; k++) m->px[k] = m->py[k] = (int32_t)(((int64_t)k * OM_RTW_ONE + m->n / 2) / m->n);
     *state = m;
     return OM_OK;

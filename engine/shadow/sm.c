@@ -58,6 +58,7 @@ static om_status sm_init(void **state, om_arena *a, const om_method_cfg *c, cons
     m->look.pcf = c->pcf;
     m->look.warp_x = m->look.warp_y = NULL;
     m->look.warp_n = 0;
+    m->look.unwarped_pcf = false;
     *state = m;
     return OM_OK;
 }

@@ -40,8 +40,9 @@ static inline void warp(const om__smlook *L, double *u, double *v, double *densi
 }
 
 /* Where one sample's test looks: its biased depth and the texel under it (before the
- * clamp to the map). */
-typedef struct tap { double z; int64_t cx, cy; } tap;
+ * clamp to the map); for a warped map also where it lies before the warp (normalized
+ * coordinates), from which unwarped PCF taps are placed. */
+typedef struct tap { double z; int64_t cx, cy; double u, v; } tap;
 
 /* All of the test's arithmetic; false when the sample is behind the light. */
 static bool locate(const om__smlook *L, const om_sample *smp, tap *out)
@@ -63,8 +64,13 @@ static bool locate(const om__smlook *L, const om_sample *smp, tap *out)
         double iw0 = 1.0 / (double)q0.w, dens = 1.0;
         u0 = ((double)q0.x * iw0 + 1.0) * 0.5;
         v0 = (1.0 - (double)q0.y * iw0) * 0.5;
+        out->u = u0;
+        out->v = v0;
         warp(L, &u0, &v0, &dens);
-        texel = (float)((double)texel / dens);
+        /* Unwarped PCF taps lie an unwarped texel apart, and the bias must cover the
+         * receiver's depth across that span: the texel of the bias rules stays the
+         * unwarped one. */
+        if (!(L->unwarped_pcf && L->pcf > 1)) texel = (float)((double)texel / dens);
     }
     float cosang = om__dot(n, l);
     float tanang = cosang > 0.0995f ? sqrtf(1.0f - cosang * cosang) / cosang : 10.0f;
@@ -84,11 +90,14 @@ static bool locate(const om__smlook *L, const om_sample *smp, tap *out)
             double dens;
             u0 = ((double)q.x * iw + 1.0) * 0.5;
             v0 = (1.0 - (double)q.y * iw) * 0.5;
+            out->u = u0;
+            out->v = v0;
             warp(L, &u0, &v0, &dens);
         }
         u = u0 * L->size;
         w = v0 * L->size;
     } else {
+        out->u = out->v = 0.0;   /* no warp: taps are the map's texels */
         u = ((double)q.x * iw + 1.0) * 0.5 * L->size;
         w = (1.0 - (double)q.y * iw) * 0.5 * L->size;
     }
@@ -107,15 +116,28 @@ static bool locate(const om__smlook *L, const om_sample *smp, tap *out)
     return true;
 }
 
-/* The map loads: k x k taps around the texel, each clamped to the map. */
+/* The texel (before the clamp) that an unwarped tap `d` texels from the sample falls
+ * in, along one axis: the tap is placed before the warp, then warped on its own. */
+static int64_t unwarped_tap(const int32_t *P, uint32_t n, uint32_t size, double at, int d)
+{
+    return (int64_t)floor(om__rtw_apply(P, n, at + (double)d / (double)size, NULL) * size);
+}
+
+/* The map loads: k x k taps around the texel (or, for unwarped PCF, around the
+ * sample's unwarped position), each clamped to the map. */
 static uint8_t test(const om__smlook *L, const tap *tp)
 {
     const double z = tp->z;
-    const int64_t cx = tp->cx, cy = tp->cy;
     int k = (int)L->pcf, half = k / 2, lit = 0;
-    for (int dy = -half; dy < k - half; dy++)
-        for (int dx = -half; dx < k - half; dx++) {
-            int64_t x = cx + dx, y = cy + dy;
+    int64_t tx[9], ty[9];   /* pcf <= 9 */
+    for (int d = -half; d < k - half; d++) {
+        const bool spread = L->unwarped_pcf && L->warp_x && d != 0;
+        tx[d + half] = spread ? unwarped_tap(L->warp_x, L->warp_n, L->size, tp->u, d) : tp->cx + d;
+        ty[d + half] = spread ? unwarped_tap(L->warp_y, L->warp_n, L->size, tp->v, d) : tp->cy + d;
+    }
+    for (int j = 0; j < k; j++)
+        for (int i = 0; i < k; i++) {
+            int64_t x = tx[i], y = ty[j];
             if (x < 0) x = 0;
             if (y < 0) y = 0;
             if (x >= L->size) x = L->size - 1;

@@ -7,7 +7,7 @@
  * a coordinate mapping, two 1-D tables: it moves normalized light-image coordinates (u
  * right, v down, [0, 1] across the map) to the warped map's, and tells how many warped
  * texels one unwarped texel spans there, so that "a texel" in the bias rules is a
- * warped texel. */
+ * warped texel (and PCF's taps are warped texels, unless asked to be unwarped ones). */
 #ifndef OM_SMLOOKUP_H
 #define OM_SMLOOKUP_H
 
@@ -44,6 +44,10 @@ typedef struct om__smlook {
      * and v are warped by them, and "a texel" in the bias rules is a warped one. */
     const int32_t *warp_x, *warp_y;
     uint32_t warp_n;
+    /* With a warped map: PCF taps one unwarped texel (1 / size of the light's image)
+     * apart, each warped on its own, rather than one warped texel apart (RTW section
+     * 6.2: the filter then covers the same area of the light's image everywhere). */
+    bool unwarped_pcf;
 } om__smlook;
 
 /* Fills the frame-dependent part (view, span) for this frame's light. */
