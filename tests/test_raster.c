@@ -42,7 +42,7 @@ static void add_coverage(const om_vec4 c[3], uint32_t w, uint32_t h)
 {
     om_target t = target(w, h);
     om__target_clear(&t);
-    om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL, NULL, NULL, 0, false, NULL, NULL};
+    om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL, NULL, NULL, 0, false, NULL, NULL, NULL, NULL, 0, 0};
     om__raster_tri(&r, c, 7);
     for (uint32_t i = 0; i < w * h; i++) count_buf[i] += id_buf[i] == 7;
 }
@@ -311,7 +311,7 @@ static void huge_ground(float half)
     for (int i = 0; i < 4; i++) c[i] = om__mat_apply(&vp, q[i]);
     om_target t = target(W, H);
     om__target_clear(&t);
-    om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL, NULL, NULL, 0, false, NULL, NULL};
+    om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL, NULL, NULL, 0, false, NULL, NULL, NULL, NULL, 0, 0};
     om_vec4 t1[3] = {c[0], c[1], c[2]}, t2[3] = {c[0], c[2], c[3]};
     om__raster_tri(&r, t1, 1);
     om__raster_tri(&r, t2, 2);
@@ -392,7 +392,7 @@ static void snapped_matches_clipped(void)
             z[i] = (double)c[i].z * 4294967296.0;
         }
         om_target t = target(TW, TH);
-        om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL, NULL, NULL, 0, false, NULL, NULL};
+        om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL, NULL, NULL, 0, false, NULL, NULL, NULL, NULL, 0, 0};
         om__target_clear(&t);
         om__raster_tri(&r, c, 5);
         memcpy(d0, depth_buf, sizeof d0);
@@ -407,11 +407,14 @@ static void snapped_matches_clipped(void)
 /* A depth pass on a rectilinear grid (om_raster.grid_x, grid_y) gives every pixel the
  * nearest depth of the triangles covering its grid point, by the point-in-triangle test
  * and the plane: random non-decreasing grids with repeated points, points on vertices
- * and edges, triangles partly off the grid, both windings, 40 triangles layered. */
+ * and edges, triangles partly off the grid, both windings, 40 triangles layered; every
+ * other round with the grids indexed (om__grid_index) in buckets of 16 to 2048 units,
+ * some indexes covering only the lower half of the grid. */
 static void grid_matches_point_tests(void)
 {
     enum { GW = 48, GH = 40, NT = 40 };
     static int64_t gx[GW], gy[GH];
+    static int32_t xs[2048], ys[2048];
     static om__rtri tris[NT];
     rng_state = 77;
     int bad = 0, covered = 0;
@@ -423,7 +426,16 @@ static void grid_matches_point_tests(void)
         for (int i = 0; i < GH; i++) { gy[i] = g; g += (int64_t)(rnd() % 4 ? rnd() % 600 : 0); }
         om_target t = target(GW, GH);
         t.id = NULL;
-        om_raster r = {&t, OM_RASTER_DEPTH, NULL, NULL, NULL, NULL, 0, false, gx, gy};
+        om_raster r = {&t, OM_RASTER_DEPTH, NULL, NULL, NULL, NULL, 0, false, gx, gy, NULL, NULL, 0, 0};
+        if (round % 2) {
+            r.grid_shift = 4 + (uint32_t)(round / 2) % 8;
+            r.grid_buckets = (uint32_t)((gx[GW - 1] > gy[GH - 1] ? gx[GW - 1] : gy[GH - 1]) >> r.grid_shift) + 1;
+            if (round % 4 == 3) r.grid_buckets /= 2;
+            om__grid_index(gx, GW, r.grid_shift, r.grid_buckets, xs);
+            om__grid_index(gy, GH, r.grid_shift, r.grid_buckets, ys);
+            r.grid_xs = xs;
+            r.grid_ys = ys;
+        }
         om__target_clear(&t);
         int nt = 0;
         for (int k = 0; k < NT; k++) {
@@ -474,7 +486,7 @@ static void fill_matches_point_tests(void)
     int bad = 0, covered = 0;
     for (int round = 0; round < 30; round++) {
         om_target t = target(W, H);
-        om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL, NULL, NULL, 0, false, NULL, NULL};
+        om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL, NULL, NULL, 0, false, NULL, NULL, NULL, NULL, 0, 0};
         om__target_clear(&t);
         int nt = 0;
         for (int k = 0; k < NT; k++) {
@@ -537,7 +549,7 @@ static void conservative_superset(void)
         memset(cons, 0, sizeof cons);
         om_target t = target(TW, TH);
         cons_ctx ctx = {cons, TW};
-        om_raster r = {&t, OM_RASTER_CONSERVATIVE, cons_span, &ctx, NULL, NULL, 0, false, NULL, NULL};
+        om_raster r = {&t, OM_RASTER_CONSERVATIVE, cons_span, &ctx, NULL, NULL, 0, false, NULL, NULL, NULL, NULL, 0, 0};
         om__raster_tri(&r, c, 1);
         for (int i = 0; i < TW * TH; i++) {
             if (count_buf[i] && !cons[i]) missing++;
@@ -580,13 +592,13 @@ static void conservative_centres_match_depth_pass(void)
         for (int i = 0; i < 3; i++) c[k][i] = at((double)x[i], (double)y[i], TW, TH, (float)(rnd() % 1000) / 1000.0f);
     }
     om_target t = target(TW, TH);
-    om_raster r = {&t, OM_RASTER_DEPTH, NULL, NULL, NULL, NULL, 0, false, NULL, NULL};
+    om_raster r = {&t, OM_RASTER_DEPTH, NULL, NULL, NULL, NULL, 0, false, NULL, NULL, NULL, NULL, 0, 0};
     om__target_clear(&t);
     for (int k = 0; k < 60; k++) om__raster_tri(&r, c[k], (uint32_t)k);
     memcpy(plain, depth_buf, sizeof plain);
     om_target ct = {TW, TH, 0, TH, alongside, NULL}, scratch = target(TW, TH);
     om__target_clear(&ct);
-    om_raster rc = {&scratch, OM_RASTER_CONSERVATIVE, no_span, NULL, &ct, NULL, 0, false, NULL, NULL};
+    om_raster rc = {&scratch, OM_RASTER_CONSERVATIVE, no_span, NULL, &ct, NULL, 0, false, NULL, NULL, NULL, NULL, 0, 0};
     for (int k = 0; k < 60; k++) om__raster_tri(&rc, c[k], (uint32_t)k);
     int differ = 0, written = 0;
     for (int i = 0; i < TW * TH; i++) {
@@ -629,7 +641,7 @@ static void strips_match_whole(void)
                             TW, TH, (float)(rnd() % 1000) / 1000.0f);
     om_target t = target(TW, TH);
     om__target_clear(&t);
-    om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL, NULL, NULL, 0, false, NULL, NULL};
+    om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL, NULL, NULL, 0, false, NULL, NULL, NULL, NULL, 0, 0};
     for (int k = 0; k < 40; k++) om__raster_tri(&r, tris[k], (uint32_t)k);
     memcpy(whole_d, depth_buf, sizeof whole_d);
     memcpy(whole_i, id_buf, sizeof whole_i);

@@ -112,6 +112,8 @@ void om__scene_raster(const om_scene *s, const om_mat4 *vp, const om_target *tg,
     r.centres = NULL;
     r.centre_mask = NULL;
     r.grid_x = r.grid_y = NULL;
+    r.grid_xs = r.grid_ys = NULL;
+    r.grid_shift = r.grid_buckets = 0;
     r.mask_words = 0;
     r.cull_back = false;
     om__cull cl;

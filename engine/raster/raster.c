@@ -408,6 +408,34 @@ static int32_t grid_cross(const int64_t *g, int32_t lo, int32_t hi, int64_t a, i
     return b + !grid_past(g, b, a, k);
 }
 
+void om__grid_index(const int64_t *g, int32_t n, uint32_t shift, uint32_t buckets, int32_t *start)
+{
+    int32_t i = 0;
+    for (uint32_t b = 0; b <= buckets; b++) {
+        while (i < n && g[i] < ((int64_t)b << shift)) i++;
+        start[b] = i;
+    }
+}
+
+/* The first i in [lo, hi] with g[i] >= T, hi + 1 when none; with an index (start,
+ * NULL for none), searched between the first grid points of T's bucket and the next:
+ * those before the one are below T, and the other is past it. */
+static int32_t grid_first(const int64_t *g, const int32_t *start, uint32_t shift, uint32_t buckets,
+                          int32_t lo, int32_t hi, int64_t T)
+{
+    if (lo > hi) return lo;
+    int32_t L = lo, H = hi;
+    if (start && T >= 0) {
+        const int64_t b = (T >> shift) < (int64_t)buckets ? (T >> shift) : (int64_t)buckets;
+        if (start[b] > L) L = start[b];
+        if (b < (int64_t)buckets && start[b + 1] < H) H = start[b + 1];
+    } else if (start && start[0] < H) {
+        H = start[0];   /* the first point at or past 0 is past T */
+    }
+    const int32_t x = grid_cross(g, L, H, 1, -T);
+    return x > hi + 1 ? hi + 1 : x;
+}
+
 /* The pixels whose grid point lies in the triangle's bounding box. */
 static bool bounds_grid(om__rtri *t, const om_raster *r)
 {
@@ -416,11 +444,12 @@ static bool bounds_grid(om__rtri *t, const om_raster *r)
     int64_t minX, maxX, minY, maxY;
     tri_box(e, &minX, &maxX, &minY, &maxY);
     const int32_t xe = (int32_t)tg->width - 1, ye = (int32_t)(tg->y0 + tg->rows) - 1;
-    /* the first grid point at or past each side: the edge 1 * g - side */
-    t->minx = grid_cross(r->grid_x, 0, xe, 1, -minX);
-    t->maxx = grid_cross(r->grid_x, t->minx, xe, 1, -(maxX + 1)) - 1;
-    t->miny = grid_cross(r->grid_y, (int32_t)tg->y0, ye, 1, -minY);
-    t->maxy = grid_cross(r->grid_y, t->miny, ye, 1, -(maxY + 1)) - 1;
+    const uint32_t s = r->grid_shift, nb = r->grid_buckets;
+    /* the first grid point at or past each side */
+    t->minx = grid_first(r->grid_x, r->grid_xs, s, nb, 0, xe, minX);
+    t->maxx = grid_first(r->grid_x, r->grid_xs, s, nb, t->minx, xe, maxX + 1) - 1;
+    t->miny = grid_first(r->grid_y, r->grid_ys, s, nb, (int32_t)tg->y0, ye, minY);
+    t->maxy = grid_first(r->grid_y, r->grid_ys, s, nb, t->miny, ye, maxY + 1) - 1;
     return t->minx <= t->maxx && t->miny <= t->maxy;
 }
 

@@ -132,7 +132,17 @@ typedef struct om_raster {
      * plane; both tables non-decreasing, grid_y indexed by image row. A warped map
      * (rtw) samples the unwarped light image at its texels' inverse-warped centres. */
     const int64_t *grid_x, *grid_y;
+    /* With a grid, may be NULL: an index of each table (om__grid_index) in buckets of
+     * 2^grid_shift grid units, grid_buckets + 1 entries, so that a triangle's bounds
+     * are found among the few grid points of their buckets rather than by searching
+     * the whole table. The same pixels either way. */
+    const int32_t *grid_xs, *grid_ys;
+    uint32_t grid_shift, grid_buckets;
 } om_raster;
+
+/* Indexes a non-decreasing grid table g[0..n): start[b] = the first i with g[i] >=
+ * b << shift (n when none), for b = 0..buckets. */
+void om__grid_index(const int64_t *g, int32_t n, uint32_t shift, uint32_t buckets, int32_t *start);
 
 /* The first pixel x..x1 whose bit is set in `row` (one row of such a mask), x1 + 1
  * when none: clear words are passed over whole. */

@@ -21,6 +21,21 @@
 
 /* ---------------------------------------------------------------- sizes */
 
+/* The exact map's grid indexes: buckets of 2^shift light-grid units, about as many as
+ * the map has texels per side. */
+static uint32_t grid_shift(uint32_t size)
+{
+    const uint32_t steps = OM_LIGHT_GRID * OM_SUBPIX;
+    uint32_t s = 0;
+    while ((steps >> (s + 1)) >= size) s++;
+    return s;
+}
+
+static uint32_t grid_buckets(uint32_t size)
+{
+    return ((OM_LIGHT_GRID * OM_SUBPIX) >> grid_shift(size)) + 1;
+}
+
 static size_t rtw_need(const om_method_cfg *c)
 {
     size_t n = c->rtw_importance, nn = n * n, s = c->map_size;
@@ -30,7 +45,9 @@ static size_t rtw_need(const om_method_cfg *c)
                om_arena_need((n + 1) * sizeof(int32_t), 16) * 2 +
                om_arena_need(s * s * sizeof(uint32_t), 16);
     if (c->rtw_analysis != OM_RTW_BACKWARD) b += om_arena_need(nn * sizeof(uint32_t), 16) * 2;
-    if (c->rtw_exact) b += om_arena_need(s * sizeof(int64_t), 16) * 2;
+    if (c->rtw_exact)
+        b += om_arena_need(s * sizeof(int64_t), 16) * 2 +
+             om_arena_need(((size_t)grid_buckets(c->map_size) + 1) * sizeof(int32_t), 16) * 2;
     return b;
 }
 
@@ -97,11 +114,18 @@ static om_status rtw_init(void **state, om_arena *a, const om_method_cfg *c, con
     if ((st = carve(a, (size_t)m->size * m->size * sizeof(uint32_t), &p, d))) return st;
     m->depth = (uint32_t *)p;
     m->gridx = m->gridy = NULL;
+    m->gridxs = m->gridys = NULL;
+    m->grid_shift = grid_shift(m->size);
+    m->grid_buckets = grid_buckets(m->size);
     if (c->rtw_exact) {
         if ((st = carve(a, (size_t)m->size * sizeof(int64_t), &p, d))) return st;
         m->gridx = (int64_t *)p;
         if ((st = carve(a, (size_t)m->size * sizeof(int64_t), &p, d))) return st;
         m->gridy = (int64_t *)p;
+        if ((st = carve(a, ((size_t)m->grid_buckets + 1) * sizeof(int32_t), &p, d))) return st;
+        m->gridxs = (int32_t *)p;
+        if ((st = carve(a, ((size_t)m->grid_buckets + 1) * sizeof(int32_t), &p, d))) return st;
+        m->gridys = (int32_t *)p;
     }
     if (c->rtw_analysis != OM_RTW_BACKWARD) {
         if ((st = carve(a, nn * sizeof(uint32_t), &p, d))) return st;
@@ -364,8 +388,14 @@ static void render_exact(om__rtw *m, om_raster *r, om__cull *cl)
     const double steps = (double)OM_LIGHT_GRID * OM_SUBPIX;
     om__rtw_unwarp_grid(m->px, m->n, m->size, steps, m->gridx);
     om__rtw_unwarp_grid(m->py, m->n, m->size, steps, m->gridy);
+    om__grid_index(m->gridx, (int32_t)m->size, m->grid_shift, m->grid_buckets, m->gridxs);
+    om__grid_index(m->gridy, (int32_t)m->size, m->grid_shift, m->grid_buckets, m->gridys);
     r->grid_x = m->gridx;
     r->grid_y = m->gridy;
+    r->grid_xs = m->gridxs;
+    r->grid_ys = m->gridys;
+    r->grid_shift = m->grid_shift;
+    r->grid_buckets = m->grid_buckets;
     uint32_t drawn = 0;
     for (uint32_t t = 0; t < s->ntris; t++) {
         const uint32_t *ix = s->idx + (size_t)t * 3;
@@ -392,6 +422,8 @@ void om__rtw_render_map(om__rtw *m)
     x.r.centre_mask = NULL;
     x.r.mask_words = 0;
     x.r.grid_x = x.r.grid_y = NULL;
+    x.r.grid_xs = x.r.grid_ys = NULL;
+    x.r.grid_shift = x.r.grid_buckets = 0;
     om__cull cl;
     om__cull_begin(&cl, s, &m->view.light_vp);
     if (m->cfg.rtw_exact) {

@@ -81,6 +81,8 @@ typedef struct om__rtw {
     int32_t *px, *py;          /* warp tables, n + 1 each */
     uint32_t *depth;           /* size * size warped shadow map */
     int64_t *gridx, *gridy;    /* rtw_exact: each texel's sample point on the light grid */
+    int32_t *gridxs, *gridys;  /* and their indexes (om__grid_index), grid_buckets + 1 */
+    uint32_t grid_shift, grid_buckets;
     om_view view;
     om__smlook look;
     double limit;              /* tessellation: longest warped edge in [0, 1] units; 0 = off */

@@ -397,6 +397,8 @@ static om_status spsm_build(void *state, om_diag *d)
     r.centres = &tc;
     r.centre_mask = whole_plain ? NULL : m->need;
     r.grid_x = r.grid_y = NULL;
+    r.grid_xs = r.grid_ys = NULL;
+    r.grid_shift = r.grid_buckets = 0;
     r.mask_words = m->words;
     /* A light ray that meets a closed shape's back face has met a front face before
      * it, so a back face is never the occluder a record should describe: culled, the
