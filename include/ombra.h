@@ -274,7 +274,9 @@ typedef struct om_method_cfg {
     uint32_t izb_leaf;     /* most samples in a BSP leaf (the paper: 64) */
     uint32_t izb_pool;     /* samples the pool holds; 0 = the whole frame in one pass */
     /* rtw */
-    uint32_t rtw_importance;  /* importance map side */
+    uint32_t rtw_importance;  /* importance map side; 0 = 512, or the map's side when that
+                                 is smaller (at least 8): a small budget's small map
+                                 gets a small importance map */
     uint32_t rtw_analysis;    /* 0 backward (visible samples), 1 forward, 2 hybrid */
     uint32_t rtw_funcs;       /* importance functions: 1 desired view, 2 distance to eye,
                                  4 shadow edge, 8 surface normal */

@@ -556,6 +556,38 @@ static void pcf_footprints(void)
     h_scene_free(&hs);
 }
 
+/* The importance map's default side is 512, or the map's when that is smaller: the
+ * same bytes and frames as asking for that side, and a small map's budget is not
+ * spent on a 1 MB importance map. */
+static void importance_follows_small_maps(void)
+{
+    enum { w = 160, h = 120 };
+    h_scene hs;
+    if (!h_scene_parse(&hs, om_scene_default_text())) return;
+    const om_method *m = om_method_find("rtw");
+    CHECK(m != NULL);
+    if (!m) return;
+    static const uint32_t maps[] = {4, 128, 512, 1024};
+    static const uint32_t sides[] = {8, 128, 512, 512};
+    for (int i = 0; i < 4; i++) {
+        om_method_cfg c;
+        om_method_cfg_default(&c);
+        CHECK_EQ_U(c.rtw_importance, 0);
+        c.map_size = maps[i];
+        size_t mn0, full0, mn1, full1;
+        CHECK_OK(m->bytes(&c, &hs.s, w, h, &mn0, &full0));
+        if (maps[i] <= 128) CHECK_OK(run_rtw(&hs.s, &c, w, h, 0, pcf_terms[0], NULL, NULL));
+        c.rtw_importance = sides[i];
+        CHECK_OK(m->bytes(&c, &hs.s, w, h, &mn1, &full1));
+        CHECK_MSG(mn0 == mn1, "map %u: %zu bytes by default, %zu with importance %u", maps[i], mn0, mn1, sides[i]);
+        if (maps[i] <= 128) {
+            CHECK_OK(run_rtw(&hs.s, &c, w, h, 0, pcf_terms[1], NULL, NULL));
+            CHECK(memcmp(pcf_terms[0], pcf_terms[1], (size_t)w * h * sizeof pcf_terms[0][0]) == 0);
+        }
+    }
+    h_scene_free(&hs);
+}
+
 void suite_rtw(void)
 {
     RUN(uniform_is_identity);
@@ -569,4 +601,5 @@ void suite_rtw(void)
     RUN(analyses_and_functions);
     RUN(budget_and_determinism);
     RUN(pcf_footprints);
+    RUN(importance_follows_small_maps);
 }

@@ -228,8 +228,9 @@ int cmd_render(int argc, char **argv)
         if (fit == 0) {
             size_t need = cs.bytes + main_run.min + one;
             fprintf(stderr, "ombra: --budget %zu is too small: this scene (%zu bytes), method '%s' "
-                    "(at least %zu) and one %u-pixel row (%zu) need %zu bytes; raise --budget "
-                    "or make --size smaller\n", budget, cs.bytes, mname, main_run.min, W, one, need);
+                    "(at least %zu) and one %u-pixel row (%zu) need %zu bytes; raise --budget, "
+                    "make --size smaller, or ask the method for less (--map; 'ombra methods' "
+                    "lists its settings)\n", budget, cs.bytes, mname, main_run.min, W, one, need);
             rc = 1;
             goto out;
         }

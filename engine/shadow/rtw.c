@@ -21,6 +21,15 @@
 
 /* ---------------------------------------------------------------- sizes */
 
+/* The importance map's side: as asked, or by default 512 (section 6's size), no finer
+ * than the map itself (a super-cell narrower than a texel moves nothing), at least 8. */
+static uint32_t importance_side(const om_method_cfg *c)
+{
+    if (c->rtw_importance) return c->rtw_importance;
+    uint32_t n = c->map_size < 512 ? c->map_size : 512;
+    return n < 8 ? 8 : n;
+}
+
 /* The exact map's grid indexes: buckets of 2^shift light-grid units, about as many as
  * the map has texels per side. */
 static uint32_t grid_shift(uint32_t size)
@@ -38,7 +47,7 @@ static uint32_t grid_buckets(uint32_t size)
 
 static size_t rtw_need(const om_method_cfg *c)
 {
-    size_t n = c->rtw_importance, nn = n * n, s = c->map_size;
+    size_t n = importance_side(c), nn = n * n, s = c->map_size;
     size_t b = om_arena_need(sizeof(om__rtw), 16) + om_arena_need(nn * sizeof(float), 16) +
                om_arena_need((nn + 7) / 8, 16) + om_arena_need(n * sizeof(double), 16) * 3 +
                om_arena_need((OM_RTW_MAX_RADIUS + 1) * sizeof(double), 16) +
@@ -55,7 +64,8 @@ static const char *check_cfg(const om_method_cfg *c)
 {
     if (c->map_size < 1 || c->map_size > OM_MAX_DIM) return "rtw: map size must be 1..8192";
     if (c->pcf < 1 || c->pcf > 9) return "rtw: pcf must be 1..9";
-    if (c->rtw_importance < 8 || c->rtw_importance > OM_MAX_DIM) return "rtw: importance map side must be 8..8192";
+    if (c->rtw_importance != 0 && (c->rtw_importance < 8 || c->rtw_importance > OM_MAX_DIM))
+        return "rtw: importance map side must be 8..8192, or 0 for 512 (the map's side if smaller)";
     if (c->rtw_analysis > 2) return "rtw: analysis must be 0 (backward), 1 (forward) or 2 (hybrid)";
     if (c->rtw_funcs > 15) return "rtw: importance functions are a mask of 1, 2, 4, 8";
     if (!(c->rtw_sigma >= 0.0f && c->rtw_sigma <= 64.0f)) return "rtw: sigma must be 0..64";
@@ -92,7 +102,7 @@ static om_status rtw_init(void **state, om_arena *a, const om_method_cfg *c, con
     om__rtw *m = (om__rtw *)p;
     m->scene = s;
     m->cfg = *c;
-    m->n = c->rtw_importance;
+    m->n = importance_side(c);
     m->size = c->map_size;
     size_t n = m->n, nn = n * n;
     if ((st = carve(a, nn * sizeof(float), &p, d))) return st;
