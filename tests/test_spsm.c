@@ -252,12 +252,13 @@ static void default_scene_accuracy(void)
     for (uint32_t map = 1024; map <= 4096; map *= 2) {
         uint64_t sm = mismatches(&hs.s, "sm", map, RW, RH), sp = mismatches(&hs.s, "spsm", map, RW, RH);
         /* Issue 7 asks for a fifth of the map's mismatches at 1024; this build reaches
-         * 0.17-0.31 (see README: triangles inside a curved occluder's outline). It was
-         * 0.58-0.66 before near ties alternated, 0.46-0.53 before the plain map's four
+         * 0.12-0.26 (see README: triangles inside a curved occluder's outline). It was
+         * 0.14-0.31 before the outline took texel centres, 0.58-0.66 before near ties
+         * alternated, 0.46-0.53 before the plain map's four
          * centres could shadow what recovery left lit, 0.29-0.41 while ties only
          * alternated between the first and the last, and 0.21-0.33 before the build's
          * conservative depth was clipped to the texel. */
-        CHECK_MSG(sp * 5 <= sm * 2, "map %u: spsm %llu mismatches, sm %llu", map,
+        CHECK_MSG(sp * 10 <= sm * 3, "map %u: spsm %llu mismatches, sm %llu", map,
                   (unsigned long long)sp, (unsigned long long)sm);
         CHECK_MSG(sp < prev, "map %u: spsm does not improve with resolution", map);
         prev = sp;

@@ -83,4 +83,12 @@ double om__tan(double x);
 double om__atan(double x);
 #define OM_PI 3.14159265358979323846
 
+/* A cold path kept out of its caller, so that the hot path stays small enough to be
+ * inlined where it runs (a hint; GCC and Clang only). */
+#if defined(__GNUC__) || defined(__clang__)
+#define OM_NOINLINE __attribute__((noinline))
+#else
+#define OM_NOINLINE
+#endif
+
 #endif

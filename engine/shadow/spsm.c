@@ -74,7 +74,14 @@ typedef struct spsm_state {
      * of the texel t4_at, while bd_have. */
     const dtri *occ[9];
     int nocc;
-    boundary bd;
+    /* and the texel centres that may join the outline (cand_k: their texels): those
+     * nearer than the sample, which varies, do. bd is the outline without them, bx
+     * with those in bx_pts (a superset of bd's hulls: points only join pieces). */
+    outline_pt cand[9];
+    uint8_t cand_k[9];
+    int ncand;
+    uint16_t bx_pts;
+    boundary bd, bx;
     uint16_t bd_keep;
     bool bd_have;
 } spsm_state;
@@ -663,6 +670,20 @@ static bool centres_shadow(const spsm_state *m, const receiver *r, int64_t tx, i
     return true;
 }
 
+/* Which of the outline's candidate centres (m->cand) hold something nearer than the
+ * sample's own plane carried there: bit c for cand[c]. Sets the receiver plane. */
+static uint16_t centres_nearer(const spsm_state *m, receiver *rp, bool *have_rp, const om_sample *smp,
+                               int64_t tx, int64_t ty, int64_t px, int64_t py)
+{
+    uint16_t use = 0;
+    for (int c = 0; c < m->ncand; c++) {
+        const int k = m->cand_k[c], dx = k % 3 - 1, dy = k / 3 - 1;
+        if (!*have_rp) { *rp = receiver_plane(m, smp); *have_rp = true; }
+        if (centre_test(m, rp, tx + dx, ty + dy, px - dx * OM_SUBPIX, py - dy * OM_SUBPIX)) use |= (uint16_t)(1u << c);
+    }
+    return use;
+}
+
 /* World-space step to the neighbouring eye pixel on the same triangle (for AA). */
 static om_vec3 pixel_step(const om_strip *st, size_t i, int axis)
 {
@@ -679,6 +700,60 @@ static om_vec3 pixel_step(const om_strip *st, size_t i, int axis)
     if (!o) return om__v3(0, 0, 0);
     return om__scale(om__v3(o->p[0] - s->p[0], o->p[1] - s->p[1], o->p[2] - s->p[2]), sign);
 }
+
+/* The occluders the pattern `keep` keeps in the 3x3 of texel (tx, ty) (distinct
+ * triangles), their outline, and the texel centres that may extend it. Out of line:
+ * it runs once per texel and pattern. */
+static void occluders_of(spsm_state *m, dtri t[9], uint16_t keep, int64_t tx, int64_t ty)
+{
+    m->nocc = 0;
+    m->ncand = 0;
+    for (int k = 0; k < 9; k++) {
+        if (!((keep >> k) & 1u) || !t[k].ok) continue;
+        edges(t, k);
+        int j = 0;   /* neighbours often hold the same triangle */
+        while (j < m->nocc && (memcmp(m->occ[j]->e.x, t[k].e.x, sizeof t[k].e.x) ||
+                               memcmp(m->occ[j]->e.y, t[k].e.y, sizeof t[k].e.y)))
+            j++;
+        if (j == m->nocc) m->occ[m->nocc++] = &t[k];
+        /* the texel's centre, when the plain map saw this occluder's surface there
+         * but its stored triangle does not reach it */
+        const int64_t x = tx + k % 3 - 1, y = ty + k / 3 - 1;
+        if (x < 0 || y < 0 || x >= (int64_t)m->size || y >= (int64_t)m->size) continue;
+        const uint32_t c = m->cdepth[(size_t)y * m->size + (size_t)x];
+        if (c == 0xFFFFFFFFu || om__tri2_covers(&t[k].e, t[k].cx, t[k].cy)) continue;
+        if (fabs(plane_at(&t[k], t[k].cx, t[k].cy) - (double)c) > tol_at(&t[k], t[k].cx, t[k].cy) + LINK_DZ)
+            continue;
+        m->cand[m->ncand].x = t[k].cx;
+        m->cand[m->ncand].y = t[k].cy;
+        m->cand[m->ncand].owner = j;
+        m->cand_k[m->ncand++] = (uint8_t)k;
+    }
+    /* one triangle's hull is itself (hits decides there), but its points may be
+     * extended */
+    om__spsm_outline_build(&m->bd, m->occ, m->nocc);
+    if (m->nocc < 2) m->bd.nh = 0;
+    m->bd_keep = keep;
+    m->bx_pts = 0;   /* none built yet (0 is never asked for) */
+    m->bd_have = true;
+}
+
+/* Whether (qx, qy) lies inside the outline extended by the candidate centres in `use`
+ * (built once per set). */
+static bool inside_extended(spsm_state *m, uint16_t use, int64_t qx, int64_t qy)
+{
+    if (use != m->bx_pts) {
+        outline_pt pts[9];
+        int npts = 0;
+        for (int c = 0; c < m->ncand; c++)
+            if (use >> c & 1u) pts[npts++] = m->cand[c];
+        om__spsm_outline_extend(&m->bx, &m->bd, pts, npts);
+        m->bx_pts = use;
+    }
+    return om__spsm_outline_inside(&m->bx, qx, qy);
+}
+
+OM_NOINLINE static uint8_t recover(spsm_state *m, const om_strip *st, size_t i, const sample_pt *pp, int64_t tx, int64_t ty);
 
 /* The whole lookup of one sample; returns the term value (255 lit, 0 shadowed, partial
  * with AA). */
@@ -727,6 +802,20 @@ static uint8_t lookup(spsm_state *m, const om_strip *st, size_t i)
         if (t[k].ok) edges(t, k);
         if (hits(&t[k], px, py, p.z)) { m->shadowed++; return 0; }
     }
+    return recover(m, st, i, &p, tx, ty);
+}
+
+/* 4.2 for an uncertain sample: its term. Out of line: few samples come here, and the
+ * decisions above stay small enough to sit in the strip's loop. p is the sample's
+ * projection, (tx, ty) its texel, whose 3x3 is decoded in m->t. */
+OM_NOINLINE static uint8_t recover(spsm_state *m, const om_strip *st, size_t i, const sample_pt *pp, int64_t tx, int64_t ty)
+{
+    const om_sample *smp = &st->samples[i];
+    const om_vec3 pw = om__v3(smp->p[0], smp->p[1], smp->p[2]);
+    const sample_pt p = *pp;
+    const int64_t ox = tx * OM_SUBPIX + OM_SUBPIX / 2, oy = ty * OM_SUBPIX + OM_SUBPIX / 2;
+    const int64_t px = p.x - ox, py = p.y - oy;
+    dtri *t = m->t;
 
     /* 4.2 uncertain: the silhouette from partial geometry. Consistent depth tests give
      * the 3x3 pattern: a texel holds an occluder when its triangle reaches nearer than
@@ -754,28 +843,15 @@ static uint8_t lookup(spsm_state *m, const om_strip *st, size_t i)
     /* The occluders the pattern keeps and their outline depend on nothing but the texel
      * and `keep`: the next uncertain sample in this texel with the same pattern reuses
      * them. */
-    if (!m->bd_have || m->bd_keep != tg->keep) {
-        m->nocc = 0;
-        for (int k = 0; k < 9; k++) {
-            if (!((tg->keep >> k) & 1u) || !t[k].ok) continue;
-            edges(t, k);
-            bool dup = false;   /* neighbours often hold the same triangle */
-            for (int j = 0; j < m->nocc && !dup; j++)
-                dup = !memcmp(m->occ[j]->e.x, t[k].e.x, sizeof t[k].e.x) &&
-                      !memcmp(m->occ[j]->e.y, t[k].e.y, sizeof t[k].e.y);
-            if (!dup) m->occ[m->nocc++] = &t[k];
-        }
-        m->bd.nv = m->bd.nh = 0;
-        if (m->nocc > 1) om__spsm_outline_build(&m->bd, m->occ, m->nocc);   /* one triangle's hull is itself */
-        m->bd_keep = tg->keep;
-        m->bd_have = true;
-    }
+    if (!m->bd_have || m->bd_keep != tg->keep) occluders_of(m, t, tg->keep, tx, ty);
     const dtri *const *occ = m->occ;
     const int nocc = m->nocc;
     const boundary *bd = &m->bd;
 
     /* The decision at one point of the pixel. */
     uint32_t K = m->cfg.spsm_aa > 1 ? m->cfg.spsm_aa : 1, nlit = 0;
+    uint16_t use = 0;   /* the candidate centres that join the outline, once asked */
+    bool have_use = false;
     om_vec3 sx = om__v3(0, 0, 0), sy = sx;
     if (K > 1) { sx = pixel_step(st, i, 0); sy = pixel_step(st, i, 1); }
     for (uint32_t s = 0; s < K; s++) {
@@ -796,6 +872,10 @@ static uint8_t lookup(spsm_state *m, const om_strip *st, size_t i)
         bool shadow = false;
         for (int k = 0; k < nocc && !shadow; k++) shadow = hits(occ[k], qx, qy, q.z);
         if (!shadow && bd->nh) shadow = om__spsm_outline_inside(bd, qx, qy);
+        if (!shadow && m->ncand) {
+            if (!have_use) { use = centres_nearer(m, &rp, &have_rp, smp, tx, ty, px, py); have_use = true; }
+            if (use) shadow = inside_extended(m, use, qx, qy);
+        }
         if (!shadow && tg->keep == 511) shadow = centre_test(m, &rp, tx, ty, px, py);   /* rp set */
         if (!shadow) {
             if (!have_rp) { rp = receiver_plane(m, smp); have_rp = true; }

@@ -10,7 +10,7 @@
 #define STEP 65536.0             /* one 16-bit depth step in raw units */
 #define TOL0 (1.5 * STEP)        /* what a record's depth cannot resolve at its centre */
 #define LINK_DZ (32.0 * STEP)    /* planes of one smooth surface agree this well */
-#define MAXV 27                  /* outline vertices: 9 triangles x 3 */
+#define MAXV 36                  /* outline points: 9 triangles x 3, and 9 texel centres */
 
 /* A texel's record decoded around the sample's texel: grid coordinates relative to
  * the centre of the sample's texel, plane in raw depth per grid unit. */
@@ -32,6 +32,7 @@ typedef struct boundary {
     int nv;
     int64_t x[MAXV], y[MAXV];
     uint8_t piece[MAXV];
+    uint8_t first[9];            /* a vertex of each occluder (its piece's) */
     /* the pieces' hulls, counter-clockwise without collinear points, one after another:
      * hull h has the vertices [hoff[h], hoff[h + 1]) of hx, hy; pieces with no area
      * (a point, a segment) have none */
@@ -54,6 +55,12 @@ static inline double tol_at(const dtri *t, int64_t px, int64_t py)
 /* Builds the outline of the occluders occ[0..nocc) (distinct triangles, their edges
  * set up): their vertices, linked into pieces, and each piece's convex hull. */
 void om__spsm_outline_build(boundary *b, const dtri *const occ[9], int nocc);
+/* A point known to lie under the surface of occluder `owner` (an index into the
+ * occluders the outline was built from): a texel centre that the plain map saw there. */
+typedef struct outline_pt { int64_t x, y; int owner; } outline_pt;
+
+/* The outline `base` with the points pts[0..npts) joined to their owners' pieces. */
+void om__spsm_outline_extend(boundary *out, const boundary *base, const outline_pt *pts, int npts);
 /* Whether (px, py) lies strictly inside one of the outline's hulls. */
 bool om__spsm_outline_inside(const boundary *b, int64_t px, int64_t py);
 

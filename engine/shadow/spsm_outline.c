@@ -85,6 +85,7 @@ void om__spsm_outline_build(boundary *b, const dtri *const occ[9], int nocc)
             while (j < b->nv && (b->x[j] != x || b->y[j] != y)) j++;
             if (j == b->nv) { b->x[j] = x; b->y[j] = y; tri_of[j] = 0; b->nv++; }
             tri_of[j] |= 1u << k;
+            if (i == 0) b->first[k] = (uint8_t)j;
         }
     /* A piece is labelled by its first vertex. Vertices of one triangle are one piece
      * from the start: a vertex joins the piece of the first earlier vertex it shares a
@@ -110,6 +111,27 @@ void om__spsm_outline_build(boundary *b, const dtri *const occ[9], int nocc)
             join(b, b->piece[j], b->piece[i]);
         }
     hulls_build(b);
+}
+
+/* Texel centres under an occluder's surface beyond its stored triangle: on a finely
+ * tessellated rim the record keeps the nearest, innermost triangle of each texel, and
+ * the surface reaches on towards the silhouette; its piece reaches as far as the
+ * plain map saw it (spsm.c chooses the points). */
+void om__spsm_outline_extend(boundary *out, const boundary *base, const outline_pt *pts, int npts)
+{
+    out->nv = base->nv;
+    for (int i = 0; i < base->nv; i++) {
+        out->x[i] = base->x[i];
+        out->y[i] = base->y[i];
+        out->piece[i] = base->piece[i];
+    }
+    for (int p = 0; p < npts && out->nv < MAXV; p++) {
+        out->x[out->nv] = pts[p].x;
+        out->y[out->nv] = pts[p].y;
+        out->piece[out->nv] = base->piece[base->first[pts[p].owner]];
+        out->nv++;
+    }
+    hulls_build(out);
 }
 
 /* Strictly inside the hull of one piece: strictly left of each of its edges. */
