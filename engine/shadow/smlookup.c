@@ -68,9 +68,10 @@ static bool locate(const om__smlook *L, const om_sample *smp, tap *out)
         out->v = v0;
         warp(L, &u0, &v0, &dens);
         /* Unwarped PCF taps lie an unwarped texel apart, and the bias must cover the
-         * receiver's depth across that span: the texel of the bias rules stays the
-         * unwarped one. */
-        if (!(L->unwarped_pcf && L->pcf > 1)) texel = (float)((double)texel / dens);
+         * receiver's depth across that span as well as across the warped texel each
+         * tap reads: the larger of the two, where the warp compresses the map. */
+        if (!(L->unwarped_pcf && L->pcf > 1) || dens < 1.0)
+            texel = (float)((double)texel / dens);
     }
     float cosang = om__dot(n, l);
     float tanang = cosang > 0.0995f ? sqrtf(1.0f - cosang * cosang) / cosang : 10.0f;
