@@ -358,6 +358,11 @@ static void texel(build_ctx *b, int32_t x, int32_t y, const om__rtri *t)
 /* Sets a buffer to the far plane (empty) at the needed texels, a word of them at a time. */
 static void clear_needed(const spsm_state *m, uint32_t *buf)
 {
+    if (!m->marks) {   /* every texel is needed: one pass over the buffer */
+        const size_t n = (size_t)m->size * m->size;
+        for (size_t i = 0; i < n; i++) buf[i] = 0xFFFFFFFFu;
+        return;
+    }
     for (uint32_t y = 0; y < m->size; y++)
         for (uint32_t j = 0; j < m->words; j++) {
             if (!m->need[(size_t)y * m->words + j]) continue;
@@ -870,7 +875,9 @@ OM_NOINLINE static uint8_t recover(spsm_state *m, const om_strip *st, size_t i, 
             qy = q.y - oy;
         }
         bool shadow = false;
-        for (int k = 0; k < nocc && !shadow; k++) shadow = hits(occ[k], qx, qy, q.z);
+        /* at the sample itself the lookup found no hit in the whole 3x3 */
+        if (K > 1)
+            for (int k = 0; k < nocc && !shadow; k++) shadow = hits(occ[k], qx, qy, q.z);
         if (!shadow && bd->nh) shadow = om__spsm_outline_inside(bd, qx, qy);
         if (!shadow && m->ncand) {
             if (!have_use) { use = centres_nearer(m, &rp, &have_rp, smp, tx, ty, px, py); have_use = true; }

@@ -65,51 +65,62 @@ static void hulls_build(boundary *b)
  * tangent into phi and shadows everything beyond it, the hull also closes the piece
  * on its far side, so two thin occluders a texel or more apart (a fence) do not shadow
  * the gap between them (see README: the one-sided phi measured worse). */
-/* Merges piece `from` into piece `to` (every vertex labelled `from` takes `to`), keeping
- * a piece's label its first vertex's: the smaller index wins. */
-static void join(boundary *b, uint8_t from, uint8_t to)
+/* The pieces as a union-find over the occluders (at most nine): a vertex's piece is
+ * its triangles', and every link joins two occluders' sets. */
+static int root(uint8_t up[9], int k)
 {
-    if (from < to) { uint8_t s = from; from = to; to = s; }
-    for (int k = 0; k < b->nv; k++)
-        if (b->piece[k] == from) b->piece[k] = to;
+    while (up[k] != k) k = up[k] = up[up[k]];
+    return k;
+}
+
+/* Joins the sets of occluders a and c; returns 1 when they were apart. */
+static int unite(uint8_t up[9], int a, int c)
+{
+    a = root(up, a);
+    c = root(up, c);
+    if (a == c) return 0;
+    up[a > c ? a : c] = (uint8_t)(a < c ? a : c);
+    return 1;
 }
 
 void om__spsm_outline_build(boundary *b, const dtri *const occ[9], int nocc)
 {
-    uint32_t tri_of[MAXV];       /* bit k: a vertex of occluder k */
+    uint8_t owner[MAXV];         /* the first occluder with this vertex */
+    uint8_t up[9];
+    int sets = nocc;
     b->nv = 0;
-    for (int k = 0; k < nocc; k++)
+    for (int k = 0; k < nocc; k++) {
+        up[k] = (uint8_t)k;
         for (int i = 0; i < 3; i++) {
             int64_t x = occ[k]->e.x[i], y = occ[k]->e.y[i];
             int j = 0;
             while (j < b->nv && (b->x[j] != x || b->y[j] != y)) j++;
-            if (j == b->nv) { b->x[j] = x; b->y[j] = y; tri_of[j] = 0; b->nv++; }
-            tri_of[j] |= 1u << k;
+            if (j == b->nv) { b->x[j] = x; b->y[j] = y; owner[j] = (uint8_t)k; b->nv++; }
+            else sets -= unite(up, owner[j], k);   /* a shared vertex: one piece */
             if (i == 0) b->first[k] = (uint8_t)j;
         }
-    /* A piece is labelled by its first vertex. Vertices of one triangle are one piece
-     * from the start: a vertex joins the piece of the first earlier vertex it shares a
-     * triangle with, and pieces that a shared vertex bridges are merged. */
-    for (int i = 0; i < b->nv; i++) {
-        b->piece[i] = (uint8_t)i;
-        for (int j = 0; j < i; j++) {
-            if (!(tri_of[i] & tri_of[j]) || b->piece[j] == b->piece[i]) continue;
-            join(b, b->piece[i], b->piece[j]);
-        }
     }
-    for (int i = 0; i < b->nv; i++)
+    for (int i = 0; i < b->nv && sets > 1; i++)   /* (one piece: nothing to link) */
         for (int j = i + 1; j < b->nv; j++) {
-            if (b->piece[j] == b->piece[i]) continue;   /* joined already: nothing to test */
             int64_t dx = b->x[j] - b->x[i], dy = b->y[j] - b->y[i];
             if (dx > OM_SPSM_LINK || dx < -OM_SPSM_LINK || dy > OM_SPSM_LINK || dy < -OM_SPSM_LINK) continue;
+            if (root(up, owner[i]) == root(up, owner[j])) continue;   /* joined already */
             /* one surface: i's triangle's plane, carried to j, meets j's triangle there
              * (a smooth mesh bends little over a texel; a cloud of separate triangles
              * does not line up) */
-            const dtri *a = occ[om__ctz32(tri_of[i])], *c = occ[om__ctz32(tri_of[j])];
+            const dtri *a = occ[owner[i]], *c = occ[owner[j]];
             double za = plane_at(a, b->x[j], b->y[j]), zc = plane_at(c, b->x[j], b->y[j]);
             if (fabs(za - zc) > tol_at(a, b->x[j], b->y[j]) + LINK_DZ) continue;
-            join(b, b->piece[j], b->piece[i]);
+            sets -= unite(up, owner[i], owner[j]);
         }
+    /* A piece is labelled by its first vertex. */
+    int8_t label[9];
+    for (int k = 0; k < nocc; k++) label[k] = -1;
+    for (int i = 0; i < b->nv; i++) {
+        int r = root(up, owner[i]);
+        if (label[r] < 0) label[r] = (int8_t)i;
+        b->piece[i] = (uint8_t)label[r];
+    }
     hulls_build(b);
 }
 
