@@ -297,6 +297,9 @@ typedef struct om_method_cfg {
                               marks them), 0 = 2 when the map has more than twice as
                               many texels as the image has pixels, else 1. The same
                               frames either way; only the time differs. */
+    uint32_t spsm_fine;    /* 1: the plain-map fallback at 2 x 2 points per texel (16
+                              more bytes per texel and a second pass; fewer false-lit
+                              samples along fine rims), 0: at texel centres */
 } om_method_cfg;
 
 /* One settable field of om_method_cfg. */

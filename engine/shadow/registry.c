@@ -76,6 +76,7 @@ void om_method_cfg_default(om_method_cfg *c)
     c->rtw_footprint = 0;
     c->spsm_aa = 0;
     c->spsm_records = 0;
+    c->spsm_fine = 0;
 }
 
 #define F(name, kind, field, lo, hi, help) {name, help, kind, offsetof(om_method_cfg, field), lo, hi}
@@ -105,6 +106,7 @@ static const om_cfg_field fields[] = {
     F("rtw.footprint", 'u', rtw_footprint, 0, 1, "RTW PCF taps: 0 a warped texel apart, 1 an unwarped one"),
     F("spsm.aa", 'u', spsm_aa, 0, 64, "SPSM sub-samples at uncertain samples, 0 = off"),
     F("spsm.records", 'u', spsm_records, 0, 2, "SPSM records made: 1 all, 2 those the view reads, 0 auto"),
+    F("spsm.fine", 'u', spsm_fine, 0, 1, "SPSM fallback: 1 the plain map at 2 x 2 points per texel, 0 at centres"),
 };
 
 #undef F

@@ -16,7 +16,8 @@
  * in a 32-bit buffer beside the texels, and the winner's record (section 3.3) is
  * written to the texel; near ties share the texels out in a fixed pattern (texel,
  * below). A second 32-bit buffer keeps the plain map's depth at texel centres for the
- * cases recovery cannot decide.
+ * cases recovery cannot decide; with spsm.fine a third keeps it at twice the
+ * resolution (four points a quarter texel from the centre) for the test below.
  *
  * Lookup (section 4): each exposed sample is projected with the light's matrix, as the
  * conventional map does, onto the sub-texel grid. Then
@@ -32,7 +33,8 @@
  *    around holds an occluder there is no outline to find, and the plain map's test at
  *    the texel centre decides (the paper assumes shadow there). A point the outline
  *    leaves lit is still shadowed when the plain map finds an occluder at all four
- *    texel centres around it (centres_shadow: not in the paper).
+ *    texel centres around it (centres_shadow: not in the paper), or with spsm.fine at
+ *    all four points of the twice finer map around it (fine_shadow).
  * The depth tolerance is what the record cannot resolve: half a 16-bit depth step for
  * rounding, one step of margin, and the derivative code's error bound times the
  * distance from the texel centre. No bias setting is used. */
@@ -52,6 +54,11 @@ typedef struct spsm_state {
     uint32_t *depth;             /* minimum conservative depth: the build's depth test
                                   * (low 8 bits: ties so far; all ones: empty) */
     uint32_t *cdepth;            /* nearest depth at each texel centre (fallback) */
+    /* spsm.fine: the plain map at 2 x 2 points per texel (fine_shadow), and need at
+     * those points, fwords words per row */
+    bool fine;
+    uint32_t *fdepth, *fneed;
+    uint32_t fwords;
     /* Texels the lookup will read, one bit each, `words` 32-bit words per row: `seen`
      * (the samples' texels, from observe) grown by one texel into `need` (build). */
     uint32_t *seen, *need;
@@ -93,14 +100,17 @@ static uint32_t row_words(uint32_t size) { return (size + 31) / 32; }
 static size_t spsm_need(const om_method_cfg *c)
 {
     size_t n = (size_t)c->map_size * c->map_size, bits = (size_t)c->map_size * row_words(c->map_size);
+    size_t fbits = (size_t)2 * c->map_size * row_words(2 * c->map_size);
+    size_t fine = c->spsm_fine ? om_arena_need(4 * n * sizeof(uint32_t), 16) +
+                                     om_arena_need(fbits * sizeof(uint32_t), 16) : 0;
     return om_arena_need(sizeof(spsm_state), 16) + om_arena_need(n * sizeof(om__spsm_texel), 16) +
-           om_arena_need(n * sizeof(uint32_t), 16) * 2 + om_arena_need(bits * sizeof(uint32_t), 16) * 2;
+           om_arena_need(n * sizeof(uint32_t), 16) * 2 + om_arena_need(bits * sizeof(uint32_t), 16) * 2 + fine;
 }
 
 static size_t map_bytes(const spsm_state *m)
 {
-    return (size_t)m->size * m->size * (sizeof(om__spsm_texel) + 2 * sizeof(uint32_t)) +
-           (size_t)m->size * m->words * 2 * sizeof(uint32_t);
+    return (size_t)m->size * m->size * (sizeof(om__spsm_texel) + (m->fine ? 6 : 2) * sizeof(uint32_t)) +
+           ((size_t)m->size * m->words * 2 + (m->fine ? (size_t)2 * m->size * m->fwords : 0)) * sizeof(uint32_t);
 }
 
 static om_status spsm_bytes(const om_method_cfg *c, const om_scene *s, uint32_t w, uint32_t h,
@@ -120,6 +130,7 @@ static om_status spsm_init(void **state, om_arena *a, const om_method_cfg *c, co
     if (!size_ok(c)) return om__fail(d, OM_E_INVALID, "spsm: map size must be 1..8192");
     if (c->spsm_aa > 64) return om__fail(d, OM_E_INVALID, "spsm: aa must be 0..64");
     if (c->spsm_records > 2) return om__fail(d, OM_E_INVALID, "spsm: records must be 0 (auto), 1 (all) or 2 (read)");
+    if (c->spsm_fine > 1) return om__fail(d, OM_E_INVALID, "spsm: fine must be 0 (off) or 1 (on)");
     if ((st = om__need(a, spsm_need(c), "spsm", d))) return st;
     if ((st = om_arena_alloc(a, sizeof(spsm_state), 16, &p, d))) return st;
     spsm_state *m = (spsm_state *)p;
@@ -134,6 +145,9 @@ static om_status spsm_init(void **state, om_arena *a, const om_method_cfg *c, co
     if ((st = om_arena_alloc(a, n * sizeof(uint32_t), 16, &p, d))) return st;
     m->cdepth = (uint32_t *)p;
     m->words = row_words(m->size);
+    m->fine = c->spsm_fine == 1;
+    m->fwords = row_words(2 * m->size);
+    m->fdepth = m->fneed = NULL;
     /* Marking costs a projection per sample and saves the build a texel's work where
      * no sample reads: it pays when the map is finer than the image (measured at
      * 1024x768: a loss at maps 512 and 1024, a gain from 2048). */
@@ -144,6 +158,12 @@ static om_status spsm_init(void **state, om_arena *a, const om_method_cfg *c, co
     m->seen = (uint32_t *)p;
     if ((st = om_arena_alloc(a, bits * sizeof(uint32_t), 16, &p, d))) return st;
     m->need = (uint32_t *)p;
+    if (m->fine) {
+        if ((st = om_arena_alloc(a, 4 * n * sizeof(uint32_t), 16, &p, d))) return st;
+        m->fdepth = (uint32_t *)p;
+        if ((st = om_arena_alloc(a, (size_t)2 * m->size * m->fwords * sizeof(uint32_t), 16, &p, d))) return st;
+        m->fneed = (uint32_t *)p;
+    }
     m->t4_at = (size_t)-1;
     m->t_have = 0;
     m->bd_have = false;
@@ -371,6 +391,52 @@ static void clear_needed(const spsm_state *m, uint32_t *buf)
         }
 }
 
+/* fneed = need at twice the resolution (a texel's bit becomes its four points'), and
+ * those points of the fine map cleared. */
+static void grow_fine_needs(spsm_state *m)
+{
+    const uint32_t S = m->size, W = m->words, FW = m->fwords;
+    for (uint32_t y = 0; y < S; y++) {
+        uint32_t *f0 = m->fneed + (size_t)(2 * y) * FW, *f1 = f0 + FW;
+        for (uint32_t j = 0; j < FW; j++) {
+            /* fine word j holds texels 16j .. 16j + 15, each bit twice */
+            const uint32_t w = m->need[(size_t)y * W + j / 2] >> (16 * (j & 1)) & 0xFFFFu;
+            uint32_t v = 0;
+            for (uint32_t b = w; b; b &= b - 1) v |= 3u << (2 * om__ctz32(b));
+            /* (need may hold bits past the map's side; no point lies there) */
+            const uint32_t left = 2 * S - 32 * j;
+            if (left < 32) v &= (1u << left) - 1u;
+            f0[j] = f1[j] = v;
+            for (uint32_t bit = v; bit; bit &= bit - 1) {   /* and clears them */
+                const size_t x = 32 * (size_t)j + (size_t)om__ctz32(bit);
+                m->fdepth[(size_t)(2 * y) * (2 * S) + x] = m->fdepth[(size_t)(2 * y + 1) * (2 * S) + x] = 0xFFFFFFFFu;
+            }
+        }
+    }
+}
+
+/* The fine pass has no records to write: its conservative spans are not needed. */
+static void no_span(void *user, int32_t y, int32_t x0, int32_t x1, const om__rtri *t)
+{
+    (void)user; (void)y; (void)x0; (void)x1; (void)t;
+}
+
+/* Every triangle of the scene through r, from the light, back faces of closed shapes
+ * culled. */
+static void raster_scene(const spsm_state *m, om_raster *r)
+{
+    const om_scene *s = m->scene;
+    om__cull cl;
+    om__cull_begin(&cl, s, &m->view.light_vp);
+    for (uint32_t t = 0; t < s->ntris; t++) {
+        r->cull_back = om__cull_next(&cl, t);
+        const uint32_t *ix = s->idx + (size_t)t * 3;
+        om_vec4 c[3];
+        for (int k = 0; k < 3; k++) c[k] = om__mat_apply(&m->view.light_vp, s->verts[ix[k]]);
+        om__raster_tri(r, c, t);
+    }
+}
+
 /* The texels of a span that the lookup will read (need). */
 static void span(void *user, int32_t y, int32_t x0, int32_t x1, const om__rtri *t)
 {
@@ -383,7 +449,6 @@ static om_status spsm_build(void *state, om_diag *d)
 {
     (void)d;
     spsm_state *m = (spsm_state *)state;
-    const om_scene *s = m->scene;
     m->t4_at = (size_t)-1;   /* no texel index: the map is about to change */
     m->bd_have = false;
     m->needed = grow_needs(m);
@@ -417,15 +482,32 @@ static om_status spsm_build(void *state, om_diag *d)
      * record of a rim texel is more often the grazing front face the ray really hits
      * (default scene, mismatches at maps 512 / 1024 / 2048 / 4096: 5,838 / 1,278 /
      * 458 / 163 -> 5,789 / 1,268 / 328 / 133). The plain depth is the same. */
-    om__cull cl;
-    om__cull_begin(&cl, s, &m->view.light_vp);
-    for (uint32_t t = 0; t < s->ntris; t++) {
-        r.cull_back = om__cull_next(&cl, t);
-        const uint32_t *ix = s->idx + (size_t)t * 3;
-        om_vec4 c[3];
-        for (int k = 0; k < 3; k++) c[k] = om__mat_apply(&m->view.light_vp, s->verts[ix[k]]);
-        om__raster_tri(&r, c, t);
+    raster_scene(m, &r);
+    if (!m->fine) return OM_OK;
+    /* The plain map at twice the resolution, at the points the lookup reads (all of
+     * them with AA), for fine_shadow: a second pass, since its grid is not the
+     * records'. */
+    const uint32_t F = 2 * m->size;
+    om_target tf = {F, F, 0, F, m->fdepth, NULL};
+    r.target = &tf;
+    r.user = NULL;
+    if (whole_plain || !m->marks) {
+        /* every point: the plain depth pass itself */
+        om__target_clear(&tf);
+        r.mode = OM_RASTER_DEPTH;
+        r.span = NULL;
+        r.centres = NULL;
+        r.centre_mask = NULL;
+    } else {
+        /* the points needed: the depth pass that runs alongside a conservative one
+         * (the same depths), with nothing for the conservative one to do */
+        grow_fine_needs(m);
+        r.span = no_span;
+        r.centres = &tf;
+        r.centre_mask = m->fneed;
+        r.mask_words = m->fwords;
     }
+    raster_scene(m, &r);
     return OM_OK;
 }
 
@@ -675,6 +757,33 @@ static bool centres_shadow(const spsm_state *m, const receiver *r, int64_t tx, i
     return true;
 }
 
+/* The plain map at twice the resolution around a point at grid offset (qx, qy) from
+ * the centre of texel (tx, ty), the sample itself being at (px, py): whether the four
+ * points of that map nearest to it (a quarter texel from texel centres) all hold
+ * something nearer than the sample's plane carried there. The point then lies inside
+ * a shadow wider than half a texel, whatever outline recovery found: a record keeps
+ * one triangle per texel, and across a thin bar or along a finely tessellated rim the
+ * 3x3 can miss the triangles that reach the point; at texel centres alone the band
+ * left along such a rim is a texel wide, at these points half that. */
+static bool fine_shadow(const spsm_state *m, const receiver *r, int64_t tx, int64_t ty, int64_t px,
+                        int64_t py, int64_t qx, int64_t qy)
+{
+    const int64_t H = OM_SUBPIX / 2, Q = OM_SUBPIX / 4, F = 2 * (int64_t)m->size;
+    /* the point and the sample in the map's own grid units */
+    const int64_t ox = tx * OM_SUBPIX + H, oy = ty * OM_SUBPIX + H;
+    const int64_t ax = floordiv(ox + qx - Q, H), ay = floordiv(oy + qy - Q, H);
+    for (int64_t j = ay; j <= ay + 1; j++)
+        for (int64_t i = ax; i <= ax + 1; i++) {
+            if (i < 0 || j < 0 || i >= F || j >= F) return false;
+            const uint32_t c = m->fdepth[(size_t)j * (size_t)F + (size_t)i];
+            if (c == 0xFFFFFFFFu) return false;
+            const double dx = (double)(i * H + Q - ox - px), dy = (double)(j * H + Q - oy - py);
+            const double z = r->ok ? r->z + r->gx * dx + r->gy * dy : r->z;
+            if (!((double)c < z - TOL0)) return false;
+        }
+    return true;
+}
+
 /* Which of the outline's candidate centres (m->cand) hold something nearer than the
  * sample's own plane carried there: bit c for cand[c]. Sets the receiver plane. */
 static uint16_t centres_nearer(const spsm_state *m, receiver *rp, bool *have_rp, const om_sample *smp,
@@ -886,7 +995,8 @@ OM_NOINLINE static uint8_t recover(spsm_state *m, const om_strip *st, size_t i, 
         if (!shadow && tg->keep == 511) shadow = centre_test(m, &rp, tx, ty, px, py);   /* rp set */
         if (!shadow) {
             if (!have_rp) { rp = receiver_plane(m, smp); have_rp = true; }
-            shadow = centres_shadow(m, &rp, tx, ty, px, py, qx, qy);
+            shadow = m->fine ? fine_shadow(m, &rp, tx, ty, px, py, qx, qy)
+                             : centres_shadow(m, &rp, tx, ty, px, py, qx, qy);
         }
         nlit += !shadow;
     }

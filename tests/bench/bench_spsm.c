@@ -7,12 +7,13 @@
  * scene: our "frame" figure adds the eye pass to both), each one's mismatch share
  * against the reference, SPSM's classification shares (lit, shadowed, uncertain; and
  * the uncertain share that recovery shadowed) and the share of texels whose records
- * it made. */
+ * it made. On the default scene a third series, spsm.fine = 1 (the plain-map fallback
+ * at 2 x 2 points per texel), runs with them. */
 #include "bench.h"
 
 enum { N = 5 };   /* runs per method and size */
 
-static void one_scene(const bscene *b)
+static void one_scene(const bscene *b, bool fine)
 {
     const uint32_t W = 1024, H = 768;
     uint8_t *ref = malloc((size_t)W * H), *mask = malloc((size_t)W * H);
@@ -23,15 +24,20 @@ static void one_scene(const bscene *b)
     for (uint32_t size = 512; size <= 4096; size *= 2) {
         /* the two methods' runs alternate, so that a busy spell of the machine slows
          * both alike and the overhead stays meaningful */
-        const char *names[2] = {"sm", "spsm"};
-        double ob[2], bu[2], lo[2], ey[2], miss[2], to[2][N], tb[2][N], tl[2][N], te[2][N];
-        mrun last;
-        om_method_cfg c;
-        om_method_cfg_default(&c);
-        c.map_size = size;
+        const char *names[3] = {"sm", "spsm", "spsm"};
+        double ob[3], bu[3], lo[3], ey[3], miss[3], to[3][N], tb[3][N], tl[3][N], te[3][N];
+        const int series = fine ? 3 : 2;
+        mrun last, lastsp;
+        om_method_cfg c[3];
+        for (int k = 0; k < 3; k++) {
+            om_method_cfg_default(&c[k]);
+            c[k].map_size = size;
+        }
+        c[2].spsm_fine = 1;
         for (int run = 0; run < N; run++)
-            for (int k = 0; k < 2; k++) {
-                if (bench_run(b, names[k], &c, W, H, 0, mask, &last)) goto out;
+            for (int k = 0; k < series; k++) {
+                if (bench_run(b, names[k], &c[k], W, H, 0, mask, &last)) goto out;
+                if (k == 1) lastsp = last;
                 to[k][run] = last.observe_ms;
                 tb[k][run] = last.build_ms;
                 tl[k][run] = last.resolve_ms;
@@ -42,13 +48,13 @@ static void one_scene(const bscene *b)
                     miss[k] = 100.0 * (1.0 - om_metrics_match(&mt));
                 }
             }
-        for (int k = 0; k < 2; k++) {
+        for (int k = 0; k < series; k++) {
             ob[k] = bench_median(to[k], N);
             bu[k] = bench_median(tb[k], N);
             lo[k] = bench_median(tl[k], N);
             ey[k] = bench_median(te[k], N);
         }
-        const uint32_t *cn = last.stats.counters;   /* spsm's, from its last run */
+        const uint32_t *cn = lastsp.stats.counters;   /* spsm's, from its last run */
         double n = cn[0] ? (double)cn[0] : 1.0;
         const double sm = ob[0] + bu[0] + lo[0], sp = ob[1] + bu[1] + lo[1];
         printf("%-12s %4u  sm %6.2f + %6.2f ms, %.4f%% wrong | spsm %5.2f + %6.2f + %6.2f ms, %.4f%% wrong, "
@@ -57,6 +63,12 @@ static void one_scene(const bscene *b)
                b->name, size, bu[0], lo[0], miss[0], ob[1], bu[1], lo[1], miss[1], 100.0 * (sp / sm - 1.0),
                100.0 * ((ey[1] + sp) / (ey[0] + sm) - 1.0), 100.0 * cn[1] / n, 100.0 * cn[2] / n,
                100.0 * cn[3] / n, 100.0 * cn[4] / n, 100.0 * cn[7] / ((double)size * size));
+        if (fine) {
+            const double sf = ob[2] + bu[2] + lo[2];
+            printf("%-12s %4u  spsm.fine=1 %5.2f + %6.2f + %6.2f ms, %.4f%% wrong, overhead %+5.0f%% (frame %+4.0f%%)\n",
+                   b->name, size, ob[2], bu[2], lo[2], miss[2], 100.0 * (sf / sm - 1.0),
+                   100.0 * ((ey[2] + sf) / (ey[0] + sm) - 1.0));
+        }
     }
 out:
     free(ref);
@@ -67,12 +79,12 @@ void bench_spsm(void)
 {
     bscene b;
     if (bench_load(&b, "default", om_scene_default_text())) return;
-    one_scene(&b);
+    one_scene(&b, true);
     bench_free(&b);
     static const unsigned counts[] = {10000, 100000};
     for (int k = 0; k < 2; k++) {
         if (bench_load_random(&b, counts[k])) return;
-        one_scene(&b);
+        one_scene(&b, false);
         bench_free(&b);
     }
 }
