@@ -300,7 +300,8 @@ static void depth_row(const om__rtri *t, const om_target *tg, int32_t y, int32_t
     int32_t x = x0;
 #ifdef OM_RASTER_SSE2
     if (x1 - x0 >= 3) {
-        /* offsets fit in int32: pixel centres lie below 2^21, vertices within 2^29 */
+        /* offsets fit in int32: pixel centres lie below 2^22 (a 16384-wide target:
+         * spsm.fine at map 8192), vertices within 2^29 */
         const zlanes k = zlanes_of(t, ztail);
         __m128i g = _mm_add_epi32(_mm_set1_epi32((int32_t)((int64_t)x0 * S + H - e->x[0])),
                                   _mm_setr_epi32(0, (int32_t)S, 2 * (int32_t)S, 3 * (int32_t)S));
