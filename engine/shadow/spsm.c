@@ -2,7 +2,8 @@
  * whose texels keep a 128-bit record of the nearest triangle, so shadow edges are
  * rebuilt below texel size. The texel format, the derivative code and the tangent
  * table are in spsm_texel.c (spsm.h), the recovered outline in spsm_outline.c
- * (spsm_lookup.h); this file owns the method: observe, build and lookup.
+ * (spsm_lookup.h), the build in spsm_build.c (spsm_method.h: the state); this file
+ * owns the method's settings, observe and lookup.
  *
  * Observe (not in the paper; spsm.records, by default when the map is finer than the
  * image): each exposed sample marks its texel. The lookup reads the records of the
@@ -10,14 +11,7 @@
  * marks grown by one texel); a record nobody reads is not made. The frames are the
  * same as with every record made; the build's work follows the view's needs.
  *
- * Build (section 3.2): every triangle is rasterized conservatively from the light
- * (every texel whose square it touches); the depth test uses the minimum conservative
- * depth over the texel (the least depth the triangle reaches inside the square), kept
- * in a 32-bit buffer beside the texels, and the winner's record (section 3.3) is
- * written to the texel; near ties share the texels out in a fixed pattern (texel,
- * below). A second 32-bit buffer keeps the plain map's depth at texel centres for the
- * cases recovery cannot decide; with spsm.fine a third keeps it at twice the
- * resolution (four points a quarter texel from the centre) for the test below.
+ * Build (section 3.2): spsm_build.c, the conservative rasterization and the records.
  *
  * Lookup (section 4): each exposed sample is projected with the light's matrix, as the
  * conventional map does, onto the sub-texel grid. Then
@@ -33,65 +27,15 @@
  *    around holds an occluder there is no outline to find, and the plain map's test at
  *    the texel centre decides (the paper assumes shadow there). A point the outline
  *    leaves lit is still shadowed when the plain map finds an occluder at all four
- *    texel centres around it (centres_shadow: not in the paper), or with spsm.fine at
- *    all four points of the twice finer map around it (fine_shadow).
+ *    texel centres around it, or with spsm.fine at all four points of the twice finer
+ *    map around it (plain_shadow: not in the paper).
  * The depth tolerance is what the record cannot resolve: half a 16-bit depth step for
  * rounding, one step of margin, and the derivative code's error bound times the
  * distance from the texel centre. No bias setting is used. */
-#include "shadow.h"
-#include "spsm_lookup.h"
+#include "spsm_method.h"
 
-#define TIE_DZ (LINK_DZ / 2)     /* the build's near tie: one surface to recovery */
-#define TIES 0xFFu               /* the depth buffer's low bits: ties counted (texel) */
 #define LIT_CAP (64.0 * STEP)    /* a plane known this loosely proves nothing lit */
 #define PAT_CAP (16.0 * STEP)    /* the pattern's tests use at most this much slack */
-
-typedef struct spsm_state {
-    const om_scene *scene;
-    om_method_cfg cfg;
-    uint32_t size;
-    om__spsm_texel *tex;
-    uint32_t *depth;             /* minimum conservative depth: the build's depth test
-                                  * (low 8 bits: ties so far; all ones: empty) */
-    uint32_t *cdepth;            /* nearest depth at each texel centre (fallback) */
-    /* spsm.fine: the plain map at 2 x 2 points per texel (fine_shadow), and need at
-     * those points, fwords words per row */
-    bool fine;
-    uint32_t *fdepth, *fneed;
-    uint32_t fwords;
-    /* Texels the lookup will read, one bit each, `words` 32-bit words per row: `seen`
-     * (the samples' texels, from observe) grown by one texel into `need` (build). */
-    uint32_t *seen, *need;
-    uint32_t words;
-    bool marks;                  /* observe marks texels (spsm.records); else need is full */
-    om_view view;
-    om__spsm_qtable q;
-    om__spsm_tangent lut[512];
-    /* per frame */
-    uint32_t samples, lit, shadowed, uncertain, recovered, needed;
-    /* The lookup's 3x3 of decoded texels. Consecutive samples mostly fall in the same
-     * texel, and the 3x3 around it depends on nothing but the map and that texel's
-     * index, so it is kept from one sample to the next while `t4_at` names the texel
-     * (and what it shares with the next texel's 3x3 is kept too: shift_window): bit k
-     * of `t_have` says t[k] is decoded. The build forgets it. */
-    dtri t[9];
-    size_t t4_at;
-    uint32_t t_have;
-    /* The recovery's occluders (pointers into t) and outline for the pattern `bd_keep`
-     * of the texel t4_at, while bd_have. */
-    const dtri *occ[9];
-    int nocc;
-    /* and the texel centres that may join the outline (cand_k: their texels): those
-     * nearer than the sample, which varies, do. bd is the outline without them, bx
-     * with those in bx_pts (a superset of bd's hulls: points only join pieces). */
-    outline_pt cand[9];
-    uint8_t cand_k[9];
-    int ncand;
-    uint16_t bx_pts;
-    boundary bd, bx;
-    uint16_t bd_keep;
-    bool bd_have;
-} spsm_state;
 
 static bool size_ok(const om_method_cfg *c) { return c->map_size >= 1 && c->map_size <= OM_MAX_DIM; }
 
@@ -234,282 +178,6 @@ static om_status spsm_observe(void *state, const om_strip *st, om_diag *d)
     return OM_OK;
 }
 
-/* need = seen grown by one texel each way (the 3x3 the lookup decodes); returns the
- * number of texels in it. Bits past the map's width in a row's last word may be set:
- * no texel reads them. */
-static uint32_t grow_needs(spsm_state *m)
-{
-    const uint32_t W = m->words, S = m->size;
-    uint32_t count = 0;
-    if (!m->marks) {
-        memset(m->need, 0xFF, (size_t)S * W * sizeof(uint32_t));
-        return S * S;
-    }
-    for (uint32_t y = 0; y < S; y++) {
-        uint32_t *out = m->need + (size_t)y * W;
-        for (uint32_t j = 0; j < W; j++) {
-            uint32_t v = 0;   /* the three rows' words, each grown sideways */
-            for (uint32_t r = y ? y - 1 : 0; r <= y + 1 && r < S; r++) {
-                const uint32_t *row = m->seen + (size_t)r * W;
-                uint32_t w = row[j];
-                v |= w | w << 1 | w >> 1;
-                if (j) v |= row[j - 1] >> 31;
-                if (j + 1 < W) v |= row[j + 1] << 31;
-            }
-            out[j] = v;
-            for (uint32_t b = v; b; b &= b - 1) count++;
-        }
-    }
-    return count;
-}
-
-/* A depth plane: z at grid point (ox, oy), slopes gx, gy per grid unit. */
-typedef struct zplane { double z, gx, gy; int64_t ox, oy; } zplane;
-
-/* The least depth of plane p over the triangle (X, Y) clipped to the square
- * [x0, x0 + side] x [y0, y0 + side], for a square whose corner the slopes point to
- * (the plane's least value over the square) lies outside the triangle: the least
- * value over the two's overlap is then on the triangle's boundary, at an end of one
- * of its edges clipped to the square (Liang-Barsky), whichever the slope along the
- * edge points to. HUGE_VAL when no edge crosses the square. */
-static double clipped_min(const int64_t X[3], const int64_t Y[3], int64_t x0, int64_t y0, int64_t side,
-                          const zplane *p)
-{
-    const double lo[2] = {(double)x0, (double)y0}, hi[2] = {(double)(x0 + side), (double)(y0 + side)};
-    double best = HUGE_VAL;
-    for (int i = 0; i < 3; i++) {
-        const int j = i == 2 ? 0 : i + 1;
-        const double a[2] = {(double)X[i], (double)Y[i]}, d[2] = {(double)(X[j] - X[i]), (double)(Y[j] - Y[i])};
-        double t0 = 0.0, t1 = 1.0;
-        bool in = true;
-        for (int k = 0; k < 2 && in; k++) {
-            if (d[k] == 0.0) { in = a[k] >= lo[k] && a[k] <= hi[k]; continue; }
-            double inv = 1.0 / d[k], ta = (lo[k] - a[k]) * inv, tb = (hi[k] - a[k]) * inv;
-            if (ta > tb) { double s = ta; ta = tb; tb = s; }
-            if (ta > t0) t0 = ta;
-            if (tb < t1) t1 = tb;
-            in = t0 <= t1;
-        }
-        if (!in) continue;
-        double t = p->gx * d[0] + p->gy * d[1] < 0.0 ? t1 : t0;
-        double z = p->z + p->gx * (a[0] + t * d[0] - (double)p->ox) + p->gy * (a[1] + t * d[1] - (double)p->oy);
-        if (z < best) best = z;
-    }
-    return best;
-}
-
-/* ---------------------------------------------------------------- build (3.2) */
-
-typedef struct build_ctx {
-    spsm_state *m;
-    double zx, zy;               /* the plane whose codes are cached */
-    uint8_t qx, qy;
-    bool have;
-    /* the y codes of the row being filled, for the triangle with these y coordinates:
-     * the fill runs along rows, so most texels written reuse them */
-    int64_t ry[3];
-    int32_t row;
-    bool have_row;
-    uint16_t vy[3];
-} build_ctx;
-
-/* One texel x of row y touched by t: the depth test and, for the winner, its record. */
-static void texel(build_ctx *b, int32_t x, int32_t y, const om__rtri *t)
-{
-    spsm_state *m = b->m;
-    const om__tri2 *e = &t->e;
-    const double H = OM_SUBPIX / 2;
-    double cx = (double)((int64_t)x * OM_SUBPIX) + H - (double)e->x[0];
-    double cy = (double)((int64_t)y * OM_SUBPIX) + H - (double)e->y[0];
-    /* Minimum conservative depth (section 3.2): the least depth the triangle reaches
-     * inside the texel's square. That is the plane's least value over the square, at
-     * the corner its slopes point to, when the triangle covers that corner; otherwise
-     * it is on the triangle clipped to the square. (The paper takes the plane's value
-     * at the corner even there, nearer than the triangle reaches: a steep triangle
-     * behind an occluder then takes its texels.) A long sliver, a fence bar's face,
-     * so competes with its depth in this texel, not with its nearest end's. */
-    double z = t->z0 + t->zx * cx + t->zy * cy - (fabs(t->zx) + fabs(t->zy)) * H;
-    const int64_t kx = (int64_t)x * OM_SUBPIX, ky = (int64_t)y * OM_SUBPIX;
-    /* a triangle touching this texel alone lies inside it: its nearest vertex is the
-     * answer (at the map's edge the bounds are clamped, and zmin stays a lower bound) */
-    const bool alone = t->minx == t->maxx && t->miny == t->maxy;
-    if (!alone && !om__tri2_covers(e, kx + (t->zx > 0 ? 0 : OM_SUBPIX), ky + (t->zy > 0 ? 0 : OM_SUBPIX))) {
-        const zplane p = {t->z0, t->zx, t->zy, e->x[0], e->y[0]};
-        double zc = clipped_min(e->x, e->y, kx, ky, OM_SUBPIX, &p);
-        if (zc > z && zc != HUGE_VAL) z = zc;   /* (no overlap: only touching) */
-    }
-    if (!(z >= t->zmin)) z = t->zmin;
-    uint32_t dz = (uint32_t)z & ~TIES;
-    size_t i = (size_t)y * m->size + (size_t)x;
-    /* Near ties (within TIE_DZ, what recovery takes for one surface) are most often
-     * the halves of one flat quad, the faces of one thin part (a fence bar, a pole)
-     * or the small triangles of a fine mesh. The k-th triangle to tie for a texel (k
-     * = nt) takes it where (x + (k - 1) y) mod k = k - 1: the second on a checkerboard,
-     * the third on one texel of each row and column of a 3x3, and so on, so that the
-     * neighbourhood recovery reads holds as many of them as it can (keeping the first
-     * everywhere loses the rest of the outline). The depth keeps the nearer. */
-    uint32_t o = m->depth[i], od = o & ~TIES, nt = o & TIES;
-    if (o != 0xFFFFFFFFu && (dz >= od ? dz - od : od - dz) <= (uint32_t)TIE_DZ) {
-        if (nt < TIES - 1) nt++;
-        m->depth[i] = (dz < od ? dz : od) | nt;
-        if (((uint32_t)x + (nt - 1) * (uint32_t)y) % nt != nt - 1) return;
-    } else {
-        if (dz > od) return;
-        m->depth[i] = dz | 1u;
-    }
-    if (!b->have || t->zx != b->zx || t->zy != b->zy) {
-        /* derivatives in depth steps per texel, scaled (spsm.h) */
-        const double k = (double)OM_SUBPIX / STEP / OM_SPSM_DSCALE;
-        b->qx = om__spsm_q_encode(t->zx * k);
-        b->qy = om__spsm_q_encode(t->zy * k);
-        b->zx = t->zx;
-        b->zy = t->zy;
-        b->have = true;
-    }
-    if (!b->have_row || y != b->row || memcmp(b->ry, e->y, sizeof b->ry)) {
-        om__spsm_row_codes(b->vy, t, y);
-        memcpy(b->ry, e->y, sizeof b->ry);
-        b->row = y;
-        b->have_row = true;
-    }
-    om__spsm_pack_row(&m->tex[i], t, x, y, b->qx, b->qy, b->vy);
-}
-
-/* Sets a buffer to the far plane (empty) at the needed texels, a word of them at a time. */
-static void clear_needed(const spsm_state *m, uint32_t *buf)
-{
-    if (!m->marks) {   /* every texel is needed: one pass over the buffer */
-        const size_t n = (size_t)m->size * m->size;
-        for (size_t i = 0; i < n; i++) buf[i] = 0xFFFFFFFFu;
-        return;
-    }
-    for (uint32_t y = 0; y < m->size; y++)
-        for (uint32_t j = 0; j < m->words; j++) {
-            if (!m->need[(size_t)y * m->words + j]) continue;
-            const uint32_t x0 = j * 32, x1 = x0 + 32 < m->size ? x0 + 32 : m->size;
-            for (uint32_t x = x0; x < x1; x++) buf[(size_t)y * m->size + x] = 0xFFFFFFFFu;
-        }
-}
-
-/* fneed = need at twice the resolution (a texel's bit becomes its four points'), and
- * those points of the fine map cleared. */
-static void grow_fine_needs(spsm_state *m)
-{
-    const uint32_t S = m->size, W = m->words, FW = m->fwords;
-    for (uint32_t y = 0; y < S; y++) {
-        uint32_t *f0 = m->fneed + (size_t)(2 * y) * FW, *f1 = f0 + FW;
-        for (uint32_t j = 0; j < FW; j++) {
-            /* fine word j holds texels 16j .. 16j + 15, each bit twice */
-            const uint32_t w = m->need[(size_t)y * W + j / 2] >> (16 * (j & 1)) & 0xFFFFu;
-            uint32_t v = 0;
-            for (uint32_t b = w; b; b &= b - 1) v |= 3u << (2 * om__ctz32(b));
-            /* (need may hold bits past the map's side; no point lies there) */
-            const uint32_t left = 2 * S - 32 * j;
-            if (left < 32) v &= (1u << left) - 1u;
-            f0[j] = f1[j] = v;
-            for (uint32_t bit = v; bit; bit &= bit - 1) {   /* and clears them */
-                const size_t x = 32 * (size_t)j + (size_t)om__ctz32(bit);
-                m->fdepth[(size_t)(2 * y) * (2 * S) + x] = m->fdepth[(size_t)(2 * y + 1) * (2 * S) + x] = 0xFFFFFFFFu;
-            }
-        }
-    }
-}
-
-/* The fine pass has no records to write: its conservative spans are not needed. */
-static void no_span(void *user, int32_t y, int32_t x0, int32_t x1, const om__rtri *t)
-{
-    (void)user; (void)y; (void)x0; (void)x1; (void)t;
-}
-
-/* Every triangle of the scene through r, from the light, back faces of closed shapes
- * culled. */
-static void raster_scene(const spsm_state *m, om_raster *r)
-{
-    const om_scene *s = m->scene;
-    om__cull cl;
-    om__cull_begin(&cl, s, &m->view.light_vp);
-    for (uint32_t t = 0; t < s->ntris; t++) {
-        r->cull_back = om__cull_next(&cl, t);
-        const uint32_t *ix = s->idx + (size_t)t * 3;
-        om_vec4 c[3];
-        for (int k = 0; k < 3; k++) c[k] = om__mat_apply(&m->view.light_vp, s->verts[ix[k]]);
-        om__raster_tri(r, c, t);
-    }
-}
-
-/* The texels of a span that the lookup will read (need). */
-static void span(void *user, int32_t y, int32_t x0, int32_t x1, const om__rtri *t)
-{
-    build_ctx *b = (build_ctx *)user;
-    const uint32_t *row = b->m->need + (size_t)y * b->m->words;
-    for (int32_t x = om__mask_next(row, x0, x1); x <= x1; x = om__mask_next(row, x + 1, x1)) texel(b, x, y, t);
-}
-
-static om_status spsm_build(void *state, om_diag *d)
-{
-    (void)d;
-    spsm_state *m = (spsm_state *)state;
-    m->t4_at = (size_t)-1;   /* no texel index: the map is about to change */
-    m->bd_have = false;
-    m->needed = grow_needs(m);
-    /* The plain map at texel centres, for the fallback of 4.2, is the rasterizer's own
-     * depth pass, made alongside the conservative one. Without AA the lookup reads it
-     * inside the 3x3 too, so both buffers are cleared and written at the needed texels
-     * only; sub-samples reach beyond, so with AA the plain map is made whole. */
-    const bool whole_plain = m->cfg.spsm_aa > 1;
-    om_target tc = {m->size, m->size, 0, m->size, m->cdepth, NULL};
-    if (whole_plain) om__target_clear(&tc);
-    else clear_needed(m, m->cdepth);
-    clear_needed(m, m->depth);
-    /* texels are not cleared: one whose depth is still the far plane's is empty */
-    om_target tg = {m->size, m->size, 0, m->size, m->depth, NULL};
-    build_ctx b;
-    memset(&b, 0, sizeof b);
-    b.m = m;
-    om_raster r;
-    r.target = &tg;
-    r.mode = OM_RASTER_CONSERVATIVE;
-    r.span = span;
-    r.user = &b;
-    r.centres = &tc;
-    r.centre_mask = whole_plain ? NULL : m->need;
-    r.grid_x = r.grid_y = NULL;
-    r.grid_xs = r.grid_ys = NULL;
-    r.grid_shift = r.grid_buckets = 0;
-    r.mask_words = m->words;
-    /* A light ray that meets a closed shape's back face has met a front face before
-     * it, so a back face is never the occluder a record should describe: culled, the
-     * record of a rim texel is more often the grazing front face the ray really hits
-     * (default scene, mismatches at maps 512 / 1024 / 2048 / 4096: 5,838 / 1,278 /
-     * 458 / 163 -> 5,789 / 1,268 / 328 / 133). The plain depth is the same. */
-    raster_scene(m, &r);
-    if (!m->fine) return OM_OK;
-    /* The plain map at twice the resolution, at the points the lookup reads (all of
-     * them with AA), for fine_shadow: a second pass, since its grid is not the
-     * records'. */
-    const uint32_t F = 2 * m->size;
-    om_target tf = {F, F, 0, F, m->fdepth, NULL};
-    r.target = &tf;
-    r.user = NULL;
-    if (whole_plain || !m->marks) {
-        /* every point: the plain depth pass itself */
-        om__target_clear(&tf);
-        r.mode = OM_RASTER_DEPTH;
-        r.span = NULL;
-        r.centres = NULL;
-        r.centre_mask = NULL;
-    } else {
-        /* the points needed: the depth pass that runs alongside a conservative one
-         * (the same depths), with nothing for the conservative one to do */
-        grow_fine_needs(m);
-        r.span = no_span;
-        r.centres = &tf;
-        r.centre_mask = m->fneed;
-        r.mask_words = m->fwords;
-    }
-    raster_scene(m, &r);
-    return OM_OK;
-}
 
 /* ---------------------------------------------------------------- lookup (4) */
 
@@ -739,45 +407,27 @@ static bool centre_test(const spsm_state *m, const receiver *r, int64_t tx, int6
 }
 
 /* The plain map around a point of the pixel at grid offset (qx, qy) from the centre of
- * texel (tx, ty): whether the four texel centres nearest to it all hold something
- * nearer than the sample's plane carried there, the sample itself being at (px, py).
- * The point then lies inside a shadow wider than a texel, whatever outline recovery
- * found: a record keeps one triangle per texel, and across a thin bar or along a
- * finely tessellated rim the 3x3 can miss the triangles that reach the point. */
-static bool centres_shadow(const spsm_state *m, const receiver *r, int64_t tx, int64_t ty,
-                           int64_t px, int64_t py, int64_t qx, int64_t qy)
+ * texel (tx, ty), the sample itself being at (px, py): whether the four points of the
+ * map nearest to it all hold something nearer than the sample's plane carried there.
+ * The map is `buf`, `side` points a side, one every `step` grid units (its point i at
+ * i step + step / 2): the texel centres (cdepth), or with spsm.fine the points a
+ * quarter texel from them (fdepth). The point then lies inside a shadow wider than the
+ * map's spacing, whatever outline recovery found: a record keeps one triangle per
+ * texel, and across a thin bar or along a finely tessellated rim the 3x3 can miss the
+ * triangles that reach the point; the band such a rim leaves lit is as wide as the
+ * spacing. */
+static bool plain_shadow(const uint32_t *buf, int64_t side, int64_t step, const receiver *r, int64_t tx,
+                         int64_t ty, int64_t px, int64_t py, int64_t qx, int64_t qy)
 {
-    const int64_t ax = floordiv(qx, OM_SUBPIX), ay = floordiv(qy, OM_SUBPIX);
+    /* the texel centre, the point and the sample in the map's own grid units */
+    const int64_t ox = tx * OM_SUBPIX + OM_SUBPIX / 2, oy = ty * OM_SUBPIX + OM_SUBPIX / 2, h = step / 2;
+    const int64_t ax = floordiv(ox + qx - h, step), ay = floordiv(oy + qy - h, step);
     for (int64_t j = ay; j <= ay + 1; j++)
         for (int64_t i = ax; i <= ax + 1; i++) {
-            int64_t x = tx + i, y = ty + j;
-            if (x < 0 || y < 0 || x >= (int64_t)m->size || y >= (int64_t)m->size) return false;
-            if (!centre_test(m, r, x, y, px - i * OM_SUBPIX, py - j * OM_SUBPIX)) return false;
-        }
-    return true;
-}
-
-/* The plain map at twice the resolution around a point at grid offset (qx, qy) from
- * the centre of texel (tx, ty), the sample itself being at (px, py): whether the four
- * points of that map nearest to it (a quarter texel from texel centres) all hold
- * something nearer than the sample's plane carried there. The point then lies inside
- * a shadow wider than half a texel, whatever outline recovery found: a record keeps
- * one triangle per texel, and across a thin bar or along a finely tessellated rim the
- * 3x3 can miss the triangles that reach the point; at texel centres alone the band
- * left along such a rim is a texel wide, at these points half that. */
-static bool fine_shadow(const spsm_state *m, const receiver *r, int64_t tx, int64_t ty, int64_t px,
-                        int64_t py, int64_t qx, int64_t qy)
-{
-    const int64_t H = OM_SUBPIX / 2, Q = OM_SUBPIX / 4, F = 2 * (int64_t)m->size;
-    /* the point and the sample in the map's own grid units */
-    const int64_t ox = tx * OM_SUBPIX + H, oy = ty * OM_SUBPIX + H;
-    const int64_t ax = floordiv(ox + qx - Q, H), ay = floordiv(oy + qy - Q, H);
-    for (int64_t j = ay; j <= ay + 1; j++)
-        for (int64_t i = ax; i <= ax + 1; i++) {
-            if (i < 0 || j < 0 || i >= F || j >= F) return false;
-            const uint32_t c = m->fdepth[(size_t)j * (size_t)F + (size_t)i];
+            if (i < 0 || j < 0 || i >= side || j >= side) return false;
+            const uint32_t c = buf[(size_t)j * (size_t)side + (size_t)i];
             if (c == 0xFFFFFFFFu) return false;
-            const double dx = (double)(i * H + Q - ox - px), dy = (double)(j * H + Q - oy - py);
+            const double dx = (double)(i * step + h - ox - px), dy = (double)(j * step + h - oy - py);
             const double z = r->ok ? r->z + r->gx * dx + r->gy * dy : r->z;
             if (!((double)c < z - TOL0)) return false;
         }
@@ -995,8 +645,8 @@ OM_NOINLINE static uint8_t recover(spsm_state *m, const om_strip *st, size_t i, 
         if (!shadow && tg->keep == 511) shadow = centre_test(m, &rp, tx, ty, px, py);   /* rp set */
         if (!shadow) {
             if (!have_rp) { rp = receiver_plane(m, smp); have_rp = true; }
-            shadow = m->fine ? fine_shadow(m, &rp, tx, ty, px, py, qx, qy)
-                             : centres_shadow(m, &rp, tx, ty, px, py, qx, qy);
+            shadow = m->fine ? plain_shadow(m->fdepth, 2 * (int64_t)m->size, OM_SUBPIX / 2, &rp, tx, ty, px, py, qx, qy)
+                             : plain_shadow(m->cdepth, m->size, OM_SUBPIX, &rp, tx, ty, px, py, qx, qy);
         }
         nlit += !shadow;
     }
@@ -1052,6 +702,6 @@ static void spsm_stats(const void *state, om_method_stats *out)
 
 const om_method om__method_spsm = {
     "spsm", "sub-pixel shadow map: 128-bit texels with the nearest triangle, silhouette recovery",
-    OM_METHOD_OBSERVES, spsm_bytes, spsm_init, spsm_begin, spsm_observe, spsm_build, spsm_resolve, spsm_stats,
+    OM_METHOD_OBSERVES, spsm_bytes, spsm_init, spsm_begin, spsm_observe, om__spsm_build, spsm_resolve, spsm_stats,
     spsm_observes,
 };

@@ -1,0 +1,249 @@
+/* spsm_build.c — the build of the Sub-Pixel Shadow Map (paper 004, section 3.2): every
+ * triangle is rasterized conservatively from the light (every texel whose square it
+ * touches); the depth test uses the minimum conservative depth over the texel (the
+ * least depth the triangle reaches inside the square), kept in a 32-bit buffer beside
+ * the texels, and the winner's record (section 3.3, spsm_texel.c) is written to the
+ * texel; near ties share the texels out in a fixed pattern (texel, below). The plain
+ * map's depth at texel centres is made in the same pass, and with spsm.fine the plain
+ * map at twice the resolution in a second one. With marks (spsm.c's observe) all of it
+ * is done only at the texels the lookup will read. */
+#include "spsm_method.h"
+
+/* need = seen grown by one texel each way (the 3x3 the lookup decodes); returns the
+ * number of texels in it. Bits past the map's width in a row's last word may be set:
+ * no texel reads them. */
+static uint32_t grow_needs(spsm_state *m)
+{
+    const uint32_t W = m->words, S = m->size;
+    uint32_t count = 0;
+    if (!m->marks) {
+        memset(m->need, 0xFF, (size_t)S * W * sizeof(uint32_t));
+        return S * S;
+    }
+    for (uint32_t y = 0; y < S; y++) {
+        uint32_t *out = m->need + (size_t)y * W;
+        for (uint32_t j = 0; j < W; j++) {
+            uint32_t v = 0;   /* the three rows' words, each grown sideways */
+            for (uint32_t r = y ? y - 1 : 0; r <= y + 1 && r < S; r++) {
+                const uint32_t *row = m->seen + (size_t)r * W;
+                uint32_t w = row[j];
+                v |= w | w << 1 | w >> 1;
+                if (j) v |= row[j - 1] >> 31;
+                if (j + 1 < W) v |= row[j + 1] << 31;
+            }
+            out[j] = v;
+            for (uint32_t b = v; b; b &= b - 1) count++;
+        }
+    }
+    return count;
+}
+typedef struct build_ctx {
+    spsm_state *m;
+    double zx, zy;               /* the plane whose codes are cached */
+    uint8_t qx, qy;
+    bool have;
+    /* the y codes of the row being filled, for the triangle with these y coordinates:
+     * the fill runs along rows, so most texels written reuse them */
+    int64_t ry[3];
+    int32_t row;
+    bool have_row;
+    uint16_t vy[3];
+} build_ctx;
+
+/* One texel x of row y touched by t: the depth test and, for the winner, its record. */
+static void texel(build_ctx *b, int32_t x, int32_t y, const om__rtri *t)
+{
+    spsm_state *m = b->m;
+    const om__tri2 *e = &t->e;
+    const double H = OM_SUBPIX / 2;
+    double cx = (double)((int64_t)x * OM_SUBPIX) + H - (double)e->x[0];
+    double cy = (double)((int64_t)y * OM_SUBPIX) + H - (double)e->y[0];
+    /* Minimum conservative depth (section 3.2): the least depth the triangle reaches
+     * inside the texel's square. That is the plane's least value over the square, at
+     * the corner its slopes point to, when the triangle covers that corner; otherwise
+     * it is on the triangle clipped to the square. (The paper takes the plane's value
+     * at the corner even there, nearer than the triangle reaches: a steep triangle
+     * behind an occluder then takes its texels.) A long sliver, a fence bar's face,
+     * so competes with its depth in this texel, not with its nearest end's. */
+    double z = t->z0 + t->zx * cx + t->zy * cy - (fabs(t->zx) + fabs(t->zy)) * H;
+    const int64_t kx = (int64_t)x * OM_SUBPIX, ky = (int64_t)y * OM_SUBPIX;
+    /* a triangle touching this texel alone lies inside it: its nearest vertex is the
+     * answer (at the map's edge the bounds are clamped, and zmin stays a lower bound) */
+    const bool alone = t->minx == t->maxx && t->miny == t->maxy;
+    if (!alone && !om__tri2_covers(e, kx + (t->zx > 0 ? 0 : OM_SUBPIX), ky + (t->zy > 0 ? 0 : OM_SUBPIX))) {
+        const zplane p = {t->z0, t->zx, t->zy, e->x[0], e->y[0]};
+        double zc = clipped_min(e->x, e->y, kx, ky, OM_SUBPIX, &p);
+        if (zc > z && zc != HUGE_VAL) z = zc;   /* (no overlap: only touching) */
+    }
+    if (!(z >= t->zmin)) z = t->zmin;
+    uint32_t dz = (uint32_t)z & ~TIES;
+    size_t i = (size_t)y * m->size + (size_t)x;
+    /* Near ties (within TIE_DZ, what recovery takes for one surface) are most often
+     * the halves of one flat quad, the faces of one thin part (a fence bar, a pole)
+     * or the small triangles of a fine mesh. The k-th triangle to tie for a texel (k
+     * = nt) takes it where (x + (k - 1) y) mod k = k - 1: the second on a checkerboard,
+     * the third on one texel of each row and column of a 3x3, and so on, so that the
+     * neighbourhood recovery reads holds as many of them as it can (keeping the first
+     * everywhere loses the rest of the outline). The depth keeps the nearer. */
+    uint32_t o = m->depth[i], od = o & ~TIES, nt = o & TIES;
+    if (o != 0xFFFFFFFFu && (dz >= od ? dz - od : od - dz) <= (uint32_t)TIE_DZ) {
+        if (nt < TIES - 1) nt++;
+        m->depth[i] = (dz < od ? dz : od) | nt;
+        if (((uint32_t)x + (nt - 1) * (uint32_t)y) % nt != nt - 1) return;
+    } else {
+        if (dz > od) return;
+        m->depth[i] = dz | 1u;
+    }
+    if (!b->have || t->zx != b->zx || t->zy != b->zy) {
+        /* derivatives in depth steps per texel, scaled (spsm.h) */
+        const double k = (double)OM_SUBPIX / STEP / OM_SPSM_DSCALE;
+        b->qx = om__spsm_q_encode(t->zx * k);
+        b->qy = om__spsm_q_encode(t->zy * k);
+        b->zx = t->zx;
+        b->zy = t->zy;
+        b->have = true;
+    }
+    if (!b->have_row || y != b->row || memcmp(b->ry, e->y, sizeof b->ry)) {
+        om__spsm_row_codes(b->vy, t, y);
+        memcpy(b->ry, e->y, sizeof b->ry);
+        b->row = y;
+        b->have_row = true;
+    }
+    om__spsm_pack_row(&m->tex[i], t, x, y, b->qx, b->qy, b->vy);
+}
+
+/* Sets a buffer to the far plane (empty) at the needed texels, a word of them at a time. */
+static void clear_needed(const spsm_state *m, uint32_t *buf)
+{
+    if (!m->marks) {   /* every texel is needed: one pass over the buffer */
+        const size_t n = (size_t)m->size * m->size;
+        for (size_t i = 0; i < n; i++) buf[i] = 0xFFFFFFFFu;
+        return;
+    }
+    for (uint32_t y = 0; y < m->size; y++)
+        for (uint32_t j = 0; j < m->words; j++) {
+            if (!m->need[(size_t)y * m->words + j]) continue;
+            const uint32_t x0 = j * 32, x1 = x0 + 32 < m->size ? x0 + 32 : m->size;
+            for (uint32_t x = x0; x < x1; x++) buf[(size_t)y * m->size + x] = 0xFFFFFFFFu;
+        }
+}
+
+/* fneed = need at twice the resolution (a texel's bit becomes its four points'), and
+ * those points of the fine map cleared. */
+static void grow_fine_needs(spsm_state *m)
+{
+    const uint32_t S = m->size, W = m->words, FW = m->fwords;
+    for (uint32_t y = 0; y < S; y++) {
+        uint32_t *f0 = m->fneed + (size_t)(2 * y) * FW, *f1 = f0 + FW;
+        for (uint32_t j = 0; j < FW; j++) {
+            /* fine word j holds texels 16j .. 16j + 15, each bit twice */
+            const uint32_t w = m->need[(size_t)y * W + j / 2] >> (16 * (j & 1)) & 0xFFFFu;
+            uint32_t v = 0;
+            for (uint32_t b = w; b; b &= b - 1) v |= 3u << (2 * om__ctz32(b));
+            /* (need may hold bits past the map's side; no point lies there) */
+            const uint32_t left = 2 * S - 32 * j;
+            if (left < 32) v &= (1u << left) - 1u;
+            f0[j] = f1[j] = v;
+            for (uint32_t bit = v; bit; bit &= bit - 1) {   /* and clears them */
+                const size_t x = 32 * (size_t)j + (size_t)om__ctz32(bit);
+                m->fdepth[(size_t)(2 * y) * (2 * S) + x] = m->fdepth[(size_t)(2 * y + 1) * (2 * S) + x] = 0xFFFFFFFFu;
+            }
+        }
+    }
+}
+
+/* The fine pass has no records to write: its conservative spans are not needed. */
+static void no_span(void *user, int32_t y, int32_t x0, int32_t x1, const om__rtri *t)
+{
+    (void)user; (void)y; (void)x0; (void)x1; (void)t;
+}
+
+/* Every triangle of the scene through r, from the light, back faces of closed shapes
+ * culled. */
+static void raster_scene(const spsm_state *m, om_raster *r)
+{
+    const om_scene *s = m->scene;
+    om__cull cl;
+    om__cull_begin(&cl, s, &m->view.light_vp);
+    for (uint32_t t = 0; t < s->ntris; t++) {
+        r->cull_back = om__cull_next(&cl, t);
+        const uint32_t *ix = s->idx + (size_t)t * 3;
+        om_vec4 c[3];
+        for (int k = 0; k < 3; k++) c[k] = om__mat_apply(&m->view.light_vp, s->verts[ix[k]]);
+        om__raster_tri(r, c, t);
+    }
+}
+
+/* The texels of a span that the lookup will read (need). */
+static void span(void *user, int32_t y, int32_t x0, int32_t x1, const om__rtri *t)
+{
+    build_ctx *b = (build_ctx *)user;
+    const uint32_t *row = b->m->need + (size_t)y * b->m->words;
+    for (int32_t x = om__mask_next(row, x0, x1); x <= x1; x = om__mask_next(row, x + 1, x1)) texel(b, x, y, t);
+}
+
+om_status om__spsm_build(void *state, om_diag *d)
+{
+    (void)d;
+    spsm_state *m = (spsm_state *)state;
+    m->t4_at = (size_t)-1;   /* no texel index: the map is about to change */
+    m->bd_have = false;
+    m->needed = grow_needs(m);
+    /* The plain map at texel centres, for the fallback of 4.2, is the rasterizer's own
+     * depth pass, made alongside the conservative one. Without AA the lookup reads it
+     * inside the 3x3 too, so both buffers are cleared and written at the needed texels
+     * only; sub-samples reach beyond, so with AA the plain map is made whole. */
+    const bool whole_plain = m->cfg.spsm_aa > 1;
+    om_target tc = {m->size, m->size, 0, m->size, m->cdepth, NULL};
+    if (whole_plain) om__target_clear(&tc);
+    else clear_needed(m, m->cdepth);
+    clear_needed(m, m->depth);
+    /* texels are not cleared: one whose depth is still the far plane's is empty */
+    om_target tg = {m->size, m->size, 0, m->size, m->depth, NULL};
+    build_ctx b;
+    memset(&b, 0, sizeof b);
+    b.m = m;
+    om_raster r;
+    r.target = &tg;
+    r.mode = OM_RASTER_CONSERVATIVE;
+    r.span = span;
+    r.user = &b;
+    r.centres = &tc;
+    r.centre_mask = whole_plain ? NULL : m->need;
+    r.grid_x = r.grid_y = NULL;
+    r.grid_xs = r.grid_ys = NULL;
+    r.grid_shift = r.grid_buckets = 0;
+    r.mask_words = m->words;
+    /* A light ray that meets a closed shape's back face has met a front face before
+     * it, so a back face is never the occluder a record should describe: culled, the
+     * record of a rim texel is more often the grazing front face the ray really hits
+     * (default scene, mismatches at maps 512 / 1024 / 2048 / 4096: 5,838 / 1,278 /
+     * 458 / 163 -> 5,789 / 1,268 / 328 / 133). The plain depth is the same. */
+    raster_scene(m, &r);
+    if (!m->fine) return OM_OK;
+    /* The plain map at twice the resolution, at the points the lookup reads (all of
+     * them with AA), for plain_shadow: a second pass, since its grid is not the
+     * records'. */
+    const uint32_t F = 2 * m->size;
+    om_target tf = {F, F, 0, F, m->fdepth, NULL};
+    r.target = &tf;
+    r.user = NULL;
+    if (whole_plain || !m->marks) {
+        /* every point: the plain depth pass itself */
+        om__target_clear(&tf);
+        r.mode = OM_RASTER_DEPTH;
+        r.span = NULL;
+        r.centres = NULL;
+        r.centre_mask = NULL;
+    } else {
+        /* the points needed: the depth pass that runs alongside a conservative one
+         * (the same depths), with nothing for the conservative one to do */
+        grow_fine_needs(m);
+        r.span = no_span;
+        r.centres = &tf;
+        r.centre_mask = m->fneed;
+        r.mask_words = m->fwords;
+    }
+    raster_scene(m, &r);
+    return OM_OK;
+}

@@ -1,0 +1,98 @@
+/* spsm_method.h — the state of the SPSM method (paper 004), shared by its two halves:
+ * spsm.c (settings, observe, lookup and recovery: sections 4 and 5) and spsm_build.c
+ * (the conservative build of the records: section 3.2). */
+#ifndef OM_SPSM_METHOD_H
+#define OM_SPSM_METHOD_H
+
+#include "shadow.h"
+#include "spsm_lookup.h"
+
+#define TIE_DZ (LINK_DZ / 2)     /* the build's near tie: one surface to recovery */
+#define TIES 0xFFu               /* the depth buffer's low bits: ties counted (texel) */
+
+typedef struct spsm_state {
+    const om_scene *scene;
+    om_method_cfg cfg;
+    uint32_t size;
+    om__spsm_texel *tex;
+    uint32_t *depth;             /* minimum conservative depth: the build's depth test
+                                  * (low 8 bits: ties so far; all ones: empty) */
+    uint32_t *cdepth;            /* nearest depth at each texel centre (fallback) */
+    /* spsm.fine: the plain map at 2 x 2 points per texel (plain_shadow), and need at
+     * those points, fwords words per row */
+    bool fine;
+    uint32_t *fdepth, *fneed;
+    uint32_t fwords;
+    /* Texels the lookup will read, one bit each, `words` 32-bit words per row: `seen`
+     * (the samples' texels, from observe) grown by one texel into `need` (build). */
+    uint32_t *seen, *need;
+    uint32_t words;
+    bool marks;                  /* observe marks texels (spsm.records); else need is full */
+    om_view view;
+    om__spsm_qtable q;
+    om__spsm_tangent lut[512];
+    /* per frame */
+    uint32_t samples, lit, shadowed, uncertain, recovered, needed;
+    /* The lookup's 3x3 of decoded texels. Consecutive samples mostly fall in the same
+     * texel, and the 3x3 around it depends on nothing but the map and that texel's
+     * index, so it is kept from one sample to the next while `t4_at` names the texel
+     * (and what it shares with the next texel's 3x3 is kept too: shift_window): bit k
+     * of `t_have` says t[k] is decoded. The build forgets it. */
+    dtri t[9];
+    size_t t4_at;
+    uint32_t t_have;
+    /* The recovery's occluders (pointers into t) and outline for the pattern `bd_keep`
+     * of the texel t4_at, while bd_have. */
+    const dtri *occ[9];
+    int nocc;
+    /* and the texel centres that may join the outline (cand_k: their texels): those
+     * nearer than the sample, which varies, do. bd is the outline without them, bx
+     * with those in bx_pts (a superset of bd's hulls: points only join pieces). */
+    outline_pt cand[9];
+    uint8_t cand_k[9];
+    int ncand;
+    uint16_t bx_pts;
+    boundary bd, bx;
+    uint16_t bd_keep;
+    bool bd_have;
+} spsm_state;
+
+/* A depth plane: z at grid point (ox, oy), slopes gx, gy per grid unit. */
+typedef struct zplane { double z, gx, gy; int64_t ox, oy; } zplane;
+
+/* The least depth of plane p over the triangle (X, Y) clipped to the square
+ * [x0, x0 + side] x [y0, y0 + side], for a square whose corner the slopes point to
+ * (the plane's least value over the square) lies outside the triangle: the least
+ * value over the two's overlap is then on the triangle's boundary, at an end of one
+ * of its edges clipped to the square (Liang-Barsky), whichever the slope along the
+ * edge points to. HUGE_VAL when no edge crosses the square. */
+static inline double clipped_min(const int64_t X[3], const int64_t Y[3], int64_t x0, int64_t y0, int64_t side,
+                                 const zplane *p)
+{
+    const double lo[2] = {(double)x0, (double)y0}, hi[2] = {(double)(x0 + side), (double)(y0 + side)};
+    double best = HUGE_VAL;
+    for (int i = 0; i < 3; i++) {
+        const int j = i == 2 ? 0 : i + 1;
+        const double a[2] = {(double)X[i], (double)Y[i]}, d[2] = {(double)(X[j] - X[i]), (double)(Y[j] - Y[i])};
+        double t0 = 0.0, t1 = 1.0;
+        bool in = true;
+        for (int k = 0; k < 2 && in; k++) {
+            if (d[k] == 0.0) { in = a[k] >= lo[k] && a[k] <= hi[k]; continue; }
+            double inv = 1.0 / d[k], ta = (lo[k] - a[k]) * inv, tb = (hi[k] - a[k]) * inv;
+            if (ta > tb) { double s = ta; ta = tb; tb = s; }
+            if (ta > t0) t0 = ta;
+            if (tb < t1) t1 = tb;
+            in = t0 <= t1;
+        }
+        if (!in) continue;
+        double t = p->gx * d[0] + p->gy * d[1] < 0.0 ? t1 : t0;
+        double z = p->z + p->gx * (a[0] + t * d[0] - (double)p->ox) + p->gy * (a[1] + t * d[1] - (double)p->oy);
+        if (z < best) best = z;
+    }
+    return best;
+}
+
+/* The build (spsm_build.c): the records the lookup will read, from the marks. */
+om_status om__spsm_build(void *state, om_diag *d);
+
+#endif
