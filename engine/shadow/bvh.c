@@ -73,16 +73,34 @@ static float centre(const boxes *bx, uint32_t t, int axis)
     return (b.lo[axis] + b.hi[axis]) * 0.5f;
 }
 
-/* Puts the k-th smallest centroid (along axis) of tris[0..n) at k: quickselect. */
+/* A centroid as an integer whose unsigned order is the floats' order (-0 equal to +0,
+ * as a float comparison has them; a NaN gets a place of its own). The quickselect
+ * compares these keys: a float comparison need not give the same answer twice (with
+ * x87 excess precision a centroid recomputed in a register and the pivot stored as a
+ * float disagree, and the scans below ran past their sentinel forever), while the
+ * bits of a stored float are what they are. */
+static uint32_t centre_key(const boxes *bx, uint32_t t, int axis)
+{
+    float c = centre(bx, t, axis);
+    uint32_t u;
+    memcpy(&u, &c, sizeof u);
+    if (u == 0x80000000u) u = 0;
+    return u & 0x80000000u ? ~u : u | 0x80000000u;
+}
+
+/* Puts the k-th smallest centroid (along axis) of tris[0..n) at k: Hoare's quickselect.
+ * The scans are also kept inside [lo, hi], so that [lo, hi] shrinks every round and
+ * the loop ends whatever the keys say; with consistent keys the bounds never bind,
+ * and the order is the one the float comparison gave on SSE. */
 static void select_median(uint32_t *tris, const boxes *bx, uint32_t n, uint32_t k, int axis)
 {
     uint32_t lo = 0, hi = n - 1;
     while (lo < hi) {
-        float pivot = centre(bx, tris[lo + (hi - lo) / 2], axis);
+        const uint32_t pivot = centre_key(bx, tris[lo + (hi - lo) / 2], axis);
         uint32_t i = lo, j = hi;
         while (i <= j) {
-            while (centre(bx, tris[i], axis) < pivot) i++;
-            while (centre(bx, tris[j], axis) > pivot) j--;
+            while (i < hi && centre_key(bx, tris[i], axis) < pivot) i++;
+            while (j > lo && centre_key(bx, tris[j], axis) > pivot) j--;
             if (i <= j) {
                 uint32_t t = tris[i]; tris[i] = tris[j]; tris[j] = t;
                 i++;

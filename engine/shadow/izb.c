@@ -165,7 +165,9 @@ static void swap(om__izb_key *a, om__izb_key *b)
 }
 
 /* Puts the k-th smallest key (of `axis`) at position k of s[0..n), smaller before,
- * larger after: Hoare's quickselect with a median-of-three pivot (deterministic). */
+ * larger after: Hoare's quickselect with a median-of-three pivot (deterministic). The
+ * keys are integers stored once, so every comparison gives the same answer twice in
+ * any floating-point mode, and the scans stop at their sentinels. */
 static void quickselect(om__izb_key *s, uint32_t n, uint32_t k, int axis)
 {
     uint32_t lo = 0, hi = n - 1;
