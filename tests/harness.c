@@ -4,19 +4,21 @@
 
 #include <stdlib.h>
 
-bool h_scene_parse(h_scene *hs, const char *text)
+bool h_scene_parse(h_scene *hs, const char *text) { return h_scene_parse_ld(hs, text, NULL); }
+
+bool h_scene_parse_ld(h_scene *hs, const char *text, const om_loader *ld)
 {
     om_diag d;
     size_t bytes;
     memset(hs, 0, sizeof *hs);
-    if (om_scene_bytes(text, strlen(text), NULL, &bytes, &d) != OM_OK) {
+    if (om_scene_bytes(text, strlen(text), ld, &bytes, &d) != OM_OK) {
         CHECK_MSG(0, "scene bytes: %s", d.msg);
         return false;
     }
     hs->mem = malloc(bytes ? bytes : 1);
     om_arena a;
     om_arena_init(&a, hs->mem, bytes, "scene");
-    if (om_scene_parse(text, strlen(text), NULL, &a, &hs->s, &d) != OM_OK) {
+    if (om_scene_parse(text, strlen(text), ld, &a, &hs->s, &d) != OM_OK) {
         CHECK_MSG(0, "scene parse: %s", d.msg);
         return false;
     }

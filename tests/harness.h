@@ -12,6 +12,8 @@ typedef struct h_scene {
 
 /* Parses `text`; fails the current test (and returns false) on error. */
 bool h_scene_parse(h_scene *hs, const char *text);
+/* The same with a loader for the scene's `mesh` files (NULL: none). */
+bool h_scene_parse_ld(h_scene *hs, const char *text, const om_loader *ld);
 void h_scene_free(h_scene *hs);
 
 /* Renders with method `name` and configuration `cfg` (NULL: defaults) at the scene's

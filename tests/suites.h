@@ -17,6 +17,7 @@
     X(suite_asm) \
     X(suite_robust) \
     X(suite_spsm) \
+    X(suite_oracle) \
     /* end of list */
 #endif
 #define X(suite) void suite(void);

@@ -23,10 +23,54 @@ void om__lspace_init_lean(om__lspace *ls, const om_scene *s)
     ls->scene = s;
 }
 
+/* Sum of |terms| of clip-space row r over the scene's box: what the float rounding of
+ * that coordinate is relative to. A row that is exactly 1 (an orthographic w) has no
+ * rounding at all. */
+static double row_mag(const om_mat4 *m, int r, double big)
+{
+    const float *a = m->m + 4 * r;
+    if (a[0] == 0.0f && a[1] == 0.0f && a[2] == 0.0f && a[3] == 1.0f) return 0.0;
+    return (fabs((double)a[0]) + fabs((double)a[1]) + fabs((double)a[2])) * big + fabs((double)a[3]);
+}
+
+static void bound_begin(om__lspace *ls, const om_view *v)
+{
+    const om_scene *s = ls->scene;
+    const double u8 = 8.0 / 16777216.0;   /* 8 roundings of 2^-24 each (occlude.h) */
+    double big = 0.0;
+    const float c[6] = {s->lo.x, s->lo.y, s->lo.z, s->hi.x, s->hi.y, s->hi.z};
+    for (int i = 0; i < 6; i++)
+        if (fabs((double)c[i]) > big) big = fabs((double)c[i]);
+    double sx = row_mag(&ls->vp, 0, big), sy = row_mag(&ls->vp, 1, big);
+    double sz = row_mag(&ls->vp, 2, big), sw = row_mag(&ls->vp, 3, big);
+    /* x/w, y/w reach 3 at the guard band's edge; z/w is clamped to [0, 1]. The grid has
+     * 2^20 units per unit of x/w, depth 2^32 per unit of z/w. */
+    ls->lat = u8 * ((sx > sy ? sx : sy) + 3.0 * sw) * 1048576.0;
+    ls->dep = u8 * (sz + sw) * 4294967296.0;
+    if (v->light.kind == OM_LIGHT_SPOT) {
+        /* z/w = -p10 + p11 / w for the perspective projection, so 1/w is affine in depth */
+        double p10 = v->light_proj.m[10], p11 = v->light_proj.m[11];
+        ls->iw0 = p10 / p11;
+        ls->iw1 = 1.0 / (p11 * 4294967296.0);
+    } else {
+        ls->iw0 = 1.0;
+        ls->iw1 = 0.0;
+    }
+}
+
+/* The snapping bound of a triangle whose nearest depth is zmin (occlude.h). */
+static double bound(const om__lspace *ls, const om__rtri *r)
+{
+    double iw = ls->iw0 + ls->iw1 * r->zmin;
+    if (!(iw > 0.0)) iw = 0.0;
+    return 2.0 * ((fabs(r->zx) + fabs(r->zy)) * (0.5 + ls->lat * iw) + ls->dep * iw);
+}
+
 void om__lspace_begin(om__lspace *ls, const om_view *v)
 {
     const om_scene *s = ls->scene;
     ls->vp = v->light_vp;
+    bound_begin(ls, v);
     for (uint32_t i = 0; ls->verts && i < s->nverts; i++) {
         om_vec4 c = om__mat_apply(&ls->vp, s->verts[i]);
         om__lvert *o = &ls->verts[i];
@@ -53,18 +97,20 @@ bool om__lspace_point(const om__lspace *ls, const om_sample *smp, om__lpoint *ou
     return om__project(&c, OM_LIGHT_GRID, OM_LIGHT_GRID, &out->x, &out->y, &out->z);
 }
 
-static void add_sub(om__ltri *lt, const int64_t x[3], const int64_t y[3], const double z[3])
+static void add_sub(const om__lspace *ls, om__ltri *lt, const int64_t x[3], const int64_t y[3],
+                    const double z[3])
 {
     om__rtri *r = &lt->sub[lt->n];
     if (!om__tri2_setup(&r->e, x, y, true)) return;
     om__rtri_plane(r, z);
+    double b = lt->bound[lt->n] = bound(ls, r);
     for (int i = 0; i < 3; i++) {
         if (x[i] < lt->lox) lt->lox = x[i];
         if (x[i] > lt->hix) lt->hix = x[i];
         if (y[i] < lt->loy) lt->loy = y[i];
         if (y[i] > lt->hiy) lt->hiy = y[i];
     }
-    if (r->zmin < lt->zmin) lt->zmin = r->zmin;
+    if (r->zmin + b < lt->zmin) lt->zmin = r->zmin + b;
     lt->n++;
 }
 
@@ -81,7 +127,7 @@ bool om__lspace_tri(const om__lspace *ls, uint32_t t, om__ltri *lt)
     if (a && a->x != INT32_MIN && b->x != INT32_MIN && c->x != INT32_MIN) {
         int64_t x[3] = {a->x, b->x, c->x}, y[3] = {a->y, b->y, c->y};
         double z[3] = {a->z, b->z, c->z};
-        add_sub(lt, x, y, z);
+        add_sub(ls, lt, x, y, z);
         return lt->n > 0;
     }
     om_vec4 clip[3];
@@ -96,7 +142,7 @@ bool om__lspace_tri(const om__lspace *ls, uint32_t t, om__ltri *lt)
     for (int k = 1; k + 1 < n; k++) {
         int64_t x[3] = {gx[0], gx[k], gx[k + 1]}, y[3] = {gy[0], gy[k], gy[k + 1]};
         double z[3] = {gz[0], gz[k], gz[k + 1]};
-        add_sub(lt, x, y, z);
+        add_sub(ls, lt, x, y, z);
     }
     return lt->n > 0;
 }

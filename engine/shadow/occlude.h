@@ -11,9 +11,32 @@
  *     top-left tie rule (a point on an edge shared by two occluders is inside exactly
  *     one of them), and
  *   - the triangle's light depth (z/w, the plane through its snapped vertices) at that
- *     point is strictly nearer the light than the sample's own light depth.
- * No epsilon or bias enters; only the light's frustum depth range bounds which
- * geometry casts, as it does for every shadow map. */
+ *     point, pushed back by the triangle's snapping bound (below), is strictly nearer
+ *     the light than the sample's own light depth.
+ * Only the light's frustum depth range bounds which geometry casts, as it does for
+ * every shadow map.
+ *
+ * The snapping bound: a surface never shadows itself. In exact geometry a sample on a
+ * surface is never behind that surface as seen from the light: not a coplanar
+ * neighbour (the floor's seams), nor the next facet of a convex solid, nor the facet
+ * the eye pass's snapping handed the pixel to instead of its true one (the sample then
+ * lies on its own facet's plane a sub-pixel past the shared edge, in front of the true
+ * facet on the lit side of a convex solid). Snapping and float rounding move both
+ * depths the predicate compares, by at most
+ *   - laterally, per axis: half a grid step for the snap of the sample's point and
+ *     another for the triangle's vertices, plus the float rounding of x/w and y/w;
+ *     times the triangle's depth gradient on the grid (|dz/dx| + |dz/dy|);
+ *   - in depth: the float rounding of z and w in the light's clip space (the float
+ *     matrix product: 4 roundings, the clipper's cut: 2 more, and the rounding of the
+ *     sample and the vertices to float: 1 each; 8 units of 2^-24 on the sum of the
+ *     terms' magnitudes, bounded with the scene box), over w.
+ * Each rounding term grows with 1/w, so the sample's own is at most the triangle's at
+ * its nearest vertex whenever the triangle is nearer at all; the bound is therefore
+ * twice the triangle's own (om__lspace_tri sets it per sub-triangle). A
+ * blocker must be nearer than the sample by more than that: depths closer than the
+ * grid and the float positions resolve are a tie, and a tie is lit. This is derived
+ * from the grid and the number formats, not tuned; in world units it is of the order
+ * of ten grid steps (2^-18 of the light's frustum), along the light's ray. */
 #ifndef OM_OCCLUDE_H
 #define OM_OCCLUDE_H
 
@@ -35,6 +58,10 @@ typedef struct om__lspace {
     const om_scene *scene;
     om_mat4 vp;            /* the light's world -> clip */
     om__lvert *verts;      /* scene->nverts projected once per frame; NULL: lean mode */
+    /* The snapping bound's parts for this frame (occlude.c, bound()): 1/w as an affine
+     * function of light depth, and the lateral (grid units) and depth rounding per
+     * unit of 1/w. */
+    double iw0, iw1, lat, dep;
 } om__lspace;
 
 /* Bytes of the per-frame vertex projection (om__lspace_init). */
@@ -49,13 +76,16 @@ void om__lspace_begin(om__lspace *ls, const om_view *v);
 /* Projects a sample; false when it is not in front of the light. */
 bool om__lspace_point(const om__lspace *ls, const om_sample *smp, om__lpoint *out);
 
-/* A triangle on the light's grid: up to 7 sub-triangles after clipping. */
+/* A triangle on the light's grid: up to 7 sub-triangles after clipping, each with its
+ * snapping bound. */
 typedef struct om__ltri {
     om__rtri sub[7];
+    double bound[7];
     int n;
     uint32_t tri;
     int64_t lox, loy, hix, hiy;   /* grid bounds of all sub-triangles */
-    double zmin;                  /* nearest light depth of the triangle */
+    double zmin;                  /* nearest light depth of the triangle, plus its bound:
+                                     it blocks no sample at this depth or farther */
 } om__ltri;
 
 /* Sets up triangle t; returns false when nothing of it is inside the light's frustum. */
@@ -83,7 +113,7 @@ static inline bool om__blocks(const om__ltri *lt, const om__lpoint *p)
     if (lt->tri == p->tri) return false;
     for (int k = 0; k < lt->n; k++) {
         const om__rtri *r = &lt->sub[k];
-        if (om__tri2_covers(&r->e, p->x, p->y)) return om__rtri_depth(r, p->x, p->y) < p->z;
+        if (om__tri2_covers(&r->e, p->x, p->y)) return om__rtri_depth(r, p->x, p->y) + lt->bound[k] < p->z;
     }
     return false;
 }
