@@ -11,8 +11,14 @@ CC      ?= cc
 OPT     ?= -O2
 O       ?= build
 WARN    = -std=c99 -Wall -Wextra -Wpedantic -Werror -Wshadow -Wstrict-prototypes
-# No FMA contraction, SSE not x87: frames must be bit-identical on every CPU.
-DETERM  = -ffp-contract=off
+# No FMA contraction, float arithmetic in float (FLT_EVAL_METHOD 0; engine/core/core.h
+# refuses other modes): frames must be bit-identical on every CPU. gcc says which
+# excess precision it keeps: "standard" rounds to float at every assignment and cast
+# (the default under -std=c99, not under -std=gnu*); s390x gcc's standard mode keeps
+# float in double, its fast mode computes in float, as the other CPUs do. clang has no
+# such flag (it computes in float wherever it does not use x87).
+CC_KIND := $(if $(shell $(CC) --version 2>/dev/null | grep -i clang),clang,$(shell $(CC) -dumpmachine 2>/dev/null))
+DETERM  = -ffp-contract=off $(if $(findstring clang,$(CC_KIND)),,$(if $(filter s390%,$(CC_KIND)),-fexcess-precision=fast,-fexcess-precision=standard))
 CFLAGS_ALL = $(WARN) $(DETERM) $(OPT) -g -Iinclude $(EXTRA)
 LDLIBS  = -lm
 

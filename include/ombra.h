@@ -13,9 +13,21 @@
  *
  * Coordinates: right-handed world space. Cameras look down -z of their view space.
  * Pixel (x, y) has its centre at (x + 0.5, y + 0.5); row 0 is the top row.
+ *
+ * Determinism: the same inputs give the same bits on every CPU and compiler when
+ * float arithmetic is evaluated in float (FLT_EVAL_METHOD == 0: SSE2, not x87, on
+ * i386; -fexcess-precision=fast with s390x gcc) and never contracted into FMA
+ * (-ffp-contract=off). The engine does not compile where FLT_EVAL_METHOD != 0 unless
+ * OM_ALLOW_EXCESS_PRECISION is defined (README, Determinism).
  */
 #ifndef OMBRA_H
 #define OMBRA_H
+
+/* The release this header belongs to (`ombra --version` prints the string). */
+#define OMBRA_VERSION_MAJOR 0
+#define OMBRA_VERSION_MINOR 1
+#define OMBRA_VERSION_PATCH 0
+#define OMBRA_VERSION_STRING "0.1.0"
 
 #include <stddef.h>
 #include <stdint.h>

@@ -6,6 +6,23 @@
 
 #include "ombra.h"
 
+#include <float.h>
+
+/* ---- determinism (README, Determinism): every engine file includes this header.
+ * Float arithmetic must be evaluated in float (FLT_EVAL_METHOD 0): x87 (2) and s390x
+ * gcc's standard mode (1) compute in a wider type, and the frames differ in their last
+ * bits from every other CPU's. OM_ALLOW_EXCESS_PRECISION builds anyway, outside that
+ * promise (every loop still ends). */
+#if FLT_EVAL_METHOD != 0 && !defined(OM_ALLOW_EXCESS_PRECISION)
+#error "ombra: FLT_EVAL_METHOD != 0 (x87 or s390x gcc): frames would differ from other CPUs; use -msse2 -mfpmath=sse on i386, -fexcess-precision=fast with s390x gcc, or define OM_ALLOW_EXCESS_PRECISION"
+#endif
+/* No a * b + c fused into one rounding (FMA) unless the source says so, even when the
+ * build forgets -ffp-contract=off. clang honours the pragma (not under
+ * -ffp-contract=fast); gcc ignores it with a warning, so gcc needs the flag. */
+#if defined(__clang__)
+#pragma STDC FP_CONTRACT OFF
+#endif
+
 /* ---- diagnostics: a bounded string builder (no stdio in the engine) */
 typedef struct om__str { char *buf; size_t cap, len; } om__str;
 

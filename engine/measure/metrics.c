@@ -2,7 +2,7 @@
  * share, false lit and false shadowed, the same in a band around the reference's
  * shadow edges, difference images, and flicker along a path. Masks in, counts out:
  * any two masks of one frame compare, whichever method made them. */
-#include "ombra.h"
+#include "../core/core.h"   /* the determinism checks every engine file has */
 
 #include <string.h>
 
