@@ -23,6 +23,12 @@
 #ifndef OMBRA_H
 #define OMBRA_H
 
+/* The release this header belongs to (`ombra --version` prints the string). */
+#define OMBRA_VERSION_MAJOR 0
+#define OMBRA_VERSION_MINOR 1
+#define OMBRA_VERSION_PATCH 0
+#define OMBRA_VERSION_STRING "0.1.0"
+
 #include <stddef.h>
 #include <stdint.h>
 #include <stdbool.h>

@@ -1,4 +1,5 @@
-/* file.c — whole-file reads for the host, and an om_loader over them. */
+/* file.c — whole-file reads for the host, and an om_loader over them that reads each
+ * file once. */
 #include "platform.h"
 
 #include <errno.h>
@@ -45,29 +46,50 @@ om_status om_file_read(const char *path, char **data, size_t *len, om_diag *d)
     return OM_OK;
 }
 
-void om_file_loader_init(om_file_loader *fl, const char *scene_path)
+om_status om_file_loader_init(om_file_loader *fl, const char *scene_path)
 {
     memset(fl, 0, sizeof *fl);
     const char *slash = scene_path ? strrchr(scene_path, '/') : NULL;
-    if (slash && (size_t)(slash - scene_path) + 2 < sizeof fl->base) {
-        memcpy(fl->base, scene_path, (size_t)(slash - scene_path) + 1);
-        fl->base[slash - scene_path + 1] = '\0';
+    if (slash) {
+        size_t n = (size_t)(slash - scene_path) + 1;
+        if (!(fl->base = malloc(n + 1))) return OM_E_IO;
+        memcpy(fl->base, scene_path, n);
+        fl->base[n] = '\0';
     }
+    return OM_OK;
 }
 
 static om_status load(void *user, const char *name, const char **data, size_t *len)
 {
     om_file_loader *fl = (om_file_loader *)user;
-    char path[2048];
     om_diag local;
-    if (fl->nbufs == (int)(sizeof fl->bufs / sizeof fl->bufs[0])) return OM_E_INVALID;
-    if (name[0] == '/') snprintf(path, sizeof path, "%s", name);
-    else snprintf(path, sizeof path, "%s%s", fl->base, name);
-    char *buf;
-    om_status st = om_file_read(path, &buf, len, fl->diag ? fl->diag : &local);
-    if (st != OM_OK) return st;
-    fl->bufs[fl->nbufs++] = buf;
-    *data = buf;
+    om_diag *d = fl->diag ? fl->diag : &local;
+    size_t nb = name[0] != '/' && fl->base ? strlen(fl->base) : 0, nn = strlen(name);
+    char *path = malloc(nb + nn + 1);
+    if (!path) return OM_E_IO;
+    if (nb) memcpy(path, fl->base, nb);
+    memcpy(path + nb, name, nn + 1);
+    for (size_t i = 0; i < fl->nfiles; i++)
+        if (!strcmp(fl->files[i].path, path)) {
+            free(path);
+            *data = fl->files[i].data;
+            *len = fl->files[i].len;
+            return OM_OK;
+        }
+    if (fl->nfiles == fl->cap) {
+        size_t cap = fl->cap ? 2 * fl->cap : 8;
+        om_file_entry *more = realloc(fl->files, cap * sizeof *more);
+        if (!more) { free(path); return OM_E_IO; }
+        fl->files = more;
+        fl->cap = cap;
+    }
+    om_file_entry *e = &fl->files[fl->nfiles];
+    om_status st = om_file_read(path, &e->data, &e->len, d);
+    if (st != OM_OK) { free(path); return st; }
+    e->path = path;
+    fl->nfiles++;
+    *data = e->data;
+    *len = e->len;
     return OM_OK;
 }
 
@@ -81,6 +103,11 @@ om_loader om_file_loader_get(om_file_loader *fl)
 
 void om_file_loader_free(om_file_loader *fl)
 {
-    for (int i = 0; i < fl->nbufs; i++) free(fl->bufs[i]);
-    fl->nbufs = 0;
+    for (size_t i = 0; i < fl->nfiles; i++) {
+        free(fl->files[i].path);
+        free(fl->files[i].data);
+    }
+    free(fl->files);
+    free(fl->base);
+    memset(fl, 0, sizeof *fl);
 }

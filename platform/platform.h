@@ -1,5 +1,6 @@
 /* platform.h — what touches the operating system: reading files, a monotonic clock,
- * and PPM/PGM sinks that stream a frame row by row. Hosts without an OS (the Cortex-M
+ * output files that appear whole or not at all, and PPM/PGM sinks that stream a
+ * frame row by row. Hosts without an OS (the Cortex-M
  * build) replace this directory's .c files; the engine never calls them. */
 #ifndef OM_PLATFORM_H
 #define OM_PLATFORM_H
@@ -12,44 +13,94 @@
  * the file and the system's reason. */
 om_status om_file_read(const char *path, char **data, size_t *len, om_diag *d);
 
-/* An om_loader that reads files relative to a base directory and keeps them until
- * om_file_loader_free. */
+/* An om_loader that reads files relative to the scene file's directory. Each file is
+ * read once and kept until om_file_loader_free, however many passes or `mesh` lines
+ * ask for it (so a FIFO works and a file changing between passes cannot make them
+ * disagree); there is no limit on how many files. */
+typedef struct om_file_entry {
+    char *path;            /* as resolved: base + name, or name when absolute */
+    char *data;
+    size_t len;
+} om_file_entry;
+
 typedef struct om_file_loader {
-    char base[1024];
-    char *bufs[64];
-    int nbufs;
-    om_diag *diag;
+    char *base;            /* the scene's directory with its '/', or NULL */
+    om_file_entry *files;
+    size_t nfiles, cap;
+    om_diag *diag;         /* where a failed read's message goes; may be NULL */
 } om_file_loader;
 
-void om_file_loader_init(om_file_loader *fl, const char *scene_path);
+/* OM_E_IO only when out of memory (scene_path may be NULL: the current directory). */
+om_status om_file_loader_init(om_file_loader *fl, const char *scene_path);
 om_loader om_file_loader_get(om_file_loader *fl);
 void om_file_loader_free(om_file_loader *fl);
 
 /* Nanoseconds from a monotonic clock (an om_clock_fn; user is unused). */
 uint64_t om_clock_ns(void *user);
 
-/* A sink writing a binary PPM (P6) of the shaded frame and, optionally, a PGM (P5)
- * shadow mask: 255 lit, 0 shadowed, 128 background. Rows are written as strips
- * arrive, so a frame never needs to be whole in memory. */
+/* An output file a reader never sees half-written (out.c). A regular file, or a name
+ * not yet taken, is written to a temporary beside it ("DIR/.NAME.XXXXXX") that
+ * om_out_commit flushes, fsyncs and renames over it; any failure removes the
+ * temporary and leaves the old file's bytes alone. "-" (standard output), names under
+ * /dev/ and /proc/, and anything that is not a regular file (a FIFO, a device) are
+ * written directly. Errors name the path and give the system's reason. */
+typedef struct om_out {
+    FILE *f;               /* NULL when not open */
+    const char *path;      /* as the caller named it (kept, not copied) */
+    char *target, *tmp;    /* the file a rename replaces and its temporary; NULL if direct */
+    int err;               /* the first errno a write saw, else 0 */
+    bool direct, is_stdout;
+} om_out;
+
+om_status om_out_open(om_out *o, const char *path, om_diag *d);
+/* Writes n bytes; after the first failure every write fails (om_out_failed says why). */
+bool om_out_write(om_out *o, const void *p, size_t n);
+/* OM_E_IO naming the path and the reason when a write has failed, else OM_OK. */
+om_status om_out_failed(const om_out *o, om_diag *d);
+/* Finishes every open file of outs (NULL entries and closed ones are skipped); only
+ * when all were written whole are the temporaries renamed over their targets, so a
+ * set of outputs (an image and its mask) is replaced together or not at all. */
+om_status om_out_commit(om_out *const *outs, size_t n, om_diag *d);
+/* Closes without keeping anything: the temporary is removed (a direct file keeps
+ * what already reached it). Safe on a closed or zeroed om_out. */
+void om_out_discard(om_out *o);
+/* Whether a path is written directly rather than through a temporary. */
+bool om_out_is_direct(const char *path);
+/* Whether two names reach the same file ("-" is standard output; /dev/null is never
+ * "the same" as itself: discarding twice loses nothing). */
+bool om_out_same(const char *a, const char *b);
+
+/* A sink writing a binary PPM (P6) of the shaded frame, or a PGM (P5) when `grey`, and,
+ * optionally, a PGM shadow mask: 255 lit, 0 shadowed, 128 background. Rows are
+ * written as strips arrive, so a frame never needs to be whole in memory; the files
+ * appear only when om_ppm_close commits them. */
 typedef struct om_ppm_sink {
-    FILE *img, *mask;
-    const char *img_path, *mask_path;
+    om_out img, mask;      /* .f NULL when not asked for */
     unsigned char *row;    /* one row of conversion scratch (3 * width bytes) */
     uint32_t width, height;
+    bool grey;
     uint64_t hash_img, hash_mask;   /* FNV-1a of the pixel rows written (not headers) */
 } om_ppm_sink;
 
-/* Opens the files (mask_path may be NULL) and writes the headers. */
+/* Opens the files (either path may be NULL) and writes the headers; on failure
+ * nothing stays open and om_ppm_discard is harmless. */
 om_status om_ppm_open(om_ppm_sink *k, const char *img_path, const char *mask_path,
-                      uint32_t width, uint32_t height, om_diag *d);
-/* An om_strip_fn: pass the sink as `user`. */
+                      uint32_t width, uint32_t height, bool grey, om_diag *d);
+/* An om_strip_fn: pass the sink as `user`. A failed write stops the frame with
+ * OM_E_IO; om_out_failed(&k->img or &k->mask) then names the file and reason. */
 om_status om_ppm_strip(void *user, const om_strip *st, const om_framebuffer *fb);
-/* Flushes and closes; reports a write error with the file's name. */
+/* Commits both files (om_out_commit) and frees the scratch. */
 om_status om_ppm_close(om_ppm_sink *k, om_diag *d);
+/* Drops both files and frees the scratch; old files stay as they were. */
+void om_ppm_discard(om_ppm_sink *k);
+/* The first write error of either file, naming it, or OM_OK. */
+om_status om_ppm_failed(const om_ppm_sink *k, om_diag *d);
 
 /* Reads a binary PGM (P5, maxval 255) into a malloc'd buffer. */
 om_status om_pgm_read(const char *path, uint32_t *w, uint32_t *h, uint8_t **pixels, om_diag *d);
-/* Writes a whole RGB888 image as a binary PPM. */
+/* Writes a whole RGB888 image as a binary PPM into an open output. */
+bool om_ppm_put(om_out *o, const uint8_t *rgb, uint32_t w, uint32_t h);
+/* Writes a whole RGB888 image as a binary PPM file (om_out: old file kept on failure). */
 om_status om_ppm_write(const char *path, const uint8_t *rgb, uint32_t w, uint32_t h, om_diag *d);
 
 /* Converts one framebuffer row to RGB888. */

@@ -1,8 +1,8 @@
 /* ppm.c — PPM (P6) and PGM (P5) sinks that write each strip as it arrives, plus the
- * shadow mask. A framebuffer in RGB565 or L8 is widened to RGB888 for the PPM. */
+ * shadow mask, through om_out (out.c): the files appear whole or not at all. A
+ * framebuffer in RGB565 is widened to RGB888 for the PPM; an L8 one may go to a PGM. */
 #include "platform.h"
 
-#include <errno.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -26,67 +26,83 @@ void om_row_to_rgb(const om_framebuffer *fb, uint32_t y, unsigned char *rgb)
     }
 }
 
-static om_status io_fail(om_diag *d, const char *path, const char *what)
+static om_status oom(om_diag *d, const char *path)
 {
     if (d) {
         d->status = OM_E_IO;
-        snprintf(d->msg, sizeof d->msg, "%s: %s: %s", path, what, strerror(errno));
+        snprintf(d->msg, sizeof d->msg, "%s: out of memory", path);
     }
     return OM_E_IO;
 }
 
+/* Opens one output and writes its header; NULL path: nothing to open. */
+static om_status open_one(om_out *o, const char *path, char kind, uint32_t w, uint32_t h, om_diag *d)
+{
+    if (!path) return OM_OK;
+    om_status st = om_out_open(o, path, d);
+    if (st != OM_OK) return st;
+    char hdr[64];
+    int n = snprintf(hdr, sizeof hdr, "P%c\n%u %u\n255\n", kind, w, h);
+    om_out_write(o, hdr, (size_t)n);
+    return om_out_failed(o, d);
+}
+
 om_status om_ppm_open(om_ppm_sink *k, const char *img_path, const char *mask_path,
-                      uint32_t width, uint32_t height, om_diag *d)
+                      uint32_t width, uint32_t height, bool grey, om_diag *d)
 {
     memset(k, 0, sizeof *k);
     k->width = width;
     k->height = height;
-    k->img_path = img_path;
-    k->mask_path = mask_path;
+    k->grey = grey;
     k->hash_img = k->hash_mask = OM_HASH_INIT;
     k->row = malloc((size_t)width * 3);
-    if (!k->row) return io_fail(d, img_path ? img_path : "-", "out of memory");
-    if (img_path) {
-        k->img = fopen(img_path, "wb");
-        if (!k->img) return io_fail(d, img_path, "cannot create");
-        fprintf(k->img, "P6\n%u %u\n255\n", width, height);
-    }
-    if (mask_path) {
-        k->mask = fopen(mask_path, "wb");
-        if (!k->mask) return io_fail(d, mask_path, "cannot create");
-        fprintf(k->mask, "P5\n%u %u\n255\n", width, height);
-    }
-    return OM_OK;
+    om_status st = k->row ? OM_OK : oom(d, img_path ? img_path : mask_path ? mask_path : "-");
+    if (st == OM_OK) st = open_one(&k->img, img_path, grey ? '5' : '6', width, height, d);
+    if (st == OM_OK) st = open_one(&k->mask, mask_path, '5', width, height, d);
+    if (st != OM_OK) om_ppm_discard(k);
+    return st;
 }
 
 om_status om_ppm_strip(void *user, const om_strip *st, const om_framebuffer *fb)
 {
     om_ppm_sink *k = (om_ppm_sink *)user;
+    if (k->grey && fb->format != OM_L8) return OM_E_INVALID;
     for (uint32_t y = 0; y < st->rows; y++) {
-        om_row_to_rgb(fb, y, k->row);
-        k->hash_img = om_hash(k->hash_img, k->row, (size_t)st->width * 3);
-        if (k->img && fwrite(k->row, 3, st->width, k->img) != st->width) return OM_E_IO;
+        size_t n = (size_t)st->width * (k->grey ? 1 : 3);
+        if (k->grey) memcpy(k->row, fb->pixels + (size_t)y * fb->stride, n);
+        else om_row_to_rgb(fb, y, k->row);
+        k->hash_img = om_hash(k->hash_img, k->row, n);
+        if (k->img.f && !om_out_write(&k->img, k->row, n)) return OM_E_IO;
         for (uint32_t x = 0; x < st->width; x++)
             k->row[x] = om_mask_of(&st->samples[(size_t)y * st->width + x],
                                    &st->terms[(size_t)y * st->width + x]);
         k->hash_mask = om_hash(k->hash_mask, k->row, st->width);
-        if (k->mask && fwrite(k->row, 1, st->width, k->mask) != st->width) return OM_E_IO;
+        if (k->mask.f && !om_out_write(&k->mask, k->row, st->width)) return OM_E_IO;
     }
     return OM_OK;
 }
 
+om_status om_ppm_failed(const om_ppm_sink *k, om_diag *d)
+{
+    om_status st = om_out_failed(&k->img, d);
+    return st != OM_OK ? st : om_out_failed(&k->mask, d);
+}
+
 om_status om_ppm_close(om_ppm_sink *k, om_diag *d)
 {
-    om_status st = OM_OK;
-    if (k->img && (fflush(k->img) != 0 || ferror(k->img))) st = io_fail(d, k->img_path, "write failed");
-    if (k->img && fclose(k->img) != 0 && st == OM_OK) st = io_fail(d, k->img_path, "close failed");
-    if (k->mask && (fflush(k->mask) != 0 || ferror(k->mask)) && st == OM_OK)
-        st = io_fail(d, k->mask_path, "write failed");
-    if (k->mask && fclose(k->mask) != 0 && st == OM_OK) st = io_fail(d, k->mask_path, "close failed");
+    om_out *outs[2] = {&k->img, &k->mask};
+    om_status st = om_out_commit(outs, 2, d);
     free(k->row);
-    k->img = k->mask = NULL;
     k->row = NULL;
     return st;
+}
+
+void om_ppm_discard(om_ppm_sink *k)
+{
+    om_out_discard(&k->img);
+    om_out_discard(&k->mask);
+    free(k->row);
+    k->row = NULL;
 }
 
 /* A PGM header token: skips whitespace and '#' comments; false on anything else. */
@@ -132,13 +148,23 @@ om_status om_pgm_read(const char *path, uint32_t *w, uint32_t *h, uint8_t **pixe
     return OM_OK;
 }
 
+bool om_ppm_put(om_out *o, const uint8_t *rgb, uint32_t w, uint32_t h)
+{
+    char hdr[64];
+    int n = snprintf(hdr, sizeof hdr, "P6\n%u %u\n255\n", w, h);
+    return om_out_write(o, hdr, (size_t)n) && om_out_write(o, rgb, (size_t)w * h * 3);
+}
+
 om_status om_ppm_write(const char *path, const uint8_t *rgb, uint32_t w, uint32_t h, om_diag *d)
 {
-    FILE *f = fopen(path, "wb");
-    if (!f) return io_fail(d, path, "cannot create");
-    fprintf(f, "P6\n%u %u\n255\n", w, h);
-    size_t n = (size_t)w * h * 3;
-    bool ok = fwrite(rgb, 1, n, f) == n;
-    ok = fclose(f) == 0 && ok;
-    return ok ? OM_OK : io_fail(d, path, "write failed");
+    om_out o;
+    om_status st = om_out_open(&o, path, d);
+    if (st != OM_OK) return st;
+    om_out *outs[1] = {&o};
+    if (!om_ppm_put(&o, rgb, w, h)) {
+        st = om_out_failed(&o, d);
+        om_out_discard(&o);
+        return st;
+    }
+    return om_out_commit(outs, 1, d);
 }

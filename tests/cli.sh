@@ -97,7 +97,7 @@ expect 1 "compare a non-PGM" -- "$OMBRA" compare "$dir/ref.pgm" "$dir/ok.scene"
 has "$dir/err" "ok.scene" "bad mask file named"
 
 # A small sweep: one CSV row per point with every column filled, well-formed SVG.
-expect 0 "bench sweep" -- "$OMBRA" bench --scenes "$dir/ok.scene" --size 48x36 --runs 1 --methods ref,izb --out "$dir/bench"
+expect 0 "bench sweep" -- "$OMBRA" bench --scenes "$dir/ok.scene" --runs 1 --methods ref,izb --out "$dir/bench"
 rows=$(tail -n +2 "$dir/bench/bench.csv" | wc -l)
 if [ "$rows" -eq 4 ]; then ok; else bad "bench.csv has $rows rows, wanted 4 (ref + 3 izb pools)"; fi
 if awk -F, 'NR == 1 {n = NF} NF != n {exit 1} {for (i = 1; i <= NF; i++) if ($i == "") exit 1}' "$dir/bench/bench.csv"; then ok; else bad "bench.csv has empty or missing columns"; fi
@@ -111,6 +111,123 @@ if grep -q '<svg' "$dir/report/index.html" && grep -q 'data:image/png;base64' "$
 if command -v xmllint >/dev/null 2>&1; then
     xmllint --noout "$dir/report/index.html" && ok || bad "report page is not well-formed"
 fi
+
+# Nothing lost: every output is written to a temporary beside it and renamed over the
+# old file only once whole, so a later failure, a kill or a full device leaves the old
+# file's bytes; streams and devices are written directly, with errors naming the path.
+cp "$dir/a.ppm" "$dir/good.ppm"
+cp "$dir/a.ppm" "$dir/keep.ppm"
+leftovers() { ls -A "$dir" | grep '^\.' ; }
+expect 1 "a failing mask leaves the old image" -- "$OMBRA" render --size 64x48 --out "$dir/good.ppm" --mask "$dir/no/such/m.pgm"
+has "$dir/err" "m.pgm: cannot create: No such file or directory" "failed output named with its reason"
+if grep -q "input/output error" "$dir/err"; then bad "a missing directory reads as an I/O error"; else ok; fi
+cmp -s "$dir/good.ppm" "$dir/keep.ppm" && ok || bad "the old image was damaged by a failed render"
+expect 1 "a render onto a full device" -- "$OMBRA" render --size 64x48 --out /dev/full
+has "$dir/err" "/dev/full: cannot write: No space left on device" "full device named, with the reason"
+# killed midway (a file-size limit kills it while it writes): the old file survives whole
+(ulimit -f 20; "$OMBRA" render --size 160x120 --out "$dir/good.ppm" -q; echo $? >"$dir/code") >/dev/null 2>&1
+if [ "$(cat "$dir/code")" -ne 0 ]; then ok; else bad "a render over the file-size limit succeeded"; fi
+cmp -s "$dir/good.ppm" "$dir/keep.ppm" && ok || bad "a killed render damaged the old image"
+if [ -z "$(leftovers)" ]; then ok; else bad "temporaries left behind: $(leftovers)"; fi
+expect 2 "--out and --mask the same file" -- "$OMBRA" render --size 16x12 --out "$dir/good.ppm" --mask "$dir/./good.ppm"
+has "$dir/err" "same file" "the same path twice explained"
+cmp -s "$dir/good.ppm" "$dir/keep.ppm" && ok || bad "--out x --mask x damaged x"
+expect 2 "--diff over --out" -- "$OMBRA" render --size 16x12 --against ref --out "$dir/good.ppm" --diff "$dir/good.ppm"
+expect 2 "--out over the scene" -- "$OMBRA" render "$dir/ok.scene" --out "$dir/ok.scene"
+has "$dir/ok.scene" "mesh m.obj" "the scene survives --out over it"
+expect 0 "--out /dev/null --mask /dev/null" -- "$OMBRA" render --size 16x12 --out /dev/null --mask /dev/null
+# '-' is standard output; the report then goes to standard error
+"$OMBRA" render --size 16x12 --out - >"$dir/stdout.ppm" 2>"$dir/err"
+if [ $? -eq 0 ] && [ "$(wc -c <"$dir/stdout.ppm")" -eq $((13 + 16 * 12 * 3)) ] && [ "$(head -c 2 "$dir/stdout.ppm")" = "P6" ]; then ok; else bad "--out - is not the image alone on standard output"; fi
+has "$dir/err" "hash:" "with --out - the report goes to standard error"
+expect 0 "reference 16x12 image" -- "$OMBRA" render --size 16x12 --out "$dir/r16.ppm"
+cmp -s "$dir/stdout.ppm" "$dir/r16.ppm" && ok || bad "--out - differs from the file"
+if command -v mkfifo >/dev/null 2>&1; then
+    rm -f "$dir/fifo"
+    mkfifo "$dir/fifo"
+    cat "$dir/fifo" >"$dir/fifo.ppm" &
+    expect 0 "render into a FIFO" -- "$OMBRA" render --size 16x12 --out "$dir/fifo"
+    wait
+    cmp -s "$dir/fifo.ppm" "$dir/r16.ppm" && ok || bad "the FIFO got other bytes"
+    rm -f "$dir/fifo"
+fi
+# two renders racing to one name: the file is one of them whole, never a mix
+expect 0 "reference 160x120 image" -- "$OMBRA" render --size 160x120 --out "$dir/r160.ppm"
+"$OMBRA" render --size 160x120 --out "$dir/race.ppm" -q & p1=$!
+"$OMBRA" render --size 16x12 --out "$dir/race.ppm" -q & p2=$!
+wait $p1; r1=$?; wait $p2; r2=$?
+if [ $r1 -eq 0 ] && [ $r2 -eq 0 ] && { cmp -s "$dir/race.ppm" "$dir/r160.ppm" || cmp -s "$dir/race.ppm" "$dir/r16.ppm"; }; then ok; else bad "racing renders left a mixed file"; fi
+if [ -z "$(leftovers)" ]; then ok; else bad "temporaries left behind: $(leftovers)"; fi
+
+# Grey frames are PGM files.
+expect 0 "--format l8 writes a PGM" -- "$OMBRA" render --size 16x12 --format l8 --out "$dir/grey.pgm"
+if [ "$(head -c 2 "$dir/grey.pgm")" = "P5" ] && [ "$(wc -c <"$dir/grey.pgm")" -eq $((13 + 16 * 12)) ]; then ok; else bad "--format l8 did not write a 16x12 PGM"; fi
+
+# Budgets: 0 is refused, 'none' is spelled out.
+expect 2 "--budget 0" -- "$OMBRA" render --size 16x12 --budget 0 --out "$dir/z.ppm"
+has "$dir/err" "none" "--budget 0 points at 'none'"
+expect 0 "--budget none" -- "$OMBRA" render --size 16x12 --budget none --out "$dir/z.ppm"
+expect 1 "asm under a small budget" -- "$OMBRA" render --size 64x48 --method asm --budget 100K --out "$dir/z.ppm"
+has "$dir/err" "asm.cap" "asm's budget hint names asm.cap"
+if grep -q -- "--map" "$dir/err"; then bad "asm's budget hint suggests --map"; else ok; fi
+
+# Messages say a thing once, and help is everywhere.
+expect 2 "unknown setting" -- "$OMBRA" render --set foo=1
+if [ "$(grep -o "see 'ombra methods'" "$dir/err" | wc -l)" -eq 1 ]; then ok; else bad "unknown setting: $(cat "$dir/err")"; fi
+expect 1 "missing scene, once named" -- "$OMBRA" render "$dir/none.scene"
+if grep -q "none.scene: .*none.scene" "$dir/err"; then bad "the scene is named twice: $(cat "$dir/err")"; else ok; fi
+expect 2 "unknown method near a real one" -- "$OMBRA" render --method asn
+has "$dir/err" "did you mean 'asm'" "unknown method suggests the nearest"
+has "$dir/err" "izb" "unknown method lists the methods"
+expect 0 "--version" -- "$OMBRA" --version
+if grep -q '^ombra [0-9][0-9]*\.[0-9][0-9]*\.[0-9][0-9]*$' "$dir/out"; then ok; else bad "--version: $(cat "$dir/out")"; fi
+expect 0 "methods" -- "$OMBRA" methods
+if grep -q '^  bias  *0\.01  ' "$dir/out" && ! grep -q '0\.0099' "$dir/out"; then ok; else bad "methods prints bias as $(grep bias "$dir/out")"; fi
+if [ "$(awk '/^settings/ {s = 1; next} s {match($0, /^  [^ ]+ +[^ ]+ +/); print RLENGTH}' "$dir/out" | sort -u | wc -l)" -eq 1 ]; then ok; else bad "methods' settings are not in aligned columns"; fi
+for c in render info compare bench report methods scene; do
+    expect 0 "$c --help" -- "$OMBRA" $c --help
+    has "$dir/out" "usage: ombra $c" "$c --help prints its usage"
+done
+expect 2 "methods with an argument" -- "$OMBRA" methods sm
+
+# Meshes: each read once (a FIFO works), any number of them, long directories.
+awk 'BEGIN {print "camera eye 0 2 5 target 0 0 0 size 32 24"; for (i = 0; i < 70; i++) printf "mesh m%d.obj translate %d 0 0\n", i, i % 5}' >"$dir/many.scene"
+i=0; while [ $i -lt 70 ]; do cp "$dir/m.obj" "$dir/m$i.obj"; i=$((i + 1)); done
+expect 0 "70 meshes" -- "$OMBRA" render "$dir/many.scene" --out "$dir/many.ppm"
+has "$dir/out" "210 triangles" "70 meshes of 3 triangles"
+if command -v mkfifo >/dev/null 2>&1; then
+    rm -f "$dir/mesh.fifo"
+    mkfifo "$dir/mesh.fifo"
+    printf 'camera eye 0 2 5 target 0 0 0 size 32 24\nmesh mesh.fifo\n' >"$dir/fifo.scene"
+    cat "$dir/m.obj" >"$dir/mesh.fifo" &
+    tmo=$(command -v timeout >/dev/null 2>&1 && echo "timeout 60")
+    expect 0 "a mesh that is a FIFO (read once)" -- $tmo "$OMBRA" render "$dir/fifo.scene" --out "$dir/fifo-mesh.ppm"
+    has "$dir/out" "3 triangles" "the FIFO mesh loaded"
+    kill $! 2>/dev/null; wait 2>/dev/null
+    rm -f "$dir/mesh.fifo"
+fi
+long="$dir/long"
+while [ ${#long} -lt 1300 ]; do long="$long/dddddddddddddddddddddddddddddddddddddddddddddddddddddddddddddddddddddddddddddd"; done
+mkdir -p "$long"
+cp "$dir/ok.scene" "$dir/m.obj" "$long/"
+expect 0 "a scene under a 1.3 KB directory finds its mesh there" -- "$OMBRA" render "$long/ok.scene" --out "$dir/long.ppm"
+has "$dir/out" "5 triangles" "the long directory's mesh loaded"
+
+# bench and report: names checked before any work, a failed run writes nothing, the
+# method's init is its own stage, and a scene file renders at its own size.
+expect 2 "bench --methods foo" -- "$OMBRA" bench --scenes "$dir/ok.scene" --methods foo --out "$dir/bench-foo"
+has "$dir/err" "unknown method 'foo'" "bench names the unknown method"
+if [ -e "$dir/bench-foo/bench.csv" ]; then bad "bench --methods foo wrote a CSV"; else ok; fi
+expect 2 "report --scenes nosuch.scene" -- "$OMBRA" report --scenes "$dir/nosuch.scene" --out "$dir/report-none"
+if [ -e "$dir/report-none/bench.csv" ] || [ -e "$dir/report-none/index.html" ] || grep -q wrote "$dir/out"; then bad "a failed report wrote files"; else ok; fi
+cp "$dir/bench/bench.csv" "$dir/bench-old.csv"
+expect 1 "bench on a malformed scene" -- "$OMBRA" bench --scenes "$dir/ok.scene,$dir/bad.scene" --runs 1 --methods izb --out "$dir/bench"
+cmp -s "$dir/bench/bench.csv" "$dir/bench-old.csv" && ok || bad "a failed bench replaced the CSV"
+has "$dir/bench/bench.csv" "^scene,method,setting,width,height,time_ms,init_ms," "bench.csv has an init column"
+if awk -F, 'NR > 1 && ($4 != 64 || $5 != 48) {exit 1}' "$dir/bench/bench.csv"; then ok; else bad "bench ignored the scene's 64x48"; fi
+if [ -s "$dir/bench/ok.scene-first.svg" ]; then ok; else bad "no first-frame (init + frame) chart"; fi
+expect 0 "render --method ref" -- "$OMBRA" render --size 16x12 --method ref --out "$dir/z.ppm"
+has "$dir/out" "^time: total [0-9.]* ms (init [0-9.]*, eye" "the time line shows init"
 
 # Frame hashes of every method on the default scene, for the cross-build comparison
 # that `make test` runs (the same frames from every compiler and optimisation level).

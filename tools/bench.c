@@ -3,8 +3,11 @@
  * CSV the median frame time per stage, the method's peak arena bytes and its accuracy
  * against the reference on the same visible samples; then draws the charts: mismatch
  * share against time per frame and against bytes (each method a series, its Pareto
- * front dashed) and, for the exact methods, time against triangle count. A method
- * joins every table and chart by its registry entry alone. */
+ * front dashed), against the first frame's time (the method's init, where ref builds
+ * its BVH, plus a frame) and, for the exact methods, the first frame's time against
+ * triangle count. A method joins every table and chart by its registry entry alone.
+ * Names are checked before any work; a run that fails writes nothing, and the files
+ * of one that succeeds replace the old ones together (om_out). */
 #define _POSIX_C_SOURCE 200809L
 #include "cli.h"
 #include "svg.h"
@@ -25,7 +28,7 @@ static const char bench_help[] =
     "  --scenes LIST     comma-separated: default, random-1K, random-10K, random-100K,\n"
     "                    random-1M, or scene files (default: default,random-10K)\n"
     "  --methods LIST    comma-separated method names (default: every swept method)\n"
-    "  --size WxH        image size (default 640x480)\n"
+    "  --size WxH        image size (default: each scene's own camera size)\n"
     "  --runs N          frames per point; times are their median (default 3)\n"
     "  --tri-sweep       also time the exact methods on 1K..1M random triangles\n"
     "  --out DIR         where bench.csv and the charts go (default out/bench)\n";
@@ -48,6 +51,12 @@ static const char *random_scene(const char *name, char *buf, size_t n)
     return buf;
 }
 
+bool cli_builtin_scene(const char *name)
+{
+    char text[512];
+    return !strcmp(name, "default") || random_scene(name, text, sizeof text) != NULL;
+}
+
 om_status cli_load_named(const char *name, cli_scene *cs, om_diag *d)
 {
     char text[512];
@@ -59,6 +68,7 @@ om_status cli_load_named(const char *name, cli_scene *cs, om_diag *d)
     om_status st = om_scene_bytes(r, len, NULL, &cs->bytes, d);
     if (st) return st;
     cs->mem = malloc(cs->bytes ? cs->bytes : 1);
+    if (!cs->mem) return cli_oom(d);
     om_arena_init(&cs->arena, cs->mem, cs->bytes, "scene");
     return om_scene_parse(r, len, NULL, &cs->arena, &cs->scene, d);
 }
@@ -107,7 +117,12 @@ om_status cli_measure(const om_method *m, const om_method_cfg *cfg, const cli_sc
     void *state;
     double t[5][16];
     if (runs > 16) runs = 16;
+    /* init is a stage of its own: a user pays it whenever the scene changes */
+    uint64_t t0 = om_clock_ns(NULL);
     st = m->init(&state, &ma, cfg, &cs->scene, W, H, d);
+    p->init = (double)(om_clock_ns(NULL) - t0) / 1e6;
+    p->w = W;
+    p->h = H;
     for (int r = 0; r < runs && st == OM_OK; r++) {
         om_shade_cfg shade;
         om_shade_cfg_default(&shade);
@@ -214,10 +229,11 @@ static void progress(int i, int n, const cli_point *p)
     else fprintf(stderr, "[%d/%d] %s %s %s\n", i, n, p->scene, p->method, p->setting);
 }
 
-static void chart(const char *dir, const char *file, const svg_chart *c, cli_point *pts, int n,
-                  const char *scene, int ykind, int xkind)
+/* One chart of a scene's points, mismatch share against x: 0 time per frame, 1 method
+ * bytes, 2 the first frame (init + frame); each method a series. */
+static bool chart(om_out *o, const svg_chart *c, const cli_point *pts, int n, const char *scene,
+                  int xkind)
 {
-    /* one series per method, over this scene's points */
     svg_series s[16];
     static double xs[16][64], ys[16][64];
     static const char *labels[16][64];
@@ -227,9 +243,9 @@ static void chart(const char *dir, const char *file, const svg_chart *c, cli_poi
         size_t np = 0;
         for (int i = 0; i < n && np < 64; i++) {
             if (!pts[i].ok || strcmp(pts[i].method, m->name) || strcmp(pts[i].scene, scene)) continue;
-            double share = 1.0 - om_metrics_match(&pts[i].m);
-            xs[ns][np] = xkind == 0 ? pts[i].total : (double)pts[i].bytes;
-            ys[ns][np] = ykind == 0 ? share : pts[i].total;
+            xs[ns][np] = xkind == 0 ? pts[i].total : xkind == 1 ? (double)pts[i].bytes
+                                                                : pts[i].init + pts[i].total;
+            ys[ns][np] = 1.0 - om_metrics_match(&pts[i].m);
             labels[ns][np] = pts[i].setting;
             np++;
         }
@@ -241,17 +257,138 @@ static void chart(const char *dir, const char *file, const svg_chart *c, cli_poi
         s[ns].labels = labels[ns];
         ns++;
     }
-    char path[1024];
-    snprintf(path, sizeof path, "%s/%s", dir, file);
-    FILE *f = fopen(path, "w");
-    if (!f || !svg_write(f, c, s, ns)) fprintf(stderr, "ombra: %s: cannot write\n", path);
-    if (f) fclose(f);
+    return svg_write(o->f, c, s, ns);
+}
+
+static const char *base_name(const char *path)
+{
+    const char *b = strrchr(path, '/');
+    return b ? b + 1 : path;
+}
+
+/* Splits a comma-separated list in place; returns the count (empty items kept). */
+static size_t split(char *list, char **items, size_t max)
+{
+    size_t n = 0;
+    for (char *p = list; n < max;) {
+        items[n++] = p;
+        char *c = strchr(p, ',');
+        if (!c) break;
+        *c = '\0';
+        p = c + 1;
+    }
+    return n;
+}
+
+/* Every name on the command line means something before any work starts: a scene is
+ * built in or a file that is there, a method is in the registry and swept. */
+static int check_names(char **names, size_t n, const char *methods)
+{
+    struct stat sb;
+    for (size_t i = 0; i < n; i++) {
+        if (!names[i][0]) return cli_usage_error("bench", "--scenes has an empty name%s", "");
+        if (!cli_builtin_scene(names[i]) && (stat(names[i], &sb) != 0 || S_ISDIR(sb.st_mode)))
+            return cli_usage_error("bench", "unknown scene '%s': not default, random-1K, random-10K, "
+                                   "random-100K, random-1M or a scene file", names[i]);
+        for (size_t j = 0; j < i; j++)
+            if (!strcmp(base_name(names[i]), base_name(names[j])))
+                return cli_usage_error("bench", "two scenes named '%s' would write the same charts",
+                                       base_name(names[i]));
+    }
+    for (const char *p = methods; p && *p;) {
+        char name[32];
+        size_t l = strcspn(p, ",");
+        snprintf(name, sizeof name, "%.*s", (int)(l < 31 ? l : 31), p);
+        const om_method *m = om_method_find(name);
+        if (!m) return cli_unknown_method("bench", "--methods", name);
+        if (om_method_sweep(m) && !om_method_sweep(m)[0])
+            return cli_usage_error("bench", "'%s' is left out of sweeps (nothing to compare)", name);
+        p += l + (p[l] == ',');
+    }
+    return 0;
+}
+
+/* The CSV and the charts, all replaced together once every one is written whole. */
+static int write_outputs(const char *dir, char **names, size_t nn, const cli_point *pts, int np,
+                         const double *tri_x, const double (*tri_y)[4], const size_t *tri_n,
+                         const char *const *tri_names, size_t ntri, bool tri_sweep)
+{
+    size_t nout = 1 + 3 * nn + (tri_sweep ? 1 : 0), k = 0;
+    om_out *outs = calloc(nout, sizeof *outs);
+    om_out **list = calloc(nout, sizeof *list);
+    char **paths = calloc(nout, sizeof *paths);
+    om_diag d;
+    memset(&d, 0, sizeof d);
+    om_status st = outs && list && paths ? OM_OK : cli_oom(&d);
+    for (size_t i = 0; i < nout; i++) if (list) list[i] = outs ? &outs[i] : NULL;
+    /* the table */
+    if (st == OM_OK && !(paths[k] = cli_path(dir, "bench.csv"))) st = cli_oom(&d);
+    if (st == OM_OK && (st = om_out_open(&outs[k], paths[k], &d)) == OM_OK) {
+        FILE *f = outs[k].f;
+        fprintf(f, "scene,method,setting,width,height,time_ms,init_ms,eye_ms,observe_ms,build_ms,"
+                   "resolve_ms,shade_ms,bytes,samples,false_lit,false_shadowed,mismatch_share,"
+                   "edge_samples,edge_mismatch_share\n");
+        for (int i = 0; i < np; i++) {
+            const cli_point *p = &pts[i];
+            double share = 1.0 - om_metrics_match(&p->m);
+            double edge = p->m.edge_samples ? (double)(p->m.edge_false_lit + p->m.edge_false_shadowed) /
+                                                  (double)p->m.edge_samples : 0.0;
+            fprintf(f, "%s,%s,%s,%u,%u,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%zu,%llu,%llu,%llu,%.6f,%llu,%.6f\n",
+                    p->scene, p->method, p->setting, p->w, p->h, p->total, p->init, p->eye,
+                    p->observe, p->build, p->resolve, p->shade, p->bytes,
+                    (unsigned long long)p->m.samples, (unsigned long long)p->m.false_lit,
+                    (unsigned long long)p->m.false_shadowed, share,
+                    (unsigned long long)p->m.edge_samples, edge);
+        }
+        k++;
+    }
+    /* the charts, three per scene */
+    static const char *const suffix[3] = {"time", "bytes", "first"};
+    static const char *const xlabel[3] = {"time per frame, ms", "method bytes",
+                                          "first frame: init + frame, ms"};
+    static const char *const what[3] = {"accuracy against speed", "accuracy against memory",
+                                        "accuracy against the first frame's time"};
+    for (size_t i = 0; i < nn && st == OM_OK; i++) {
+        uint32_t W = 0, H = 0;
+        for (int j = 0; j < np; j++)
+            if (!strcmp(pts[j].scene, names[i])) { W = pts[j].w; H = pts[j].h; break; }
+        for (int c = 0; c < 3 && st == OM_OK; c++) {
+            char file[300], title[300];
+            snprintf(file, sizeof file, "%s-%s.svg", base_name(names[i]), suffix[c]);
+            snprintf(title, sizeof title, "%s at %ux%u: %s", base_name(names[i]), W, H, what[c]);
+            svg_chart ch = {title, xlabel[c], "mismatch share against ref", true, true, true, false};
+            if (!(paths[k] = cli_path(dir, file))) st = cli_oom(&d);
+            else if ((st = om_out_open(&outs[k], paths[k], &d)) == OM_OK) chart(&outs[k++], &ch, pts, np, names[i], c);
+        }
+    }
+    /* time against triangle count, exact methods, random scenes 1K..1M */
+    if (tri_sweep && st == OM_OK) {
+        svg_series s[16];
+        for (size_t i = 0; i < ntri; i++) {
+            s[i].name = tri_names[i];
+            s[i].x = tri_x;
+            s[i].y = tri_y[i];
+            s[i].n = tri_n[i];
+            s[i].labels = NULL;
+        }
+        svg_chart c = {"exact methods on the random scenes: time against triangles", "triangles",
+                       "first frame: init + frame, ms", true, true, false, true};
+        if (!(paths[k] = cli_path(dir, "triangles.svg"))) st = cli_oom(&d);
+        else if ((st = om_out_open(&outs[k], paths[k], &d)) == OM_OK) svg_write(outs[k++].f, &c, s, ntri);
+    }
+    if (st == OM_OK) st = om_out_commit(list, nout, &d);
+    for (size_t i = 0; outs && i < nout; i++) om_out_discard(&outs[i]);
+    for (size_t i = 0; paths && i < nout; i++) free(paths[i]);
+    free(outs);
+    free(list);
+    free(paths);
+    return st == OM_OK ? 0 : cli_error(NULL, &d, st);
 }
 
 int cmd_bench(int argc, char **argv)
 {
     const char *scenes = "default,random-10K", *methods = NULL, *dir = "out/bench";
-    uint32_t W = 640, H = 480, runs = 3;
+    uint32_t w = 0, h = 0, runs = 3;
     bool tri_sweep = false;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -261,58 +398,67 @@ int cmd_bench(int argc, char **argv)
         if (!strcmp(a, "--scenes")) scenes = v;
         else if (!strcmp(a, "--methods")) methods = v;
         else if (!strcmp(a, "--out")) dir = v;
-        else if (!strcmp(a, "--size")) { if (!cli_parse_size(v, &W, &H)) return cli_usage_error("bench", "--size takes WxH, not '%s'", v); }
+        else if (!strcmp(a, "--size")) { if (!cli_parse_size(v, &w, &h)) return cli_usage_error("bench", "--size takes WxH, not '%s'", v); }
         else if (!strcmp(a, "--runs")) { if (!cli_parse_u32(v, 1, 16, &runs)) return cli_usage_error("bench", "--runs takes 1..16, not '%s'", v); }
         else return cli_usage_error("bench", "unknown option '%s'", a);
         i++;
     }
-    char path[1024];
-    snprintf(path, sizeof path, "%s", dir);
-    for (char *p = path + 1; *p; p++)
-        if (*p == '/') { *p = 0; mkdir(path, 0777); *p = '/'; }
-    if (mkdir(path, 0777) != 0 && errno != EEXIST) {
-        fprintf(stderr, "ombra: %s: cannot create the output directory\n", dir);
-        return 1;
-    }
+    size_t cap = 1;
+    for (const char *p = scenes; *p; p++) cap += *p == ',';
+    char *list = malloc(strlen(scenes) + 1), **names = calloc(cap, sizeof *names);
     enum { MAXP = 512 };
     cli_point *pts = calloc(MAXP, sizeof *pts);
-    int np = 0;
-    uint8_t *ref = malloc((size_t)W * H), *mask = malloc((size_t)W * H);
-    char list[1024];
-    snprintf(list, sizeof list, "%s", scenes);
-    /* count the points for the progress line */
-    int total = 0, nscenes = 0;
-    for (const char *p = list; *p; nscenes++) { const char *c = strchr(p, ','); p = c ? c + 1 : p + strlen(p); }
-    for (size_t k = 0; k < om_method_count(); k++) {
+    if (!list || !names || !pts) {
+        free(list); free(names); free(pts);
+        om_diag d;
+        return cli_error(NULL, &d, cli_oom(&d));
+    }
+    memcpy(list, scenes, strlen(scenes) + 1);
+    size_t nn = split(list, names, cap);
+    int rc = check_names(names, nn, methods);
+    /* the directory first, so that an unwritable one fails before the work */
+    char *path = rc ? NULL : malloc(strlen(dir) + 1);
+    if (!rc && path) {
+        memcpy(path, dir, strlen(dir) + 1);
+        for (char *p = path + 1; *p; p++)
+            if (*p == '/') { *p = 0; mkdir(path, 0777); *p = '/'; }
+        if (mkdir(path, 0777) != 0 && errno != EEXIST) {
+            fprintf(stderr, "ombra: %s: cannot create the output directory: %s\n", dir, strerror(errno));
+            rc = 1;
+        }
+    }
+    free(path);
+    int np = 0, total = 0, done = 0;
+    for (size_t k = 0; k < om_method_count() && !rc; k++) {
         const om_method *m = om_method_at(k);
         char tmp[64][96];
         if (om_method_sweep(m) && !om_method_sweep(m)[0]) continue;
-        if (in_list(methods, m->name)) total += expand(om_method_sweep(m), tmp, 64) * nscenes;
+        if (in_list(methods, m->name)) total += expand(om_method_sweep(m), tmp, 64) * (int)nn;
     }
-    int rc = 0, done = 0;
-    for (char *name = strtok(list, ","); name; name = strtok(NULL, ",")) {
+    /* Any scene that does not load, view or measure fails the run: nothing is written. */
+    for (size_t si = 0; si < nn && !rc; si++) {
+        const char *name = names[si];
         om_diag d;
         memset(&d, 0, sizeof d);
         cli_scene cs;
-        om_status st = cli_load_named(name, &cs, &d);
-        if (st) { rc = cli_error(name, &d, st); cli_scene_free(&cs); continue; }
-        om_camera cam;
-        om_light light;
         om_view v;
-        om_scene_at(&cs.scene, 0, &cam, &light);
-        cam.width = W;
-        cam.height = H;
-        if ((st = om_view_init(&v, &cam, &light, &cs.scene, &d))) { rc = cli_error(name, &d, st); cli_scene_free(&cs); continue; }
+        uint32_t W = 0, H = 0;
+        uint8_t *ref = NULL, *mask = NULL;
+        om_status st = cli_load_named(name, &cs, &d);
+        if (st == OM_OK && (st = cli_scene_view(&cs, w, h, &v, &d)) == OM_OK) {
+            W = v.cam.width;
+            H = v.cam.height;
+            ref = malloc((size_t)W * H);
+            mask = malloc((size_t)W * H);
+            if (!ref || !mask) st = cli_oom(&d);
+        }
         cli_point rp;
         memset(&rp, 0, sizeof rp);
         om_method_cfg rc_cfg;
         om_method_cfg_default(&rc_cfg);
-        if ((st = cli_measure(om_method_find("ref"), &rc_cfg, &cs, &v, 1, ref, NULL, &rp, &d))) {
-            rc = cli_error(name, &d, st);
-            cli_scene_free(&cs);
-            continue;
-        }
-        for (size_t k = 0; k < om_method_count() && np < MAXP; k++) {
+        if (st == OM_OK) st = cli_measure(om_method_find("ref"), &rc_cfg, &cs, &v, 1, ref, NULL, &rp, &d);
+        if (st != OM_OK) rc = cli_error(name, &d, st);
+        for (size_t k = 0; k < om_method_count() && np < MAXP && !rc; k++) {
             const om_method *m = om_method_at(k);
             if ((om_method_sweep(m) && !om_method_sweep(m)[0]) || !in_list(methods, m->name)) continue;
             char settings[64][96];
@@ -332,6 +478,7 @@ int cmd_bench(int argc, char **argv)
                 if (settings[j][0] && !apply(&cfg, settings[j])) continue;
                 st = cli_measure(m, &cfg, &cs, &v, (int)runs, mask, NULL, p, &d);
                 if (st) {
+                    /* a point a method cannot run (its memory, say) is left out, said */
                     fprintf(stderr, "\nombra: %s %s on %s: %s\n", m->name, p->setting, name, d.msg);
                     continue;
                 }
@@ -340,102 +487,70 @@ int cmd_bench(int argc, char **argv)
                 np++;
             }
         }
+        free(ref);
+        free(mask);
         cli_scene_free(&cs);
     }
-    if (isatty(2)) fprintf(stderr, "\n");
-    /* the table */
-    snprintf(path, sizeof path, "%s/bench.csv", dir);
-    FILE *f = fopen(path, "w");
-    if (!f) { fprintf(stderr, "ombra: %s: cannot create\n", path); free(pts); return 1; }
-    fprintf(f, "scene,method,setting,width,height,time_ms,eye_ms,observe_ms,build_ms,resolve_ms,shade_ms,"
-               "bytes,samples,false_lit,false_shadowed,mismatch_share,edge_samples,edge_mismatch_share\n");
-    printf("%-12s %-5s %-28s %9s %9s %11s %9s %9s\n", "scene", "meth", "setting", "time ms",
-           "resolve", "bytes", "mismatch", "edge");
-    for (int i = 0; i < np; i++) {
-        cli_point *p = &pts[i];
-        double share = 1.0 - om_metrics_match(&p->m);
-        double edge = p->m.edge_samples ? (double)(p->m.edge_false_lit + p->m.edge_false_shadowed) /
-                                              (double)p->m.edge_samples : 0.0;
-        fprintf(f, "%s,%s,%s,%u,%u,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%zu,%llu,%llu,%llu,%.6f,%llu,%.6f\n",
-                p->scene, p->method, p->setting, W, H, p->total, p->eye, p->observe, p->build,
-                p->resolve, p->shade, p->bytes, (unsigned long long)p->m.samples,
-                (unsigned long long)p->m.false_lit, (unsigned long long)p->m.false_shadowed, share,
-                (unsigned long long)p->m.edge_samples, edge);
-        printf("%-12s %-5s %-28s %9.2f %9.2f %11zu %8.4f%% %8.3f%%\n", p->scene, p->method,
-               p->setting, p->total, p->resolve, p->bytes, 100 * share, 100 * edge);
-    }
-    fclose(f);
-    /* the charts, one pair per scene */
-    snprintf(list, sizeof list, "%s", scenes);
-    for (char *name = strtok(list, ","); name; name = strtok(NULL, ",")) {
-        char file[256], title[256];
-        const char *base = strrchr(name, '/') ? strrchr(name, '/') + 1 : name;
-        svg_chart c = {title, "time per frame, ms", "mismatch share against ref", true, true, true, false};
-        snprintf(title, sizeof title, "%s at %ux%u: accuracy against speed", base, W, H);
-        snprintf(file, sizeof file, "%s-time.svg", base);
-        chart(dir, file, &c, pts, np, name, 0, 0);
-        svg_chart c2 = {title, "method bytes", "mismatch share against ref", true, true, true, false};
-        snprintf(title, sizeof title, "%s at %ux%u: accuracy against memory", base, W, H);
-        snprintf(file, sizeof file, "%s-bytes.svg", base);
-        chart(dir, file, &c2, pts, np, name, 0, 1);
-    }
-    /* time against triangle count, exact methods, random scenes 1K..1M */
-    if (tri_sweep) {
-        static const char *const counts[] = {"random-1K", "random-10K", "random-100K", "random-1M"};
-        static const double tris[] = {1e3, 1e4, 1e5, 1e6};
-        static double xs[16][4], ys[16][4];
-        svg_series s[16];
-        size_t ns = 0;
-        for (size_t k = 0; k < om_method_count() && ns < 16; k++) {
-            const om_method *m = om_method_at(k);
-            if (!(m->flags & OM_METHOD_EXACT)) continue;
-            size_t n = 0;
-            for (int j = 0; j < 4; j++) {
-                om_diag d;
-                cli_scene cs;
-                if (cli_load_named(counts[j], &cs, &d) == OM_OK) {
-                    om_camera cam;
-                    om_light light;
-                    om_view v;
-                    om_scene_at(&cs.scene, 0, &cam, &light);
-                    cam.width = W;
-                    cam.height = H;
-                    om_method_cfg cfg;
-                    om_method_cfg_default(&cfg);
-                    cli_point p;
-                    memset(&p, 0, sizeof p);
-                    snprintf(p.scene, sizeof p.scene, "%s", counts[j]);
-                    snprintf(p.method, sizeof p.method, "%s", m->name);
-                    snprintf(p.setting, sizeof p.setting, "triangle sweep");
-                    progress(j + 1, 4, &p);
-                    if (om_view_init(&v, &cam, &light, &cs.scene, &d) == OM_OK &&
-                        cli_measure(m, &cfg, &cs, &v, (int)runs, mask, NULL, &p, &d) == OM_OK) {
-                        xs[ns][n] = tris[j];
-                        ys[ns][n++] = p.total;
-                        printf("%-12s %-5s triangle sweep %9.2f ms\n", counts[j], m->name, p.total);
-                    }
+    if (isatty(2) && done) fprintf(stderr, "\n");
+    /* time against triangle count, exact methods, random scenes 1K..1M, each at its
+     * first frame: init (the BVH) is paid whenever the triangles change */
+    static const char *const counts[] = {"random-1K", "random-10K", "random-100K", "random-1M"};
+    static const double tris[] = {1e3, 1e4, 1e5, 1e6};
+    double ty[16][4];
+    size_t tn[16] = {0}, ntri = 0;
+    const char *tnames[16];
+    for (size_t k = 0; tri_sweep && !rc && k < om_method_count() && ntri < 16; k++) {
+        const om_method *m = om_method_at(k);
+        if (!(m->flags & OM_METHOD_EXACT)) continue;
+        tnames[ntri] = m->name;
+        for (int j = 0; j < 4 && !rc; j++) {
+            om_diag d;
+            memset(&d, 0, sizeof d);
+            cli_scene cs;
+            uint8_t *tmask = NULL;
+            om_status st = cli_load_named(counts[j], &cs, &d);
+            om_view v;
+            if (st == OM_OK && (st = cli_scene_view(&cs, w, h, &v, &d)) == OM_OK) {
+                om_method_cfg cfg;
+                om_method_cfg_default(&cfg);
+                cli_point p;
+                memset(&p, 0, sizeof p);
+                snprintf(p.scene, sizeof p.scene, "%s", counts[j]);
+                snprintf(p.method, sizeof p.method, "%s", m->name);
+                snprintf(p.setting, sizeof p.setting, "triangle sweep");
+                progress(j + 1, 4, &p);
+                if (!(tmask = malloc((size_t)v.cam.width * v.cam.height))) st = cli_oom(&d);
+                if (st == OM_OK) st = cli_measure(m, &cfg, &cs, &v, (int)runs, tmask, NULL, &p, &d);
+                if (st == OM_OK) {
+                    ty[ntri][tn[ntri]++] = p.init + p.total;
+                    printf("%-12s %-5s triangle sweep: init %.2f ms, frame %.2f ms\n", counts[j],
+                           m->name, p.init, p.total);
                 }
-                cli_scene_free(&cs);
             }
-            s[ns].name = m->name;
-            s[ns].x = xs[ns];
-            s[ns].y = ys[ns];
-            s[ns].n = n;
-            s[ns].labels = NULL;
-            ns++;
+            if (st != OM_OK) rc = cli_error(counts[j], &d, st);
+            free(tmask);
+            cli_scene_free(&cs);
         }
-        if (isatty(2)) fprintf(stderr, "\n");
-        snprintf(path, sizeof path, "%s/triangles.svg", dir);
-        FILE *g = fopen(path, "w");
-        char title[128];
-        snprintf(title, sizeof title, "exact methods at %ux%u: time against triangles", W, H);
-        svg_chart c = {title, "triangles", "time per frame, ms", true, true, false, true};
-        if (!g || !svg_write(g, &c, s, ns)) fprintf(stderr, "ombra: %s: cannot write\n", path);
-        if (g) fclose(g);
+        ntri++;
     }
-    printf("wrote %s/bench.csv and the charts beside it\n", dir);
+    if (tri_sweep && isatty(2)) fprintf(stderr, "\n");
+    if (!rc) {
+        printf("%-12s %-5s %-28s %9s %9s %9s %11s %9s %9s\n", "scene", "meth", "setting", "time ms",
+               "init", "resolve", "bytes", "mismatch", "edge");
+        for (int i = 0; i < np; i++) {
+            const cli_point *p = &pts[i];
+            double share = 1.0 - om_metrics_match(&p->m);
+            double edge = p->m.edge_samples ? (double)(p->m.edge_false_lit + p->m.edge_false_shadowed) /
+                                                  (double)p->m.edge_samples : 0.0;
+            printf("%-12s %-5s %-28s %9.2f %9.2f %9.2f %11zu %8.4f%% %8.3f%%\n", p->scene, p->method,
+                   p->setting, p->total, p->init, p->resolve, p->bytes, 100 * share, 100 * edge);
+        }
+        rc = write_outputs(dir, names, nn, pts, np, tris, (const double (*)[4])ty, tn, tnames, ntri,
+                           tri_sweep);
+    }
+    if (!rc) printf("wrote %s/bench.csv and the charts beside it\n", dir);
     free(pts);
-    free(ref);
-    free(mask);
+    free(names);
+    free(list);
     return rc;
 }

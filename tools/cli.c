@@ -9,8 +9,14 @@
 int cli_error(const char *where, const om_diag *d, om_status st)
 {
     const char *msg = d && d->msg[0] ? d->msg : om_status_str(st);
-    fprintf(stderr, "ombra: %s%s%s (%s)\n", where ? where : "", where ? ": " : "", msg,
-            om_status_str(st));
+    /* A message that already starts with the file's name is not given it twice. */
+    size_t n = where ? strlen(where) : 0;
+    if (where && !strncmp(msg, where, n) && msg[n] == ':') where = NULL;
+    /* File errors end with the system's reason; the status name would only repeat it
+     * (or contradict it: "No such file ... (input/output error)"). */
+    bool suffix = msg != om_status_str(st) && st != OM_E_IO && st != OM_E_NOTFOUND;
+    fprintf(stderr, "ombra: %s%s%s%s%s%s\n", where ? where : "", where ? ": " : "", msg,
+            suffix ? " (" : "", suffix ? om_status_str(st) : "", suffix ? ")" : "");
     return 1;
 }
 
@@ -20,6 +26,79 @@ int cli_usage_error(const char *cmd, const char *fmt, const char *arg)
     fprintf(stderr, fmt, arg);
     fprintf(stderr, "\n(see 'ombra %s --help')\n", cmd);
     return 2;
+}
+
+/* Edit distance, for "did you mean" (names are short). */
+static size_t distance(const char *a, const char *b)
+{
+    size_t la = strlen(a), lb = strlen(b), row[32];
+    if (la >= 32 || lb >= 32) return 99;
+    for (size_t j = 0; j <= lb; j++) row[j] = j;
+    for (size_t i = 1; i <= la; i++) {
+        size_t diag = row[0];
+        row[0] = i;
+        for (size_t j = 1; j <= lb; j++) {
+            size_t up = row[j], best = diag + (a[i - 1] != b[j - 1]);
+            if (up + 1 < best) best = up + 1;
+            if (row[j - 1] + 1 < best) best = row[j - 1] + 1;
+            diag = up;
+            row[j] = best;
+        }
+    }
+    return row[lb];
+}
+
+int cli_unknown_method(const char *cmd, const char *option, const char *name)
+{
+    const char *best = NULL;
+    size_t bd = 3;   /* suggest only a name at most two edits away */
+    for (size_t i = 0; i < om_method_count(); i++) {
+        size_t dd = distance(name, om_method_at(i)->name);
+        if (dd < bd) { bd = dd; best = om_method_at(i)->name; }
+    }
+    fprintf(stderr, "ombra %s: %s: unknown method '%s'", cmd, option, name);
+    if (best) fprintf(stderr, "; did you mean '%s'?", best);
+    fprintf(stderr, "\nmethods:");
+    for (size_t i = 0; i < om_method_count(); i++) fprintf(stderr, " %s", om_method_at(i)->name);
+    fprintf(stderr, " (see 'ombra methods')\n");
+    return 2;
+}
+
+void cli_method_hint(const om_method *m, char *buf, size_t n)
+{
+    /* The settings that size this method's memory: `map` where its help names the
+     * method, else the method's own settings about bytes or a pool. */
+    size_t nf;
+    const om_cfg_field *f = om_method_cfg_fields(&nf);
+    size_t ml = strlen(m->name);
+    for (size_t i = 0; i < nf; i++) {
+        const char *h = f[i].help, *p = strchr(h, '(');
+        bool own = !strncmp(f[i].name, m->name, ml) && f[i].name[ml] == '.';
+        bool names = false;
+        for (; p && (p = strstr(p, m->name)) != NULL; p += ml)
+            names |= (p[-1] == '(' || p[-1] == ' ') && (p[ml] == ',' || p[ml] == ')');
+        if ((!strcmp(f[i].name, "map") && names) ||
+            (own && (strstr(h, "bytes") || strstr(h, "pool")))) {
+            snprintf(buf, n, ", or ask the method for less (--set %s=N: %s)", f[i].name, h);
+            return;
+        }
+    }
+    snprintf(buf, n, "%s", "");
+}
+
+bool cli_parse_budget(const char *cmd, const char *s, size_t *out)
+{
+    if (!strcmp(s, "none")) { *out = 0; return true; }
+    if (!cli_parse_bytes(s, out)) {
+        cli_usage_error(cmd, "--budget takes bytes like 65536, 64K or 8M (or 'none'), not '%s'", s);
+        return false;
+    }
+    if (*out == 0) {
+        cli_usage_error(cmd, "--budget %s leaves no memory at all; give bytes like 64K, or "
+                        "'none' for no limit", s);
+        return false;
+    }
+    return true;
 }
 
 om_status cli_scene_load(cli_scene *cs, const char *path, om_diag *d)
@@ -33,16 +112,19 @@ om_status cli_scene_load(cli_scene *cs, const char *path, om_diag *d)
         if ((st = om_file_read(path, &cs->text, &len, d)) != OM_OK) return st;
         text = cs->text;
     }
-    om_file_loader_init(&cs->files, path);
+    if (om_file_loader_init(&cs->files, path) != OM_OK) return cli_oom(d);
     cs->files.diag = d;
     om_loader ld = om_file_loader_get(&cs->files);
-    /* Model no more than the scene needs: the arena is exactly its bytes query. */
-    if ((st = om_scene_bytes(text, len, &ld, &cs->bytes, d)) != OM_OK) return st;
-    om_file_loader_free(&cs->files);
-    cs->mem = malloc(cs->bytes ? cs->bytes : 1);
-    if (!cs->mem) return OM_E_BUDGET;
-    om_arena_init(&cs->arena, cs->mem, cs->bytes, "scene");
-    st = om_scene_parse(text, len, &ld, &cs->arena, &cs->scene, d);
+    /* Model no more than the scene needs: the arena is exactly its bytes query. The
+     * loader keeps every mesh it read for the second pass: each file is read once. */
+    if ((st = om_scene_bytes(text, len, &ld, &cs->bytes, d)) == OM_OK) {
+        cs->mem = malloc(cs->bytes ? cs->bytes : 1);
+        if (!cs->mem) st = cli_oom(d);
+    }
+    if (st == OM_OK) {
+        om_arena_init(&cs->arena, cs->mem, cs->bytes, "scene");
+        st = om_scene_parse(text, len, &ld, &cs->arena, &cs->scene, d);
+    }
     om_file_loader_free(&cs->files);
     return st;
 }
@@ -51,6 +133,7 @@ void cli_scene_free(cli_scene *cs)
 {
     free(cs->text);
     free(cs->mem);
+    om_file_loader_free(&cs->files);
     cs->text = NULL;
     cs->mem = NULL;
 }
@@ -103,6 +186,27 @@ bool cli_parse_float(const char *s, float *out)
     return true;
 }
 
+char *cli_path(const char *dir, const char *file)
+{
+    size_t a = strlen(dir), b = strlen(file);
+    char *p = malloc(a + b + 2);
+    if (p) {
+        memcpy(p, dir, a);
+        p[a] = '/';
+        memcpy(p + a + 1, file, b + 1);
+    }
+    return p;
+}
+
+om_status cli_scene_view(const cli_scene *cs, uint32_t w, uint32_t h, om_view *v, om_diag *d)
+{
+    om_camera cam;
+    om_light light;
+    om_scene_at(&cs->scene, 0, &cam, &light);
+    if (w) { cam.width = w; cam.height = h; }
+    return om_view_init(v, &cam, &light, &cs->scene, d);
+}
+
 om_status cli_oom(om_diag *d)
 {
     if (d) {
@@ -132,7 +236,9 @@ bool cli_set(om_method_cfg *c, const char *setting)
     om_diag d;
     om_status st = om_method_cfg_set(c, name, v, &d);
     if (st != OM_OK) {
-        fprintf(stderr, "ombra: setting '%s': %s (see 'ombra methods')\n", name, d.msg);
+        /* the engine's message may already point at the list */
+        fprintf(stderr, "ombra: setting '%s': %s%s\n", name, d.msg,
+                strstr(d.msg, "ombra methods") ? "" : " (see 'ombra methods')");
         return false;
     }
     return true;

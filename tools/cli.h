@@ -22,6 +22,12 @@ typedef struct cli_scene {
 /* Prints "ombra: <where>: <message>" to stderr; returns exit status 1 (2 for usage). */
 int cli_error(const char *where, const om_diag *d, om_status st);
 int cli_usage_error(const char *cmd, const char *fmt, const char *arg);
+/* "unknown method" with the nearest name and the list; returns 2. */
+int cli_unknown_method(const char *cmd, const char *option, const char *name);
+/* The tail of a too-small-budget message: the setting that sizes m's memory. */
+void cli_method_hint(const om_method *m, char *buf, size_t n);
+/* --budget BYTES or 'none' (0 out); 0 bytes is a usage error (printed). */
+bool cli_parse_budget(const char *cmd, const char *s, size_t *out);
 
 om_status cli_scene_load(cli_scene *cs, const char *path, om_diag *d);
 void cli_scene_free(cli_scene *cs);
@@ -41,7 +47,9 @@ int cmd_bench(int argc, char **argv);
 /* One measured sweep point (ombra bench, ombra report). */
 typedef struct cli_point {
     char scene[64], method[16], setting[96];
-    double total, eye, observe, build, resolve, shade;
+    uint32_t w, h;         /* the image size it was measured at */
+    double init;           /* the method's init, ms (once per point; ref builds its BVH) */
+    double total, eye, observe, build, resolve, shade;   /* per frame, ms (medians) */
     size_t bytes;
     om_metrics m;
     int ok;
@@ -49,12 +57,21 @@ typedef struct cli_point {
 
 /* Loads "default", "random-1K" ... "random-1M", or a scene file. */
 om_status cli_load_named(const char *name, cli_scene *cs, om_diag *d);
-/* Inits `m` with its one-pass bytes and renders `runs` frames of view `v`; median
- * times into p, the last frame's mask (and shaded RGB888 pixels, if rgb) out. */
+/* Inits `m` with its one-pass bytes (timed: p->init) and renders `runs` frames of
+ * view `v`; median times into p, the last frame's mask (and shaded RGB888 pixels, if
+ * rgb) out. */
 om_status cli_measure(const om_method *m, const om_method_cfg *cfg, const cli_scene *cs,
                       const om_view *v, int runs, uint8_t *mask, uint8_t *rgb, cli_point *p,
                       om_diag *d);
 int cmd_report(int argc, char **argv);
+
+/* "dir/file", malloc'd (NULL when out of memory): paths are never cut short. */
+char *cli_path(const char *dir, const char *file);
+/* Whether NAME is a built-in scene ("default", "random-1K" ...). */
+bool cli_builtin_scene(const char *name);
+/* The view a sweep measures: the scene at time 0, at --size w x h when given (w > 0),
+ * else at its camera's own size (v->cam.width, height). */
+om_status cli_scene_view(const cli_scene *cs, uint32_t w, uint32_t h, om_view *v, om_diag *d);
 
 /* Host memory ran out: OM_E_BUDGET with a message. */
 om_status cli_oom(om_diag *d);

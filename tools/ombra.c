@@ -1,6 +1,7 @@
 /* ombra.c — the `ombra` command: dispatches to its subcommands. */
 #include "cli.h"
 
+#include <stdlib.h>
 #include <string.h>
 
 static const char usage[] =
@@ -19,7 +20,71 @@ static const char usage[] =
     "  methods          list the shadow methods\n"
     "  scene            print the built-in default scene (a start for your own)\n"
     "\n"
-    "'ombra <command> --help' describes a command's options.\n";
+    "'ombra <command> --help' describes a command's options; 'ombra --version' prints\n"
+    "the version.\n";
+
+static const char methods_help[] =
+    "usage: ombra methods\n"
+    "\n"
+    "Lists the shadow methods and every setting ('--set NAME=VALUE') with its default.\n";
+
+static const char scene_help[] =
+    "usage: ombra scene\n"
+    "\n"
+    "Prints the built-in default scene in the scene format: a start for your own.\n";
+
+/* A setting's default as it would be written: the shortest decimal that reads back
+ * as the same float (0.01, not 0.00999999978). */
+static void format_value(const om_cfg_field *f, const om_method_cfg *c, char *buf, size_t n)
+{
+    const unsigned char *p = (const unsigned char *)c + f->offset;
+    if (f->kind == 'u') { uint32_t u; memcpy(&u, p, sizeof u); snprintf(buf, n, "%lu", (unsigned long)u); return; }
+    if (f->kind == 'z') { uint64_t u; memcpy(&u, p, sizeof u); snprintf(buf, n, "%llu", (unsigned long long)u); return; }
+    float x;
+    memcpy(&x, p, sizeof x);
+    for (int prec = 1; prec <= 9; prec++) {
+        snprintf(buf, n, "%.*g", prec, (double)x);
+        if (strtof(buf, NULL) == x) return;
+    }
+}
+
+static int list_methods(void)
+{
+    for (size_t i = 0; i < om_method_count(); i++)
+        printf("%-6s %s\n", om_method_at(i)->name, om_method_at(i)->summary);
+    size_t n, wn = 0, wv = 0;
+    const om_cfg_field *f = om_method_cfg_fields(&n);
+    om_method_cfg c;
+    om_method_cfg_default(&c);
+    char v[32];
+    for (size_t i = 0; i < n; i++) {
+        format_value(&f[i], &c, v, sizeof v);
+        if (strlen(f[i].name) > wn) wn = strlen(f[i].name);
+        if (strlen(v) > wv) wv = strlen(v);
+    }
+    printf("\nsettings (--set NAME=VALUE):\n");
+    for (size_t i = 0; i < n; i++) {
+        format_value(&f[i], &c, v, sizeof v);
+        printf("  %-*s  %-*s  %s\n", (int)wn, f[i].name, (int)wv, v, f[i].help);
+    }
+    return 0;
+}
+
+/* A subcommand without options: --help prints its help, anything else is refused. */
+static int no_options(int argc, char **argv, const char *help, int (*run)(void))
+{
+    if (argc > 2) {
+        if (!strcmp(argv[2], "--help") || !strcmp(argv[2], "-h")) { fputs(help, stdout); return 0; }
+        return cli_usage_error(argv[1], "takes no arguments; unexpected '%s'", argv[2]);
+    }
+    return run();
+}
+
+static int print_scene(void)
+{
+    fputs(om_scene_default_text(), stdout);
+    return 0;
+}
 
 int main(int argc, char **argv)
 {
@@ -28,33 +93,17 @@ int main(int argc, char **argv)
         fputs(usage, argc < 2 ? stderr : stdout);
         return argc < 2 ? 2 : 0;
     }
+    if (!strcmp(argv[1], "--version") || !strcmp(argv[1], "-V")) {
+        printf("ombra %s\n", OMBRA_VERSION_STRING);
+        return 0;
+    }
     if (!strcmp(argv[1], "render")) return cmd_render(argc - 1, argv + 1);
     if (!strcmp(argv[1], "info")) return cmd_info(argc - 1, argv + 1);
     if (!strcmp(argv[1], "compare")) return cmd_compare(argc - 1, argv + 1);
     if (!strcmp(argv[1], "bench")) return cmd_bench(argc - 1, argv + 1);
     if (!strcmp(argv[1], "report")) return cmd_report(argc - 1, argv + 1);
-    if (!strcmp(argv[1], "scene")) {
-        fputs(om_scene_default_text(), stdout);
-        return 0;
-    }
-    if (!strcmp(argv[1], "methods")) {
-        for (size_t i = 0; i < om_method_count(); i++)
-            printf("%-6s %s\n", om_method_at(i)->name, om_method_at(i)->summary);
-        size_t n;
-        const om_cfg_field *f = om_method_cfg_fields(&n);
-        om_method_cfg c;
-        om_method_cfg_default(&c);
-        printf("\nsettings (--set NAME=VALUE):\n");
-        for (size_t i = 0; i < n; i++) {
-            const unsigned char *p = (const unsigned char *)&c + f[i].offset;
-            double v;
-            if (f[i].kind == 'u') { uint32_t u; memcpy(&u, p, sizeof u); v = u; }
-            else if (f[i].kind == 'z') { uint64_t u; memcpy(&u, p, sizeof u); v = (double)u; }
-            else { float x; memcpy(&x, p, sizeof x); v = x; }
-            printf("  %-15s %-11.9g %s\n", f[i].name, v, f[i].help);
-        }
-        return 0;
-    }
+    if (!strcmp(argv[1], "scene")) return no_options(argc, argv, scene_help, print_scene);
+    if (!strcmp(argv[1], "methods")) return no_options(argc, argv, methods_help, list_methods);
     fprintf(stderr, "ombra: unknown command '%s'\n\n%s", argv[1], usage);
     return 2;
 }

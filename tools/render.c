@@ -39,6 +39,7 @@ typedef struct run {
     void *mem;
     om_arena arena;
     void *state;
+    uint64_t ns_init;      /* the method's init (ref builds its BVH there) */
 } run;
 
 static om_status run_init(run *r, const cli_scene *cs, uint32_t W, uint32_t H, om_diag *d)
@@ -47,8 +48,10 @@ static om_status run_init(run *r, const cli_scene *cs, uint32_t W, uint32_t H, o
     r->mem = malloc(r->given ? r->given : 1);
     if (!r->mem) return cli_oom(d);
     om_arena_init(&r->arena, r->mem, r->given, "method");
-    if ((st = r->m->init(&r->state, &r->arena, &r->cfg, &cs->scene, W, H, d)) != OM_OK) return st;
-    return OM_OK;
+    uint64_t t0 = om_clock_ns(NULL);
+    st = r->m->init(&r->state, &r->arena, &r->cfg, &cs->scene, W, H, d);
+    r->ns_init = om_clock_ns(NULL) - t0;
+    return st;
 }
 
 /* Where each strip goes: the PPM sink, and a whole-frame mask when asked. */
@@ -118,26 +121,40 @@ static int parse_format(const char *s, om_format *f)
     return 1;
 }
 
-static void print_metrics(const char *name, const char *against, const om_metrics *m)
+static void print_metrics(FILE *f, const char *name, const char *against, const om_metrics *m)
 {
     double n = m->samples ? (double)m->samples : 1.0, e = m->edge_samples ? (double)m->edge_samples : 1.0;
-    printf("accuracy of %s against %s: match %.4f%% of %llu samples; false lit %llu (%.4f%%), "
+    fprintf(f, "accuracy of %s against %s: match %.4f%% of %llu samples; false lit %llu (%.4f%%), "
            "false shadowed %llu (%.4f%%)\n",
            name, against, 100.0 * om_metrics_match(m), (unsigned long long)m->samples,
            (unsigned long long)m->false_lit, 100.0 * (double)m->false_lit / n,
            (unsigned long long)m->false_shadowed, 100.0 * (double)m->false_shadowed / n);
-    printf("near reference edges (%d px): %llu samples; false lit %llu (%.3f%%), false shadowed %llu (%.3f%%)\n",
+    fprintf(f, "near reference edges (%d px): %llu samples; false lit %llu (%.3f%%), false shadowed %llu (%.3f%%)\n",
            OM_EDGE_BAND, (unsigned long long)m->edge_samples, (unsigned long long)m->edge_false_lit,
            100.0 * (double)m->edge_false_lit / e, (unsigned long long)m->edge_false_shadowed,
            100.0 * (double)m->edge_false_shadowed / e);
 }
 
+/* Two of the files a render reads or writes are one file: a usage error, since one
+ * would destroy the other (--out x --mask x lost the image). */
+static int same_files(const char *const *paths, const char *const *names, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        for (size_t j = i + 1; j < n; j++)
+            if (paths[i] && paths[j] && om_out_same(paths[i], paths[j])) {
+                fprintf(stderr, "ombra render: %s and %s name the same file '%s': each needs "
+                        "its own\n(see 'ombra render --help')\n", names[i], names[j], paths[j]);
+                return 2;
+            }
+    return 0;
+}
+
 int cmd_render(int argc, char **argv)
 {
-    const char *scene_path = NULL, *out = "ombra.ppm", *mask = NULL, *mname = "sm";
+    const char *scene_path = NULL, *out = NULL, *mask = NULL, *mname = "sm";
     const char *against = NULL, *diff = NULL;
     uint32_t w = 0, h = 0, strip = 0;
-    size_t budget = 0;
+    size_t budget = 0;     /* 0: no --budget (or --budget none) */
     float t = 0.0f;
     bool quiet = false;
     om_format fmt = OM_RGB888;
@@ -164,7 +181,7 @@ int cmd_render(int argc, char **argv)
         else if (!strcmp(a, "--diff")) diff = v;
         else if (!strcmp(a, "--size")) { if (!cli_parse_size(v, &w, &h)) return cli_usage_error("render", "--size takes WxH with each side 1..8192, not '%s'", v); }
         else if (!strcmp(a, "--strip")) { if (!cli_parse_u32(v, 1, OM_MAX_DIM, &strip)) return cli_usage_error("render", "--strip takes a row count 1..8192, not '%s'", v); }
-        else if (!strcmp(a, "--budget")) { if (!cli_parse_bytes(v, &budget)) return cli_usage_error("render", "--budget takes bytes like 65536, 64K or 8M, not '%s'", v); }
+        else if (!strcmp(a, "--budget")) { if (!cli_parse_budget("render", v, &budget)) return 2; }
         else if (!strcmp(a, "--time")) { if (!cli_parse_float(v, &t)) return cli_usage_error("render", "--time takes a number, not '%s'", v); }
         else if (!strcmp(a, "--format")) { if (!parse_format(v, &fmt)) return cli_usage_error("render", "--format is rgb888, rgb565 or l8, not '%s'", v); }
         else if (a[0] != '-') {
@@ -174,18 +191,30 @@ int cmd_render(int argc, char **argv)
         } else {
             /* --set NAME=VALUE and its short forms */
             char setting[128];
-            if (!strcmp(a, "--set")) snprintf(setting, sizeof setting, "%s", v);
-            else snprintf(setting, sizeof setting, "%s=%s", a + 2, v);
+            int n = !strcmp(a, "--set") ? snprintf(setting, sizeof setting, "%s", v)
+                                        : snprintf(setting, sizeof setting, "%s=%s", a + 2, v);
+            if (n < 0 || (size_t)n >= sizeof setting) return cli_usage_error("render", "setting too long: '%s'", v);
             if (!cli_set(&main_run.cfg, setting)) return 2;
         }
         i++;
     }
+    /* A grey frame is written as a PGM; the default name says so. */
+    if (!out) out = fmt == OM_L8 ? "ombra.pgm" : "ombra.ppm";
     if (diff && !against) return cli_usage_error("render", "%s needs --against", "--diff");
     main_run.m = om_method_find(mname);
-    if (!main_run.m) return cli_usage_error("render", "unknown method '%s' (see 'ombra methods')", mname);
+    if (!main_run.m) return cli_unknown_method("render", "--method", mname);
     if (against && !(ref_run.m = om_method_find(against)))
-        return cli_usage_error("render", "unknown method '%s' for --against (see 'ombra methods')", against);
+        return cli_unknown_method("render", "--against", against);
     om_method_cfg_default(&ref_run.cfg);
+    {
+        const char *paths[4] = {scene_path, out, mask, diff};
+        const char *names[4] = {"the scene", "--out", "--mask", "--diff"};
+        int rc = same_files(paths, names, 4);
+        if (rc) return rc;
+    }
+    /* With an image on standard output the report goes to standard error. */
+    FILE *info = om_out_same(out, "-") || (mask && om_out_same(mask, "-")) ||
+                 (diff && om_out_same(diff, "-")) ? stderr : stdout;
 
     om_diag d;
     memset(&d, 0, sizeof d);
@@ -200,9 +229,11 @@ int cmd_render(int argc, char **argv)
     if (w) { cam.width = w; cam.height = h; }
     om_view view;
     int rc = 0;
-    uint8_t *mask_main = NULL, *mask_ref = NULL;
+    uint8_t *mask_main = NULL, *mask_ref = NULL, *rgb = NULL;
     om_ppm_sink sink;
+    om_out diff_out;
     memset(&sink, 0, sizeof sink);
+    memset(&diff_out, 0, sizeof diff_out);
     if ((st = om_view_init(&view, &cam, &light, &cs.scene, &d)) != OM_OK) { rc = cli_error(where, &d, st); goto out; }
     const uint32_t W = cam.width, H = cam.height;
     if ((st = main_run.m->bytes(&main_run.cfg, &cs.scene, W, H, &main_run.min, &main_run.full)) != OM_OK) {
@@ -227,14 +258,23 @@ int cmd_render(int argc, char **argv)
         size_t fit = left >= one ? 1 + (left - one) / row_bytes : 0;
         if (fit == 0) {
             size_t need = cs.bytes + main_run.min + one;
+            char hint[160];
+            cli_method_hint(main_run.m, hint, sizeof hint);
             fprintf(stderr, "ombra: --budget %zu is too small: this scene (%zu bytes), method '%s' "
                     "(at least %zu) and one %u-pixel row (%zu) need %zu bytes; raise --budget, "
-                    "make --size smaller, or ask the method for less (--map; 'ombra methods' "
-                    "lists its settings)\n", budget, cs.bytes, mname, main_run.min, W, one, need);
+                    "make --size smaller%s\n", budget, cs.bytes, mname, main_run.min, W, one,
+                    need, hint);
             rc = 1;
             goto out;
         }
         if (fit < rows) rows = (uint32_t)fit;
+    }
+    /* The outputs open (as temporaries) before any work, so an unwritable one fails
+     * at once; they replace the old files only once all are complete. */
+    if ((st = om_ppm_open(&sink, out, mask, W, H, fmt == OM_L8, &d)) != OM_OK ||
+        (diff && (st = om_out_open(&diff_out, diff, &d)) != OM_OK)) {
+        rc = cli_error(NULL, &d, st);
+        goto out;
     }
     if ((st = run_init(&main_run, &cs, W, H, &d)) != OM_OK) { rc = cli_error(mname, &d, st); goto out; }
     if (against) {
@@ -255,52 +295,63 @@ int cmd_render(int argc, char **argv)
             goto out;
         }
     }
-    if ((st = om_ppm_open(&sink, out, mask, W, H, &d)) != OM_OK) { rc = cli_error(NULL, &d, st); goto out; }
     strip_out so = {&sink, mask_main};
     om_frame_stats fs;
     size_t frame_bytes;
     uint64_t t0 = om_clock_ns(NULL);
     st = run_frame(&main_run, &cs, &view, rows, fmt, &so, &fs, &frame_bytes, &d);
     uint64_t t1 = om_clock_ns(NULL);
-    om_status cst = om_ppm_close(&sink, st == OM_OK ? &d : NULL);
-    if (st != OM_OK) { rc = cli_error(mname, &d, st); goto out; }
-    if (cst != OM_OK) { rc = cli_error(NULL, &d, cst); goto out; }
+    if (st != OM_OK) {
+        /* A write that failed stopped the frame: name the file, not the method. */
+        om_status wst = om_ppm_failed(&sink, &d);
+        rc = wst != OM_OK ? cli_error(NULL, &d, wst) : cli_error(mname, &d, st);
+        goto out;
+    }
+    om_metrics mt;
+    if (against) {
+        om_compare_masks(mask_ref, mask_main, W, H, &mt);
+        if (diff) {
+            if (!(rgb = malloc((size_t)W * H * 3))) { rc = cli_error(NULL, &d, cli_oom(&d)); goto out; }
+            om_diff_image(mask_ref, mask_main, W, H, rgb);
+            if (!om_ppm_put(&diff_out, rgb, W, H)) {
+                rc = cli_error(NULL, &d, om_out_failed(&diff_out, &d));
+                goto out;
+            }
+        }
+    }
+    {
+        om_out *outs[3] = {&sink.img, &sink.mask, &diff_out};
+        if ((st = om_out_commit(outs, 3, &d)) != OM_OK) { rc = cli_error(NULL, &d, st); goto out; }
+    }
     if (!quiet) {
         om_method_stats ms;
         main_run.m->stats(main_run.state, &ms);
-        printf("%s: %ux%u, %u triangles, method %s, %u strip(s) of %u rows\n", where, W, H,
-               cs.scene.ntris, mname, fs.strips, rows);
-        printf("time: total %.2f ms (eye %.2f x%u, observe %.2f, build %.2f, resolve %.2f, shade %.2f)\n",
-               (double)(t1 - t0) / 1e6, (double)fs.ns_eye / 1e6, fs.eye_passes,
-               (double)fs.ns_observe / 1e6, (double)fs.ns_build / 1e6,
-               (double)fs.ns_resolve / 1e6, (double)fs.ns_shade / 1e6);
-        printf("memory: scene %zu, frame %zu (peak %zu), method %zu (peak %zu) bytes\n", cs.bytes,
-               frame_bytes, fs.frame_peak, main_run.given, main_run.arena.peak);
+        fprintf(info, "%s: %ux%u, %u triangles, method %s, %u strip(s) of %u rows\n", where, W, H,
+                cs.scene.ntris, mname, fs.strips, rows);
+        fprintf(info, "time: total %.2f ms (init %.2f, eye %.2f x%u, observe %.2f, build %.2f, "
+                "resolve %.2f, shade %.2f)\n",
+                (double)(main_run.ns_init + (t1 - t0)) / 1e6, (double)main_run.ns_init / 1e6,
+                (double)fs.ns_eye / 1e6, fs.eye_passes, (double)fs.ns_observe / 1e6,
+                (double)fs.ns_build / 1e6, (double)fs.ns_resolve / 1e6, (double)fs.ns_shade / 1e6);
+        fprintf(info, "memory: scene %zu, frame %zu (peak %zu), method %zu (peak %zu) bytes\n", cs.bytes,
+                frame_bytes, fs.frame_peak, main_run.given, main_run.arena.peak);
         for (uint32_t k = 0; k < ms.ncounters; k++)
-            printf("%s%s %u", k ? ", " : "stats: ", ms.counter_names[k], ms.counters[k]);
-        if (ms.ncounters) printf("\n");
-        printf("hash: image %016llx mask %016llx\n", (unsigned long long)sink.hash_img,
-               (unsigned long long)sink.hash_mask);
-        printf("wrote %s%s%s\n", out, mask ? " and " : "", mask ? mask : "");
+            fprintf(info, "%s%s %u", k ? ", " : "stats: ", ms.counter_names[k], ms.counters[k]);
+        if (ms.ncounters) fprintf(info, "\n");
+        fprintf(info, "hash: image %016llx mask %016llx\n", (unsigned long long)sink.hash_img,
+                (unsigned long long)sink.hash_mask);
+        fprintf(info, "wrote %s%s%s%s%s\n", out, mask ? " and " : "", mask ? mask : "",
+                diff ? " and " : "", diff ? diff : "");
     }
-    if (against) {
-        om_metrics mt;
-        om_compare_masks(mask_ref, mask_main, W, H, &mt);
-        print_metrics(mname, against, &mt);
-        if (diff) {
-            uint8_t *rgb = malloc((size_t)W * H * 3);
-            if (!rgb) { rc = cli_error(NULL, &d, cli_oom(&d)); goto out; }
-            om_diff_image(mask_ref, mask_main, W, H, rgb);
-            st = om_ppm_write(diff, rgb, W, H, &d);
-            free(rgb);
-            if (st != OM_OK) { rc = cli_error(NULL, &d, st); goto out; }
-        }
-    }
+    if (against) print_metrics(info, mname, against, &mt);
 out:
+    om_ppm_discard(&sink);
+    om_out_discard(&diff_out);
     free(main_run.mem);
     free(ref_run.mem);
     free(mask_main);
     free(mask_ref);
+    free(rgb);
     cli_scene_free(&cs);
     return rc;
 }
@@ -400,7 +451,7 @@ int cmd_compare(int argc, char **argv)
     } else {
         om_metrics m;
         om_compare_masks(ma, mb, wa, ha, &m);
-        print_metrics(b_path, a_path, &m);
+        print_metrics(stdout, b_path, a_path, &m);
         if (m.mismatched_bg)
             printf("warning: %llu pixels are background in one mask only: not the same frame?\n",
                    (unsigned long long)m.mismatched_bg);

@@ -16,7 +16,7 @@ static const char report_help[] =
     "\n"
     "Runs 'ombra bench' with the same options, then writes DIR/index.html: the charts,\n"
     "the table, and crops of each scene where the methods disagree most (default: the\n"
-    "default scene at 640x480 into out/report).\n";
+    "default scene at its own size into out/report).\n";
 
 #define CROP_MAX 64
 #define ZOOM 3
@@ -84,20 +84,16 @@ static void table(FILE *f, const char *csv)
 /* Renders every swept method at its defaults beside the reference and writes the
  * scene's section: the reference frame, then crops at the window where the methods'
  * masks disagree most with the reference's. */
-static int scene_section(FILE *f, const char *name, uint32_t W, uint32_t H)
+static int scene_section(FILE *f, const char *name, uint32_t w, uint32_t h)
 {
     om_diag d;
     memset(&d, 0, sizeof d);
     cli_scene cs;
     om_status st = cli_load_named(name, &cs, &d);
     if (st) { cli_scene_free(&cs); return cli_error(name, &d, st); }
-    om_camera cam;
-    om_light light;
     om_view v;
-    om_scene_at(&cs.scene, 0, &cam, &light);
-    cam.width = W;
-    cam.height = H;
-    if ((st = om_view_init(&v, &cam, &light, &cs.scene, &d))) { cli_scene_free(&cs); return cli_error(name, &d, st); }
+    if ((st = cli_scene_view(&cs, w, h, &v, &d))) { cli_scene_free(&cs); return cli_error(name, &d, st); }
+    const uint32_t W = v.cam.width, H = v.cam.height;
     size_t n = (size_t)W * H;
     uint8_t *ref = malloc(n), *frame = malloc(n * 3);
     const om_method *ms[16];
@@ -169,9 +165,17 @@ static int scene_section(FILE *f, const char *name, uint32_t W, uint32_t H)
     return 0;
 }
 
+/* Copies a file that bench wrote into the page, or says it is missing. */
+static void inline_file(FILE *f, const char *dir, const char *file, void (*put)(FILE *, const char *))
+{
+    char *path = cli_path(dir, file);
+    if (path) put(f, path);
+    free(path);
+}
+
 int cmd_report(int argc, char **argv)
 {
-    const char *scenes = "default", *dir = "out/report", *size = "640x480", *runs = "3";
+    const char *scenes = "default", *dir = "out/report", *size = NULL, *runs = "3";
     bool tri = false;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -185,16 +189,21 @@ int cmd_report(int argc, char **argv)
         else return cli_usage_error("report", "unknown option '%s'", a);
         i++;
     }
-    uint32_t W, H;
-    if (!cli_parse_size(size, &W, &H)) return cli_usage_error("report", "--size takes WxH, not '%s'", size);
-    char *bargv[12] = {"bench", "--scenes", (char *)scenes, "--size", (char *)size, "--runs",
-                       (char *)runs, "--out", (char *)dir, tri ? "--tri-sweep" : NULL, NULL};
-    int rc = cmd_bench(tri ? 10 : 9, bargv);
+    uint32_t W = 0, H = 0;
+    if (size && !cli_parse_size(size, &W, &H)) return cli_usage_error("report", "--size takes WxH, not '%s'", size);
+    char *bargv[12] = {"bench", "--scenes", (char *)scenes, "--runs", (char *)runs, "--out", (char *)dir};
+    int bargc = 7;
+    if (size) { bargv[bargc++] = "--size"; bargv[bargc++] = (char *)size; }
+    if (tri) bargv[bargc++] = "--tri-sweep";
+    int rc = cmd_bench(bargc, bargv);
     if (rc) return rc;
-    char path[1024];
-    snprintf(path, sizeof path, "%s/index.html", dir);
-    FILE *f = fopen(path, "w");
-    if (!f) { fprintf(stderr, "ombra: %s: cannot create\n", path); return 1; }
+    om_diag d;
+    memset(&d, 0, sizeof d);
+    om_out page;
+    char *path = cli_path(dir, "index.html"), *list = malloc(strlen(scenes) + 1);
+    om_status st = path && list ? om_out_open(&page, path, &d) : cli_oom(&d);
+    if (st != OM_OK) { free(path); free(list); return cli_error(NULL, &d, st); }
+    FILE *f = page.f;
     fprintf(f, "<!DOCTYPE html>\n<html xmlns=\"http://www.w3.org/1999/xhtml\" lang=\"en\">\n<head>\n"
                "<meta charset=\"utf-8\"/>\n<title>ombra report</title>\n<style>\n"
                "body { font-family: sans-serif; margin: 2em; color: #222; }\n"
@@ -206,44 +215,45 @@ int cmd_report(int argc, char **argv)
                "</style>\n</head>\n<body>\n<h1>ombra: hard shadows, accuracy against speed</h1>\n"
                "<p>Every method renders the same visible samples; accuracy is the share of samples "
                "whose binary shadow state differs from the exact reference (<code>ref</code>). "
-               "Times are medians of %s frames on one core at %s.</p>\n", runs, size);
-    char list[1024];
-    snprintf(list, sizeof list, "%s", scenes);
+               "Times are medians of %s frames on one core at %s; a method's init (where "
+               "<code>ref</code> builds its BVH) is its own stage, paid again whenever the scene "
+               "changes.</p>\n", runs, size ? size : "each scene's own size");
+    memcpy(list, scenes, strlen(scenes) + 1);
     fprintf(f, "<h2>Charts</h2>\n");
+    static const char *const charts[3] = {"time", "bytes", "first"};
     for (char *name = strtok(list, ","); name; name = strtok(NULL, ",")) {
         const char *base = strrchr(name, '/') ? strrchr(name, '/') + 1 : name;
-        snprintf(path, sizeof path, "%s/%s-time.svg", dir, base);
-        inline_svg(f, path);
-        snprintf(path, sizeof path, "%s/%s-bytes.svg", dir, base);
-        inline_svg(f, path);
+        for (int c = 0; c < 3; c++) {
+            char file[300];
+            snprintf(file, sizeof file, "%s-%s.svg", base, charts[c]);
+            inline_file(f, dir, file, inline_svg);
+        }
     }
-    if (tri) {
-        snprintf(path, sizeof path, "%s/triangles.svg", dir);
-        inline_svg(f, path);
-    }
+    if (tri) inline_file(f, dir, "triangles.svg", inline_svg);
     fprintf(f, "<h2>The table</h2>\n");
-    snprintf(path, sizeof path, "%s/bench.csv", dir);
-    table(f, path);
-    snprintf(list, sizeof list, "%s", scenes);
-    char *names[16];
-    int nn = 0;
-    for (char *name = strtok(list, ","); name && nn < 16; name = strtok(NULL, ",")) names[nn++] = name;
-    snprintf(path, sizeof path, "%s/stability.csv", dir);
-    FILE *st = fopen(path, "r");
-    if (st) {
-        fclose(st);
+    inline_file(f, dir, "bench.csv", table);
+    memcpy(list, scenes, strlen(scenes) + 1);
+    char *stab = cli_path(dir, "stability.csv");
+    FILE *sf = stab ? fopen(stab, "r") : NULL;
+    if (sf) {
+        fclose(sf);
         fprintf(f, "<h2>Stability: where each method is known to fail</h2>\n"
                    "<p>Every method along the 30-frame camera and light paths of the cases in "
                    "<code>tests/stability/</code> (<code>make stability</code>): mismatch share "
                    "against the reference (mean and worst frame), the same near shadow edges, "
                    "flicker (state changes the reference does not have), median frame time and "
                    "arena bytes.</p>\n");
-        table(f, path);
+        table(f, stab);
     }
-    for (int i = 0; i < nn; i++)
-        if ((rc = scene_section(f, names[i], W, H)) != 0) break;
+    free(stab);
+    for (char *name = strtok(list, ","); name && !rc; name = strtok(NULL, ","))
+        rc = scene_section(f, name, W, H);
     fprintf(f, "</body>\n</html>\n");
-    if (fclose(f) != 0) rc = 1;
-    if (!rc) printf("wrote %s/index.html\n", dir);
+    om_out *outs[1] = {&page};
+    if (rc) om_out_discard(&page);
+    else if ((st = om_out_commit(outs, 1, &d)) != OM_OK) rc = cli_error(NULL, &d, st);
+    if (!rc) printf("wrote %s\n", path);
+    free(path);
+    free(list);
     return rc;
 }
