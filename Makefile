@@ -6,6 +6,7 @@
 #   make bench      benchmark figures (medians of several runs)
 #   make cross-test the same frames from every compiler and CPU (qemu-user)
 #   make fuzz       libFuzzer targets, FUZZ_SECONDS each; make test-valgrind
+#   make fuzz-regress   the fuzz targets over tests/fuzz/regress/ (part of make check)
 
 CC      ?= cc
 OPT     ?= -O2
@@ -75,10 +76,25 @@ test:
 	  echo "determinism: ok — every method's frame is bit-identical across gcc/clang -O0/-O2"
 	sh tests/freestanding.sh
 
-check: $(O)/run-tests $(O)/ombra
+# The fuzz targets' entry points without libFuzzer, replayed over the inputs that once
+# crashed or hung a target and the hostile inputs of issue 24 (tests/fuzz/regress/),
+# and the seeds: part of `make check`, so of `make test` and `make test-sanitize`.
+FUZZ_TARGETS = scene obj render
+FUZZ_INPUTS  = $(sort $(wildcard tests/fuzz/regress/* tests/fuzz/seeds/*))
+
+$(O)/fuzz-replay-%: tests/fuzz/fuzz_%.c tests/fuzz/replay.c $(O)/libombra.a
+	$(Q)$(CC) $(CFLAGS_ALL) -o $@ $(filter %.c %.a,$^) $(LDLIBS)
+
+REPLAY = for t in $(FUZZ_TARGETS); do printf 'fuzz_%s: ' $$t; $(O)/fuzz-replay-$$t $(FUZZ_INPUTS) || exit 1; done
+
+fuzz-regress: $(FUZZ_TARGETS:%=$(O)/fuzz-replay-%)
+	$(Q)$(REPLAY)
+
+check: $(O)/run-tests $(O)/ombra $(FUZZ_TARGETS:%=$(O)/fuzz-replay-%)
 	@echo "== $(O)"
 	$(O)/run-tests
 	sh tests/cli.sh $(O)/ombra
+	$(Q)$(REPLAY)
 
 test-sanitize:
 	$(MAKE) --no-print-directory check CC=clang OPT=-O1 O=build/san \
@@ -123,4 +139,4 @@ test-valgrind:
 clean:
 	rm -rf build out
 
-.PHONY: all run test check test-sanitize bench cross-test fuzz test-valgrind stress stability clean
+.PHONY: all run test check test-sanitize bench cross-test fuzz fuzz-regress test-valgrind stress stability clean
