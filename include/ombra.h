@@ -312,6 +312,8 @@ typedef struct om_method_cfg {
     uint32_t spsm_fine;    /* 1: the plain-map fallback at 2 x 2 points per texel (16
                               more bytes per texel and a second pass; fewer false-lit
                               samples along fine rims), 0: at texel centres */
+    /* hybrid (also izb_leaf, izb_pool for the samples its map leaves uncertain) */
+    uint32_t hybrid_map;   /* side of its conservative map, 20 bytes per texel */
 } om_method_cfg;
 
 /* One settable field of om_method_cfg. */

@@ -51,6 +51,13 @@ om_status h_render(const om_scene *s, const char *name, const om_method_cfg *cfg
                    uint32_t h, float t, uint32_t strip_rows, uint8_t *mask, om_term *terms,
                    om_sample *samples)
 {
+    return h_render_in(s, name, cfg, w, h, t, strip_rows, 0, mask, terms, samples);
+}
+
+om_status h_render_in(const om_scene *s, const char *name, const om_method_cfg *cfg, uint32_t w,
+                      uint32_t h, float t, uint32_t strip_rows, size_t method_bytes, uint8_t *mask,
+                      om_term *terms, om_sample *samples)
+{
     om_camera cam;
     om_light light;
     om_view v;
@@ -66,6 +73,7 @@ om_status h_render(const om_scene *s, const char *name, const om_method_cfg *cfg
     else om_method_cfg_default(&c);
     size_t mn, full;
     if ((st = m->bytes(&c, s, cam.width, cam.height, &mn, &full))) return st;
+    if (method_bytes) full = method_bytes;
     uint32_t rows = strip_rows ? strip_rows : cam.height;
     size_t fbytes = om_frame_bytes(cam.width, rows);
     void *mm = malloc(full), *fm = malloc(fbytes), *px = malloc((size_t)cam.width * rows * 3);

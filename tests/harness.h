@@ -22,5 +22,9 @@ void h_scene_free(h_scene *hs);
 om_status h_render(const om_scene *s, const char *name, const om_method_cfg *cfg, uint32_t w,
                    uint32_t h, float t, uint32_t strip_rows, uint8_t *mask, om_term *terms,
                    om_sample *samples);
+/* The same with a method arena of `method_bytes` (0: the one-pass size). */
+om_status h_render_in(const om_scene *s, const char *name, const om_method_cfg *cfg, uint32_t w,
+                      uint32_t h, float t, uint32_t strip_rows, size_t method_bytes, uint8_t *mask,
+                      om_term *terms, om_sample *samples);
 
 #endif

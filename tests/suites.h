@@ -18,6 +18,7 @@
     X(suite_robust) \
     X(suite_spsm) \
     X(suite_oracle) \
+    X(suite_hybrid) \
     /* end of list */
 #endif
 #define X(suite) void suite(void);

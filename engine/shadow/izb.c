@@ -37,19 +37,24 @@ static uint32_t node_bound(uint32_t samples, uint32_t leaf)
     return 2 * (leaves ? leaves : 1) + 1;
 }
 
-/* What izb keeps besides its pools; the per-frame vertex projection only when the
- * arena has room for one pass (it speeds up triangle setup, it changes no result). */
-static size_t fixed_bytes(const om_scene *s, bool cache)
+/* The per-frame vertex projection is kept only when the arena has room for one pass
+ * (it speeds up triangle setup, it changes no result). */
+size_t om__izb_parts_bytes(const om_scene *s, bool cache)
 {
-    return om_arena_need(sizeof(izb_state), 16) + (cache ? om__lspace_bytes(s) : 0) +
+    return (cache ? om__lspace_bytes(s) : 0) +
            om_arena_need((size_t)(s->nmats ? s->nmats : 1) * sizeof(om__odepth), 4);
 }
 
-static size_t pool_bytes(uint32_t samples, uint32_t leaf)
+size_t om__izb_pool_bytes(uint32_t samples, uint32_t leaf)
 {
     return om_arena_need((size_t)samples * sizeof(om__izb_sample), 16) +
            om_arena_need((size_t)samples * sizeof(om__izb_key), 16) +
            om_arena_need((size_t)node_bound(samples, leaf) * sizeof(om__izb_node), 16);
+}
+
+static size_t fixed_bytes(const om_scene *s, bool cache)
+{
+    return om_arena_need(sizeof(izb_state), 16) + om__izb_parts_bytes(s, cache);
 }
 
 static om_status izb_bytes(const om_method_cfg *c, const om_scene *s, uint32_t w, uint32_t h,
@@ -58,8 +63,44 @@ static om_status izb_bytes(const om_method_cfg *c, const om_scene *s, uint32_t w
     if (c->izb_leaf < 1) return OM_E_INVALID;
     uint32_t one_pass = w * h, smallest = w;   /* the smallest tile: one row */
     if (c->izb_pool) one_pass = smallest = c->izb_pool;
-    *min = fixed_bytes(s, false) + pool_bytes(smallest, c->izb_leaf);
-    *full = fixed_bytes(s, true) + pool_bytes(one_pass, c->izb_leaf);
+    *min = fixed_bytes(s, false) + om__izb_pool_bytes(smallest, c->izb_leaf);
+    *full = fixed_bytes(s, true) + om__izb_pool_bytes(one_pass, c->izb_leaf);
+    return OM_OK;
+}
+
+om_status om__izb_setup(om__izb *z, om_arena *a, const om_method_cfg *c, const om_scene *s,
+                        uint32_t want, uint32_t least, om_diag *d)
+{
+    om_status st;
+    void *p;
+    z->scene = s;
+    z->leaf = c->izb_leaf;
+    if (c->izb_pool) want = least = c->izb_pool;
+    if (om_arena_left(a) >= om__izb_parts_bytes(s, true) + om__izb_pool_bytes(want, z->leaf)) {
+        if ((st = om__lspace_init(&z->ls, a, s, d))) return st;
+    } else {
+        om__lspace_init_lean(&z->ls, s);
+    }
+    if ((st = om_arena_alloc(a, (size_t)(s->nmats ? s->nmats : 1) * sizeof(om__odepth), 4, &p, d)))
+        return st;
+    z->mat_od = (om__odepth *)p;
+    for (uint32_t i = 0; i < s->nmats; i++) z->mat_od[i] = om__material_odepth(&s->mats[i]);
+    /* The pool: as configured, or as many samples as the arena holds, up to one pass. */
+    uint32_t cap = least, hi = want;
+    size_t left = om_arena_left(a);
+    while (cap < hi) {   /* largest pool that fits */
+        uint32_t mid = cap + (hi - cap + 1) / 2;
+        if (om__izb_pool_bytes(mid, z->leaf) <= left) cap = mid;
+        else hi = mid - 1;
+    }
+    z->cap = cap;
+    z->node_cap = node_bound(cap, z->leaf);
+    if ((st = om_arena_alloc(a, (size_t)cap * sizeof(om__izb_sample), 16, &p, d))) return st;
+    z->samples = (om__izb_sample *)p;
+    if ((st = om_arena_alloc(a, (size_t)cap * sizeof(om__izb_key), 16, &p, d))) return st;
+    z->keys = (om__izb_key *)p;
+    if ((st = om_arena_alloc(a, (size_t)z->node_cap * sizeof(om__izb_node), 16, &p, d))) return st;
+    z->nodes = (om__izb_node *)p;
     return OM_OK;
 }
 
@@ -74,41 +115,10 @@ static om_status izb_init(void **state, om_arena *a, const om_method_cfg *c, con
     if ((st = om__need(a, mn, "izb", d))) return st;
     if ((st = om_arena_alloc(a, sizeof(izb_state), 16, &p, d))) return st;
     izb_state *m = (izb_state *)p;
-    om__izb *z = &m->z;
     m->cfg = *c;
     m->width = w;
     m->height = h;
-    z->scene = s;
-    z->leaf = c->izb_leaf;
-    if (om_arena_left(a) >= full - om_arena_need(sizeof(izb_state), 16)) {
-        if ((st = om__lspace_init(&z->ls, a, s, d))) return st;
-    } else {
-        om__lspace_init_lean(&z->ls, s);
-    }
-    if ((st = om_arena_alloc(a, (size_t)(s->nmats ? s->nmats : 1) * sizeof(om__odepth), 4, &p, d)))
-        return st;
-    z->mat_od = (om__odepth *)p;
-    for (uint32_t i = 0; i < s->nmats; i++) z->mat_od[i] = om__material_odepth(&s->mats[i]);
-    /* The pool: as configured, or as many samples as the arena holds, up to one pass. */
-    uint32_t cap = c->izb_pool;
-    if (!cap) {
-        uint32_t lo = w, hi = w * h;
-        size_t left = om_arena_left(a);
-        while (lo < hi) {   /* largest pool that fits */
-            uint32_t mid = lo + (hi - lo + 1) / 2;
-            if (pool_bytes(mid, z->leaf) <= left) lo = mid;
-            else hi = mid - 1;
-        }
-        cap = lo;
-    }
-    z->cap = cap;
-    z->node_cap = node_bound(cap, z->leaf);
-    if ((st = om_arena_alloc(a, (size_t)cap * sizeof(om__izb_sample), 16, &p, d))) return st;
-    z->samples = (om__izb_sample *)p;
-    if ((st = om_arena_alloc(a, (size_t)cap * sizeof(om__izb_key), 16, &p, d))) return st;
-    z->keys = (om__izb_key *)p;
-    if ((st = om_arena_alloc(a, (size_t)z->node_cap * sizeof(om__izb_node), 16, &p, d))) return st;
-    z->nodes = (om__izb_node *)p;
+    if ((st = om__izb_setup(&m->z, a, c, s, w * h, w, d))) return st;
     *state = m;
     return OM_OK;
 }
@@ -136,7 +146,8 @@ static om_status izb_build(void *state, om_diag *d)
 
 /* ---- stage 1: transform */
 
-uint32_t om__izb_transform(om__izb *z, const om_strip *st, size_t *next, size_t end)
+uint32_t om__izb_transform(om__izb *z, const om_strip *st, size_t *next, size_t end,
+                           om__izb_decide decide, void *user)
 {
     size_t i = *next;
     uint32_t n = 0;
@@ -144,6 +155,7 @@ uint32_t om__izb_transform(om__izb *z, const om_strip *st, size_t *next, size_t 
         if (!(st->terms[i].flags & OM_TERM_EXPOSED)) continue;
         om__izb_sample *s = &z->samples[n];
         if (!om__lspace_point(&z->ls, &st->samples[i], &s->p)) continue;   /* behind the light */
+        if (decide && decide(user, &s->p, &st->terms[i])) continue;
         s->idx = (uint32_t)i;
         memset(&s->od, 0, sizeof s->od);
         n++;
@@ -358,7 +370,7 @@ static om_status izb_resolve(void *state, om_strip *st, om_diag *d)
     size_t n = (size_t)st->rows * st->width, next = 0;
     for (size_t i = 0; i < n; i++) st->terms[i].r = st->terms[i].g = st->terms[i].b = 255;
     while (next < n) {
-        if (om__izb_transform(z, st, &next, n) == 0) break;
+        if (om__izb_transform(z, st, &next, n, NULL, NULL) == 0) break;
         om__izb_build(z);
         om__izb_raster(z);
         om__izb_write(z, st);
@@ -372,7 +384,7 @@ static void izb_stats(const void *state, om_method_stats *out)
     const izb_state *m = (const izb_state *)state;
     const om__izb *z = &m->z;
     memset(out, 0, sizeof *out);
-    out->bytes_used = fixed_bytes(z->scene, z->ls.verts != NULL) + pool_bytes(z->cap, z->leaf);
+    out->bytes_used = fixed_bytes(z->scene, z->ls.verts != NULL) + om__izb_pool_bytes(z->cap, z->leaf);
     static const char *const names[] = {"bsp nodes", "nodes visited", "nodes culled (shadowed)",
                                         "nodes culled (depth)", "samples tested", "tiles",
                                         "pool samples"};

@@ -53,9 +53,24 @@ typedef struct om__izb {
 
 /* The izb method's state begins with an om__izb, so a state pointer converts to one. */
 
+/* Arena bytes of om__izb_setup's parts: the material depths and, with `cache`, the
+ * per-frame vertex projection; and of a pool of `samples` with its BSP nodes. */
+size_t om__izb_parts_bytes(const om_scene *s, bool cache);
+size_t om__izb_pool_bytes(uint32_t samples, uint32_t leaf);
+/* Carves z's parts from `a`: the vertex projection when the arena also holds a pool of
+ * `want` samples beside it, then the pool: c->izb_pool samples when set, else the
+ * largest from `least` up to `want` that fits. The caller has checked the minimum. */
+om_status om__izb_setup(om__izb *z, om_arena *a, const om_method_cfg *c, const om_scene *s,
+                        uint32_t want, uint32_t least, om_diag *d);
+
+/* Decides a sample without the BSP when it can: writes its term and returns true. */
+typedef bool (*om__izb_decide)(void *user, const om__lpoint *p, om_term *t);
+
 /* Fills the pool from strip samples [*next, end) that are exposed, up to its capacity;
- * advances *next. Returns the number taken. */
-uint32_t om__izb_transform(om__izb *z, const om_strip *st, size_t *next, size_t end);
+ * advances *next. With `decide`, only the samples it leaves undecided enter the pool.
+ * Returns the number taken. */
+uint32_t om__izb_transform(om__izb *z, const om_strip *st, size_t *next, size_t end,
+                           om__izb_decide decide, void *user);
 void om__izb_build(om__izb *z);
 /* Rasterizes every triangle of the scene through the BSP. */
 void om__izb_raster(om__izb *z);

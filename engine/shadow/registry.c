@@ -10,6 +10,7 @@ static const om_method *const methods[] = {
     &om__method_rtw,
     &om__method_spsm,
     &om__method_izb,
+    &om__method_hybrid,
 };
 
 /* What `ombra bench` sweeps, by method name (see om_method_sweep). */
@@ -20,6 +21,7 @@ static const struct { const char *name, *sweep; } sweeps[] = {
     {"asm", "asm.cap=1048576,4194304,8388608,16777216"},
     {"rtw", "map=512,1024,2048 rtw.exact=1,0"},
     {"spsm", "map=512,1024,2048,4096"},
+    {"hybrid", "hybrid.map=256,512,1024"},
 };
 
 size_t om_method_count(void) { return sizeof methods / sizeof methods[0]; }
@@ -77,6 +79,7 @@ void om_method_cfg_default(om_method_cfg *c)
     c->spsm_aa = 0;
     c->spsm_records = 0;
     c->spsm_fine = 0;
+    c->hybrid_map = 512;
 }
 
 #define F(name, kind, field, lo, hi, help) {name, help, kind, offsetof(om_method_cfg, field), lo, hi}
@@ -95,8 +98,8 @@ static const om_cfg_field fields[] = {
     F("asm.stride", 'u', asm_stride, 1, 1024, "ASM analyses one visible sample in N"),
     F("asm.a", 'f', asm_cost_a, 0, 1e6, "ASM node cost per required texel"),
     F("asm.b", 'f', asm_cost_b, 0, 1e6, "ASM node cost, constant part"),
-    F("izb.leaf", 'u', izb_leaf, 1, 65536, "most samples in an IZB BSP leaf"),
-    F("izb.pool", 'u', izb_pool, 0, 1e9, "IZB sample pool, 0 = whole frame in one pass"),
+    F("izb.leaf", 'u', izb_leaf, 1, 65536, "most samples in an IZB BSP leaf (izb, hybrid)"),
+    F("izb.pool", 'u', izb_pool, 0, 1e9, "IZB sample pool, 0 = whole frame in one pass (izb, hybrid)"),
     F("rtw.importance", 'u', rtw_importance, 0, 8192, "RTW importance map side, 0 = 512 or the map's if smaller"),
     F("rtw.analysis", 'u', rtw_analysis, 0, 2, "RTW analysis: 0 backward, 1 forward, 2 hybrid"),
     F("rtw.funcs", 'u', rtw_funcs, 0, 15, "RTW importance: 1 view, 2 distance, 4 edge, 8 normal"),
@@ -107,6 +110,7 @@ static const om_cfg_field fields[] = {
     F("spsm.aa", 'u', spsm_aa, 0, 64, "SPSM sub-samples at uncertain samples, 0 = off"),
     F("spsm.records", 'u', spsm_records, 0, 2, "SPSM records made: 1 all, 2 those the view reads, 0 auto"),
     F("spsm.fine", 'u', spsm_fine, 0, 1, "SPSM fallback: 1 the plain map at 2 x 2 points per texel, 0 at centres"),
+    F("hybrid.map", 'u', hybrid_map, 1, 8192, "hybrid's conservative map side (20 bytes a texel)"),
 };
 
 #undef F

@@ -11,5 +11,6 @@ extern const om_method om__method_asm;
 extern const om_method om__method_rtw;
 extern const om_method om__method_spsm;
 extern const om_method om__method_izb;
+extern const om_method om__method_hybrid;
 
 #endif

@@ -46,6 +46,7 @@ int bench_run_hooked(const bscene *b, const char *method, const om_method_cfg *c
     X(bench_rtw) \
     X(bench_asm) \
     X(bench_spsm) \
+    X(bench_hybrid) \
     /* end of list */
 #define X(name) void name(void);
 OM_BENCHES

@@ -38,7 +38,7 @@ static void table_row(const bscene *b, uint32_t W, uint32_t H)
         om__izb *z = (om__izb *)state;
         size_t next = 0;
         uint64_t t0 = om_clock_ns(NULL);
-        om__izb_transform(z, &st, &next, n);
+        om__izb_transform(z, &st, &next, n, NULL, NULL);
         uint64_t t1 = om_clock_ns(NULL);
         om__izb_build(z);
         uint64_t t2 = om_clock_ns(NULL);

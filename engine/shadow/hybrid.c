@@ -1,0 +1,307 @@
+/* hybrid.c — exact shadows at close to a shadow map's cost. A conservative map of the
+ * occlusion predicate's light grid (occlude.h) proves most samples lit or shadowed;
+ * only the samples it leaves uncertain go through the irregular z-buffer (izb.c),
+ * whose answer is the reference's. The result equals `ref` bit for bit.
+ *
+ * The map has hybrid.map x hybrid.map texels over the light's grid, each a square of
+ * T x T grid points (the last row and column reach on to the guard band). A triangle
+ * touches a texel when its edge functions admit a point of the texel's square (tested
+ * against the square's extreme corner per edge: never missed, sometimes extra). Per
+ * texel the build keeps
+ *   lo, id  the least over touching triangles of (their plane's least depth over the
+ *           square, clamped as the predicate clamps, + their snapping bound), and
+ *           which triangle gave it;
+ *   lo2     the same least over every triangle but `id`;
+ *   hi, cid over unclipped opaque triangles whose edges admit all four corners of the
+ *           square (so every point of it: the admitted set is convex): the least of
+ *           (their plane's greatest depth over the square + their bound), and which.
+ * Depths are rounded outwards by a depth unit (far above the double evaluation's
+ * error), then to float outwards.
+ *
+ * Why the two certain answers are the predicate's, for a sample p with grid point g in
+ * texel e (om__blocks: a triangle t blocks p when t != p's own triangle, g is inside
+ * t's first sub-triangle that admits it, and that sub-triangle's depth at g plus its
+ * bound is below p.z):
+ *   certainly lit when L >= p.z, L = (id == own ? lo2 : lo). A blocker t != own admits
+ *     g, so it touches e and its entry is at most its depth at g plus its bound, which
+ *     is below p.z; if t == id then id != own and L = lo <= that; else L <= lo2 <=
+ *     that (lo2 is over every triangle but id, and lo <= lo2). Either way L < p.z.
+ *   certainly shadowed when hi < p.z and cid != own. cid is one sub-triangle (unclipped)
+ *     admitting every point of e, g among them, with depth at g at most its greatest
+ *     over the square, so its depth + bound < p.z: it blocks p; it is opaque, so the
+ *     optical depth saturates whatever else blocks, and the term is 0 in every
+ *     channel, as the reference's.
+ * A semi-transparent caster never makes a sample certain but lit (then nothing blocks
+ * and the term is exactly 255); the sample's own triangle is excluded by its id; a
+ * sample on a texel's border belongs to the one texel its grid point falls in, and
+ * that texel's square holds the point. Everything else is uncertain. */
+#include "shadow.h"
+#include "hybrid.h"
+
+#include <float.h>
+
+/* A texel: a plane P(x, y) = z + gx (x - xc) + gy (y - yc) about the texel's centre,
+ * below every touching triangle's depth plus bound over the texel; and the nearest
+ * opaque triangle touching it, with its least depth there. */
+typedef struct htexel { float z, gx, gy, near; uint32_t cid; } htexel;
+
+#define MRU 4
+
+typedef struct hybrid_state {
+    om__izb z;             /* first: the irregular z-buffer for the uncertain samples */
+    om_method_cfg cfg;
+    htexel *map;
+    uint32_t side;         /* texels per side */
+    int64_t T;             /* grid units per texel side */
+    uint32_t lit, shadowed, uncertain;
+    om__ltri mru[MRU];     /* opaque triangles that blocked recent samples, newest first */
+} hybrid_state;
+
+#define GRID_SIDE ((int64_t)OM_LIGHT_GRID * OM_SUBPIX)   /* 2^21 grid units */
+#define FAR_OUT ((int64_t)1 << 27)   /* beyond every grid point a triangle can admit */
+
+static size_t fixed_bytes(const om_method_cfg *c, const om_scene *s, bool cache)
+{
+    return om_arena_need(sizeof(hybrid_state), 16) + om__izb_parts_bytes(s, cache) +
+           om_arena_need((size_t)c->hybrid_map * c->hybrid_map * sizeof(htexel), 16);
+}
+
+static om_status hybrid_bytes(const om_method_cfg *c, const om_scene *s, uint32_t w, uint32_t h,
+                              size_t *min, size_t *full)
+{
+    if (c->izb_leaf < 1 || c->hybrid_map < 1) return OM_E_INVALID;
+    uint32_t one_pass = w * h, smallest = w;
+    if (c->izb_pool) one_pass = smallest = c->izb_pool;
+    *min = fixed_bytes(c, s, false) + om__izb_pool_bytes(smallest, c->izb_leaf);
+    *full = fixed_bytes(c, s, true) + om__izb_pool_bytes(one_pass, c->izb_leaf);
+    return OM_OK;
+}
+
+static om_status hybrid_init(void **state, om_arena *a, const om_method_cfg *c, const om_scene *s,
+                             uint32_t w, uint32_t h, om_diag *d)
+{
+    om_status st;
+    void *p;
+    size_t mn, full;
+    if (c->izb_leaf < 1) return om__fail(d, OM_E_INVALID, "hybrid: izb.leaf must be at least 1");
+    if (c->hybrid_map < 1 || c->hybrid_map > OM_LIGHT_GRID)
+        return om__fail(d, OM_E_INVALID, "hybrid: hybrid.map must be 1..8192");
+    if ((st = hybrid_bytes(c, s, w, h, &mn, &full))) return st;
+    if ((st = om__need(a, mn, "hybrid", d))) return st;
+    if ((st = om_arena_alloc(a, sizeof(hybrid_state), 16, &p, d))) return st;
+    hybrid_state *m = (hybrid_state *)p;
+    m->cfg = *c;
+    m->side = c->hybrid_map;
+    m->T = (GRID_SIDE + m->side - 1) / m->side;
+    size_t tex = (size_t)m->side * m->side;
+    if ((st = om_arena_alloc(a, tex * sizeof(htexel), 16, &p, d))) return st;
+    m->map = (htexel *)p;
+    if ((st = om__izb_setup(&m->z, a, c, s, w * h, w, d))) return st;
+    *state = m;
+    return OM_OK;
+}
+
+static om_status hybrid_begin(void *state, const om_view *v, om_diag *d)
+{
+    (void)d;
+    hybrid_state *m = (hybrid_state *)state;
+    om__lspace_begin(&m->z.ls, v);
+    memset(&m->z.st, 0, sizeof m->z.st);
+    m->lit = m->shadowed = m->uncertain = 0;
+    return OM_OK;
+}
+
+static om_status hybrid_observe(void *state, const om_strip *st, om_diag *d)
+{
+    (void)state; (void)st; (void)d;
+    return OM_OK;
+}
+
+/* A double depth to float, never above it. */
+static float f_down(double v)
+{
+    float f = (float)v;
+    return (double)f > v ? nextafterf(f, -FLT_MAX) : f;
+}
+
+/* Does any point of the square [x0, x1] x [y0, y1] pass every edge of e? Each edge is
+ * tested at the corner where it is largest: a square outside one edge is out. */
+static bool square_touches(const om__tri2 *e, int64_t x0, int64_t y0, int64_t x1, int64_t y1)
+{
+    for (int i = 0; i < 3; i++)
+        if ((e->a[i] > 0 ? e->a[i] * x1 : e->a[i] * x0) + (e->b[i] > 0 ? e->b[i] * y1 : e->b[i] * y0) +
+                e->c[i] < 0)
+            return false;
+    return true;
+}
+
+/* The least of a - b over the square's corners, for a and b linear (a given at the
+ * corner (x0, y0) with slopes ax, ay, b likewise): at the corner each slope picks. */
+static double least_diff(double a0, double ax, double ay, double b0, double bx, double by, int64_t w,
+                         int64_t h)
+{
+    double dx = ax - bx, dy = ay - by;
+    return a0 - b0 + (dx < 0.0 ? dx * (double)w : 0.0) + (dy < 0.0 ? dy * (double)h : 0.0);
+}
+
+static void add_sub(hybrid_state *m, const om__rtri *r, double bound, uint32_t t, bool opaque)
+{
+    const om__tri2 *e = &r->e;
+    int64_t lox = e->x[0], hix = e->x[0], loy = e->y[0], hiy = e->y[0];
+    for (int i = 1; i < 3; i++) {
+        if (e->x[i] < lox) lox = e->x[i];
+        if (e->x[i] > hix) hix = e->x[i];
+        if (e->y[i] < loy) loy = e->y[i];
+        if (e->y[i] > hiy) hiy = e->y[i];
+    }
+    int64_t last = (int64_t)m->side - 1;
+    int64_t tx0 = lox / m->T, tx1 = hix / m->T, ty0 = loy / m->T, ty1 = hiy / m->T;
+    if (lox < 0) tx0 = 0;
+    if (loy < 0) ty0 = 0;
+    if (tx1 > last) tx1 = last;
+    if (ty1 > last) ty1 = last;
+    if (hix < 0 || hiy < 0 || tx0 > last || ty0 > last) return;
+    bool xlo = r->zx > 0.0, ylo = r->zy > 0.0;   /* where the plane is least */
+    for (int64_t ty = ty0; ty <= ty1; ty++) {
+        int64_t y0 = ty * m->T, y1 = y0 + m->T - 1;
+        if (ty == 0) y0 = -FAR_OUT;
+        if (ty == last) y1 = FAR_OUT;
+        for (int64_t tx = tx0; tx <= tx1; tx++) {
+            int64_t x0 = tx * m->T, x1 = x0 + m->T - 1;
+                if (tx == 0) x0 = -FAR_OUT;
+            if (tx == last) x1 = FAR_OUT;
+            if (!square_touches(e, x0, y0, x1, y1)) continue;
+            htexel *h = &m->map[ty * (int64_t)m->side + tx];
+            int64_t xc = tx * m->T + m->T / 2, yc = ty * m->T + m->T / 2;
+            if (h->gx != h->gx) {   /* empty (NaN): the texel takes this plane's slopes */
+                h->gx = (float)r->zx;
+                h->gy = (float)r->zy;
+                h->z = FLT_MAX;
+            }
+            /* The clamped depth is at least min(plane, zmax): the least of each over
+             * the square, less the texel's plane, bounds how far down z must go. */
+            double gx = h->gx, gy = h->gy;
+            double p0 = gx * (double)(x0 - xc) + gy * (double)(y0 - yc);
+            double d0 = r->z0 + r->zx * (double)(x0 - e->x[0]) + r->zy * (double)(y0 - e->y[0]);
+            double a = least_diff(d0, r->zx, r->zy, p0, gx, gy, x1 - x0, y1 - y0);
+            double b = least_diff(r->zmax, 0.0, 0.0, p0, gx, gy, x1 - x0, y1 - y0);
+            float z = f_down((a < b ? a : b) + bound - 1.0);
+            if (z < h->z) h->z = z;
+            if (opaque) {
+                float lo = f_down(om__rtri_depth(r, xlo ? x0 : x1, ylo ? y0 : y1) + bound);
+                if (lo < h->near) {
+                    h->near = lo;
+                    h->cid = t;
+                }
+            }
+        }
+    }
+}
+
+static om_status hybrid_build(void *state, om_diag *d)
+{
+    (void)d;
+    hybrid_state *m = (hybrid_state *)state;
+    size_t n = (size_t)m->side * m->side;
+    for (size_t i = 0; i < n; i++) {
+        htexel *h = &m->map[i];
+        h->z = h->near = FLT_MAX;
+        h->gx = h->gy = NAN;
+        h->cid = OM_NO_TRI;
+    }
+    const om_scene *s = m->z.scene;
+    for (uint32_t t = 0; t < s->ntris; t++) {
+        om__ltri lt;
+        if (!om__lspace_tri(&m->z.ls, t, &lt)) continue;
+        bool opaque = om__odepth_opaque(&m->z.mat_od[s->tri_mat[t]]);
+        for (int k = 0; k < lt.n; k++) add_sub(m, &lt.sub[k], lt.bound[k], t, opaque);
+    }
+    for (int k = 0; k < MRU; k++) m->mru[k].tri = OM_NO_TRI;
+    return OM_OK;
+}
+
+int om__hybrid_decide(void *state, const om__lpoint *p, om_term *t)
+{
+    hybrid_state *m = (hybrid_state *)state;
+    int64_t last = (int64_t)m->side - 1, tx = p->x / m->T, ty = p->y / m->T;
+    if (p->x < 0) tx = 0;
+    if (p->y < 0) ty = 0;
+    if (tx > last) tx = last;
+    if (ty > last) ty = last;
+    const htexel *h = &m->map[ty * (int64_t)m->side + tx];
+    int64_t xc = tx * m->T + m->T / 2, yc = ty * m->T + m->T / 2;
+    if ((double)h->z + (double)h->gx * (double)(p->x - xc) + (double)h->gy * (double)(p->y - yc) >= p->z ||
+        h->z == FLT_MAX) {
+        m->lit++;
+        return 1;   /* the term is already 255 */
+    }
+    /* An opaque triangle that blocks p decides it: the predicate itself says so. The
+     * candidates: triangles that blocked recent samples (neighbours in the image are
+     * mostly neighbours in the light's), then the texel's nearest opaque one. */
+    if ((double)h->near < p->z) {
+        for (int k = 0; k <= MRU; k++) {
+            om__ltri *lt = &m->mru[k < MRU ? k : MRU - 1];
+            if (k == MRU) {
+                if (h->cid == p->tri || h->cid == m->mru[0].tri || h->cid == m->mru[1].tri ||
+                    h->cid == m->mru[2].tri || h->cid == m->mru[3].tri ||
+                    !om__lspace_tri(&m->z.ls, h->cid, lt))
+                    break;
+            } else if (lt->tri == OM_NO_TRI || lt->tri == p->tri) {
+                continue;
+            }
+            if (!om__blocks(lt, p)) continue;
+            if (k > 0) {   /* to the front */
+                om__ltri hit = *lt;
+                memmove(&m->mru[1], &m->mru[0], (size_t)(k < MRU ? k : MRU - 1) * sizeof hit);
+                m->mru[0] = hit;
+            }
+            t->r = t->g = t->b = 0;
+            m->shadowed++;
+            return 2;
+        }
+    }
+    m->uncertain++;
+    return 0;
+}
+
+static bool decide(void *user, const om__lpoint *p, om_term *t) { return om__hybrid_decide(user, p, t) != 0; }
+
+static om_status hybrid_resolve(void *state, om_strip *st, om_diag *d)
+{
+    (void)d;
+    hybrid_state *m = (hybrid_state *)state;
+    om__izb *z = &m->z;
+    size_t n = (size_t)st->rows * st->width, next = 0;
+    for (size_t i = 0; i < n; i++) st->terms[i].r = st->terms[i].g = st->terms[i].b = 255;
+    while (next < n) {
+        if (om__izb_transform(z, st, &next, n, decide, m) == 0) break;
+        om__izb_build(z);
+        om__izb_raster(z);
+        om__izb_write(z, st);
+        z->st.tiles++;
+    }
+    return OM_OK;
+}
+
+static void hybrid_stats(const void *state, om_method_stats *out)
+{
+    const hybrid_state *m = (const hybrid_state *)state;
+    const om__izb *z = &m->z;
+    memset(out, 0, sizeof *out);
+    out->bytes_used = fixed_bytes(&m->cfg, z->scene, z->ls.verts != NULL) +
+                      om__izb_pool_bytes(z->cap, z->leaf);
+    static const char *const names[] = {"certain lit", "certain shadowed", "uncertain", "bsp nodes",
+                                        "samples tested", "tiles", "pool samples"};
+    uint32_t v[7] = {m->lit, m->shadowed, m->uncertain, z->st.nodes, z->st.tested, z->st.tiles, z->cap};
+    for (int i = 0; i < 7; i++) {
+        out->counters[i] = v[i];
+        out->counter_names[i] = names[i];
+    }
+    out->ncounters = 7;
+}
+
+const om_method om__method_hybrid = {
+    "hybrid", "exact: a conservative map decides most samples, the irregular z-buffer the rest",
+    OM_METHOD_EXACT, hybrid_bytes, hybrid_init, hybrid_begin, hybrid_observe, hybrid_build,
+    hybrid_resolve, hybrid_stats, NULL,
+};

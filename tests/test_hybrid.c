@@ -1,0 +1,136 @@
+/* test_hybrid.c — the hybrid method equals the reference sample for sample: on the
+ * default scene, on seeded random scenes with semi-transparent casters and grazing
+ * lights, with maps coarser and finer than the image, through strips and under its
+ * minimum budget; and every sample its map calls certain (lit or shadowed) is what the
+ * reference says, checked one by one. */
+#include "test.h"
+#include "harness.h"
+#include "../engine/shadow/hybrid.h"
+
+#include <stdlib.h>
+
+#define W 160
+#define H 120
+static om_term ref_t[W * H], hyb_t[W * H];
+static om_sample smp[W * H];
+
+static int term_diff(void)
+{
+    int diff = 0;
+    for (int i = 0; i < W * H; i++)
+        diff += ref_t[i].r != hyb_t[i].r || ref_t[i].g != hyb_t[i].g || ref_t[i].b != hyb_t[i].b ||
+                ref_t[i].flags != hyb_t[i].flags;
+    return diff;
+}
+
+/* Every certain answer of the map, held against the reference's term for the sample.
+ * Returns how many samples the map decided. */
+static uint32_t certain_agree(const om_scene *s, const om_method_cfg *c, const char *what)
+{
+    const om_method *m = om_method_find("hybrid");
+    om_camera cam;
+    om_light light;
+    om_view v;
+    om_diag d;
+    om_scene_at(s, 0, &cam, &light);
+    cam.width = W;
+    cam.height = H;
+    CHECK_OK(om_view_init(&v, &cam, &light, s, &d));
+    size_t mn, full;
+    CHECK_OK(m->bytes(c, s, W, H, &mn, &full));
+    void *mem = malloc(full), *state;
+    om_arena a;
+    om_arena_init(&a, mem, full, "method");
+    uint32_t decided = 0, wrong = 0;
+    if (m->init(&state, &a, c, s, W, H, &d) == OM_OK && m->begin(state, &v, &d) == OM_OK &&
+        m->build(state, &d) == OM_OK) {
+        const om__izb *z = (const om__izb *)state;   /* the state begins with one */
+        for (int i = 0; i < W * H; i++) {
+            if (!(ref_t[i].flags & OM_TERM_EXPOSED)) continue;
+            om__lpoint p;
+            if (!om__lspace_point(&z->ls, &smp[i], &p)) continue;
+            om_term t = {255, 255, 255, ref_t[i].flags};
+            int k = om__hybrid_decide(state, &p, &t);
+            if (k == 0) continue;
+            decided++;
+            bool lit = ref_t[i].r == 255 && ref_t[i].g == 255 && ref_t[i].b == 255;
+            bool black = ref_t[i].r == 0 && ref_t[i].g == 0 && ref_t[i].b == 0;
+            if ((k == 1 && !lit) || (k == 2 && !black) || t.r != ref_t[i].r || t.g != ref_t[i].g ||
+                t.b != ref_t[i].b) {
+                if (++wrong <= 3)
+                    fprintf(stderr, "  %s: pixel (%d,%d) certain %s, reference %u %u %u\n", what, i % W,
+                            i / W, k == 1 ? "lit" : "shadowed", ref_t[i].r, ref_t[i].g, ref_t[i].b);
+            }
+        }
+    }
+    CHECK_MSG(wrong == 0, "%s: %u certain samples differ from the reference", what, wrong);
+    free(mem);
+    return decided;
+}
+
+static void equals_ref(const char *text, const char *what, double least_certain)
+{
+    h_scene hs;
+    if (!h_scene_parse(&hs, text)) return;
+    CHECK_OK(h_render(&hs.s, "ref", NULL, W, H, 0, 0, NULL, ref_t, smp));
+    om_method_cfg c;
+    om_method_cfg_default(&c);
+    /* maps from far coarser than the image to far finer */
+    static const uint32_t maps[] = {1, 16, 96, 512, 2048};
+    for (int k = 0; k < 5; k++) {
+        c.hybrid_map = maps[k];
+        CHECK_OK(h_render(&hs.s, "hybrid", &c, W, H, 0, 0, NULL, hyb_t, NULL));
+        CHECK_MSG(term_diff() == 0, "%s, map %u: %d samples differ", what, maps[k], term_diff());
+        uint32_t decided = certain_agree(&hs.s, &c, what);
+        uint32_t exposed = 0;
+        for (int i = 0; i < W * H; i++) exposed += ref_t[i].flags & OM_TERM_EXPOSED;
+        if (maps[k] == 512) {
+            printf("  %s map 512: %u of %u certain\n", what, decided, exposed);
+            CHECK_MSG(decided >= least_certain * exposed, "%s, map 512: %u of %u exposed samples certain",
+                      what, decided, exposed);
+        }
+    }
+    /* strips of 7 rows, and the least memory it renders in (tiles of the uncertain) */
+    c.hybrid_map = 96;
+    CHECK_OK(h_render(&hs.s, "hybrid", &c, W, H, 0, 7, NULL, hyb_t, NULL));
+    CHECK_MSG(term_diff() == 0, "%s, strips: %d samples differ", what, term_diff());
+    const om_method *m = om_method_find("hybrid");
+    size_t mn, full;
+    CHECK_OK(m->bytes(&c, &hs.s, W, H, &mn, &full));
+    CHECK_OK(h_render_in(&hs.s, "hybrid", &c, W, H, 0, 0, mn, NULL, hyb_t, NULL));
+    CHECK_MSG(term_diff() == 0, "%s, minimum budget: %d samples differ", what, term_diff());
+    h_scene_free(&hs);
+}
+
+static void hybrid_default_scene(void) { equals_ref(om_scene_default_text(), "default scene", 0.8); }
+
+static void hybrid_random_scenes(void)
+{
+    for (int seed = 1; seed <= 3; seed++) {
+        char text[1024];
+        /* seed 3's spot light grazes the floor at a few degrees */
+        snprintf(text, sizeof text,
+                 "camera eye 0 5 8 target 0 0.5 0 fov 55\n"
+                 "light spot pos %d %s 2 target 0 0 0 fov 75 near 1 far 40\n"
+                 "plane size 14 14 divisions %d\n"
+                 "triangles count 500 seed %d area 25 in -3 0.3 -3 3 3 3\n"
+                 "triangles count 200 seed %d area 20 in -3 0.3 -3 3 3 3 albedo 1 0.6 0.2 opacity 0.5\n"
+                 "sphere radius 0.7 segments 24 rings 12 translate 1 1 1 opacity 0.4 albedo 0.3 0.8 1\n"
+                 "box size 1 1 1 translate -1 0.5 1\n",
+                 seed * 2 - 3 + (seed == 3 ? 20 : 0), seed == 3 ? "1.5" : "9", seed * 3, seed, seed + 10);
+        equals_ref(text, "random scene", 0.25);
+    }
+    equals_ref("camera eye 2 6 9 target 0 0.5 0 fov 50\n"
+               "light directional dir -0.4 -1 -0.3\n"
+               "plane size 20 20 divisions 5\n"
+               "sphere radius 1 segments 32 rings 16 translate 0 1.5 0\n"
+               "box size 1 2 1 translate 2 1 -1 rotate 0 30 0\n"
+               "triangles count 300 seed 5 area 10 in -3 2 -3 3 4 3\n",
+               "directional", 0.8);
+}
+
+void suite_hybrid(void)
+{
+    RUN(hybrid_default_scene);
+    RUN(hybrid_random_scenes);
+}
