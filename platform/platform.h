@@ -8,9 +8,17 @@
 #include "ombra.h"
 #include <stdio.h>
 
+/* The most bytes om_file_read takes from one file: past it the read stops with
+ * OM_E_BUDGET rather than growing until the system stops it (a scene or mask named
+ * /dev/zero). A budget (om_file_read_max) may ask for less. */
+#define OM_FILE_MAX ((size_t)1 << 31)
+
 /* Reads a whole file into a malloc'd buffer (NUL-terminated for convenience; *len
  * excludes the NUL). On failure returns OM_E_IO or OM_E_NOTFOUND with d->msg naming
- * the file and the system's reason. */
+ * the file and the system's reason, or OM_E_BUDGET for a file of more than max bytes
+ * (a regular file is refused by its size before anything is read). */
+om_status om_file_read_max(const char *path, size_t max, char **data, size_t *len, om_diag *d);
+/* om_file_read_max with OM_FILE_MAX. */
 om_status om_file_read(const char *path, char **data, size_t *len, om_diag *d);
 
 /* An om_loader that reads files relative to the scene file's directory. Each file is
@@ -27,6 +35,7 @@ typedef struct om_file_loader {
     char *base;            /* the scene's directory with its '/', or NULL */
     om_file_entry *files;
     size_t nfiles, cap;
+    size_t limit, held;    /* bytes the files may hold together (0: OM_FILE_MAX each), held */
     om_diag *diag;         /* where a failed read's message goes; may be NULL */
 } om_file_loader;
 

@@ -3,6 +3,7 @@
  * framebuffer in RGB565 is widened to RGB888 for the PPM; an L8 one may go to a PGM. */
 #include "platform.h"
 
+#include <errno.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -122,29 +123,51 @@ static bool pnm_uint(const char *s, size_t len, size_t *at, uint32_t *out)
     return true;
 }
 
+/* Reads only the header and the pixels it states, so a huge or endless file (a mask
+ * named /dev/zero) costs a header's worth of reading before it is refused. */
 om_status om_pgm_read(const char *path, uint32_t *w, uint32_t *h, uint8_t **pixels, om_diag *d)
 {
-    char *data;
+    char head[4096];
     size_t len, at = 2;
     uint32_t maxval;
     *pixels = NULL;
-    om_status st = om_file_read(path, &data, &len, d);
-    if (st != OM_OK) return st;
-    if (len < 2 || data[0] != 'P' || data[1] != '5' || !pnm_uint(data, len, &at, w) ||
-        !pnm_uint(data, len, &at, h) || !pnm_uint(data, len, &at, &maxval) || maxval != 255 ||
-        at >= len || *w == 0 || *h == 0 || *w > OM_MAX_DIM || *h > OM_MAX_DIM ||
-        len - at - 1 < (size_t)*w * *h) {
-        free(data);
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        om_status st = errno == ENOENT ? OM_E_NOTFOUND : OM_E_IO;
+        if (d) {
+            d->status = st;
+            snprintf(d->msg, sizeof d->msg, "%s: %s", path, strerror(errno));
+        }
+        return st;
+    }
+    len = fread(head, 1, sizeof head, f);
+    bool ok = len >= 2 && head[0] == 'P' && head[1] == '5' && pnm_uint(head, len, &at, w) &&
+              pnm_uint(head, len, &at, h) && pnm_uint(head, len, &at, &maxval) && maxval == 255 &&
+              at < len && *w > 0 && *h > 0 && *w <= OM_MAX_DIM && *h <= OM_MAX_DIM;
+    size_t n = ok ? (size_t)*w * *h : 0, have = ok ? len - at - 1 : 0;
+    if (ok && !(*pixels = malloc(n))) {
+        fclose(f);
+        if (d) {
+            d->status = OM_E_IO;
+            snprintf(d->msg, sizeof d->msg, "%s: out of memory", path);
+        }
+        return OM_E_IO;
+    }
+    if (ok) {
+        if (have > n) have = n;
+        memcpy(*pixels, head + at + 1, have);
+        ok = have == n || fread(*pixels + have, 1, n - have, f) == n - have;
+    }
+    fclose(f);
+    if (!ok) {
+        free(*pixels);
+        *pixels = NULL;
         if (d) {
             d->status = OM_E_PARSE;
             snprintf(d->msg, sizeof d->msg, "%s: not a binary 8-bit PGM (P5, maxval 255) of its stated size", path);
         }
         return OM_E_PARSE;
     }
-    *pixels = malloc((size_t)*w * *h);
-    if (!*pixels) { free(data); return OM_E_IO; }
-    memcpy(*pixels, data + at + 1, (size_t)*w * *h);
-    free(data);
     return OM_OK;
 }
 

@@ -167,7 +167,7 @@ if [ "$(head -c 2 "$dir/grey.pgm")" = "P5" ] && [ "$(wc -c <"$dir/grey.pgm")" -e
 expect 2 "--budget 0" -- "$OMBRA" render --size 16x12 --budget 0 --out "$dir/z.ppm"
 has "$dir/err" "none" "--budget 0 points at 'none'"
 expect 0 "--budget none" -- "$OMBRA" render --size 16x12 --budget none --out "$dir/z.ppm"
-expect 1 "asm under a small budget" -- "$OMBRA" render --size 64x48 --method asm --budget 100K --out "$dir/z.ppm"
+expect 1 "asm under a small budget" -- "$OMBRA" render --size 64x48 --method asm --budget 1M --out "$dir/z.ppm"
 has "$dir/err" "asm.cap" "asm's budget hint names asm.cap"
 if grep -q -- "--map" "$dir/err"; then bad "asm's budget hint suggests --map"; else ok; fi
 
@@ -212,6 +212,42 @@ mkdir -p "$long"
 cp "$dir/ok.scene" "$dir/m.obj" "$long/"
 expect 0 "a scene under a 1.3 KB directory finds its mesh there" -- "$OMBRA" render "$long/ok.scene" --out "$dir/long.ppm"
 has "$dir/out" "5 triangles" "the long directory's mesh loaded"
+
+# Budgets hold from the first byte: a scene whose arena cannot fit is refused by its
+# bytes query before anything is made, a file is read no further than the budget
+# allows, a mask no further than its header states. With GNU time the peak RSS is
+# checked against the budget plus what the process needs to do nothing at all.
+rss() {  # rss COMMAND...: peak resident KB, or nothing without GNU time
+    /usr/bin/time -f %M -o "$dir/rss" "$@" >/dev/null 2>&1
+    [ -s "$dir/rss" ] && tail -n 1 "$dir/rss"
+}
+rss_ok() {  # rss_ok BUDGET_KB WHAT COMMAND...: peak RSS within budget + idle + 4 MB
+    limit=$1; what=$2; shift 2
+    if [ -n "$idle" ]; then
+        got=$(rss "$@")
+        if [ -n "$got" ] && [ "$got" -le $((idle + limit + 4096)) ]; then ok; else bad "$what: peak RSS $got KB, over $limit KB + idle $idle KB + 4 MB"; fi
+    fi
+}
+idle=""
+if [ -x /usr/bin/time ] && /usr/bin/time -f %M -o "$dir/rss" true >/dev/null 2>&1; then idle=$(rss "$OMBRA" --version); fi
+printf 'camera eye 0 2 5 target 0 0 0 size 160 120\ntriangles count 10000000\n' >"$dir/tenmillion.scene"
+expect 1 "10M triangles under --budget 64K" -- "$OMBRA" render "$dir/tenmillion.scene" --budget 64K --out "$dir/z.ppm"
+has "$dir/err" "too small for the scene alone: its arena needs 500000026 bytes" "the scene is refused by its bytes query"
+rss_ok 64 "10M triangles under --budget 64K" "$OMBRA" render "$dir/tenmillion.scene" --budget 64K --out "$dir/z.ppm"
+yes 'v 0 0 0' | head -c 400000 >"$dir/bigmesh.obj"
+printf 'camera eye 0 2 5 target 0 0 0 size 32 24\nmesh bigmesh.obj\n' >"$dir/bigmesh.scene"
+expect 1 "a mesh larger than --budget" -- "$OMBRA" render "$dir/bigmesh.scene" --budget 64K --out "$dir/z.ppm"
+has "$dir/err" "bigmesh.obj: larger than the" "the mesh over budget is named"
+rss_ok 64 "a 400 KB mesh under --budget 64K" "$OMBRA" render "$dir/bigmesh.scene" --budget 64K --out "$dir/z.ppm"
+expect 0 "the same mesh without a budget" -- "$OMBRA" render "$dir/bigmesh.scene" --out "$dir/z.ppm"
+rss_ok 2048 "the default scene at --budget 2M" "$OMBRA" render --map 512 --budget 2M --out "$dir/z.ppm" --mask "$dir/z.pgm"
+rss_ok 1024 "izb at --budget 1M" "$OMBRA" render --method izb --budget 1M --out "$dir/z.ppm"
+# a mask is read as far as its header says, not to the end of the file
+{ printf 'P5\n16 12\n255\n'; head -c 192 /dev/zero; head -c 50000000 /dev/zero; } >"$dir/long.pgm"
+"$OMBRA" render --size 16x12 --mask "$dir/m16.pgm" --out "$dir/z.ppm" -q
+expect 0 "compare a mask with 50 MB after its pixels" -- "$OMBRA" compare "$dir/m16.pgm" "$dir/long.pgm"
+rss_ok 0 "compare reads a mask's stated size only" "$OMBRA" compare "$dir/m16.pgm" "$dir/long.pgm"
+rm -f "$dir/long.pgm"
 
 # bench and report: names checked before any work, a failed run writes nothing, the
 # method's init is its own stage, and a scene file renders at its own size.

@@ -60,9 +60,9 @@ bool cli_builtin_scene(const char *name)
 om_status cli_load_named(const char *name, cli_scene *cs, om_diag *d)
 {
     char text[512];
-    if (!strcmp(name, "default")) return cli_scene_load(cs, NULL, d);
+    if (!strcmp(name, "default")) return cli_scene_load(cs, NULL, 0, d);
     const char *r = random_scene(name, text, sizeof text);
-    if (!r) return cli_scene_load(cs, name, d);
+    if (!r) return cli_scene_load(cs, name, 0, d);
     memset(cs, 0, sizeof *cs);
     size_t len = strlen(r);
     om_status st = om_scene_bytes(r, len, NULL, &cs->bytes, d);

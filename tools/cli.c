@@ -101,23 +101,38 @@ bool cli_parse_budget(const char *cmd, const char *s, size_t *out)
     return true;
 }
 
-om_status cli_scene_load(cli_scene *cs, const char *path, om_diag *d)
+om_status cli_scene_load(cli_scene *cs, const char *path, size_t budget, om_diag *d)
 {
     memset(cs, 0, sizeof *cs);
     cs->path = path;
     const char *text = om_scene_default_text();
     size_t len = strlen(text);
     om_status st;
-    if (path) {
-        if ((st = om_file_read(path, &cs->text, &len, d)) != OM_OK) return st;
-        text = cs->text;
-    }
+    /* With a budget, the scene's text and meshes count against it while they are
+     * held, and the arena is refused by its bytes query before anything is made. */
+    if (path && (st = om_file_read_max(path, budget ? budget : OM_FILE_MAX, &cs->text, &len, d)) != OM_OK)
+        return st;
+    if (path) text = cs->text;
     if (om_file_loader_init(&cs->files, path) != OM_OK) return cli_oom(d);
     cs->files.diag = d;
+    cs->files.limit = budget ? (budget > len ? budget - len : 1) : 0;
     om_loader ld = om_file_loader_get(&cs->files);
     /* Model no more than the scene needs: the arena is exactly its bytes query. The
      * loader keeps every mesh it read for the second pass: each file is read once. */
-    if ((st = om_scene_bytes(text, len, &ld, &cs->bytes, d)) == OM_OK) {
+    st = om_scene_bytes(text, len, &ld, &cs->bytes, d);
+    size_t files = (path ? len : 0) + cs->files.held;
+    if (st == OM_OK && budget && (cs->bytes > budget || files > budget - cs->bytes)) {
+        st = OM_E_BUDGET;
+        if (d) d->status = st, d->asked = cs->bytes + files, d->left = budget;
+        if (d) {
+            int n = snprintf(d->msg, sizeof d->msg, "--budget %zu is too small for the scene "
+                             "alone: its arena needs %zu bytes", budget, cs->bytes);
+            if (files && n > 0 && (size_t)n < sizeof d->msg)
+                snprintf(d->msg + n, sizeof d->msg - (size_t)n, ", and its text and meshes %zu "
+                         "more while it is read", files);
+        }
+    }
+    if (st == OM_OK) {
         cs->mem = malloc(cs->bytes ? cs->bytes : 1);
         if (!cs->mem) st = cli_oom(d);
     }
@@ -125,7 +140,10 @@ om_status cli_scene_load(cli_scene *cs, const char *path, om_diag *d)
         om_arena_init(&cs->arena, cs->mem, cs->bytes, "scene");
         st = om_scene_parse(text, len, &ld, &cs->arena, &cs->scene, d);
     }
+    /* The scene keeps nothing of its text or files. */
     om_file_loader_free(&cs->files);
+    free(cs->text);
+    cs->text = NULL;
     return st;
 }
 

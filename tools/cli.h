@@ -11,7 +11,7 @@
 
 typedef struct cli_scene {
     const char *path;      /* NULL: the built-in default scene */
-    char *text;            /* file contents (malloc'd) or NULL */
+    char *text;            /* file contents while it is read (malloc'd), then NULL */
     void *mem;             /* the scene arena's buffer */
     size_t bytes;
     om_arena arena;
@@ -29,7 +29,9 @@ void cli_method_hint(const om_method *m, char *buf, size_t n);
 /* --budget BYTES or 'none' (0 out); 0 bytes is a usage error (printed). */
 bool cli_parse_budget(const char *cmd, const char *s, size_t *out);
 
-om_status cli_scene_load(cli_scene *cs, const char *path, om_diag *d);
+/* Loads a scene file (NULL: the default scene). With a budget (0: none) its text,
+ * meshes and arena must fit in it: refused before the arena is made. */
+om_status cli_scene_load(cli_scene *cs, const char *path, size_t budget, om_diag *d);
 void cli_scene_free(cli_scene *cs);
 
 bool cli_parse_size(const char *s, uint32_t *w, uint32_t *h);

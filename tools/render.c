@@ -219,7 +219,7 @@ int cmd_render(int argc, char **argv)
     om_diag d;
     memset(&d, 0, sizeof d);
     cli_scene cs;
-    om_status st = cli_scene_load(&cs, scene_path, &d);
+    om_status st = cli_scene_load(&cs, scene_path, budget, &d);
     const char *where = scene_path ? scene_path : "default scene";
     if (st != OM_OK) { cli_scene_free(&cs); return cli_error(where, &d, st); }
 
@@ -247,7 +247,9 @@ int cmd_render(int argc, char **argv)
     uint32_t rows = strip && strip < H ? strip : H;
     main_run.given = main_run.full;
     if (budget) {
-        size_t one = om_frame_bytes(W, 1), row_bytes = om_frame_bytes(W, 2) - one;
+        /* a row of the frame: its arena's share and the framebuffer's pixels */
+        size_t px = (size_t)W * om_format_bpp(fmt);
+        size_t one = om_frame_bytes(W, 1) + px, row_bytes = om_frame_bytes(W, 2) - om_frame_bytes(W, 1) + px;
         size_t rest = budget > cs.bytes ? budget - cs.bytes : 0;
         if (rest < main_run.full + om_frame_bytes(W, rows)) {
             size_t spare = rest > main_run.min + one ? rest - main_run.min - one : 0;
@@ -389,7 +391,7 @@ int cmd_info(int argc, char **argv)
     memset(&d, 0, sizeof d);
     cli_scene cs;
     const char *where = scene_path ? scene_path : "default scene";
-    om_status st = cli_scene_load(&cs, scene_path, &d);
+    om_status st = cli_scene_load(&cs, scene_path, 0, &d);
     if (st != OM_OK) { cli_scene_free(&cs); return cli_error(where, &d, st); }
     const om_scene *s = &cs.scene;
     uint32_t W = w ? w : s->camera.width, H = w ? h : s->camera.height;
