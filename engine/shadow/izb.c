@@ -48,7 +48,7 @@ size_t om__izb_parts_bytes(const om_scene *s, bool cache)
 size_t om__izb_pool_bytes(uint32_t samples, uint32_t leaf)
 {
     return om_arena_need((size_t)samples * sizeof(om__izb_sample), 16) +
-           om_arena_need((size_t)samples * sizeof(om__izb_key), 16) +
+           2 * om_arena_need((size_t)samples * sizeof(om__izb_key), 16) +
            om_arena_need((size_t)node_bound(samples, leaf) * sizeof(om__izb_node), 16);
 }
 
@@ -99,6 +99,8 @@ om_status om__izb_setup(om__izb *z, om_arena *a, const om_method_cfg *c, const o
     z->samples = (om__izb_sample *)p;
     if ((st = om_arena_alloc(a, (size_t)cap * sizeof(om__izb_key), 16, &p, d))) return st;
     z->keys = (om__izb_key *)p;
+    if ((st = om_arena_alloc(a, (size_t)cap * sizeof(om__izb_key), 16, &p, d))) return st;
+    z->sorted = (om__izb_key *)p;
     if ((st = om_arena_alloc(a, (size_t)z->node_cap * sizeof(om__izb_node), 16, &p, d))) return st;
     z->nodes = (om__izb_node *)p;
     return OM_OK;
@@ -158,6 +160,17 @@ uint32_t om__izb_transform(om__izb *z, const om_strip *st, size_t *next, size_t 
         if (decide && decide(user, &s->p, &st->terms[i])) continue;
         s->idx = (uint32_t)i;
         memset(&s->od, 0, sizeof s->od);
+        /* the sample's key for the BSP, and the tile's bounds, while it is at hand */
+        om__izb_key *k = &z->keys[n];
+        float f = (float)s->p.z;
+        k->x = (int32_t)s->p.x;   /* the light grid fits in 27 bits */
+        k->y = (int32_t)s->p.y;
+        k->s = n;
+        k->z = (double)f < s->p.z ? f * (1.0f + FLT_EPSILON) : f;   /* never below */
+        if (n == 0 || k->x < z->kx0) z->kx0 = k->x;
+        if (n == 0 || k->x > z->kx1) z->kx1 = k->x;
+        if (n == 0 || k->y < z->ky0) z->ky0 = k->y;
+        if (n == 0 || k->y > z->ky1) z->ky1 = k->y;
         n++;
     }
     *next = i;
@@ -167,43 +180,79 @@ uint32_t om__izb_transform(om__izb *z, const om_strip *st, size_t *next, size_t 
 
 /* ---- stage 2: the 2-D BSP */
 
-static int32_t key(const om__izb_key *k, int axis) { return axis ? k->y : k->x; }
-
-static void swap(om__izb_key *a, om__izb_key *b)
+/* The Z-order (Morton) code of a key: x and y relative to the tile's corner, shifted
+ * to 16 bits each, bits interleaved. */
+static uint32_t spread(uint32_t v)
 {
-    om__izb_key t = *a;
-    *a = *b;
-    *b = t;
+    v &= 0xFFFFu;
+    v = (v | (v << 8)) & 0x00FF00FFu;
+    v = (v | (v << 4)) & 0x0F0F0F0Fu;
+    v = (v | (v << 2)) & 0x33333333u;
+    return (v | (v << 1)) & 0x55555555u;
 }
 
-/* Puts the k-th smallest key (of `axis`) at position k of s[0..n), smaller before,
- * larger after: Hoare's quickselect with a median-of-three pivot (deterministic). The
- * keys are integers stored once, so every comparison gives the same answer twice in
- * any floating-point mode, and the scans stop at their sentinels. */
-static void quickselect(om__izb_key *s, uint32_t n, uint32_t k, int axis)
+static uint32_t zcode(const om__izb_key *k, int32_t x0, int32_t y0, int shift)
 {
-    uint32_t lo = 0, hi = n - 1;
-    while (lo < hi) {
-        uint32_t mid = lo + (hi - lo) / 2;
-        if (key(&s[mid], axis) < key(&s[lo], axis)) swap(&s[mid], &s[lo]);
-        if (key(&s[hi], axis) < key(&s[lo], axis)) swap(&s[hi], &s[lo]);
-        if (key(&s[hi], axis) < key(&s[mid], axis)) swap(&s[hi], &s[mid]);
-        int32_t pivot = key(&s[mid], axis);
-        uint32_t i = lo, j = hi;
-        while (i <= j) {
-            while (key(&s[i], axis) < pivot) i++;
-            while (key(&s[j], axis) > pivot) j--;
-            if (i <= j) {
-                swap(&s[i], &s[j]);
-                i++;
-                if (j == 0) break;
-                j--;
-            }
-        }
-        if (k <= j) hi = j;
-        else if (k >= i) lo = i;
-        else return;
+    return spread((uint32_t)(k->x - x0) >> shift) | spread((uint32_t)(k->y - y0) >> shift) << 1;
+}
+
+/* Sorts z->keys into Z order (a stable least-significant-digit radix sort through
+ * z->sorted, three passes of 11 bits; keys of equal code keep the screen's order), so
+ * that halving the array again and again gives nodes that are compact in the light's
+ * image. Integer keys only: the same order in any floating-point mode. */
+typedef struct zframe { int32_t x0, y0; int shift; } zframe;
+
+static zframe zsort(om__izb *z)
+{
+    uint32_t n = z->n;
+    int32_t x0 = z->kx0, y0 = z->ky0, x1 = z->kx1, y1 = z->ky1;
+    uint32_t span = (uint32_t)(x1 - x0) > (uint32_t)(y1 - y0) ? (uint32_t)(x1 - x0) : (uint32_t)(y1 - y0);
+    int shift = 0;
+    while ((span >> shift) > 0xFFFFu) shift++;
+    /* three digits of 11 bits; their histograms in one pass over the keys */
+    static const int at[3] = {0, 11, 22};
+    uint32_t count[3][2049];
+    memset(count, 0, sizeof count);
+    for (uint32_t i = 0; i < n; i++) {
+        uint32_t c = zcode(&z->keys[i], x0, y0, shift);
+        count[0][(c & 2047u) + 1]++;
+        count[1][(c >> 11 & 2047u) + 1]++;
+        count[2][(c >> 22) + 1]++;
     }
+    om__izb_key *src = z->keys, *dst = z->sorted;
+    for (int pass = 0; pass < 3; pass++) {
+        uint32_t *cnt = count[pass];
+        int d = at[pass];
+        if (cnt[((zcode(&src[0], x0, y0, shift) >> d) & 2047u) + 1] == n) continue;   /* one digit */
+        for (int b = 0; b < 2048; b++) cnt[b + 1] += cnt[b];
+        for (uint32_t i = 0; i < n; i++) dst[cnt[(zcode(&src[i], x0, y0, shift) >> d) & 2047u]++] = src[i];
+        om__izb_key *t = src;
+        src = dst;
+        dst = t;
+    }
+    z->keys = src;   /* the two buffers trade places rather than copy */
+    z->sorted = dst;
+    zframe f = {x0, y0, shift};
+    return f;
+}
+
+/* Where the sorted keys [first, first + count) split: at the highest bit in which their
+ * codes differ (the node's quadtree-like cell is cut in two halves of space), or in
+ * the middle when they all share one code. */
+static uint32_t zsplit(const om__izb *z, const zframe *f, uint32_t first, uint32_t count)
+{
+    const om__izb_key *k = &z->keys[first];
+    uint32_t a = zcode(&k[0], f->x0, f->y0, f->shift), b = zcode(&k[count - 1], f->x0, f->y0, f->shift);
+    if (a == b) return count / 2;
+    uint32_t bit = 0x80000000u;
+    while (!((a ^ b) & bit)) bit >>= 1;
+    uint32_t lo = 0, hi = count - 1;   /* the first key with the bit set: in (lo, hi] */
+    while (hi - lo > 1) {
+        uint32_t mid = lo + (hi - lo) / 2;
+        if (zcode(&k[mid], f->x0, f->y0, f->shift) & bit) hi = mid;
+        else lo = mid;
+    }
+    return hi;
 }
 
 /* Bounds and farthest depth of a node: from its keys for a leaf, from its children
@@ -239,29 +288,18 @@ void om__izb_build(om__izb *z)
 {
     z->nnodes = 0;
     if (z->n == 0) return;
-    for (uint32_t i = 0; i < z->n; i++) {
-        const om__lpoint *p = &z->samples[i].p;
-        float f = (float)p->z;
-        z->keys[i].x = (int32_t)p->x;   /* the light grid fits in 27 bits */
-        z->keys[i].y = (int32_t)p->y;
-        z->keys[i].s = i;
-        z->keys[i].z = (double)f < p->z ? f * (1.0f + FLT_EPSILON) : f;   /* never below */
-    }
-    struct { uint32_t node; int axis; } stack[64];
+    zframe f = zsort(z);
+    uint32_t stack[64];
     int sp = 0;
     om__izb_node *root = &z->nodes[z->nnodes++];
     root->first = 0;
     root->count = z->n;
     root->child = 0;
-    stack[sp].node = 0;
-    stack[sp++].axis = 0;
+    stack[sp++] = 0;
     while (sp > 0) {
-        uint32_t ni = stack[--sp].node;
-        int axis = stack[sp].axis;
-        om__izb_node *nd = &z->nodes[ni];
+        om__izb_node *nd = &z->nodes[stack[--sp]];
         if (nd->count <= z->leaf || z->nnodes + 2 > z->node_cap || sp + 2 > 64) continue;
-        uint32_t half = nd->count / 2;
-        quickselect(&z->keys[nd->first], nd->count, half, axis);
+        uint32_t half = zsplit(z, &f, nd->first, nd->count);
         uint32_t c = z->nnodes;
         z->nnodes += 2;
         om__izb_node *l = &z->nodes[c], *r = &z->nodes[c + 1];
@@ -271,11 +309,8 @@ void om__izb_build(om__izb *z)
         r->count = nd->count - half;
         l->child = r->child = 0;
         nd->child = c;
-        /* Alternating splits, as the paper does. */
-        stack[sp].node = c;
-        stack[sp++].axis = !axis;
-        stack[sp].node = c + 1;
-        stack[sp++].axis = !axis;
+        stack[sp++] = c;
+        stack[sp++] = c + 1;
     }
     for (uint32_t i = z->nnodes; i-- > 0;) bound_node(z, &z->nodes[i]);
     z->st.nodes += z->nnodes;

@@ -43,11 +43,13 @@ typedef struct om__izb {
     om__odepth *mat_od;
     om__izb_sample *samples;
     om__izb_key *keys;
+    om__izb_key *sorted;   /* the radix sort's second buffer */
     om__izb_node *nodes;
     uint32_t cap;          /* samples the pool holds */
     uint32_t node_cap;
     uint32_t leaf;
     uint32_t n, nnodes;    /* samples and nodes of the current tile */
+    int32_t kx0, ky0, kx1, ky1;   /* the bounds of the tile's keys */
     om__izb_stats st;
 } om__izb;
 
@@ -66,8 +68,8 @@ om_status om__izb_setup(om__izb *z, om_arena *a, const om_method_cfg *c, const o
 /* Decides a sample without the BSP when it can: writes its term and returns true. */
 typedef bool (*om__izb_decide)(void *user, const om__lpoint *p, om_term *t);
 
-/* Fills the pool from strip samples [*next, end) that are exposed, up to its capacity;
- * advances *next. With `decide`, only the samples it leaves undecided enter the pool.
+/* Fills the pool (samples and their keys) from strip samples [*next, end) that are
+ * exposed, up to its capacity; advances *next. With `decide`, only the samples it leaves undecided enter the pool.
  * Returns the number taken. */
 uint32_t om__izb_transform(om__izb *z, const om_strip *st, size_t *next, size_t end,
                            om__izb_decide decide, void *user);
