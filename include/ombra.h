@@ -313,7 +313,8 @@ typedef struct om_method_cfg {
                               more bytes per texel and a second pass; fewer false-lit
                               samples along fine rims), 0: at texel centres */
     /* hybrid (also izb_leaf, izb_pool for the samples its map leaves uncertain) */
-    uint32_t hybrid_map;   /* side of its conservative map, 20 bytes per texel */
+    uint32_t hybrid_map;   /* side of its conservative map, 20 bytes per texel; 0 =
+                              the largest power of two at most half the image's side */
 } om_method_cfg;
 
 /* One settable field of om_method_cfg. */

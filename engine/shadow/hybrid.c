@@ -3,7 +3,8 @@
  * only the samples it leaves uncertain go through the irregular z-buffer (izb.c),
  * whose answer is the reference's. The result equals `ref` bit for bit.
  *
- * The map has hybrid.map x hybrid.map texels over the light's grid, each a square of
+ * The map has side x side texels over the light's grid (hybrid.map, or by default
+ * about half the image's larger side: map_side), each a square of
  * T x T grid points (the last row and column reach on to the guard band). A triangle
  * touches a texel when its edge functions admit a point of the texel's square (tested
  * against the square's extreme corner per edge: never missed, sometimes extra). Per
@@ -60,20 +61,32 @@ typedef struct hybrid_state {
 #define GRID_SIDE ((int64_t)OM_LIGHT_GRID * OM_SUBPIX)   /* 2^21 grid units */
 #define FAR_OUT ((int64_t)1 << 27)   /* beyond every grid point a triangle can admit */
 
-static size_t fixed_bytes(const om_method_cfg *c, const om_scene *s, bool cache)
+/* The map's side: as set, or by default the largest power of two at most half the
+ * image's larger side (at least 16): texels of about 2 x 2 pixels where the light's
+ * image and the camera's agree, and memory that scales with the image (512 at
+ * 1024x768, 64 at 160x120). */
+static uint32_t map_side(const om_method_cfg *c, uint32_t w, uint32_t h)
+{
+    if (c->hybrid_map) return c->hybrid_map;
+    uint32_t half = (w > h ? w : h) / 2, side = 16;
+    while (side * 2 <= half && side < 4096) side *= 2;
+    return side;
+}
+
+static size_t fixed_bytes(uint32_t side, const om_scene *s, bool cache)
 {
     return om_arena_need(sizeof(hybrid_state), 16) + om__izb_parts_bytes(s, cache) +
-           om_arena_need((size_t)c->hybrid_map * c->hybrid_map * sizeof(htexel), 16);
+           om_arena_need((size_t)side * side * sizeof(htexel), 16);
 }
 
 static om_status hybrid_bytes(const om_method_cfg *c, const om_scene *s, uint32_t w, uint32_t h,
                               size_t *min, size_t *full)
 {
-    if (c->izb_leaf < 1 || c->hybrid_map < 1) return OM_E_INVALID;
-    uint32_t one_pass = w * h, smallest = w;
+    if (c->izb_leaf < 1 || c->hybrid_map > OM_LIGHT_GRID) return OM_E_INVALID;
+    uint32_t one_pass = w * h, smallest = w, side = map_side(c, w, h);
     if (c->izb_pool) one_pass = smallest = c->izb_pool;
-    *min = fixed_bytes(c, s, false) + om__izb_pool_bytes(smallest, c->izb_leaf);
-    *full = fixed_bytes(c, s, true) + om__izb_pool_bytes(one_pass, c->izb_leaf);
+    *min = fixed_bytes(side, s, false) + om__izb_pool_bytes(smallest, c->izb_leaf);
+    *full = fixed_bytes(side, s, true) + om__izb_pool_bytes(one_pass, c->izb_leaf);
     return OM_OK;
 }
 
@@ -84,14 +97,14 @@ static om_status hybrid_init(void **state, om_arena *a, const om_method_cfg *c, 
     void *p;
     size_t mn, full;
     if (c->izb_leaf < 1) return om__fail(d, OM_E_INVALID, "hybrid: izb.leaf must be at least 1");
-    if (c->hybrid_map < 1 || c->hybrid_map > OM_LIGHT_GRID)
-        return om__fail(d, OM_E_INVALID, "hybrid: hybrid.map must be 1..8192");
+    if (c->hybrid_map > OM_LIGHT_GRID)
+        return om__fail(d, OM_E_INVALID, "hybrid: hybrid.map must be 0 (auto) to 8192");
     if ((st = hybrid_bytes(c, s, w, h, &mn, &full))) return st;
     if ((st = om__need(a, mn, "hybrid", d))) return st;
     if ((st = om_arena_alloc(a, sizeof(hybrid_state), 16, &p, d))) return st;
     hybrid_state *m = (hybrid_state *)p;
     m->cfg = *c;
-    m->side = c->hybrid_map;
+    m->side = map_side(c, w, h);
     m->T = (GRID_SIDE + m->side - 1) / m->side;
     size_t tex = (size_t)m->side * m->side;
     if ((st = om_arena_alloc(a, tex * sizeof(htexel), 16, &p, d))) return st;
@@ -288,7 +301,7 @@ static void hybrid_stats(const void *state, om_method_stats *out)
     const hybrid_state *m = (const hybrid_state *)state;
     const om__izb *z = &m->z;
     memset(out, 0, sizeof *out);
-    out->bytes_used = fixed_bytes(&m->cfg, z->scene, z->ls.verts != NULL) +
+    out->bytes_used = fixed_bytes(m->side, z->scene, z->ls.verts != NULL) +
                       om__izb_pool_bytes(z->cap, z->leaf);
     static const char *const names[] = {"certain lit", "certain shadowed", "uncertain", "bsp nodes",
                                         "samples tested", "tiles", "pool samples"};

@@ -79,7 +79,7 @@ void om_method_cfg_default(om_method_cfg *c)
     c->spsm_aa = 0;
     c->spsm_records = 0;
     c->spsm_fine = 0;
-    c->hybrid_map = 512;
+    c->hybrid_map = 0;
 }
 
 #define F(name, kind, field, lo, hi, help) {name, help, kind, offsetof(om_method_cfg, field), lo, hi}
@@ -110,7 +110,7 @@ static const om_cfg_field fields[] = {
     F("spsm.aa", 'u', spsm_aa, 0, 64, "SPSM sub-samples at uncertain samples, 0 = off"),
     F("spsm.records", 'u', spsm_records, 0, 2, "SPSM records made: 1 all, 2 those the view reads, 0 auto"),
     F("spsm.fine", 'u', spsm_fine, 0, 1, "SPSM fallback: 1 the plain map at 2 x 2 points per texel, 0 at centres"),
-    F("hybrid.map", 'u', hybrid_map, 1, 8192, "hybrid's conservative map side (20 bytes a texel)"),
+    F("hybrid.map", 'u', hybrid_map, 0, 8192, "hybrid's conservative map side (20 bytes a texel), 0 = auto: half the image's side"),
 };
 
 #undef F
