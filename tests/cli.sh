@@ -249,6 +249,23 @@ expect 0 "compare a mask with 50 MB after its pixels" -- "$OMBRA" compare "$dir/
 rss_ok 0 "compare reads a mask's stated size only" "$OMBRA" compare "$dir/m16.pgm" "$dir/long.pgm"
 rm -f "$dir/long.pgm"
 
+# What the parser accepts renders, and what would not is refused with its line and
+# column: values as floats (fov 179.999999 is 180), near below 1e7, far below 1e8,
+# and key paths along which the eye meets its target or a light's dir meets zero.
+regress=$(dirname "$0")/fuzz/regress
+for f in far-1e8 far-99999999 near-1e7 fov-179 keys-eye-on-target; do
+    expect 1 "$f.scene is refused" -- "$OMBRA" render "$regress/$f.scene" --time 1 --out "$dir/z.ppm"
+    has "$dir/err" "$f.scene: line [0-9]*, col [0-9]*: " "$f.scene's error has a line and column"
+done
+has "$dir/err" "the eye passes through its target" "the key path's fault is said"
+printf 'light directional dir 0 -1 0\nkey light 0 dir 1 -1 0\nkey light 1 dir -1 1 0\nbox\n' >"$dir/dirkeys.scene"
+expect 1 "directional keys through zero" -- "$OMBRA" render "$dir/dirkeys.scene" --out "$dir/z.ppm"
+has "$dir/err" "line 3, col 17: key light: .*'dir' passes through zero" "the dir path's fault is placed"
+printf 'camera eye 0 2 5 target 0 0 0 fov 179.99998 near 9999999 far 99999990 size 24 16\nlight spot pos 2 6 3 target 0 0 0 fov 179.99998 near 1e-6 far 99999990\nbox\nplane size 8 8\nkey camera 0 eye 0 1 0 target 2 1 0\nkey camera 2 eye 2 1 0 target 0 1.001 0\n' >"$dir/edges.scene"
+for m in $("$OMBRA" methods | awk 'NF == 0 {exit} {print $1}'); do
+    expect 0 "the range's edges render with $m" -- "$OMBRA" render "$dir/edges.scene" --method "$m" --time 1 --map 256 --out "$dir/z.ppm"
+done
+
 # bench and report: names checked before any work, a failed run writes nothing, the
 # method's init is its own stage, and a scene file renders at its own size.
 expect 2 "bench --methods foo" -- "$OMBRA" bench --scenes "$dir/ok.scene" --methods foo --out "$dir/bench-foo"

@@ -25,24 +25,30 @@ static const pdef pdefs[P_N_] = {
 };
 
 /* Every number has a range; `mag` ranges bound the magnitude (scale may be negative:
- * a mirror) and `open` ones exclude their ends. */
-typedef struct rdef { double lo, hi; bool open, mag; const char *text; } rdef;
+ * a mirror); `open` 1 excludes both ends, 2 only the upper one (what the view
+ * accepts: near below 1e7, far below 1e8). */
+typedef struct rdef { double lo, hi; unsigned char open; bool mag; const char *text; } rdef;
 static const rdef rdefs[R_N_] = {
-    [R_COORD] = {-1e7, 1e7, false, false, "-1e7..1e7"},
-    [R_LEN] = {1e-6, 1e7, false, false, "1e-6..1e7"},
-    [R_FOV] = {0.0, 180.0, true, false, "above 0 and below 180"},
-    [R_UNIT] = {0.0, 1.0, false, false, "0..1"},
-    [R_DIM] = {1.0, 8192.0, false, false, "1..8192"},
-    [R_DIV] = {1.0, 4096.0, false, false, "1..4096"},
-    [R_SEG] = {3.0, 4096.0, false, false, "3..4096"},
-    [R_RING] = {2.0, 4096.0, false, false, "2..4096"},
-    [R_COUNT] = {1.0, 1e7, false, false, "1..10000000"},
-    [R_SEED] = {0.0, 4294967295.0, false, false, "0..4294967295"},
-    [R_NEAR] = {1e-6, 1e7, false, false, "1e-6..1e7"},
-    [R_FAR] = {1e-6, 1e8, false, false, "1e-6..1e8"},
-    [R_AREA] = {1e-6, 1e12, false, false, "1e-6..1e12"},
-    [R_SCALE] = {1e-6, 1e6, false, true, "1e-6..1e6 in magnitude"},
+    [R_COORD] = {-1e7, 1e7, 0, false, "-1e7..1e7"},
+    [R_LEN] = {1e-6, 1e7, 0, false, "1e-6..1e7"},
+    [R_FOV] = {0.0, 180.0, 1, false, "above 0 and below 180"},
+    [R_UNIT] = {0.0, 1.0, 0, false, "0..1"},
+    [R_DIM] = {1.0, 8192.0, 0, false, "1..8192"},
+    [R_DIV] = {1.0, 4096.0, 0, false, "1..4096"},
+    [R_SEG] = {3.0, 4096.0, 0, false, "3..4096"},
+    [R_RING] = {2.0, 4096.0, 0, false, "2..4096"},
+    [R_COUNT] = {1.0, 1e7, 0, false, "1..10000000"},
+    [R_SEED] = {0.0, 4294967295.0, 0, false, "0..4294967295"},
+    [R_NEAR] = {1e-6, 1e7, 2, false, "1e-6..1e7, 1e7 excluded"},
+    [R_FAR] = {1e-6, 1e8, 2, false, "1e-6..1e8, 1e8 excluded"},
+    [R_AREA] = {1e-6, 1e12, 0, false, "1e-6..1e12"},
+    [R_SCALE] = {1e-6, 1e6, 0, true, "1e-6..1e6 in magnitude"},
 };
+
+static bool in_range(const rdef *rd, double x, double lo, double hi)
+{
+    return rd->open == 1 ? x > lo && x < hi : rd->open == 2 ? x >= lo && x < hi : x >= lo && x <= hi;
+}
 
 om__str om__parse_fail_begin(parser *p, om_status st, uint32_t col, char *tmp, size_t cap)
 {
@@ -135,8 +141,13 @@ om_status om__parse_value(parser *p, const char *what, uint8_t kind, uint8_t rng
         return OM_E_PARSE;
     }
     const rdef *rd = &rdefs[rng];
-    double x = rd->mag ? fabs(*v) : *v;
-    bool ok = rd->open ? x > rd->lo && x < rd->hi : x >= rd->lo && x <= rd->hi;
+    /* A number is checked as written and as the scene stores it, a float (against
+     * the bounds as floats): fov 179.999999 is 180 there, far 99999999 is 1e8. */
+    bool ok = in_range(rd, rd->mag ? fabs(*v) : *v, rd->lo, rd->hi);
+    if (kind != K_INT) {
+        double f = (double)(float)*v;
+        ok = ok && in_range(rd, rd->mag ? fabs(f) : f, (double)(float)rd->lo, (double)(float)rd->hi);
+    }
     if (!ok) {
         char tmp[4];
         om__str s = om__parse_fail_begin(p, OM_E_RANGE, t.col, tmp, sizeof tmp);

@@ -529,6 +529,23 @@ static om_status key_order(parser *p, const char *what, uint32_t col, float last
     return OM_E_PARSE;
 }
 
+/* A segment of a path along which the view would lose its direction (eye on its
+ * target, a spot light on its target, a directional light's dir through zero). */
+static om_status key_meets(parser *p, const char *what, uint32_t col, float last, uint32_t line,
+                           const char *how)
+{
+    char tmp[4];
+    om__str s = om__parse_fail_begin(p, OM_E_RANGE, col, tmp, sizeof tmp);
+    om__str_s(&s, what);
+    om__str_s(&s, ": between the key on line ");
+    om__str_u(&s, line);
+    om__str_s(&s, " (t = ");
+    om__str_f(&s, last, 3);
+    om__str_s(&s, ") and this one ");
+    om__str_s(&s, how);
+    return OM_E_RANGE;
+}
+
 static om_status do_key(parser *p)
 {
     pv pl[P_N_];
@@ -559,7 +576,11 @@ static om_status do_key(parser *p)
             return om__parse_fail(p, OM_E_RANGE, pl[P_TARGET].vcol[0], "camera eye and target must differ",
                         NULL, 0, NULL);
         if (p->ncam && !(tf > p->cam_t)) return key_order(p, what, tcol, p->cam_t, p->cam_t_line);
+        if (p->ncam && om__path_meets(p->cam_k.eye, p->cam_k.target, k.eye, k.target))
+            return key_meets(p, what, pl[P_EYE].vcol[0], p->cam_t, p->cam_t_line,
+                             "the eye passes through its target");
         if (p->fill) p->s->cam_keys[p->ncam] = k;
+        p->cam_k = k;
         p->ncam++;
         p->cam_t = tf;
         p->cam_t_line = p->l.no;
@@ -599,12 +620,18 @@ static om_status do_key(parser *p)
         return OM_E_PARSE;
     }
     if (p->nlight && !(tf > p->light_t)) return key_order(p, what, tcol, p->light_t, p->light_t_line);
+    const om_vec3 zero = {0.0f, 0.0f, 0.0f};
+    if (p->nlight && (form == 1 ? om__path_meets(p->light_k.pos, p->light_k.target, k.pos, k.target)
+                                : om__path_meets(p->light_k.dir, zero, k.dir, zero)))
+        return key_meets(p, what, pl[form == 1 ? P_POS : P_DIR].vcol[0], p->light_t, p->light_t_line,
+                         form == 1 ? "the light passes through its target" : "'dir' passes through zero");
     if (!p->lkey_form) {
         p->lkey_form = form;
         p->lkey_line = p->l.no;
         p->lkey_col = p->cmd.col;
     }
     if (p->fill) p->s->light_keys[p->nlight] = k;
+    p->light_k = k;
     p->nlight++;
     p->light_t = tf;
     p->light_t_line = p->l.no;

@@ -47,6 +47,8 @@ typedef struct parser {
     bool have_cam, have_light;
     uint32_t cam_line, light_line;
     float cam_t, light_t;  /* time of the last key of each kind */
+    om_camera_key cam_k;   /* the last key of each kind, for the segment to the next */
+    om_light_key light_k;
     uint32_t cam_t_line, light_t_line;
     int lkey_form;         /* 0 none yet, 1 spot (pos/target), 2 directional (dir) */
     uint32_t lkey_line, lkey_col;
@@ -79,6 +81,9 @@ om_status om__parse_second_line(parser *p, const char *what, uint32_t first);
 
 static inline om_vec3 pv3(const pv *v, int i) { return om__v3((float)v->v[i], (float)v->v[i + 1], (float)v->v[i + 2]); }
 static inline double val(const pv *pl, int id, int i, double def) { return pl[id].has ? pl[id].v[i] : def; }
+/* paths.c: whether a - b, lerped from (a0, b0) to (a1, b1), (nearly) vanishes. */
+bool om__path_meets(om_vec3 a0, om_vec3 b0, om_vec3 a1, om_vec3 b1);
+
 static inline bool v3_eq(om_vec3 a, om_vec3 b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
 static inline bool v3_zero(om_vec3 a) { return a.x == 0.0f && a.y == 0.0f && a.z == 0.0f; }
 

@@ -1,5 +1,6 @@
 /* paths.c — keyframed camera and light paths: om_scene_at interpolates linearly
- * between keys and clamps at the ends. */
+ * between keys and clamps at the ends; the parser asks om__path_meets whether a
+ * segment would leave a view without a direction at some time. */
 #include "scene.h"
 
 #include <math.h>
@@ -60,4 +61,26 @@ void om_scene_at(const om_scene *s, float t, om_camera *cam, om_light *light)
             }
         }
     }
+}
+
+/* Whether a - b, interpolated linearly from (a0, b0) to (a1, b1), comes to within a
+ * millionth of the points' size of zero for some u in [0, 1] (in exact arithmetic the
+ * difference of the two lerps is the lerp of the differences; the float lerps each
+ * round by an ulp of their size, so nearer than that they may meet exactly). */
+bool om__path_meets(om_vec3 a0, om_vec3 b0, om_vec3 a1, om_vec3 b1)
+{
+    double d0[3] = {(double)a0.x - b0.x, (double)a0.y - b0.y, (double)a0.z - b0.z};
+    double d1[3] = {(double)a1.x - b1.x, (double)a1.y - b1.y, (double)a1.z - b1.z};
+    double e[3], de = 0.0, ee = 0.0, size = 0.0;
+    const float pts[12] = {a0.x, a0.y, a0.z, b0.x, b0.y, b0.z, a1.x, a1.y, a1.z, b1.x, b1.y, b1.z};
+    for (int i = 0; i < 12; i++) size = fabs((double)pts[i]) > size ? fabs((double)pts[i]) : size;
+    for (int i = 0; i < 3; i++) {
+        e[i] = d1[i] - d0[i];
+        de += d0[i] * e[i];
+        ee += e[i] * e[i];
+    }
+    double u = ee > 0.0 ? -de / ee : 0.0, m = 0.0;
+    u = u < 0.0 ? 0.0 : u > 1.0 ? 1.0 : u;
+    for (int i = 0; i < 3; i++) m += (d0[i] + u * e[i]) * (d0[i] + u * e[i]);
+    return sqrt(m) <= 1e-6 * size;
 }
