@@ -75,7 +75,7 @@ om_status h_render_in(const om_scene *s, const char *name, const om_method_cfg *
     if ((st = m->bytes(&c, s, cam.width, cam.height, &mn, &full))) return st;
     if (method_bytes) full = method_bytes;
     uint32_t rows = strip_rows ? strip_rows : cam.height;
-    size_t fbytes = om_frame_bytes(cam.width, rows);
+    size_t fbytes = om_frame_bytes_scene(s, cam.width, rows);
     void *mm = malloc(full), *fm = malloc(fbytes), *px = malloc((size_t)cam.width * rows * 3);
     om_arena ma, fa;
     om_arena_init(&ma, mm, full, "method");

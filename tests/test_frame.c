@@ -56,6 +56,9 @@ static om_status grab(void *user, const om_strip *st, const om_framebuffer *fb)
     return OM_OK;
 }
 
+static size_t frame_size = sizeof frame_mem;   /* the frame arena render() gives */
+static uint32_t frame_carves;                  /* and how many carves it saw */
+
 static om_status render(const om_scene *s, const om_light *light, uint32_t strip, om_format f,
                         capture *cap)
 {
@@ -67,7 +70,7 @@ static om_status render(const om_scene *s, const om_light *light, uint32_t strip
     om_method_cfg_default(&cfg);
     om_arena ma, fa;
     om_arena_init(&ma, method_mem, sizeof method_mem, "method");
-    om_arena_init(&fa, frame_mem, sizeof frame_mem, "frame");
+    om_arena_init(&fa, frame_mem, frame_size, "frame");
     void *state;
     om_status st = m->init(&state, &ma, &cfg, s, v.cam.width, v.cam.height, &d);
     if (st) return st;
@@ -81,31 +84,45 @@ static om_status render(const om_scene *s, const om_light *light, uint32_t strip
     fd.scene = s; fd.view = &v; fd.method = m; fd.method_state = state; fd.shade = &shade;
     fd.strip_rows = strip; fd.fb = &fb; fd.on_strip = grab; fd.user = cap;
     cap->bpp = om_format_bpp(f);
-    return om_render_frame(&fd, &fa, NULL, &d);
+    st = om_render_frame(&fd, &fa, NULL, &d);
+    frame_carves = fa.carves;
+    return st;
 }
 
 static unsigned char pix_a[80 * 60 * 3], pix_b[80 * 60 * 3];
 static om_sample smp_a[80 * 60], smp_b[80 * 60];
 static om_term term_a[80 * 60], term_b[80 * 60];
 
+/* Strips give the whole frame's pixels, samples and terms: with row bins (the arena has
+ * room) and without (exactly om_frame_bytes), from a camera high above the floor and
+ * one at its edge, low enough that the floor's triangles cross the near plane. */
 static void strips_equal_whole(void)
 {
     om_scene s;
     make_scene(&s);
-    for (int kind = 0; kind < 2; kind++) {
-        om_light l = s.light;
-        if (kind) { l.kind = OM_LIGHT_DIRECTIONAL; l.dir = om__v3(-0.3f, -1, -0.2f); }
-        capture a = {pix_a, smp_a, term_a, 0}, b = {pix_b, smp_b, term_b, 0};
-        CHECK_OK(render(&s, &l, 0, OM_RGB888, &a));
-        static const uint32_t strips[] = {1, 7, 13, 59};
-        for (int k = 0; k < 4; k++) {
-            memset(pix_b, 0, sizeof pix_b);
-            CHECK_OK(render(&s, &l, strips[k], OM_RGB888, &b));
-            CHECK_MSG(!memcmp(pix_a, pix_b, sizeof pix_a), "light %d strip %u: pixels differ", kind, strips[k]);
-            CHECK(!memcmp(smp_a, smp_b, sizeof smp_a));
-            CHECK(!memcmp(term_a, term_b, sizeof term_a));
+    for (int cam = 0; cam < 2; cam++) {
+        if (cam) { s.camera.eye = om__v3(0.3f, 0.4f, 9.99f); s.camera.target = om__v3(0, 0.3f, 0); }
+        for (int kind = 0; kind < 2; kind++) {
+            om_light l = s.light;
+            if (kind) { l.kind = OM_LIGHT_DIRECTIONAL; l.dir = om__v3(-0.3f, -1, -0.2f); }
+            capture a = {pix_a, smp_a, term_a, 0}, b = {pix_b, smp_b, term_b, 0};
+            frame_size = sizeof frame_mem;
+            CHECK_OK(render(&s, &l, 0, OM_RGB888, &a));
+            static const uint32_t strips[] = {1, 7, 13, 59};
+            for (int k = 0; k < 8; k++) {
+                bool bins = k < 4;
+                frame_size = bins ? om_frame_bytes_scene(&s, 80, strips[k % 4]) : om_frame_bytes(80, strips[k % 4]);
+                memset(pix_b, 0, sizeof pix_b);
+                CHECK_OK(render(&s, &l, strips[k % 4], OM_RGB888, &b));
+                CHECK_EQ_U(frame_carves, bins ? 5 : 4);
+                CHECK_MSG(!memcmp(pix_a, pix_b, sizeof pix_a), "camera %d light %d strip %u%s: pixels differ",
+                          cam, kind, strips[k % 4], bins ? " (bins)" : "");
+                CHECK(!memcmp(smp_a, smp_b, sizeof smp_a));
+                CHECK(!memcmp(term_a, term_b, sizeof term_a));
+            }
         }
     }
+    frame_size = sizeof frame_mem;
 }
 
 /* Every visible point lies on its triangle's plane and on the ray through its pixel. */

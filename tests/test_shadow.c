@@ -326,8 +326,8 @@ static uint32_t cull_diff(const om_scene *s, const om_mat4 *vp, uint32_t n, uint
 {
     om_raster_mode mode = i0 ? OM_RASTER_DEPTH_ID : OM_RASTER_DEPTH;
     om_target t0 = {n, n, 0, n, d0, i0}, t1 = {n, n, 0, n, d1, i1};
-    om__scene_raster(s, vp, &t0, mode, false);
-    om__scene_raster(s, vp, &t1, mode, true);
+    om__scene_raster(s, vp, &t0, mode, false, NULL);
+    om__scene_raster(s, vp, &t1, mode, true, NULL);
     uint32_t diff = 0;
     *covered = 0;
     for (uint32_t i = 0; i < n * n; i++) {

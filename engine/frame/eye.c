@@ -101,8 +101,46 @@ bool om__cull_next(om__cull *c, uint32_t t)
     return c->on;
 }
 
+size_t om__row_bins_bytes(const om_scene *s)
+{
+    return om_arena_need((size_t)s->ntris * sizeof(uint32_t), 8);
+}
+
+void om__row_bins(const om_scene *s, const om_mat4 *vp, uint32_t width, uint32_t height,
+                  uint32_t *rows)
+{
+    const uint32_t all = (height - 1) << 16;
+    for (uint32_t t = 0; t < s->ntris; t++) {
+        om_vec4 c[3];
+        clip_tri(s, vp, t, c);
+        unsigned out_all = 0x3F, out_any = 0;
+        for (int k = 0; k < 3; k++) {
+            unsigned o = om__outcode(&c[k], width, height);
+            out_all &= o;
+            out_any |= o;
+        }
+        if (out_all) { rows[t] = 0x0000FFFFu; continue; }   /* wholly beyond one plane */
+        if (out_any) { rows[t] = all; continue; }            /* clipped: every row */
+        /* Inside every plane: the rasterizer snaps these very positions. */
+        int64_t lo = INT64_MAX, hi = INT64_MIN;
+        bool ok = true;
+        for (int k = 0; k < 3; k++) {
+            int64_t gx, gy;
+            if (!om__project_xy(&c[k], width, height, &gx, &gy)) { ok = false; break; }
+            if (gy < lo) lo = gy;
+            if (gy > hi) hi = gy;
+        }
+        if (!ok) { rows[t] = all; continue; }
+        /* Row r's centres lie at r * 256 + 128; a row either side to spare. */
+        int64_t r0 = (lo - OM_SUBPIX / 2) / OM_SUBPIX - 1, r1 = (hi - OM_SUBPIX / 2) / OM_SUBPIX + 1;
+        if (r0 < 0) r0 = 0;
+        if (r1 > (int64_t)height - 1) r1 = (int64_t)height - 1;
+        rows[t] = r0 > r1 ? 0x0000FFFFu : (uint32_t)r0 | (uint32_t)r1 << 16;
+    }
+}
+
 void om__scene_raster(const om_scene *s, const om_mat4 *vp, const om_target *tg,
-                      om_raster_mode mode, bool cull)
+                      om_raster_mode mode, bool cull, const uint32_t *rows)
 {
     om_raster r;
     r.target = tg;
@@ -119,7 +157,9 @@ void om__scene_raster(const om_scene *s, const om_mat4 *vp, const om_target *tg,
     om__cull cl;
     om__cull_begin(&cl, s, vp);
     om__target_clear(tg);
+    const uint32_t y0 = tg->y0, y1 = tg->y0 + tg->rows - 1;
     for (uint32_t t = 0; t < s->ntris; t++) {
+        if (rows && ((rows[t] & 0xFFFFu) > y1 || rows[t] >> 16 < y0)) continue;
         om_vec4 c[3];
         clip_tri(s, vp, t, c);
         r.cull_back = cull && om__cull_next(&cl, t);
@@ -127,11 +167,12 @@ void om__scene_raster(const om_scene *s, const om_mat4 *vp, const om_target *tg,
     }
 }
 
-void om__eye_pass(const om_scene *s, const om_view *v, const om_target *tg, om_strip *st)
+void om__eye_pass(const om_scene *s, const om_view *v, const om_target *tg, om_strip *st,
+                  const uint32_t *rows)
 {
     /* Culling is exact here too: the visible point of a pixel is the nearest, and the
      * nearest surface of a closed shape the camera is outside of faces the camera. */
-    om__scene_raster(s, &v->cam_vp, tg, OM_RASTER_DEPTH_ID, true);
+    om__scene_raster(s, &v->cam_vp, tg, OM_RASTER_DEPTH_ID, true, rows);
     om__persp_tri cache;
     memset(&cache, 0, sizeof cache);
     cache.tri = OM_NO_TRI;

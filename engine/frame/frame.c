@@ -14,6 +14,11 @@ size_t om_frame_bytes(uint32_t width, uint32_t strip_rows)
            om_arena_need(n * sizeof(om_term), 8);
 }
 
+size_t om_frame_bytes_scene(const om_scene *s, uint32_t width, uint32_t strip_rows)
+{
+    return om_frame_bytes(width, strip_rows) + om__row_bins_bytes(s);
+}
+
 static uint64_t now(const om_frame_desc *fd)
 {
     return fd->clock ? fd->clock(fd->clock_user) : 0;
@@ -85,6 +90,19 @@ om_status om_render_frame(const om_frame_desc *fd, om_arena *fa, om_frame_stats 
 
     om_view view = *fd->view;
     const bool single = rows == H;
+    /* Row bins when the frame has strips and the arena has room: each strip then sets
+     * up only its own triangles (the same pixels; without room, every strip walks
+     * every triangle). The camera's matrix does not change within the frame. */
+    uint32_t *bins = NULL;
+    if (!single && om_arena_left(fa) >= om__row_bins_bytes(s) && s->ntris) {
+        void *pb;
+        if (om_arena_alloc(fa, (size_t)s->ntris * sizeof(uint32_t), 8, &pb, NULL) == OM_OK) {
+            bins = (uint32_t *)pb;
+            uint64_t tb = now(fd);
+            om__row_bins(s, &view.cam_vp, W, H, bins);
+            fs->ns_eye += now(fd) - tb;
+        }
+    }
     const bool observes = (m->flags & OM_METHOD_OBSERVES) && (!m->observes || m->observes(fd->method_state));
     const bool fit = view.light.kind == OM_LIGHT_DIRECTIONAL;
     bool have_samples = false;   /* strip.samples hold the whole frame already */
@@ -96,7 +114,7 @@ om_status om_render_frame(const om_frame_desc *fd, om_arena *fa, om_frame_stats 
         strip.y0 = tg.y0 = (y);                                                  \
         strip.rows = tg.rows = (y) + rows > H ? H - (y) : rows;                  \
         t0 = now(fd);                                                            \
-        om__eye_pass(s, &view, &tg, &strip);                                     \
+        om__eye_pass(s, &view, &tg, &strip, bins);                               \
         fs->ns_eye += now(fd) - t0;                                              \
         fs->eye_passes++;                                                        \
     } while (0)

@@ -29,14 +29,26 @@ bool om__cull_next(om__cull *c, uint32_t t);
 
 /* Clears `tg` and rasterizes every triangle of the scene through `vp` into it: the
  * eye pass (OM_RASTER_DEPTH_ID) and the light depth passes (OM_RASTER_DEPTH); with
- * `cull`, the back faces of closed shapes are skipped (om__cull). */
+ * `cull`, the back faces of closed shapes are skipped (om__cull). With `rows` (from
+ * om__row_bins), triangles whose rows miss the target's are skipped before any setup. */
 void om__scene_raster(const om_scene *s, const om_mat4 *vp, const om_target *tg,
-                      om_raster_mode mode, bool cull);
+                      om_raster_mode mode, bool cull, const uint32_t *rows);
+
+/* Strips without repetition: for each triangle, the image rows its pixels can lie in
+ * through `vp` onto a width x height image (first | last << 16, conservative by a row;
+ * 0x0000FFFF for one that covers nothing; all rows for one that needs clipping), so a
+ * strip's eye pass sets up only the triangles that reach it. One pass of vertex
+ * projections per frame instead of a clip and setup of every triangle per strip. */
+size_t om__row_bins_bytes(const om_scene *s);
+void om__row_bins(const om_scene *s, const om_mat4 *vp, uint32_t width, uint32_t height,
+                  uint32_t *rows);
 
 /* Renders rows [st->y0, st->y0 + st->rows) of the camera view into `tg` (depth and
  * triangle id, strip-sized) and resolves st->samples: the exact point of the visible
- * triangle under each pixel centre, by perspective-correct barycentrics. */
-void om__eye_pass(const om_scene *s, const om_view *v, const om_target *tg, om_strip *st);
+ * triangle under each pixel centre, by perspective-correct barycentrics. `rows` may be
+ * NULL (every triangle is walked) or om__row_bins' for this view. */
+void om__eye_pass(const om_scene *s, const om_view *v, const om_target *tg, om_strip *st,
+                  const uint32_t *rows);
 
 /* The exact point of a triangle under an image position, by perspective-correct
  * barycentrics in homogeneous clip space (no division by w, so triangles crossing the

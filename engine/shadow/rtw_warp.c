@@ -260,7 +260,7 @@ static void forward(om__rtw *m)
     const bool hybrid = m->cfg.rtw_analysis == OM_RTW_HYBRID;
     /* hybrid needs only the depths (for edges); forward also the triangle under a texel */
     om_target tg = {n, n, 0, n, m->fdepth, hybrid ? NULL : m->fid};
-    om__scene_raster(m->scene, &m->view.light_vp, &tg, hybrid ? OM_RASTER_DEPTH : OM_RASTER_DEPTH_ID, false);
+    om__scene_raster(m->scene, &m->view.light_vp, &tg, hybrid ? OM_RASTER_DEPTH : OM_RASTER_DEPTH_ID, false, NULL);
     om__persp_tri cache;
     memset(&cache, 0, sizeof cache);
     cache.tri = OM_NO_TRI;

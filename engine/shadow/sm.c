@@ -84,7 +84,7 @@ static om_status sm_build(void *state, om_diag *d)
     (void)d;
     sm_state *m = (sm_state *)state;
     om_target tg = {m->size, m->size, 0, m->size, m->depth, NULL};
-    om__scene_raster(m->scene, &m->view.light_vp, &tg, OM_RASTER_DEPTH, true);
+    om__scene_raster(m->scene, &m->view.light_vp, &tg, OM_RASTER_DEPTH, true, NULL);
     return OM_OK;
 }
 

@@ -23,7 +23,7 @@ static void table_row(const bscene *b, uint32_t W, uint32_t H)
     void *mem = malloc(full);
     om_target tg = {W, H, 0, H, malloc(n * 4), malloc(n * 4)};
     om_strip st = {W, H, 0, H, malloc(n * sizeof(om_sample)), malloc(n * sizeof(om_term))};
-    om__eye_pass(&b->s, &v, &tg, &st);
+    om__eye_pass(&b->s, &v, &tg, &st, NULL);
     for (size_t i = 0; i < n; i++) {
         st.terms[i].flags = st.samples[i].tri != OM_NO_TRI && om__exposed(&v, &st.samples[i]) ? OM_TERM_EXPOSED : 0;
     }

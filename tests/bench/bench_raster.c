@@ -22,9 +22,9 @@ static void bench_eye(const bscene *b, uint32_t W, uint32_t H)
     size_t covered = 0;
     for (int r = 0; r < RUNS; r++) {
         uint64_t t0 = om_clock_ns(NULL);
-        om__scene_raster(&b->s, &v.cam_vp, &tg, OM_RASTER_DEPTH_ID, false);
+        om__scene_raster(&b->s, &v.cam_vp, &tg, OM_RASTER_DEPTH_ID, false, NULL);
         uint64_t t1 = om_clock_ns(NULL);
-        om__eye_pass(&b->s, &v, &tg, &st);
+        om__eye_pass(&b->s, &v, &tg, &st, NULL);
         uint64_t t2 = om_clock_ns(NULL);
         raster[r] = t1 - t0;
         total[r] = t2 - t1;
@@ -51,7 +51,7 @@ static void bench_light(const bscene *b, uint32_t size)
     uint64_t t[RUNS];
     for (int r = 0; r < RUNS; r++) {
         uint64_t t0 = om_clock_ns(NULL);
-        om__scene_raster(&b->s, &v.light_vp, &tg, OM_RASTER_DEPTH, true);
+        om__scene_raster(&b->s, &v.light_vp, &tg, OM_RASTER_DEPTH, true, NULL);
         t[r] = om_clock_ns(NULL) - t0;
     }
     size_t written = 0;
