@@ -187,6 +187,8 @@ om_status om_scene_parse(const char *text, size_t len, const om_loader *ld,
                          om_arena *a, om_scene *out, om_diag *d);
 /* The built-in default scene, as text in the scene format. */
 const char *om_scene_default_text(void);
+/* Its small twin for microcontrollers: the same composition in under 2,000 triangles. */
+const char *om_scene_small_text(void);
 /* Camera and light at time t along the scene's paths (the scene's own when it has
  * none). Linear interpolation between keys, clamped at the ends. */
 void om_scene_at(const om_scene *s, float t, om_camera *cam, om_light *light);

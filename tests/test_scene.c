@@ -753,6 +753,27 @@ static void default_scene(void)
     done(&p);
 }
 
+/* The small twin: the same objects, materials, camera and light, in under 2,000
+ * triangles and a scene arena a microcontroller holds. */
+static void small_scene(void)
+{
+    parsed big, small;
+    CHECK_MSG(parse(om_scene_default_text(), &big) == OM_OK, "%s", big.d.msg);
+    CHECK_MSG(parse(om_scene_small_text(), &small) == OM_OK, "%s", small.d.msg);
+    if (big.st == OM_OK && small.st == OM_OK) {
+        CHECK_MSG(small.s.ntris <= 2000 && small.s.ntris * 10 < big.s.ntris, "%u triangles", small.s.ntris);
+        CHECK_MSG(small.bytes <= 64 * 1024, "scene arena %zu bytes", small.bytes);
+        CHECK_EQ_U(small.s.nsolids, big.s.nsolids);
+        CHECK_EQ_U(small.s.nmats, big.s.nmats);
+        CHECK(!memcmp(&small.s.camera, &big.s.camera, sizeof big.s.camera));
+        CHECK(!memcmp(&small.s.light, &big.s.light, sizeof big.s.light));
+        CHECK(small.s.ncam_keys == big.s.ncam_keys && small.s.nlight_keys == big.s.nlight_keys);
+        CHECK(!memcmp(&small.s.lo, &big.s.lo, sizeof big.s.lo) && !memcmp(&small.s.hi, &big.s.hi, sizeof big.s.hi));
+    }
+    done(&big);
+    done(&small);
+}
+
 void suite_scene(void)
 {
     RUN(numbers);
@@ -767,4 +788,5 @@ void suite_scene(void)
     RUN(parse_errors);
     RUN(scene_at);
     RUN(default_scene);
+    RUN(small_scene);
 }
