@@ -110,6 +110,7 @@ om_status om_out_open(om_out *o, const char *path, om_diag *d)
 {
     memset(o, 0, sizeof *o);
     o->path = path;
+    if (!path[0]) return fail(d, "''", "cannot create", ENOENT);
     if (!strcmp(path, "-")) {
         o->f = stdout;
         o->direct = o->is_stdout = true;

@@ -129,6 +129,15 @@ has "$dir/err" "/dev/full: cannot write: No space left on device" "full device n
 if [ "$(cat "$dir/code")" -ne 0 ]; then ok; else bad "a render over the file-size limit succeeded"; fi
 cmp -s "$dir/good.ppm" "$dir/keep.ppm" && ok || bad "a killed render damaged the old image"
 if [ -z "$(leftovers)" ]; then ok; else bad "temporaries left behind: $(leftovers)"; fi
+# a write that fails (the file-size limit with its signal ignored: EFBIG, as a full
+# disk gives ENOSPC) leaves the old file and names the reason
+(ulimit -f 20; trap '' XFSZ; "$OMBRA" render --size 160x120 --out "$dir/good.ppm" -q; echo $? >"$dir/code") >/dev/null 2>"$dir/err"
+if [ "$(cat "$dir/code")" -eq 1 ]; then ok; else bad "a render past the file-size limit: exit $(cat "$dir/code"), wanted 1"; fi
+has "$dir/err" "good.ppm: cannot write: File too large" "a failed write names the file and the reason"
+cmp -s "$dir/good.ppm" "$dir/keep.ppm" && ok || bad "a failed write damaged the old image"
+if [ -z "$(leftovers)" ]; then ok; else bad "temporaries left behind: $(leftovers)"; fi
+expect 1 "an empty output name" -- "$OMBRA" render --size 16x12 --out ''
+has "$dir/err" "'': cannot create" "an empty output name is refused"
 expect 2 "--out and --mask the same file" -- "$OMBRA" render --size 16x12 --out "$dir/good.ppm" --mask "$dir/./good.ppm"
 has "$dir/err" "same file" "the same path twice explained"
 cmp -s "$dir/good.ppm" "$dir/keep.ppm" && ok || bad "--out x --mask x damaged x"
