@@ -275,7 +275,12 @@ for m in $("$OMBRA" methods | awk 'NF == 0 {exit} {print $1}'); do
     expect 0 "the range's edges render with $m" -- "$OMBRA" render "$dir/edges.scene" --method "$m" --time 1 --map 256 --out "$dir/z.ppm"
 done
 
-# bench and report: names checked before any work, a failed run writes nothing, the
+# bench and report: names checked before any work
+expect 2 "compare --diff over a mask" -- "$OMBRA" compare "$dir/ref.pgm" "$dir/sm.pgm" --diff "$dir/./sm.pgm"
+if [ "$(head -c 2 "$dir/sm.pgm")" = "P5" ]; then ok; else bad "compare --diff replaced a mask it read"; fi
+expect 0 "bench on a scene under a long path" -- "$OMBRA" bench --scenes "$long/ok.scene" --runs 1 --methods ref --out "$dir/bench-long"
+if [ "$(sed -n 2p "$dir/bench-long/bench.csv" | cut -d, -f1)" = "$long/ok.scene" ]; then ok; else bad "bench.csv cut the scene's name short"; fi
+has "$dir/bench-long/ok.scene-time.svg" "<circle" "the long-named scene's chart has its points", a failed run writes nothing, the
 # method's init is its own stage, and a scene file renders at its own size.
 expect 2 "bench --methods foo" -- "$OMBRA" bench --scenes "$dir/ok.scene" --methods foo --out "$dir/bench-foo"
 has "$dir/err" "unknown method 'foo'" "bench names the unknown method"

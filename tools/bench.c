@@ -466,7 +466,7 @@ int cmd_bench(int argc, char **argv)
             if (ns == 0) { settings[0][0] = 0; ns = 1; }
             for (int j = 0; j < ns && np < MAXP; j++) {
                 cli_point *p = &pts[np];
-                snprintf(p->scene, sizeof p->scene, "%s", name);
+                p->scene = name;
                 snprintf(p->method, sizeof p->method, "%s", m->name);
                 const char *label = settings[j][0] ? settings[j] : "defaults";
                 size_t ll = strlen(label) < sizeof p->setting ? strlen(label) : sizeof p->setting - 1;
@@ -515,7 +515,7 @@ int cmd_bench(int argc, char **argv)
                 om_method_cfg_default(&cfg);
                 cli_point p;
                 memset(&p, 0, sizeof p);
-                snprintf(p.scene, sizeof p.scene, "%s", counts[j]);
+                p.scene = counts[j];
                 snprintf(p.method, sizeof p.method, "%s", m->name);
                 snprintf(p.setting, sizeof p.setting, "triangle sweep");
                 progress(j + 1, 4, &p);

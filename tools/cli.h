@@ -48,7 +48,8 @@ int cmd_bench(int argc, char **argv);
 
 /* One measured sweep point (ombra bench, ombra report). */
 typedef struct cli_point {
-    char scene[64], method[16], setting[96];
+    const char *scene;     /* the name as given (kept by the caller; never cut short) */
+    char method[16], setting[96];
     uint32_t w, h;         /* the image size it was measured at */
     double init;           /* the method's init, ms (once per point; ref builds its BVH) */
     double total, eye, observe, build, resolve, shade;   /* per frame, ms (medians) */

@@ -440,6 +440,8 @@ int cmd_compare(int argc, char **argv)
         else return cli_usage_error("compare", "two masks only; unexpected '%s'", a);
     }
     if (!b_path) return cli_usage_error("compare", "needs two masks%s", "");
+    if (diff && (om_out_same(diff, a_path) || om_out_same(diff, b_path)))
+        return cli_usage_error("compare", "--diff '%s' would replace one of the masks it compares", diff);
     om_diag d;
     memset(&d, 0, sizeof d);
     uint32_t wa, ha, wb, hb;
