@@ -80,15 +80,27 @@ bool om_out_is_direct(const char *path)
 }
 
 /* The file a rename must replace: a symlink's final target (so the link stays a
- * link), else the path itself. */
+ * link; a dangling one is followed one step to the file it names), else the path. */
 static char *target_of(const char *path)
 {
     struct stat sb;
-    if (lstat(path, &sb) == 0 && S_ISLNK(sb.st_mode)) {
-        char *real = realpath(path, NULL);
-        if (real) return real;
+    if (lstat(path, &sb) != 0 || !S_ISLNK(sb.st_mode)) return dup_str(path);
+    char *real = realpath(path, NULL);
+    if (real) return real;
+    size_t n = sb.st_size > 0 ? (size_t)sb.st_size : 4096;
+    char *link = malloc(n + 1);
+    ssize_t got = link ? readlink(path, link, n + 1) : -1;
+    if (got <= 0 || (size_t)got > n) { free(link); return dup_str(path); }
+    link[got] = '\0';
+    const char *slash = strrchr(path, '/');
+    size_t dir = link[0] != '/' && slash ? (size_t)(slash - path) + 1 : 0;
+    char *t = malloc(dir + (size_t)got + 1);
+    if (t) {
+        memcpy(t, path, dir);
+        memcpy(t + dir, link, (size_t)got + 1);
     }
-    return dup_str(path);
+    free(link);
+    return t;
 }
 
 /* "<dir>/.<base>.XXXXXX" beside the target (".ombra.XXXXXX" for a base too long to

@@ -160,6 +160,17 @@ if command -v mkfifo >/dev/null 2>&1; then
     cmp -s "$dir/fifo.ppm" "$dir/r16.ppm" && ok || bad "the FIFO got other bytes"
     rm -f "$dir/fifo"
 fi
+# a symlink stays a link to the file that is replaced, a dangling one is followed,
+# and a replaced file keeps its permissions
+rm -f "$dir/real.ppm" "$dir/link.ppm" "$dir/dangling.ppm"
+cp "$dir/keep.ppm" "$dir/real.ppm"
+chmod 640 "$dir/real.ppm"
+ln -s real.ppm "$dir/link.ppm"
+ln -s sub/made.ppm "$dir/dangling.ppm"
+mkdir -p "$dir/sub"
+expect 0 "render through a symlink" -- "$OMBRA" render --size 16x12 --out "$dir/link.ppm" --mask "$dir/dangling.ppm"
+if [ -L "$dir/link.ppm" ] && [ -L "$dir/dangling.ppm" ] && cmp -s "$dir/real.ppm" "$dir/r16.ppm" && [ "$(head -c 2 "$dir/sub/made.ppm")" = "P5" ]; then ok; else bad "symlinks were replaced instead of their files"; fi
+if [ "$(ls -l "$dir/real.ppm" | cut -c1-10)" = "-rw-r-----" ]; then ok; else bad "the replaced file lost its permissions: $(ls -l "$dir/real.ppm")"; fi
 # two renders racing to one name: the file is one of them whole, never a mix
 expect 0 "reference 160x120 image" -- "$OMBRA" render --size 160x120 --out "$dir/r160.ppm"
 "$OMBRA" render --size 160x120 --out "$dir/race.ppm" -q & p1=$!
