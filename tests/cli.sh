@@ -297,6 +297,7 @@ expect 2 "bench --methods foo" -- "$OMBRA" bench --scenes "$dir/ok.scene" --meth
 has "$dir/err" "unknown method 'foo'" "bench names the unknown method"
 if [ -e "$dir/bench-foo/bench.csv" ]; then bad "bench --methods foo wrote a CSV"; else ok; fi
 expect 2 "report --scenes nosuch.scene" -- "$OMBRA" report --scenes "$dir/nosuch.scene" --out "$dir/report-none"
+has "$dir/err" "^ombra report: unknown scene" "report's usage error names report"
 if [ -e "$dir/report-none/bench.csv" ] || [ -e "$dir/report-none/index.html" ] || grep -q wrote "$dir/out"; then bad "a failed report wrote files"; else ok; fi
 cp "$dir/bench/bench.csv" "$dir/bench-old.csv"
 expect 1 "bench on a malformed scene" -- "$OMBRA" bench --scenes "$dir/ok.scene,$dir/bad.scene" --runs 1 --methods izb --out "$dir/bench"

@@ -282,17 +282,17 @@ static size_t split(char *list, char **items, size_t max)
 
 /* Every name on the command line means something before any work starts: a scene is
  * built in or a file that is there, a method is in the registry and swept. */
-static int check_names(char **names, size_t n, const char *methods)
+static int check_names(const char *cmd, char **names, size_t n, const char *methods)
 {
     struct stat sb;
     for (size_t i = 0; i < n; i++) {
-        if (!names[i][0]) return cli_usage_error("bench", "--scenes has an empty name%s", "");
+        if (!names[i][0]) return cli_usage_error(cmd, "--scenes has an empty name%s", "");
         if (!cli_builtin_scene(names[i]) && (stat(names[i], &sb) != 0 || S_ISDIR(sb.st_mode)))
-            return cli_usage_error("bench", "unknown scene '%s': not default, random-1K, random-10K, "
+            return cli_usage_error(cmd, "unknown scene '%s': not default, random-1K, random-10K, "
                                    "random-100K, random-1M or a scene file", names[i]);
         for (size_t j = 0; j < i; j++)
             if (!strcmp(base_name(names[i]), base_name(names[j])))
-                return cli_usage_error("bench", "two scenes named '%s' would write the same charts",
+                return cli_usage_error(cmd, "two scenes named '%s' would write the same charts",
                                        base_name(names[i]));
     }
     for (const char *p = methods; p && *p;) {
@@ -300,9 +300,9 @@ static int check_names(char **names, size_t n, const char *methods)
         size_t l = strcspn(p, ",");
         snprintf(name, sizeof name, "%.*s", (int)(l < 31 ? l : 31), p);
         const om_method *m = om_method_find(name);
-        if (!m) return cli_unknown_method("bench", "--methods", name);
+        if (!m) return cli_unknown_method(cmd, "--methods", name);
         if (om_method_sweep(m) && !om_method_sweep(m)[0])
-            return cli_usage_error("bench", "'%s' is left out of sweeps (nothing to compare)", name);
+            return cli_usage_error(cmd, "'%s' is left out of sweeps (nothing to compare)", name);
         p += l + (p[l] == ',');
     }
     return 0;
@@ -394,13 +394,13 @@ int cmd_bench(int argc, char **argv)
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) { fputs(bench_help, stdout); return 0; }
         if (!strcmp(a, "--tri-sweep")) { tri_sweep = true; continue; }
-        if (!v) return cli_usage_error("bench", "unknown option or missing value: '%s'", a);
+        if (!v) return cli_usage_error(argv[0], "unknown option or missing value: '%s'", a);
         if (!strcmp(a, "--scenes")) scenes = v;
         else if (!strcmp(a, "--methods")) methods = v;
         else if (!strcmp(a, "--out")) dir = v;
-        else if (!strcmp(a, "--size")) { if (!cli_parse_size(v, &w, &h)) return cli_usage_error("bench", "--size takes WxH, not '%s'", v); }
-        else if (!strcmp(a, "--runs")) { if (!cli_parse_u32(v, 1, 16, &runs)) return cli_usage_error("bench", "--runs takes 1..16, not '%s'", v); }
-        else return cli_usage_error("bench", "unknown option '%s'", a);
+        else if (!strcmp(a, "--size")) { if (!cli_parse_size(v, &w, &h)) return cli_usage_error(argv[0], "--size takes WxH, not '%s'", v); }
+        else if (!strcmp(a, "--runs")) { if (!cli_parse_u32(v, 1, 16, &runs)) return cli_usage_error(argv[0], "--runs takes 1..16, not '%s'", v); }
+        else return cli_usage_error(argv[0], "unknown option '%s'", a);
         i++;
     }
     size_t cap = 1;
@@ -415,7 +415,7 @@ int cmd_bench(int argc, char **argv)
     }
     memcpy(list, scenes, strlen(scenes) + 1);
     size_t nn = split(list, names, cap);
-    int rc = check_names(names, nn, methods);
+    int rc = check_names(argv[0], names, nn, methods);
     /* the directory first, so that an unwritable one fails before the work */
     char *path = rc ? NULL : malloc(strlen(dir) + 1);
     if (!rc && path) {

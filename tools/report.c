@@ -191,11 +191,11 @@ int cmd_report(int argc, char **argv)
     }
     uint32_t W = 0, H = 0;
     if (size && !cli_parse_size(size, &W, &H)) return cli_usage_error("report", "--size takes WxH, not '%s'", size);
-    char *bargv[12] = {"bench", "--scenes", (char *)scenes, "--runs", (char *)runs, "--out", (char *)dir};
+    char *bargv[12] = {"report", "--scenes", (char *)scenes, "--runs", (char *)runs, "--out", (char *)dir};
     int bargc = 7;
     if (size) { bargv[bargc++] = "--size"; bargv[bargc++] = (char *)size; }
     if (tri) bargv[bargc++] = "--tri-sweep";
-    int rc = cmd_bench(bargc, bargv);
+    int rc = cmd_bench(bargc, bargv);   /* its usage errors name 'report' (argv[0]) */
     if (rc) return rc;
     om_diag d;
     memset(&d, 0, sizeof d);
