@@ -516,17 +516,26 @@ static om_status do_object(parser *p, int cmd)
 
 /* ---------------------------------------------------------------- keys */
 
-static om_status key_order(parser *p, const char *what, uint32_t col, float last, uint32_t line)
+/* "<what><a><line of the key before><b><its t><c>": a key that does not follow
+ * from the one before it. */
+static om_status key_fail(parser *p, om_status st, uint32_t col, const char *what, const char *a,
+                          uint32_t line, const char *b, float last, const char *c)
 {
     char tmp[4];
-    om__str s = om__parse_fail_begin(p, OM_E_PARSE, col, tmp, sizeof tmp);
+    om__str s = om__parse_fail_begin(p, st, col, tmp, sizeof tmp);
     om__str_s(&s, what);
-    om__str_s(&s, " times must increase (the key before, on line ");
+    om__str_s(&s, a);
     om__str_u(&s, line);
-    om__str_s(&s, ", is at t = ");
+    om__str_s(&s, b);
     om__str_f(&s, last, 3);
-    om__str_s(&s, ")");
-    return OM_E_PARSE;
+    om__str_s(&s, c);
+    return st;
+}
+
+static om_status key_order(parser *p, const char *what, uint32_t col, float last, uint32_t line)
+{
+    return key_fail(p, OM_E_PARSE, col, what, " times must increase (the key before, on line ",
+                    line, ", is at t = ", last, ")");
 }
 
 /* A segment of a path along which the view would lose its direction (eye on its
@@ -534,16 +543,7 @@ static om_status key_order(parser *p, const char *what, uint32_t col, float last
 static om_status key_meets(parser *p, const char *what, uint32_t col, float last, uint32_t line,
                            const char *how)
 {
-    char tmp[4];
-    om__str s = om__parse_fail_begin(p, OM_E_RANGE, col, tmp, sizeof tmp);
-    om__str_s(&s, what);
-    om__str_s(&s, ": between the key on line ");
-    om__str_u(&s, line);
-    om__str_s(&s, " (t = ");
-    om__str_f(&s, last, 3);
-    om__str_s(&s, ") and this one ");
-    om__str_s(&s, how);
-    return OM_E_RANGE;
+    return key_fail(p, OM_E_RANGE, col, what, ": between the key on line ", line, " (t = ", last, how);
 }
 
 static om_status do_key(parser *p)
@@ -578,7 +578,7 @@ static om_status do_key(parser *p)
         if (p->ncam && !(tf > p->cam_t)) return key_order(p, what, tcol, p->cam_t, p->cam_t_line);
         if (p->ncam && om__path_meets(p->cam_k.eye, p->cam_k.target, k.eye, k.target))
             return key_meets(p, what, pl[P_EYE].vcol[0], p->cam_t, p->cam_t_line,
-                             "the eye passes through its target");
+                             ") and this one the eye passes through its target");
         if (p->fill) p->s->cam_keys[p->ncam] = k;
         p->cam_k = k;
         p->ncam++;
@@ -624,7 +624,8 @@ static om_status do_key(parser *p)
     if (p->nlight && (form == 1 ? om__path_meets(p->light_k.pos, p->light_k.target, k.pos, k.target)
                                 : om__path_meets(p->light_k.dir, zero, k.dir, zero)))
         return key_meets(p, what, pl[form == 1 ? P_POS : P_DIR].vcol[0], p->light_t, p->light_t_line,
-                         form == 1 ? "the light passes through its target" : "'dir' passes through zero");
+                         form == 1 ? ") and this one the light passes through its target"
+                                   : ") and this one 'dir' passes through zero");
     if (!p->lkey_form) {
         p->lkey_form = form;
         p->lkey_line = p->l.no;
