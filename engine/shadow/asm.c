@@ -57,6 +57,15 @@ typedef struct asm_state {
     asm_dvec *vclip;       /* per vertex: light clip coordinates, in double (not lean) */
     float *tbox;           /* per triangle: base-texel bounds u0, v0, u1, v1 (not lean) */
     uint32_t *cull;        /* triangles that meet the region being rendered (not lean) */
+    /* A grid of cells over the base texels, each listing the triangles whose bounds
+     * meet it, made once per frame, so that a tile gathers from its cells instead of
+     * testing every triangle's bounds; a bit per triangle puts them back in index
+     * order. Not lean; unused in a frame whose lists would overflow `gcap`. */
+    uint32_t gside;        /* cells per side */
+    uint32_t *gstart;      /* gside^2 + 1 offsets into glist */
+    uint32_t *glist, gcap;
+    uint32_t *gbits;       /* (ntris + 31) / 32 words */
+    bool gready;           /* this frame's lists were made */
     uint32_t *sdepth, *sid;   /* one tile of scratch for the rasterizer */
     om__asm_cand *cand;
     uint32_t ncand_max;
@@ -79,11 +88,26 @@ typedef struct asm_pt {
 
 /* The scene-sized arrays of the fast mode: projections once per frame, bounds once
  * per frame, a cull list per tile. */
+/* Cells per side of the triangle grid: about four triangles a cell, 16 to 256. */
+static uint32_t grid_side(const om_scene *s)
+{
+    uint32_t g = 16;
+    while (g < 256 && (uint64_t)g * g * 4 < s->ntris) g *= 2;
+    return g;
+}
+
+/* Room for twice as many cell entries as triangles: small triangles meet one to four
+ * cells; a frame whose large ones need more renders its tiles by the full scan. */
+static uint32_t grid_cap(const om_scene *s) { return 2 * (s->ntris ? s->ntris : 1) + grid_side(s) * grid_side(s); }
+
 static size_t scene_bytes(const om_scene *s)
 {
+    const size_t n = s->ntris ? s->ntris : 1, g = grid_side(s);
     return om_arena_need((size_t)(s->nverts ? s->nverts : 1) * sizeof(asm_dvec), 8) +
-           om_arena_need((size_t)(s->ntris ? s->ntris : 1) * 4 * sizeof(float), 8) +
-           om_arena_need((size_t)(s->ntris ? s->ntris : 1) * sizeof(uint32_t), 8);
+           om_arena_need(n * 4 * sizeof(float), 8) + om_arena_need(n * sizeof(uint32_t), 8) +
+           om_arena_need((g * g + 1) * sizeof(uint32_t), 8) +
+           om_arena_need((size_t)grid_cap(s) * sizeof(uint32_t), 8) +
+           om_arena_need((n + 31) / 32 * sizeof(uint32_t), 8);
 }
 
 static size_t scratch_bytes(const om__asm_layout *l, uint64_t ncand)
@@ -149,6 +173,7 @@ static om_status asm_init(void **state, om_arena *a, const om_method_cfg *c, con
     m->vclip = NULL;
     m->tbox = NULL;
     m->cull = NULL;
+    m->gready = false;
     if ((st = om__asm_tree_init(&m->tree, a, &l, d))) return st;
     const size_t t2 = (size_t)l.tile * l.tile;
     uint64_t nc = cand_count(&l);
@@ -159,6 +184,17 @@ static om_status asm_init(void **state, om_arena *a, const om_method_cfg *c, con
         m->tbox = (float *)p;
         if ((st = om_arena_alloc(a, (size_t)(s->ntris ? s->ntris : 1) * sizeof(uint32_t), 8, &p, d))) return st;
         m->cull = (uint32_t *)p;
+        const size_t g = grid_side(s);
+        m->gside = (uint32_t)g;
+        m->gcap = grid_cap(s);
+        if ((st = om_arena_alloc(a, (g * g + 1) * sizeof(uint32_t), 8, &p, d))) return st;
+        m->gstart = (uint32_t *)p;
+        if ((st = om_arena_alloc(a, (size_t)m->gcap * sizeof(uint32_t), 8, &p, d))) return st;
+        m->glist = (uint32_t *)p;
+        if ((st = om_arena_alloc(a, ((size_t)(s->ntris ? s->ntris : 1) + 31) / 32 * sizeof(uint32_t), 8, &p, d)))
+            return st;
+        m->gbits = (uint32_t *)p;
+        memset(m->gbits, 0, ((size_t)(s->ntris ? s->ntris : 1) + 31) / 32 * sizeof(uint32_t));
     }
     if ((st = om_arena_alloc(a, t2 * sizeof(uint32_t), 8, &p, d))) return st;
     m->sdepth = (uint32_t *)p;
@@ -246,6 +282,85 @@ static void render_tri(om_raster *r, const asm_dvec q[3], double s_, double kx, 
     om__raster_tri(r, c, t);
 }
 
+/* The triangles whose bounds meet the region, in index order, into m->cull: every
+ * triangle's bounds tested, without branches (most miss a deep node's region). */
+static uint32_t gather_all(asm_state *m, float u0, float v0, float u1, float v1)
+{
+    uint32_t n = 0;
+    for (uint32_t k = 0; k < m->scene->ntris; k++) {
+        m->cull[n] = k;
+        n += box_meets(&m->tbox[(size_t)k * 4], u0, v0, u1, v1);
+    }
+    return n;
+}
+
+/* The cell of a base-texel coordinate, clamped to the grid (bounds beyond the map
+ * fall in its border cells). */
+static uint32_t cell_of(const asm_state *m, float u)
+{
+    float f = u * (float)m->gside / (float)m->tree.lay.tile;
+    return !(f > 0.0f) ? 0 : f >= (float)(m->gside - 1) ? m->gside - 1 : (uint32_t)f;
+}
+
+/* This frame's cell lists (a counting sort of triangles by cell); gready stays false
+ * when they would not fit. */
+static void grid_make(asm_state *m)
+{
+    const om_scene *s = m->scene;
+    const uint32_t G = m->gside;
+    m->gready = false;
+    memset(m->gstart, 0, ((size_t)G * G + 1) * sizeof(uint32_t));
+    uint64_t total = 0;
+    for (uint32_t k = 0; k < s->ntris; k++) {
+        const float *b = &m->tbox[(size_t)k * 4];
+        uint32_t cx0 = cell_of(m, b[0]), cy0 = cell_of(m, b[1]), cx1 = cell_of(m, b[2]), cy1 = cell_of(m, b[3]);
+        total += (uint64_t)(cx1 - cx0 + 1) * (cy1 - cy0 + 1);
+        if (total > m->gcap) return;
+        for (uint32_t cy = cy0; cy <= cy1; cy++)
+            for (uint32_t cx = cx0; cx <= cx1; cx++) m->gstart[cy * G + cx + 1]++;
+    }
+    for (uint32_t c = 0; c < G * G; c++) m->gstart[c + 1] += m->gstart[c];
+    for (uint32_t k = 0; k < s->ntris; k++) {   /* each cell's list in index order */
+        const float *b = &m->tbox[(size_t)k * 4];
+        uint32_t cx0 = cell_of(m, b[0]), cy0 = cell_of(m, b[1]), cx1 = cell_of(m, b[2]), cy1 = cell_of(m, b[3]);
+        for (uint32_t cy = cy0; cy <= cy1; cy++)
+            for (uint32_t cx = cx0; cx <= cx1; cx++) m->glist[m->gstart[cy * G + cx]++] = k;
+    }
+    for (uint32_t c = G * G; c > 0; c--) m->gstart[c] = m->gstart[c - 1];   /* back to starts */
+    m->gstart[0] = 0;
+    m->gready = true;
+}
+
+/* gather_all's result from the cells the region meets: their triangles marked in a
+ * bit set (a triangle in several cells once), collected in index order and tested as
+ * gather_all tests them. */
+static uint32_t gather_cells(asm_state *m, float u0, float v0, float u1, float v1)
+{
+    const uint32_t G = m->gside;
+    uint32_t lo = UINT32_MAX, hi = 0, n = 0;
+    for (uint32_t cy = cell_of(m, v0); cy <= cell_of(m, v1); cy++)
+        for (uint32_t cx = cell_of(m, u0); cx <= cell_of(m, u1); cx++)
+            for (uint32_t i = m->gstart[cy * G + cx]; i < m->gstart[cy * G + cx + 1]; i++) {
+                uint32_t k = m->glist[i];
+                m->gbits[k >> 5] |= 1u << (k & 31);
+                if (k < lo) lo = k;
+                if (k > hi) hi = k;
+            }
+    for (uint32_t w = lo == UINT32_MAX ? 1 : lo >> 5; w <= (hi >> 5) && lo != UINT32_MAX; w++) {
+        uint32_t bits = m->gbits[w];
+        m->gbits[w] = 0;
+        while (bits) {
+            uint32_t j = 0;
+            while (!(bits & (1u << j))) j++;
+            bits &= bits - 1;
+            uint32_t k = w * 32 + j;
+            m->cull[n] = k;
+            n += box_meets(&m->tbox[(size_t)k * 4], u0, v0, u1, v1);
+        }
+    }
+    return n;
+}
+
 /* Renders texels [ox, ox + tile) x [oy, oy + tile) of level `level`'s grid into a
  * tile's depth and ids, from the triangles whose light bounds meet the region. The light's clip space is composed with the window that maps the
  * region's tile to [-1, 1] (x' = s x + k w), so the engine's rasterizer, clipping and
@@ -284,12 +399,7 @@ static void render(asm_state *m, uint32_t level, uint32_t ox, uint32_t oy, uint3
             render_tri(&r, q, s_, kx, ky, t);
         }
     } else {
-        /* Gather first, without branches (most triangles miss a deep node's region). */
-        uint32_t n = 0;
-        for (uint32_t k = 0; k < s->ntris; k++) {
-            m->cull[n] = k;
-            n += box_meets(&m->tbox[(size_t)k * 4], u0, v0, u1, v1);
-        }
+        uint32_t n = m->gready ? gather_cells(m, u0, v0, u1, v1) : gather_all(m, u0, v0, u1, v1);
         for (uint32_t k = 0; k < n; k++) {
             const uint32_t t = m->cull[k];
             const uint32_t *ix = s->idx + (size_t)t * 3;
@@ -327,6 +437,7 @@ static void prepare(asm_state *m)
             const asm_dvec q[3] = {m->vclip[ix[0]], m->vclip[ix[1]], m->vclip[ix[2]]};
             tri_box(q, m->tree.lay.tile, &m->tbox[(size_t)k * 4]);
         }
+        grid_make(m);
     }
     if (!m->built || memcmp(&m->built_vp, &m->view.light_vp, sizeof m->built_vp) != 0) {
         om__asm_tree_clear(&m->tree);

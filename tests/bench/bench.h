@@ -45,6 +45,7 @@ int bench_run_hooked(const bscene *b, const char *method, const om_method_cfg *c
     X(bench_izb) \
     X(bench_rtw) \
     X(bench_asm) \
+    X(bench_asm_big) \
     X(bench_spsm) \
     X(bench_hybrid) \
     /* end of list */

@@ -6,7 +6,8 @@
  *    (16 MiB). Twice: with the scene's drifting light (every frame a rebuild) and with
  *    the light held at its t = 0 place (the paper's walkthrough: a fixed light);
  *  - close-ups of thin and small shadows, a still view refined for 8 frames: mismatches
- *    against sm 2048 and the effective resolution reached. */
+ *    against sm 2048 and the effective resolution reached;
+ *  - bench_asm_big: one frame on the 100K and 1M random clouds against sm 2048. */
 #include "bench.h"
 
 #include <string.h>
@@ -205,6 +206,38 @@ static void closeups(const bscene *b)
     }
     free(mref);
     free(m);
+}
+
+/* Big scenes: one frame of asm (16 MiB, from an empty tree: observe, build and
+ * resolve) against sm 2048's build and lookup, at 1024x768, medians of 3 rounds. */
+void bench_asm_big(void)
+{
+    static const unsigned counts[] = {100000, 1000000};
+    printf("random clouds, 1024x768, one frame from an empty tree (medians of 3):\n");
+    for (int k = 0; k < 2; k++) {
+        bscene b;
+        if (bench_load_random(&b, counts[k])) return;
+        double a[3], o[3], sm[3], af[3], sf[3];
+        for (int r = 0; r < 3; r++) {
+            om_method_cfg c;
+            om_method_cfg_default(&c);
+            c.asm_cap = 16u << 20;
+            c.map_size = 2048;
+            mrun ra, rs;
+            if (bench_run(&b, "asm", &c, 1024, 768, 0, NULL, &ra) || bench_run(&b, "sm", &c, 1024, 768, 0, NULL, &rs))
+                return;
+            a[r] = ra.observe_ms + ra.build_ms + ra.resolve_ms;
+            o[r] = ra.observe_ms;
+            sm[r] = rs.build_ms + rs.resolve_ms;
+            af[r] = ra.eye_ms + a[r] + ra.shade_ms;
+            sf[r] = rs.eye_ms + sm[r] + rs.shade_ms;
+        }
+        double am = bench_median(a, 3), smm = bench_median(sm, 3);
+        double afm = bench_median(af, 3), sfm = bench_median(sf, 3);
+        printf("  %-12s asm 16 MiB %8.2f ms (observe %8.2f) = %.2fx sm 2048's %7.2f; frames %8.2f and %7.2f ms: "
+               "%.2fx\n", b.name, am, bench_median(o, 3), am / smm, smm, afm, sfm, afm / sfm);
+        bench_free(&b);
+    }
 }
 
 void bench_asm(void)
