@@ -130,11 +130,12 @@ static om_status hybrid_observe(void *state, const om_strip *st, om_diag *d)
     return OM_OK;
 }
 
-/* A double depth to float, never above it. */
+/* A double depth to float, never above it: when rounding went up, from a point a
+ * depth unit and a millionth below, far beyond half a float step. */
 static float f_down(double v)
 {
     float f = (float)v;
-    return (double)f > v ? nextafterf(f, -FLT_MAX) : f;
+    return (double)f > v ? (float)(v - fabs(v) * 1e-6 - 1.0) : f;
 }
 
 /* Does any point of the square [x0, x1] x [y0, y1] pass every edge of e? Each edge is
