@@ -1,31 +1,69 @@
-/* driver.c — the cross-CPU determinism driver: renders the default scene at 160x120
- * with every method, through strips of 8 rows into an RGB565 framebuffer, and prints
- * one line per method: its name and the FNV-1a hashes of the frame and of the shadow
- * mask, then a "bytes" line with its arena's peak (which depends on pointer size).
- * `make cross-test` builds it with every compiler and CPU it can find and checks
- * that all the hash lines agree. It needs nothing but the engine
- * and a way to print a line (om_host_puts, from the host file it is linked with). */
+/* driver.c — the cross-CPU determinism driver. For each case it renders every method
+ * through strips into an RGB565 framebuffer and prints one line per method: the case,
+ * the method and the FNV-1a hashes of the frame and of the shadow mask. `make
+ * cross-test` builds it with every compiler and CPU it can find and checks that the
+ * lines agree with the reference build's; small sizes miss last-bit differences that
+ * larger ones catch, hence several scenes and sizes:
+ *
+ *   default@WxH      the default scene, every method at its default settings
+ *   default-aa@WxH   the same with PCF 3x3 (sm, rtw with unwarped taps) and 4 SPSM
+ *                    sub-samples (the methods without such settings are not repeated)
+ *   cloud@WxH        10K random triangles over a floor, AA/PCF on
+ *   stab-t0@WxH      a stability case (the fast camera: ASM nodes replaced every frame)
+ *   stab-t1@WxH      at time 0 and then 0.5 with the method's state carried over
+ *
+ * at 160x120 and 320x240 with the embedded configuration (maps of 96 texels, a 192 KiB
+ * ASM cap, a 64-cell RTW importance map: what fits a microcontroller), and, where
+ * OM_CROSS_BIG is defined (hosted targets), at 640x480 with maps of 1024. After the
+ * default@160x120 lines come "bytes" lines with each method's arena peak and minimum
+ * (they depend on pointer size, so they are not compared). The stability scene's text
+ * comes from tests/stability through OM_CROSS_STAB (a header run.sh generates). It
+ * needs nothing but the engine and a way to print a line (om_host_puts, from the host
+ * file it is linked with). */
 #include "ombra.h"
 
 #include <string.h>
 
 void om_host_puts(const char *line);
 
-#define W 160
-#define H 120
-#define ROWS 8
-
+/* Strips of 40 rows at the sizes a board renders (three or six strips: each strip's
+ * eye pass projects every triangle, which a board without a double FPU pays dearly
+ * for), of 60 at 640x480. Every target renders a size through the same strips, so
+ * that only the CPU and compiler differ (frames are meant to be the same through any
+ * strips, but with spsm.aa they are not yet: README, Determinism). */
+#ifndef OM_CROSS_ROWS
+#define OM_CROSS_ROWS 40
+#endif
+#ifdef OM_CROSS_BIG
+#define FRAME_PIXELS (640 * 60)
+#else
+#define FRAME_PIXELS (320 * OM_CROSS_ROWS)
+#endif
 #ifndef OM_CROSS_METHOD_MEM
-#define OM_CROSS_METHOD_MEM (24u << 20)
+#define OM_CROSS_METHOD_MEM (96u << 20)
 #endif
 #ifndef OM_CROSS_SCENE_MEM
-#define OM_CROSS_SCENE_MEM (1u << 20)
+#define OM_CROSS_SCENE_MEM (2u << 20)
 #endif
+
+#ifndef OM_CROSS_ONLY
+#define OM_CROSS_ONLY 0xfffu
+#endif
+#ifndef OM_CROSS_STAB
+#define OM_CROSS_STAB "stab_scene.h"
+#endif
+static const char stab_text[] =
+#include OM_CROSS_STAB
+    ;
+
+static const char cloud_text[] =
+    "plane size 12 12\n"
+    "triangles count 10000 seed 4 area 20 in -4 0.3 -4 4 3 4\n";
 
 static unsigned char scene_mem[OM_CROSS_SCENE_MEM];
 static unsigned char method_mem[OM_CROSS_METHOD_MEM];
-static unsigned char frame_mem[W * ROWS * 48];
-static uint8_t pixels[W * ROWS * 2];
+static unsigned char frame_mem[FRAME_PIXELS * 48];
+static uint8_t pixels[FRAME_PIXELS * 2];
 
 typedef struct hashes { uint64_t img, mask; } hashes;
 
@@ -43,109 +81,206 @@ static om_status on_strip(void *user, const om_strip *st, const om_framebuffer *
     return OM_OK;
 }
 
-static void put_hex(char *out, uint64_t v)
+/* A line built without stdio. */
+typedef struct line { char buf[256]; size_t n; } line;
+
+static void put_s(line *l, const char *s)
 {
+    while (*s && l->n + 1 < sizeof l->buf) l->buf[l->n++] = *s++;
+    l->buf[l->n] = '\0';
+}
+
+static void put_hex(line *l, uint64_t v)
+{
+    char t[17];
     for (int i = 15; i >= 0; i--) {
-        out[i] = "0123456789abcdef"[v & 15];
+        t[i] = "0123456789abcdef"[v & 15];
         v >>= 4;
     }
-    out[16] = '\0';
+    t[16] = '\0';
+    put_s(l, t);
 }
 
-static void put_dec(char *out, uint64_t v)
+static void put_dec(line *l, uint64_t v)
 {
-    char tmp[24];
+    char tmp[24], t[24];
     int n = 0;
     do { tmp[n++] = (char)('0' + v % 10); v /= 10; } while (v);
-    for (int i = 0; i < n; i++) out[i] = tmp[n - 1 - i];
-    out[n] = '\0';
+    for (int i = 0; i < n; i++) t[i] = tmp[n - 1 - i];
+    t[n] = '\0';
+    put_s(l, t);
 }
 
-static int fail(const char *what, const om_diag *d)
+/* "<case> <method>: <what>: <diag message>"; returns 1 (a failure). */
+static int fail(const char *cs, const char *method, const char *what, const om_diag *d)
 {
-    char line[256];
-    size_t n = strlen(what);
-    memcpy(line, what, n);
-    line[n++] = ':';
-    line[n++] = ' ';
-    size_t m = strlen(d->msg);
-    if (m > sizeof line - n - 1) m = sizeof line - n - 1;
-    memcpy(line + n, d->msg, m);
-    line[n + m] = '\0';
-    om_host_puts(line);
+    line l = {{0}, 0};
+    put_s(&l, cs);
+    put_s(&l, " ");
+    put_s(&l, method);
+    put_s(&l, ": ");
+    put_s(&l, what);
+    put_s(&l, ": ");
+    put_s(&l, d->msg);
+    om_host_puts(l.buf);
     return 1;
 }
 
-int om_cross_main(void)
+typedef struct size_cfg { uint32_t w, h, rows; int embedded; const char *tag; } size_cfg;
+
+static void method_cfg(om_method_cfg *c, const size_cfg *sz, int aa)
+{
+    om_method_cfg_default(c);
+    if (sz->embedded) {
+        /* small enough for small machines, the same everywhere (the hashes must agree) */
+        c->map_size = 96;
+        c->hybrid_map = 96;
+        c->asm_cap = 192u << 10;
+        c->rtw_importance = 64;
+    } else {
+        c->map_size = 1024;
+    }
+    if (aa) {
+        c->pcf = 3;
+        c->rtw_footprint = 1;
+        c->spsm_aa = 4;
+    }
+}
+
+/* Whether a method has AA or PCF settings (the default-aa case repeats only those). */
+static int has_aa(const om_method *m)
+{
+    return !strcmp(m->name, "sm") || !strcmp(m->name, "rtw") || !strcmp(m->name, "spsm");
+}
+
+typedef struct xcase {
+    const char *name;
+    const char *text;     /* NULL: the default scene */
+    int aa, aa_only;      /* AA/PCF settings on; only the methods that have them */
+    float t0, t1;         /* t1 >= 0: a second frame at t1 with the same method state */
+} xcase;
+
+/* Renders one frame of the case at time t into h. */
+static om_status render(const om_scene *s, const om_method *m, void *state, const size_cfg *sz,
+                        float t, om_arena *fa, hashes *h, om_diag *d)
+{
+    om_camera cam;
+    om_light light;
+    om_view v;
+    om_status st;
+    om_scene_at(s, t, &cam, &light);
+    cam.width = sz->w;
+    cam.height = sz->h;
+    if ((st = om_view_init(&v, &cam, &light, s, d)) != OM_OK) return st;
+    om_shade_cfg shade;
+    om_shade_cfg_default(&shade);
+    om_framebuffer fb = {OM_RGB565, sz->w, sz->rows, sz->w * 2, pixels};
+    om_frame_desc fd;
+    memset(&fd, 0, sizeof fd);
+    fd.scene = s; fd.view = &v; fd.method = m; fd.method_state = state; fd.shade = &shade;
+    fd.strip_rows = sz->rows; fd.fb = &fb; fd.on_strip = on_strip; fd.user = h;
+    h->img = h->mask = OM_HASH_INIT;
+    om_arena_init(fa, frame_mem, sizeof frame_mem, "frame");
+    return om_render_frame(&fd, fa, NULL, d);
+}
+
+static void print_hashes(const char *cs, const char *method, const hashes *h)
+{
+    line l = {{0}, 0};
+    put_s(&l, cs);
+    put_s(&l, " ");
+    put_s(&l, method);
+    put_s(&l, " ");
+    put_hex(&l, h->img);
+    put_s(&l, " ");
+    put_hex(&l, h->mask);
+    om_host_puts(l.buf);
+}
+
+static int run_case(const xcase *c, const size_cfg *sz)
 {
     om_arena sa;
     om_scene s;
     om_diag d;
-    const char *text = om_scene_default_text();
+    const char *text = c->text ? c->text : om_scene_default_text();
+    char name[2][64];
+    for (int k = 0; k < 2; k++) {
+        line l = {{0}, 0};
+        put_s(&l, c->name);
+        if (c->t1 >= 0.0f) put_s(&l, k ? "-t1" : "-t0");
+        put_s(&l, sz->tag);
+        memcpy(name[k], l.buf, l.n + 1);
+    }
     om_arena_init(&sa, scene_mem, sizeof scene_mem, "scene");
-    if (om_scene_parse(text, strlen(text), NULL, &sa, &s, &d) != OM_OK) return fail("scene", &d);
-    om_camera cam;
-    om_light light;
-    om_view v;
-    om_scene_at(&s, 0.0f, &cam, &light);
-    cam.width = W;
-    cam.height = H;
-    if (om_view_init(&v, &cam, &light, &s, &d) != OM_OK) return fail("view", &d);
+    if (om_scene_parse(text, strlen(text), NULL, &sa, &s, &d) != OM_OK) return fail(name[0], "-", "scene", &d);
     int bad = 0;
     for (size_t k = 0; k < om_method_count(); k++) {
         const om_method *m = om_method_at(k);
-        /* One configuration everywhere (the hashes must agree), small enough for small
-         * machines: the bytes lines say which methods fit 256 KiB. */
+        if (c->aa_only && !has_aa(m)) continue;
         om_method_cfg cfg;
-        om_method_cfg_default(&cfg);
-        cfg.map_size = 96;
-        cfg.asm_cap = 192u << 10;
-        cfg.rtw_importance = 64;
+        method_cfg(&cfg, sz, c->aa);
         size_t mn, full;
         om_arena ma, fa;
         void *state;
-        if (m->bytes(&cfg, &s, W, H, &mn, &full) != OM_OK || mn > sizeof method_mem) {
-            char line[96] = "too big: ";
-            memcpy(line + 9, m->name, strlen(m->name) + 1);
-            om_host_puts(line);
+        if (m->bytes(&cfg, &s, sz->w, sz->h, &mn, &full) != OM_OK || mn > sizeof method_mem) {
+            line l = {{0}, 0};
+            put_s(&l, "too big: ");
+            put_s(&l, name[0]);
+            put_s(&l, " ");
+            put_s(&l, m->name);
+            om_host_puts(l.buf);
             bad = 1;
             continue;
         }
         /* one pass when it fits, else what there is: the result must not change */
         om_arena_init(&ma, method_mem, full < sizeof method_mem ? full : sizeof method_mem, "method");
-        om_arena_init(&fa, frame_mem, sizeof frame_mem, "frame");
-        if (m->init(&state, &ma, &cfg, &s, W, H, &d) != OM_OK) { bad |= fail(m->name, &d); continue; }
-        om_shade_cfg shade;
-        om_shade_cfg_default(&shade);
-        om_framebuffer fb = {OM_RGB565, W, ROWS, W * 2, pixels};
-        hashes h = {OM_HASH_INIT, OM_HASH_INIT};
-        om_frame_desc fd;
-        memset(&fd, 0, sizeof fd);
-        fd.scene = &s; fd.view = &v; fd.method = m; fd.method_state = state; fd.shade = &shade;
-        fd.strip_rows = ROWS; fd.fb = &fb; fd.on_strip = on_strip; fd.user = &h;
-        if (om_render_frame(&fd, &fa, NULL, &d) != OM_OK) { bad |= fail(m->name, &d); continue; }
-        char line[128], num[24];
-        size_t n = strlen(m->name);
-        memcpy(line, m->name, n);
-        line[n++] = ' ';
-        put_hex(line + n, h.img);
-        n += 16;
-        line[n++] = ' ';
-        put_hex(line + n, h.mask);
-        line[n + 16] = '\0';
-        om_host_puts(line);
-        memcpy(line, "bytes ", 6);
-        memcpy(line + 6, m->name, strlen(m->name));
-        n = 6 + strlen(m->name);
-        line[n++] = ' ';
-        put_dec(num, ma.peak);
-        memcpy(line + n, num, strlen(num));
-        n += strlen(num);
-        memcpy(line + n, " min ", 5);
-        n += 5;
-        put_dec(num, mn);
-        memcpy(line + n, num, strlen(num) + 1);
-        om_host_puts(line);
+        if (m->init(&state, &ma, &cfg, &s, sz->w, sz->h, &d) != OM_OK) { bad |= fail(name[0], m->name, "init", &d); continue; }
+        hashes h;
+        if (render(&s, m, state, sz, c->t0, &fa, &h, &d) != OM_OK) { bad |= fail(name[0], m->name, "render", &d); continue; }
+        print_hashes(name[0], m->name, &h);
+        if (c->t1 >= 0.0f) {
+            if (render(&s, m, state, sz, c->t1, &fa, &h, &d) != OM_OK) { bad |= fail(name[1], m->name, "render", &d); continue; }
+            print_hashes(name[1], m->name, &h);
+        }
+        if (!c->text && !c->aa && sz->w == 160) {   /* the embedded proof's figures */
+            line l = {{0}, 0};
+            put_s(&l, "bytes ");
+            put_s(&l, m->name);
+            put_s(&l, " ");
+            put_dec(&l, ma.peak);
+            put_s(&l, " min ");
+            put_dec(&l, mn);
+            om_host_puts(l.buf);
+        }
     }
+    return bad;
+}
+
+int om_cross_main(void)
+{
+    static const size_cfg sizes[] = {
+        {160, 120, OM_CROSS_ROWS, 1, "@160x120"},
+        {320, 240, OM_CROSS_ROWS, 1, "@320x240"},
+#ifdef OM_CROSS_BIG
+        {640, 480, 60, 0, "@640x480"},
+#endif
+    };
+    static const xcase cases[] = {
+        {"default", NULL, 0, 0, 0.0f, -1.0f},
+        {"default-aa", NULL, 1, 1, 0.0f, -1.0f},
+        {"cloud", cloud_text, 1, 0, 0.0f, -1.0f},
+        {"stab", stab_text, 1, 0, 0.0f, 0.5f},
+    };
+#ifdef OM_CROSS_TRAPS
+    /* On a board: set bits of the configuration and control register, to fault on
+     * division by zero (0x10) and unaligned accesses (0x08). A Cortex-M0 has neither
+     * a divide instruction nor unaligned accesses; its firmware runs on an M3 board
+     * with both traps on, so that it faults where a real M0 would. */
+    *(volatile uint32_t *)0xE000ED14u |= (uint32_t)(OM_CROSS_TRAPS);
+#endif
+    int bad = 0;
+    for (size_t z = 0; z < sizeof sizes / sizeof sizes[0]; z++)
+        for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++)
+            if ((OM_CROSS_ONLY >> (4 * z + c)) & 1u) bad |= run_case(&cases[c], &sizes[z]);
     return bad;
 }
