@@ -56,12 +56,13 @@ void om__eye_pass(const om_scene *s, const om_view *v, const om_target *tg, om_s
  * NDC positions (sx, sy) of the image that `vp` projects onto. */
 typedef struct om__persp_tri {
     uint32_t tri;
-    double adj[9];         /* adjugate of the 3x3 matrix of (x, y, w) columns */
-    om_vec3 v[3], n;       /* world vertices and the unit geometric normal */
+    float adj[9];          /* adjugate of the 3x3 matrix of (x, y, w) columns */
+    om_vec3 v[3], d1, d2;  /* world vertices, v1 - v0 and v2 - v0 */
+    om_vec3 n;             /* the unit geometric normal */
 } om__persp_tri;
 
 void om__persp_setup(const om_scene *s, const om_mat4 *vp, uint32_t t, om__persp_tri *c);
-om_vec3 om__persp_point(const om__persp_tri *c, double sx, double sy);
+om_vec3 om__persp_point(const om__persp_tri *c, float sx, float sy);
 
 /* The parts of the lit rule that no occluder decides, the same for every method:
  * the normal turned towards the camera faces the light, and the point lies inside

@@ -36,7 +36,7 @@ static double row_mag(const om_mat4 *m, int r, double big)
 static void bound_begin(om__lspace *ls, const om_view *v)
 {
     const om_scene *s = ls->scene;
-    const double u8 = 8.0 / 16777216.0;   /* 8 roundings of 2^-24 each (occlude.h) */
+    const double u10 = 10.0 / 16777216.0;   /* 10 roundings of 2^-24 each (occlude.h) */
     double big = 0.0;
     const float c[6] = {s->lo.x, s->lo.y, s->lo.z, s->hi.x, s->hi.y, s->hi.z};
     for (int i = 0; i < 6; i++)
@@ -45,8 +45,8 @@ static void bound_begin(om__lspace *ls, const om_view *v)
     double sz = row_mag(&ls->vp, 2, big), sw = row_mag(&ls->vp, 3, big);
     /* x/w, y/w reach 3 at the guard band's edge; z/w is clamped to [0, 1]. The grid has
      * 2^20 units per unit of x/w, depth 2^32 per unit of z/w. */
-    ls->lat = u8 * ((sx > sy ? sx : sy) + 3.0 * sw) * 1048576.0;
-    ls->dep = u8 * (sz + sw) * 4294967296.0;
+    ls->lat = u10 * ((sx > sy ? sx : sy) + 3.0 * sw) * 1048576.0;
+    ls->dep = u10 * (sz + sw) * 4294967296.0;
     if (v->light.kind == OM_LIGHT_SPOT) {
         /* z/w = -p10 + p11 / w for the perspective projection, so 1/w is affine in depth */
         double p10 = v->light_proj.m[10], p11 = v->light_proj.m[11];

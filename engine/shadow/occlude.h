@@ -27,16 +27,20 @@
  *     another for the triangle's vertices, plus the float rounding of x/w and y/w;
  *     times the triangle's depth gradient on the grid (|dz/dx| + |dz/dy|);
  *   - in depth: the float rounding of z and w in the light's clip space (the float
- *     matrix product: 4 roundings, the clipper's cut: 2 more, and the rounding of the
- *     sample and the vertices to float: 1 each; 8 units of 2^-24 on the sum of the
- *     terms' magnitudes, bounded with the scene box), over w.
+ *     matrix product: 4 roundings, the clipper's cut: 2 more, the sample's point made
+ *     in float from its triangle's vertices (eye.c: a difference, a product and a sum
+ *     a term): 3, and the vertices' rounding to float: 1; 10 units of 2^-24 on the sum
+ *     of the terms' magnitudes, bounded with the scene box), over w.
  * Each rounding term grows with 1/w, so the sample's own is at most the triangle's at
  * its nearest vertex whenever the triangle is nearer at all; the bound is therefore
  * twice the triangle's own (om__lspace_tri sets it per sub-triangle). A
  * blocker must be nearer than the sample by more than that: depths closer than the
  * grid and the float positions resolve are a tie, and a tie is lit. This is derived
- * from the grid and the number formats, not tuned; in world units it is of the order
- * of ten grid steps (2^-18 of the light's frustum), along the light's ray. */
+ * from the grid and the number formats, not tuned. Laterally it is about ten grid
+ * steps, more where the grid is finer than float positions resolve (a directional
+ * light fitted to a small view of a large scene: 20 to 70 steps, a few tens of float
+ * roundings of the scene's largest coordinate); in depth, that times the triangle's
+ * slope, plus the depth rounding. */
 #ifndef OM_OCCLUDE_H
 #define OM_OCCLUDE_H
 

@@ -277,8 +277,8 @@ static void forward(om__rtw *m)
             uint32_t t = m->fid[c];
             if (t == OM_NO_TRI) { m->imp[c] = 0.0f; continue; }
             if (cache.tri != t) om__persp_setup(m->scene, &m->view.light_vp, t, &cache);
-            double sx = ((double)i + 0.5) * 2.0 / (double)n - 1.0;
-            double sy = 1.0 - ((double)j + 0.5) * 2.0 / (double)n;
+            float sx = ((float)i + 0.5f) * (2.0f / (float)n) - 1.0f;
+            float sy = 1.0f - ((float)j + 0.5f) * (2.0f / (float)n);
             om_vec3 p = om__persp_point(&cache, sx, sy);
             float imp = edge;
             if ((funcs & OM_RTW_DV) && !in_camera(&m->view, p)) imp = 0.0f;
