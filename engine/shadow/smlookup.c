@@ -84,36 +84,41 @@ static bool locate(const om__smlook *L, const om_sample *smp, tap *out)
         q = om__mat_apply(&v->light_vp, p);
         if (!(q.w > 0.0f)) return false;
     }
-    double iw = 1.0 / (double)q.w;
-    double u, w;
+    /* The plain map's texel and every map's depth in float: per sample, the work a
+     * Cortex-M4F does in hardware. A float's 24 bits place the texel to 2^-11 of one at
+     * 8192 texels, and the depth to 2^8 of the 2^32 units, far inside the bias; the
+     * comparison with the stored depths stays exact (test). The warp keeps double:
+     * its tables' fractions need it. */
+    const float iw = 1.0f / q.w;
+    float uf, wf;
     if (L->warp_x) {
         if (L->normal_offset != 0.0f) {   /* the point moved: warp it anew */
-            double dens;
-            u0 = ((double)q.x * iw + 1.0) * 0.5;
-            v0 = (1.0 - (double)q.y * iw) * 0.5;
+            double dens, diw = 1.0 / (double)q.w;
+            u0 = ((double)q.x * diw + 1.0) * 0.5;
+            v0 = (1.0 - (double)q.y * diw) * 0.5;
             out->u = u0;
             out->v = v0;
             warp(L, &u0, &v0, &dens);
         }
-        u = u0 * L->size;
-        w = v0 * L->size;
+        out->cx = (int64_t)floor(u0 * L->size);
+        out->cy = (int64_t)floor(v0 * L->size);
     } else {
         out->u = out->v = 0.0;   /* no warp: taps are the map's texels */
-        u = ((double)q.x * iw + 1.0) * 0.5 * L->size;
-        w = (1.0 - (double)q.y * iw) * 0.5 * L->size;
+        uf = (q.x * iw + 1.0f) * (0.5f * (float)L->size);
+        wf = (1.0f - q.y * iw) * (0.5f * (float)L->size);
+        out->cx = (int64_t)floorf(uf);
+        out->cy = (int64_t)floorf(wf);
     }
-    double z = (double)q.z * iw * 4294967296.0;
+    float z = q.z * iw * 4294967296.0f;
     /* bias from world units to depth units: d(z/w)/d(distance) at this sample */
-    double dz;
+    float dz;
     if (v->light.kind == OM_LIGHT_SPOT) {
-        double f = v->light.zfar, nn = v->light.znear, e = dist > nn * 0.5f ? dist : nn * 0.5;
-        dz = f * nn / ((f - nn) * e * e) * 4294967296.0;
+        float f = v->light.zfar, nn = v->light.znear, e = dist > nn * 0.5f ? dist : nn * 0.5f;
+        dz = f * nn / ((f - nn) * e * e) * 4294967296.0f;
     } else {
-        dz = 4294967296.0 * fabs((double)v->light_proj.m[10]);
+        dz = 4294967296.0f * fabsf(v->light_proj.m[10]);
     }
-    out->z = z - (double)bias * dz;
-    out->cx = (int64_t)floor(u);
-    out->cy = (int64_t)floor(w);
+    out->z = (double)(z - bias * dz);
     return true;
 }
 
