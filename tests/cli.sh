@@ -50,6 +50,17 @@ if [ -s "$dir/out" ]; then bad "-q printed: $(head -c 200 "$dir/out")"; else ok;
 expect 0 "strip render" -- "$OMBRA" render --size 160x120 --strip 7 --out "$dir/b.ppm"
 if [ "$(grep '^hash:' "$dir/out")" = "$hash_whole" ]; then ok; else bad "strips changed the frame"; fi
 cmp -s "$dir/a.ppm" "$dir/b.ppm" && ok || bad "strip PPM differs from whole PPM"
+expect 0 "scene --small" -- "$OMBRA" scene --small
+cp "$dir/out" "$dir/small.scene"
+expect 0 "small scene info" -- "$OMBRA" info "$dir/small.scene"
+tris=$(sed -n 's/^triangles \([0-9]*\),.*/\1/p' "$dir/out")
+if [ -n "$tris" ] && [ "$tris" -le 2000 ]; then ok; else bad "the small scene has '$tris' triangles"; fi
+expect 0 "small scene whole" -- "$OMBRA" render "$dir/small.scene" --size 160x120 --out "$dir/s0.ppm"
+hash_s=$(grep '^hash:' "$dir/out")
+expect 0 "small scene strips" -- "$OMBRA" render "$dir/small.scene" --size 160x120 --strip 8 --out "$dir/s1.ppm"
+if [ "$(grep '^hash:' "$dir/out")" = "$hash_s" ]; then ok; else bad "strips (with row bins) changed the small scene"; fi
+expect 2 "scene --big" -- "$OMBRA" scene --big
+has "$dir/err" "only --small" "scene names its one option"
 expect 0 "info" -- "$OMBRA" info --size 160x120 --map 256
 scene_bytes=$(sed -n 's/.*scene \([0-9]*\), frame.*/\1/p' "$dir/out")
 sm_bytes=$(sed -n 's/^ *sm *min \([0-9]*\),.*/\1/p' "$dir/out")

@@ -29,9 +29,10 @@ static const char methods_help[] =
     "Lists the shadow methods and every setting ('--set NAME=VALUE') with its default.\n";
 
 static const char scene_help[] =
-    "usage: ombra scene\n"
+    "usage: ombra scene [--small]\n"
     "\n"
-    "Prints the built-in default scene in the scene format: a start for your own.\n";
+    "Prints the built-in default scene in the scene format: a start for your own.\n"
+    "  --small   its twin for microcontrollers: the same objects in 1,600 triangles\n";
 
 /* A setting's default as it would be written: the shortest decimal that reads back
  * as the same float (0.01, not 0.00999999978). */
@@ -80,9 +81,12 @@ static int no_options(int argc, char **argv, const char *help, int (*run)(void))
     return run();
 }
 
-static int print_scene(void)
+static int print_scene(int argc, char **argv)
 {
-    fputs(om_scene_default_text(), stdout);
+    if (argc > 2 && (!strcmp(argv[2], "--help") || !strcmp(argv[2], "-h"))) { fputs(scene_help, stdout); return 0; }
+    if (argc > 3 || (argc == 3 && strcmp(argv[2], "--small")))
+        return cli_usage_error("scene", "takes only --small; unexpected '%s'", argv[strcmp(argv[2], "--small") ? 2 : 3]);
+    fputs(argc == 3 ? om_scene_small_text() : om_scene_default_text(), stdout);
     return 0;
 }
 
@@ -102,7 +106,7 @@ int main(int argc, char **argv)
     if (!strcmp(argv[1], "compare")) return cmd_compare(argc - 1, argv + 1);
     if (!strcmp(argv[1], "bench")) return cmd_bench(argc - 1, argv + 1);
     if (!strcmp(argv[1], "report")) return cmd_report(argc - 1, argv + 1);
-    if (!strcmp(argv[1], "scene")) return no_options(argc, argv, scene_help, print_scene);
+    if (!strcmp(argv[1], "scene")) return print_scene(argc, argv);
     if (!strcmp(argv[1], "methods")) return no_options(argc, argv, methods_help, list_methods);
     fprintf(stderr, "ombra: unknown command '%s'\n\n%s", argv[1], usage);
     return 2;

@@ -75,12 +75,14 @@ static om_status on_strip(void *user, const om_strip *st, const om_framebuffer *
     return o->ppm ? om_ppm_strip(o->ppm, st, fb) : OM_OK;
 }
 
-static om_status run_frame(run *r, const cli_scene *cs, const om_view *v, uint32_t rows,
+/* The frame arena: the strips, and their row bins when `bins` (then each strip sets
+ * up only its own triangles; the same pixels either way). */
+static om_status run_frame(run *r, const cli_scene *cs, const om_view *v, uint32_t rows, bool bins,
                            om_format fmt, strip_out *out, om_frame_stats *fs, size_t *frame_bytes,
                            om_diag *d)
 {
     uint32_t W = v->cam.width;
-    *frame_bytes = om_frame_bytes(W, rows);
+    *frame_bytes = bins ? om_frame_bytes_scene(&cs->scene, W, rows) : om_frame_bytes(W, rows);
     void *frame_mem = malloc(*frame_bytes);
     om_framebuffer fb;
     fb.format = fmt;
@@ -248,6 +250,7 @@ int cmd_render(int argc, char **argv)
      * frame the other half, as strips of as many rows as fit (at least one). Both
      * halves cost the same kind of work: another strip or another method tile. */
     uint32_t rows = strip && strip < H ? strip : H;
+    bool bins = rows < H;   /* with strips, when --budget leaves room for them */
     main_run.given = main_run.full;
     if (budget) {
         /* a row of the frame: its arena's share and the framebuffer's pixels */
@@ -273,6 +276,7 @@ int cmd_render(int argc, char **argv)
             goto out;
         }
         if (fit < rows) rows = (uint32_t)fit;
+        bins = rows < H && left >= om_frame_bytes_scene(&cs.scene, W, rows) + (size_t)rows * px;
     }
     /* The outputs open (as temporaries) before any work, so an unwritable one fails
      * at once; they replace the old files only once all are complete. */
@@ -295,7 +299,7 @@ int cmd_render(int argc, char **argv)
         strip_out ro = {NULL, mask_ref};
         om_frame_stats rfs;
         size_t rfb;
-        if ((st = run_frame(&ref_run, &cs, &view, rows, fmt, &ro, &rfs, &rfb, &d)) != OM_OK) {
+        if ((st = run_frame(&ref_run, &cs, &view, rows, bins, fmt, &ro, &rfs, &rfb, &d)) != OM_OK) {
             rc = cli_error(against, &d, st);
             goto out;
         }
@@ -304,7 +308,7 @@ int cmd_render(int argc, char **argv)
     om_frame_stats fs;
     size_t frame_bytes;
     uint64_t t0 = om_clock_ns(NULL);
-    st = run_frame(&main_run, &cs, &view, rows, fmt, &so, &fs, &frame_bytes, &d);
+    st = run_frame(&main_run, &cs, &view, rows, bins, fmt, &so, &fs, &frame_bytes, &d);
     uint64_t t1 = om_clock_ns(NULL);
     if (st != OM_OK) {
         /* A write that failed stopped the frame: name the file, not the method. */
