@@ -10,6 +10,7 @@
 #include "platform.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <signal.h>
 #include <stdlib.h>
 #include <string.h>
@@ -200,6 +201,25 @@ static bool finish(om_out *o)
     return !o->err;
 }
 
+/* The rename is durable once the directory is synced too; a system that cannot sync
+ * a directory still has the file whole, old or new. */
+static void sync_dir(const char *target)
+{
+    const char *slash = strrchr(target, '/');
+    char *dir = slash ? malloc((size_t)(slash - target) + 2) : NULL;
+    if (slash && !dir) return;
+    if (dir) {
+        memcpy(dir, target, (size_t)(slash - target) + 1);
+        dir[slash - target + 1] = '\0';
+    }
+    int fd = open(dir ? dir : ".", O_RDONLY);
+    if (fd >= 0) {
+        fsync(fd);
+        close(fd);
+    }
+    free(dir);
+}
+
 void om_out_discard(om_out *o)
 {
     if (o->f && !o->is_stdout) fclose(o->f);
@@ -225,6 +245,7 @@ om_status om_out_commit(om_out *const *outs, size_t n, om_diag *d)
         om_out *o = outs[i];
         if (!o || !o->tmp) continue;
         if (rename(o->tmp, o->target) != 0) { st = fail(d, o->path, "cannot replace", errno); break; }
+        sync_dir(o->target);
         live_remove(o->tmp);
         free(o->tmp);
         o->tmp = NULL;
