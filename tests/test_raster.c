@@ -374,6 +374,28 @@ static void covers_matches_fill(void)
     CHECK(!om__tri2_setup(&ta, big, ay, true));
 }
 
+/* om__zdepth is z/w * 2^32 truncated: whole binary fractions exactly, every quotient
+ * within a unit of the double one, 0 and 2^32 - 1 at and beyond the ends, subnormals
+ * and huge ratios alike. */
+static void zdepth_exact(void)
+{
+    CHECK(om__zdepth(0.25f, 1.0f) == 1073741824.0);
+    CHECK(om__zdepth(3.0f, 4.0f) == 3221225472.0);
+    CHECK(om__zdepth(0.0f, 1.0f) == 0.0 && om__zdepth(-1.0f, 1.0f) == 0.0);
+    CHECK(om__zdepth(1.0f, 1.0f) == 4294967295.0 && om__zdepth(2.0f, 1.0f) == 4294967295.0);
+    CHECK(om__zdepth(1e-30f, 1.0f) == 0.0 && om__zdepth(0x1p-149f, 0x1p-146f) == 536870912.0);
+    CHECK(om__zdepth(0x1p-149f, 1.0f) == 0.0 && om__zdepth(0x3p-149f, 0x1p-120f) == 24.0);
+    rng_state = 77;
+    int bad = 0;
+    for (int k = 0; k < 100000; k++) {
+        float w = (float)(rnd() % 100000 + 1) / (float)(rnd() % 1000 + 1);
+        float z = w * (float)(rnd() % 1000000) / 1000000.0f;
+        double q = om__zdepth(z, w), e = (double)z / (double)w * 4294967296.0;
+        bad += !(q == floor(q) && q <= e + 1e-6 && q + 1.0 > e - 1e-6);
+    }
+    CHECK_EQ_U(bad, 0);
+}
+
 /* om__raster_snapped is what om__raster_tri does once a triangle is on the grid: the
  * same depths and ids for triangles given either way (partly off the image too). */
 static void snapped_matches_clipped(void)
@@ -388,7 +410,8 @@ static void snapped_matches_clipped(void)
         for (int i = 0; i < 3; i++) {
             x[i] = (int64_t)(rnd() % (2 * TW * 256)) - TW * 128;
             y[i] = (int64_t)(rnd() % (2 * TH * 256)) - TH * 128;
-            c[i] = at((double)x[i], (double)y[i], TW, TH, (float)(rnd() % 1000) / 1000.0f);
+            /* depths of 1/1024 steps: z/w * 2^32 is a whole number, as om__zdepth gives */
+            c[i] = at((double)x[i], (double)y[i], TW, TH, (float)(rnd() % 1000) / 1024.0f);
             z[i] = (double)c[i].z * 4294967296.0;
         }
         om_target t = target(TW, TH);
@@ -666,6 +689,7 @@ void suite_raster(void)
     RUN(clipping_near_far);
     RUN(overflow_cases);
     RUN(covers_matches_fill);
+    RUN(zdepth_exact);
     RUN(snapped_matches_clipped);
     RUN(grid_matches_point_tests);
     RUN(fill_matches_point_tests);

@@ -32,6 +32,7 @@
 #include "../core/core.h"
 
 #include <math.h>
+#include <string.h>
 
 #define OM_SUBPIX_BITS 8
 #define OM_SUBPIX (1 << OM_SUBPIX_BITS)
@@ -201,21 +202,50 @@ static inline bool om__snap(double x, double y, double z, int64_t *gx, int64_t *
 /* Projects one clip-space vertex to the sub-pixel grid of a width x height image, with
  * depth z/w * 2^32 (clamped to [0, 2^32 - 1]); false when w <= 0 or it lands beyond
  * 2^26 grid units. Clipping uses exactly this, so a vertex projects the same alone.
- * om__project_xy is its grid position alone (the same, without the depth). */
+ * om__project_xy is its grid position alone (the same, without the depth).
+ *
+ * No double: x/w and y/w are single precision, what a Cortex-M4F does in hardware
+ * (a double there is a software routine per operation), and the grid position rounds
+ * from there. On every grid the engine uses (at most 8192 pixels and a guard band of
+ * 8192 either side, 256 units a pixel) |X| < 2^23, where a float's step is at most
+ * half a unit: the division and the scaled sum move a position by at most one unit
+ * before the snap. The depth is exact: om__zdepth. */
 static inline bool om__project_xy(const om_vec4 *v, uint32_t width, uint32_t height, int64_t *gx, int64_t *gy)
 {
-    const double sx = (double)width * (OM_SUBPIX / 2), sy = (double)height * (OM_SUBPIX / 2);
+    const float sx = (float)width * (OM_SUBPIX / 2), sy = (float)height * (OM_SUBPIX / 2), lim = 67108864.0f;
     if (!(v->w > 0.0f)) return false;
-    double iw = 1.0 / (double)v->w;
-    return om__snap_xy(((double)v->x * iw + 1.0) * sx, (1.0 - (double)v->y * iw) * sy, gx, gy);
+    const float iw = 1.0f / v->w;
+    const float X = floorf((v->x * iw + 1.0f) * sx + 0.5f), Y = floorf((1.0f - v->y * iw) * sy + 0.5f);
+    if (!(X > -lim && X < lim && Y > -lim && Y < lim)) return false;
+    *gx = (int64_t)X;
+    *gy = (int64_t)Y;
+    return true;
+}
+
+/* z/w * 2^32, truncated: exact, from the floats' significands divided as integers (a
+ * 64-by-32-bit integer division, far cheaper than an emulated double one); 0 for
+ * z <= 0 (or NaN), 2^32 - 1 for z >= w. */
+static inline double om__zdepth(float z, float w)
+{
+    if (!(z > 0.0f)) return 0.0;
+    if (!(z < w)) return 4294967295.0;
+    uint32_t bz, bw;
+    memcpy(&bz, &z, sizeof bz);
+    memcpy(&bw, &w, sizeof bw);
+    int ez = (int)(bz >> 23), ew = (int)(bw >> 23);   /* positive: no sign bit */
+    const uint64_t mz = (bz & 0x7FFFFFu) | (ez ? 0x800000u : 0u), mw = (bw & 0x7FFFFFu) | (ew ? 0x800000u : 0u);
+    ez += !ez;   /* a subnormal's exponent is the least normal one's */
+    ew += !ew;
+    const int s = ez - ew + 32;   /* z/w * 2^32 = mz / mw * 2^s, s <= 32 as z < w */
+    if (s < -24) return 0.0;      /* mz / mw < 2^24: below one unit */
+    return (double)(s >= 0 ? (mz << s) / mw : mz / (mw << -s));
 }
 
 static inline bool om__project(const om_vec4 *v, uint32_t width, uint32_t height, int64_t *gx, int64_t *gy,
                                double *gz)
 {
     if (!om__project_xy(v, width, height, gx, gy)) return false;
-    double z = (double)v->z * (1.0 / (double)v->w) * 4294967296.0;
-    *gz = z < 0.0 ? 0.0 : z > 4294967295.0 ? 4294967295.0 : z;
+    *gz = om__zdepth(v->z, v->w);
     return true;
 }
 

@@ -63,7 +63,7 @@ static double bound(const om__lspace *ls, const om__rtri *r)
 {
     double iw = ls->iw0 + ls->iw1 * r->zmin;
     if (!(iw > 0.0)) iw = 0.0;
-    return 2.0 * ((fabs(r->zx) + fabs(r->zy)) * (0.5 + ls->lat * iw) + ls->dep * iw);
+    return 2.0 * ((fabs(r->zx) + fabs(r->zy)) * (1.5 + ls->lat * iw) + ls->dep * iw + 1.0);
 }
 
 void om__lspace_begin(om__lspace *ls, const om_view *v)

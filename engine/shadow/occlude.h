@@ -24,13 +24,16 @@
  * facet on the lit side of a convex solid). Snapping and float rounding move both
  * depths the predicate compares, by at most
  *   - laterally, per axis: half a grid step for the snap of the sample's point and
- *     another for the triangle's vertices, plus the float rounding of x/w and y/w;
- *     times the triangle's depth gradient on the grid (|dz/dx| + |dz/dy|);
+ *     another for the triangle's vertices, a step more each for the single-precision
+ *     division and scaling before the snap (raster.h), plus the float rounding of x/w
+ *     and y/w in clip space; times the triangle's depth gradient on the grid
+ *     (|dz/dx| + |dz/dy|);
  *   - in depth: the float rounding of z and w in the light's clip space (the float
  *     matrix product: 4 roundings, the clipper's cut: 2 more, the sample's point made
  *     in float from its triangle's vertices (eye.c: a difference, a product and a sum
  *     a term): 3, and the vertices' rounding to float: 1; 10 units of 2^-24 on the sum
- *     of the terms' magnitudes, bounded with the scene box), over w.
+ *     of the terms' magnitudes, bounded with the scene box), over w; and the depth's
+ *     truncation to a whole unit (om__zdepth), below one unit each.
  * Each rounding term grows with 1/w, so the sample's own is at most the triangle's at
  * its nearest vertex whenever the triangle is nearer at all; the bound is therefore
  * twice the triangle's own (om__lspace_tri sets it per sub-triangle). A
