@@ -59,6 +59,11 @@ expect 0 "small scene whole" -- "$OMBRA" render "$dir/small.scene" --size 160x12
 hash_s=$(grep '^hash:' "$dir/out")
 expect 0 "small scene strips" -- "$OMBRA" render "$dir/small.scene" --size 160x120 --strip 8 --out "$dir/s1.ppm"
 if [ "$(grep '^hash:' "$dir/out")" = "$hash_s" ]; then ok; else bad "strips (with row bins) changed the small scene"; fi
+# Every value a setting takes renders: an importance map asked below 8 texels is 8.
+expect 0 "rtw.importance 3" -- "$OMBRA" render --size 64x48 --method rtw --set rtw.importance=3 --out "$dir/i3.ppm"
+hash_i=$(grep '^hash:' "$dir/out")
+expect 0 "rtw.importance 8" -- "$OMBRA" render --size 64x48 --method rtw --set rtw.importance=8 --out "$dir/i8.ppm"
+if [ "$(grep '^hash:' "$dir/out")" = "$hash_i" ]; then ok; else bad "rtw.importance 3 is not 8"; fi
 expect 2 "scene --big" -- "$OMBRA" scene --big
 has "$dir/err" "only --small" "scene names its one option"
 expect 0 "info" -- "$OMBRA" info --size 160x120 --map 256

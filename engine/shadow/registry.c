@@ -100,7 +100,7 @@ static const om_cfg_field fields[] = {
     F("asm.b", 'f', asm_cost_b, 0, 1e6, "ASM node cost, constant part"),
     F("izb.leaf", 'u', izb_leaf, 1, 65536, "most samples in an IZB BSP leaf (izb, hybrid)"),
     F("izb.pool", 'u', izb_pool, 0, 1e9, "IZB sample pool, 0 = whole frame in one pass (izb, hybrid)"),
-    F("rtw.importance", 'u', rtw_importance, 0, 8192, "RTW importance map side, 0 = 512 or the map's if smaller"),
+    F("rtw.importance", 'u', rtw_importance, 0, 8192, "RTW importance map side (at least 8), 0 = 512 or the map's if smaller"),
     F("rtw.analysis", 'u', rtw_analysis, 0, 2, "RTW analysis: 0 backward, 1 forward, 2 hybrid"),
     F("rtw.funcs", 'u', rtw_funcs, 0, 15, "RTW importance: 1 view, 2 distance, 4 edge, 8 normal"),
     F("rtw.sigma", 'f', rtw_sigma, 0, 64, "RTW blur sigma in super-cells"),

@@ -22,10 +22,11 @@
 /* ---------------------------------------------------------------- sizes */
 
 /* The importance map's side: as asked, or by default 512 (section 6's size), no finer
- * than the map itself (a super-cell narrower than a texel moves nothing), at least 8. */
+ * than the map itself (a super-cell narrower than a texel moves nothing); at least 8
+ * either way (a side asked below 8 is 8, so every value the setting takes renders). */
 static uint32_t importance_side(const om_method_cfg *c)
 {
-    if (c->rtw_importance) return c->rtw_importance;
+    if (c->rtw_importance) return c->rtw_importance < 8 ? 8 : c->rtw_importance;
     uint32_t n = c->map_size < 512 ? c->map_size : 512;
     return n < 8 ? 8 : n;
 }
@@ -64,8 +65,8 @@ static const char *check_cfg(const om_method_cfg *c)
 {
     if (c->map_size < 1 || c->map_size > OM_MAX_DIM) return "rtw: map size must be 1..8192";
     if (c->pcf < 1 || c->pcf > 9) return "rtw: pcf must be 1..9";
-    if (c->rtw_importance != 0 && (c->rtw_importance < 8 || c->rtw_importance > OM_MAX_DIM))
-        return "rtw: importance map side must be 8..8192, or 0 for 512 (the map's side if smaller)";
+    if (c->rtw_importance > OM_MAX_DIM)
+        return "rtw: importance map side must be 0..8192 (0: 512, or the map's side if smaller)";
     if (c->rtw_analysis > 2) return "rtw: analysis must be 0 (backward), 1 (forward) or 2 (hybrid)";
     if (c->rtw_funcs > 15) return "rtw: importance functions are a mask of 1, 2, 4, 8";
     if (!(c->rtw_sigma >= 0.0f && c->rtw_sigma <= 64.0f)) return "rtw: sigma must be 0..64";
