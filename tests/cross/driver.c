@@ -16,7 +16,8 @@
  * ASM cap, a 64-cell RTW importance map: what fits a microcontroller), and, where
  * OM_CROSS_BIG is defined (hosted targets), at 640x480 with maps of 1024. After the
  * default@160x120 lines come "bytes" lines with each method's arena peak and minimum
- * (they depend on pointer size, so they are not compared). The stability scene's text
+ * (they depend on pointer size, so they are not compared). OM_CROSS_ONLY selects
+ * cases, bit 4 * size + case in the order above (run.sh gives slow targets fewer). The stability scene's text
  * comes from tests/stability through OM_CROSS_STAB (a header run.sh generates). It
  * needs nothing but the engine and a way to print a line (om_host_puts, from the host
  * file it is linked with). */
@@ -30,7 +31,7 @@ void om_host_puts(const char *line);
  * eye pass projects every triangle, which a board without a double FPU pays dearly
  * for), of 60 at 640x480. Every target renders a size through the same strips, so
  * that only the CPU and compiler differ (frames are meant to be the same through any
- * strips, but with spsm.aa they are not yet: README, Determinism). */
+ * strips, but with spsm.aa they are not yet: README, On small machines). */
 #ifndef OM_CROSS_ROWS
 #define OM_CROSS_ROWS 40
 #endif
