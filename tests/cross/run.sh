@@ -76,10 +76,10 @@ cortex-m7-gcc-Os|board|arm-none-eabi-gcc|-Os $M7|mps2-an500|0xf
 cortex-m7-clang-O0|board|clang|-O0 $M7|mps2-an500|0x1
 cortex-m7-clang-O2|board|clang|-O2 $M7|mps2-an500|0xf
 cortex-m7-clang-Os|board|clang|-Os $M7|mps2-an500|0x1"
-# Not here: s390x clang at -O1 and above. QEMU 7.2 emulates s390x's multiply of two
-# floats into a double (mdebr, mdeb) wrongly, and clang's optimised code uses it
-# (asm.c) where gcc's does not: the frames differ under QEMU through the emulator's fault, not the
-# engine's (README, On small machines).
+# s390x clang at -O1 and above runs only where the emulator multiplies two floats into
+# a double (mdebr, mdeb) right: QEMU 7.2 does not, and clang's optimised code uses the
+# instruction (asm.c) where gcc's does not, so the frames would differ through the
+# emulator's fault, not the engine's (README, On small machines). A probe decides.
 
 # The board build: the same driver, the firmware of platform/cortex-m, every method in
 # an arena of 256 KiB (the target for small machines; a method whose minimum is
@@ -112,6 +112,18 @@ ref=""
 summary=""
 note() { summary="$summary$(printf '    %-40s %s' "$1" "$2")
 "; }
+
+if command -v clang >/dev/null 2>&1 && command -v qemu-s390x >/dev/null 2>&1 &&
+   clang --target=s390x-linux-gnu $WARN -O2 tests/cross/mdebr_probe.c -o "$out/mdebr-probe" \
+       >"$out/mdebr-probe.txt" 2>&1; then
+    if qemu-s390x -L /usr/s390x-linux-gnu "$out/mdebr-probe" >"$out/mdebr-probe.txt" 2>&1; then
+        configs="$configs
+s390x-clang-O2|same|clang|-O2 --target=s390x-linux-gnu|qemu-s390x -L /usr/s390x-linux-gnu|$BIG"
+    else
+        echo "cross: s390x-clang-O2 not run: this QEMU's mdebr is wrong ($(cat "$out/mdebr-probe.txt"))"
+        note s390x-clang-O2 "not run: the emulator's mdebr is wrong (tests/cross/mdebr_probe.c)"
+    fi
+fi
 
 IFS='
 '
