@@ -6,8 +6,10 @@
  *    clipped in homogeneous space against the near (z >= 0) and far (z <= w) planes and
  *    against a guard band OM_GUARD_PX pixels beyond each image side, so that every
  *    snapped coordinate stays below 2^23 and edge functions fit in int64 with room.
- *  - Vertices snap to 1/256 pixel (OM_SUBPIX_BITS = 8), rounding half up. Pixel (x, y)
- *    is sampled at its centre ((x + 0.5) * 256, (y + 0.5) * 256); row 0 is the top.
+ *  - Vertices snap to 1/256 pixel (OM_SUBPIX_BITS = 8), rounding half up from x/w and
+ *    y/w in single precision; their depth z/w * 2^32 is exact, truncated (om__project).
+ *    Pixel (x, y) is sampled at its centre ((x + 0.5) * 256, (y + 0.5) * 256); row 0
+ *    is the top.
  *  - Edge functions are exact integers. A point is inside when it is strictly inside
  *    every edge, or exactly on an edge that is a top edge (horizontal, other vertex
  *    below) or a left edge (the interior lies to its right when going up): the top-left
