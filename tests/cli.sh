@@ -319,6 +319,8 @@ cp "$dir/bench/bench.csv" "$dir/bench-old.csv"
 expect 1 "bench on a malformed scene" -- "$OMBRA" bench --scenes "$dir/ok.scene,$dir/bad.scene" --runs 1 --methods izb --out "$dir/bench"
 cmp -s "$dir/bench/bench.csv" "$dir/bench-old.csv" && ok || bad "a failed bench replaced the CSV"
 has "$dir/bench/bench.csv" "^scene,method,setting,width,height,time_ms,init_ms," "bench.csv has an init column"
+has "$dir/bench/bench.csv" ",stats$" "bench.csv ends with the methods' counters"
+has "$dir/bench/bench.csv" "bsp nodes=" "bench.csv carries izb's counters"
 if awk -F, 'NR > 1 && ($4 != 64 || $5 != 48) {exit 1}' "$dir/bench/bench.csv"; then ok; else bad "bench ignored the scene's 64x48"; fi
 if [ -s "$dir/bench/ok.scene-first.svg" ]; then ok; else bad "no first-frame (init + frame) chart"; fi
 expect 0 "render --method ref" -- "$OMBRA" render --size 16x12 --method ref --out "$dir/z.ppm"

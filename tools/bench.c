@@ -150,6 +150,17 @@ om_status cli_measure(const om_method *m, const om_method_cfg *cfg, const cli_sc
         p->resolve = median(t[3], runs);
         p->shade = median(t[4], runs);
         p->bytes = ma.peak;
+        om_method_stats ms;
+        m->stats(state, &ms);
+        size_t n = 0;
+        p->stats[0] = '\0';
+        for (uint32_t k = 0; k < ms.ncounters && n + 1 < sizeof p->stats; k++) {
+            int w = snprintf(p->stats + n, sizeof p->stats - n, "%s%s=%u", k ? "; " : "", ms.counter_names[k],
+                             ms.counters[k]);
+            if (w < 0 || (size_t)w >= sizeof p->stats - n) { p->stats[n] = '\0'; break; }
+            n += (size_t)w;
+        }
+        if (!p->stats[0]) strcpy(p->stats, "-");
     }
     free(mem);
     free(fmem);
@@ -327,18 +338,18 @@ static int write_outputs(const char *dir, char **names, size_t nn, const cli_poi
         FILE *f = outs[k].f;
         fprintf(f, "scene,method,setting,width,height,time_ms,init_ms,eye_ms,observe_ms,build_ms,"
                    "resolve_ms,shade_ms,bytes,samples,false_lit,false_shadowed,mismatch_share,"
-                   "edge_samples,edge_mismatch_share\n");
+                   "edge_samples,edge_mismatch_share,stats\n");
         for (int i = 0; i < np; i++) {
             const cli_point *p = &pts[i];
             double share = 1.0 - om_metrics_match(&p->m);
             double edge = p->m.edge_samples ? (double)(p->m.edge_false_lit + p->m.edge_false_shadowed) /
                                                   (double)p->m.edge_samples : 0.0;
-            fprintf(f, "%s,%s,%s,%u,%u,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%zu,%llu,%llu,%llu,%.6f,%llu,%.6f\n",
+            fprintf(f, "%s,%s,%s,%u,%u,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%zu,%llu,%llu,%llu,%.6f,%llu,%.6f,%s\n",
                     p->scene, p->method, p->setting, p->w, p->h, p->total, p->init, p->eye,
                     p->observe, p->build, p->resolve, p->shade, p->bytes,
                     (unsigned long long)p->m.samples, (unsigned long long)p->m.false_lit,
                     (unsigned long long)p->m.false_shadowed, share,
-                    (unsigned long long)p->m.edge_samples, edge);
+                    (unsigned long long)p->m.edge_samples, edge, p->stats);
         }
         k++;
     }

@@ -55,6 +55,7 @@ typedef struct cli_point {
     double total, eye, observe, build, resolve, shade;   /* per frame, ms (medians) */
     size_t bytes;
     om_metrics m;
+    char stats[256];       /* the method's counters of the last frame: "name=value; ..." */
     int ok;
 } cli_point;
 

@@ -65,12 +65,16 @@ static void table(FILE *f, const char *csv)
     if (!g) return;
     char line[2048];
     fprintf(f, "<table>\n");
+    int skip = -1;   /* the methods' counters (the CSV's stats column) stay in the CSV */
     for (int row = 0; fgets(line, sizeof line, g); row++) {
         line[strcspn(line, "\n")] = 0;
         fprintf(f, "<tr>");
-        for (char *c = line, *e; c; c = e ? e + 1 : NULL) {
+        int col = 0;
+        for (char *c = line, *e; c; c = e ? e + 1 : NULL, col++) {
             e = strchr(c, ',');
             if (e) *e = 0;
+            if (row == 0 && !strcmp(c, "stats")) skip = col;
+            if (col == skip) continue;
             fprintf(f, row ? "<td>" : "<th>");
             svg_escape(f, c);
             fprintf(f, row ? "</td>" : "</th>");
