@@ -90,11 +90,18 @@ REPLAY = for t in $(FUZZ_TARGETS); do printf 'fuzz_%s: ' $$t; $(O)/fuzz-replay-$
 fuzz-regress: $(FUZZ_TARGETS:%=$(O)/fuzz-replay-%)
 	$(Q)$(REPLAY)
 
-check: $(O)/run-tests $(O)/ombra $(FUZZ_TARGETS:%=$(O)/fuzz-replay-%)
+# The README's embedding example, built as a user would (the library and the header,
+# the project's warnings) and run; readme.sh checks the README shows this very code.
+$(O)/embed-render-once: tests/embed/render_once.c $(O)/libombra.a include/ombra.h
+	$(Q)$(CC) $(CFLAGS_ALL) -o $@ $(filter %.c %.a,$^) $(LDLIBS)
+
+check: $(O)/run-tests $(O)/ombra $(FUZZ_TARGETS:%=$(O)/fuzz-replay-%) $(O)/embed-render-once
 	@echo "== $(O)"
 	$(O)/run-tests
 	sh tests/cli.sh $(O)/ombra
 	$(Q)$(REPLAY)
+	$(O)/embed-render-once
+	sh tests/embed/readme.sh
 
 test-sanitize:
 	$(MAKE) --no-print-directory check CC=clang OPT=-O1 O=build/san \
@@ -137,7 +144,30 @@ test-valgrind:
 	OM_TEST_QUICK=1 valgrind --error-exitcode=1 --leak-check=full --errors-for-leak-kinds=definite -q \
 	  $(O)/valgrind/run-tests
 
+# make install PREFIX=/usr/local DESTDIR=: the library, the header, the command and a
+# pkg-config file (`pkg-config --cflags --libs ombra`); make uninstall removes them.
+PREFIX  ?= /usr/local
+VERSION := $(shell sed -n 's/^\#define OMBRA_VERSION_STRING "\(.*\)"/\1/p' include/ombra.h)
+
+install: $(O)/libombra.a $(O)/ombra
+	install -d $(DESTDIR)$(PREFIX)/lib/pkgconfig $(DESTDIR)$(PREFIX)/include $(DESTDIR)$(PREFIX)/bin
+	install -m 644 $(O)/libombra.a $(DESTDIR)$(PREFIX)/lib/libombra.a
+	install -m 644 include/ombra.h $(DESTDIR)$(PREFIX)/include/ombra.h
+	install -m 755 $(O)/ombra $(DESTDIR)$(PREFIX)/bin/ombra
+	sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@VERSION@|$(VERSION)|' tools/ombra.pc.in \
+	  >$(DESTDIR)$(PREFIX)/lib/pkgconfig/ombra.pc
+
+uninstall:
+	rm -f $(DESTDIR)$(PREFIX)/lib/libombra.a $(DESTDIR)$(PREFIX)/include/ombra.h \
+	  $(DESTDIR)$(PREFIX)/bin/ombra $(DESTDIR)$(PREFIX)/lib/pkgconfig/ombra.pc
+
+# Installs into a scratch directory, builds the embedding example against that copy
+# with pkg-config, runs it, uninstalls (tests/embed/install.sh).
+install-check: $(O)/embed-render-once
+	sh tests/embed/install.sh $(O)
+
 clean:
 	rm -rf build out
 
-.PHONY: all run test check test-sanitize bench cross-test fuzz fuzz-regress test-valgrind stress stability clean
+.PHONY: all run test check test-sanitize bench cross-test fuzz fuzz-regress test-valgrind stress stability clean \
+        install uninstall install-check
