@@ -283,17 +283,7 @@ static bool decide(void *user, const om__lpoint *p, om_term *t) { return om__hyb
 static om_status hybrid_resolve(void *state, om_strip *st, om_diag *d)
 {
     (void)d;
-    hybrid_state *m = (hybrid_state *)state;
-    om__izb *z = &m->z;
-    size_t n = (size_t)st->rows * st->width, next = 0;
-    for (size_t i = 0; i < n; i++) st->terms[i].r = st->terms[i].g = st->terms[i].b = 255;
-    while (next < n) {
-        if (om__izb_transform(z, st, &next, n, decide, m) == 0) break;
-        om__izb_build(z);
-        om__izb_raster(z);
-        om__izb_write(z, st);
-        z->st.tiles++;
-    }
+    om__izb_resolve(&((hybrid_state *)state)->z, st, decide, state);
     return OM_OK;
 }
 

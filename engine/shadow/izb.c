@@ -398,19 +398,23 @@ void om__izb_write(const om__izb *z, om_strip *st)
     for (uint32_t i = 0; i < z->n; i++) om__odepth_term(&z->samples[i].od, &st->terms[z->samples[i].idx]);
 }
 
-static om_status izb_resolve(void *state, om_strip *st, om_diag *d)
+void om__izb_resolve(om__izb *z, om_strip *st, om__izb_decide decide, void *user)
 {
-    (void)d;
-    om__izb *z = &((izb_state *)state)->z;
     size_t n = (size_t)st->rows * st->width, next = 0;
     for (size_t i = 0; i < n; i++) st->terms[i].r = st->terms[i].g = st->terms[i].b = 255;
     while (next < n) {
-        if (om__izb_transform(z, st, &next, n, NULL, NULL) == 0) break;
+        if (om__izb_transform(z, st, &next, n, decide, user) == 0) break;
         om__izb_build(z);
         om__izb_raster(z);
         om__izb_write(z, st);
         z->st.tiles++;
     }
+}
+
+static om_status izb_resolve(void *state, om_strip *st, om_diag *d)
+{
+    (void)d;
+    om__izb_resolve(&((izb_state *)state)->z, st, NULL, NULL);
     return OM_OK;
 }
 

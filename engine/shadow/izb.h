@@ -78,5 +78,8 @@ void om__izb_build(om__izb *z);
 void om__izb_raster(om__izb *z);
 /* Writes the tile's terms into the strip. */
 void om__izb_write(const om__izb *z, om_strip *st);
+/* A strip's terms: 255 everywhere, then tile after tile of the exposed samples (those
+ * `decide` leaves undecided, when given) through transform, build, raster, write. */
+void om__izb_resolve(om__izb *z, om_strip *st, om__izb_decide decide, void *user);
 
 #endif

@@ -21,6 +21,8 @@ void bench_free(bscene *b);
 /* The random-triangle scenes of the Alias-Free Shadow Maps paper's Table 1: `count`
  * small triangles of constant total area above a floor, at 1024x768. */
 int bench_load_random(bscene *b, unsigned count);
+/* fn on the default scene, then on the 10K and 100K random clouds. */
+void bench_default_and_clouds(void (*fn)(const bscene *b));
 
 double bench_median_ns(uint64_t *t, int n);   /* in ms */
 double bench_median(double *v, int n);

@@ -62,6 +62,20 @@ int bench_load_random(bscene *b, unsigned count)
     return bench_load(b, names[slot], text);
 }
 
+void bench_default_and_clouds(void (*fn)(const bscene *b))
+{
+    bscene b;
+    if (bench_load(&b, "default", om_scene_default_text())) return;
+    fn(&b);
+    bench_free(&b);
+    static const unsigned counts[] = {10000, 100000};
+    for (int k = 0; k < 2; k++) {
+        if (bench_load_random(&b, counts[k])) return;
+        fn(&b);
+        bench_free(&b);
+    }
+}
+
 typedef struct mask_sink { uint8_t *mask; } mask_sink;
 
 static om_status grab_mask(void *user, const om_strip *st, const om_framebuffer *fb)

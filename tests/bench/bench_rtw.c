@@ -103,16 +103,4 @@ out:
     free(mk);
 }
 
-void bench_rtw(void)
-{
-    bscene b;
-    if (bench_load(&b, "default", om_scene_default_text())) return;
-    one_scene(&b);
-    bench_free(&b);
-    static const unsigned counts[] = {10000, 100000};
-    for (int k = 0; k < 2; k++) {
-        if (bench_load_random(&b, counts[k])) return;
-        one_scene(&b);
-        bench_free(&b);
-    }
-}
+void bench_rtw(void) { bench_default_and_clouds(one_scene); }
