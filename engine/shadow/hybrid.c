@@ -253,21 +253,22 @@ int om__hybrid_decide(void *state, const om__lpoint *p, om_term *t)
      * candidates: triangles that blocked recent samples (neighbours in the image are
      * mostly neighbours in the light's), then the texel's nearest opaque one. */
     if ((double)h->near < p->z) {
-        for (int k = 0; k <= MRU; k++) {
-            om__ltri *lt = &m->mru[k < MRU ? k : MRU - 1];
-            if (k == MRU) {
-                if (h->cid == p->tri || h->cid == m->mru[0].tri || h->cid == m->mru[1].tri ||
-                    h->cid == m->mru[2].tri || h->cid == m->mru[3].tri ||
-                    !om__lspace_tri(&m->z.ls, h->cid, lt))
-                    break;
-            } else if (lt->tri == OM_NO_TRI || lt->tri == p->tri) {
-                continue;
-            }
-            if (!om__blocks(lt, p)) continue;
-            if (k > 0) {   /* to the front */
-                om__ltri hit = *lt;
-                memmove(&m->mru[1], &m->mru[0], (size_t)(k < MRU ? k : MRU - 1) * sizeof hit);
-                m->mru[0] = hit;
+        int hit = -1;
+        bool known = false;   /* the texel's candidate is among the recent ones */
+        for (int k = 0; k < MRU && hit < 0; k++) {
+            const om__ltri *lt = &m->mru[k];
+            known |= lt->tri == h->cid;
+            if (lt->tri != OM_NO_TRI && om__blocks(lt, p)) hit = k;
+        }
+        /* the texel's candidate replaces the oldest recent one */
+        if (hit < 0 && !known && h->cid != p->tri && om__lspace_tri(&m->z.ls, h->cid, &m->mru[MRU - 1]) &&
+            om__blocks(&m->mru[MRU - 1], p))
+            hit = MRU - 1;
+        if (hit >= 0) {
+            if (hit > 0) {   /* to the front */
+                om__ltri lt = m->mru[hit];
+                memmove(&m->mru[1], &m->mru[0], (size_t)hit * sizeof lt);
+                m->mru[0] = lt;
             }
             t->r = t->g = t->b = 0;
             m->shadowed++;

@@ -90,7 +90,6 @@ static bool locate(const om__smlook *L, const om_sample *smp, tap *out)
      * comparison with the stored depths stays exact (test). The warp keeps double:
      * its tables' fractions need it. */
     const float iw = 1.0f / q.w;
-    float uf, wf;
     if (L->warp_x) {
         if (L->normal_offset != 0.0f) {   /* the point moved: warp it anew */
             double dens, diw = 1.0 / (double)q.w;
@@ -104,8 +103,8 @@ static bool locate(const om__smlook *L, const om_sample *smp, tap *out)
         out->cy = (int64_t)floor(v0 * L->size);
     } else {
         out->u = out->v = 0.0;   /* no warp: taps are the map's texels */
-        uf = (q.x * iw + 1.0f) * (0.5f * (float)L->size);
-        wf = (1.0f - q.y * iw) * (0.5f * (float)L->size);
+        const float uf = (q.x * iw + 1.0f) * (0.5f * (float)L->size);
+        const float wf = (1.0f - q.y * iw) * (0.5f * (float)L->size);
         out->cx = (int64_t)floorf(uf);
         out->cy = (int64_t)floorf(wf);
     }
