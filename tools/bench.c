@@ -143,7 +143,9 @@ om_status cli_measure(const om_method *m, const om_method_cfg *cfg, const cli_sc
     if (st == OM_OK) {
         double tot[16];
         for (int r = 0; r < runs; r++) tot[r] = t[0][r] + t[1][r] + t[2][r] + t[3][r] + t[4][r];
-        p->total = median(tot, runs);
+        p->total = median(tot, runs);   /* sorts tot */
+        p->tmin = tot[0];
+        p->tmax = tot[runs - 1];
         p->eye = median(t[0], runs);
         p->observe = median(t[1], runs);
         p->build = median(t[2], runs);
@@ -240,24 +242,58 @@ static void progress(int i, int n, const cli_point *p)
     else fprintf(stderr, "[%d/%d] %s %s %s\n", i, n, p->scene, p->method, p->setting);
 }
 
+/* A point's label on a chart: its setting, short ("asm.cap=1048576" -> "cap 1M",
+ * "map=512 rtw.exact=1" -> "map 512, exact 1"), the full one staying in the tooltip. */
+static void short_setting(const char *setting, char *out, size_t n)
+{
+    size_t o = 0;
+    out[0] = 0;
+    if (!strcmp(setting, "defaults")) { snprintf(out, n, "defaults"); return; }
+    for (const char *p = setting; *p && o + 1 < n;) {
+        size_t len = strcspn(p, " ");
+        char item[96], *eq;
+        snprintf(item, sizeof item, "%.*s", (int)(len < 95 ? len : 95), p);
+        p += len;
+        while (*p == ' ') p++;
+        if (!(eq = strchr(item, '='))) continue;
+        *eq = 0;
+        const char *name = strrchr(item, '.') ? strrchr(item, '.') + 1 : item;
+        char *end;
+        unsigned long long v = strtoull(eq + 1, &end, 10);
+        char val[32];
+        if (!*end && v >= 16384 && v % 1048576 == 0) snprintf(val, sizeof val, "%lluM", v / 1048576);
+        else if (!*end && v >= 16384 && v % 1024 == 0) snprintf(val, sizeof val, "%lluK", v / 1024);
+        else snprintf(val, sizeof val, "%s", eq + 1);
+        int w = snprintf(out + o, n - o, "%s%s %s", o ? ", " : "", name, val);
+        if (w < 0 || (size_t)w >= n - o) break;
+        o += (size_t)w;
+    }
+}
+
 /* One chart of a scene's points, mismatch share against x: 0 time per frame, 1 method
- * bytes, 2 the first frame (init + frame); each method a series. */
+ * bytes, 2 the first frame (init + frame); each method a series, each point labelled
+ * and, on the time charts, with the spread of its frames. */
 static bool chart(om_out *o, const svg_chart *c, const cli_point *pts, int n, const char *scene,
                   int xkind)
 {
     svg_series s[16];
-    static double xs[16][64], ys[16][64];
+    static double xs[16][64], ys[16][64], lo[16][64], hi[16][64];
+    static char text[16][64][48];
     static const char *labels[16][64];
     size_t ns = 0;
     for (size_t k = 0; k < om_method_count() && ns < 16; k++) {
         const om_method *m = om_method_at(k);
         size_t np = 0;
         for (int i = 0; i < n && np < 64; i++) {
-            if (!pts[i].ok || strcmp(pts[i].method, m->name) || strcmp(pts[i].scene, scene)) continue;
-            xs[ns][np] = xkind == 0 ? pts[i].total : xkind == 1 ? (double)pts[i].bytes
-                                                                : pts[i].init + pts[i].total;
-            ys[ns][np] = 1.0 - om_metrics_match(&pts[i].m);
-            labels[ns][np] = pts[i].setting;
+            const cli_point *p = &pts[i];
+            if (!p->ok || strcmp(p->method, m->name) || strcmp(p->scene, scene)) continue;
+            double first = xkind == 2 ? p->init : 0;
+            xs[ns][np] = xkind == 1 ? (double)p->bytes : first + p->total;
+            lo[ns][np] = first + p->tmin;
+            hi[ns][np] = first + p->tmax;
+            ys[ns][np] = 1.0 - om_metrics_match(&p->m);
+            short_setting(p->setting, text[ns][np], sizeof text[ns][np]);
+            labels[ns][np] = text[ns][np];
             np++;
         }
         if (!np) continue;
@@ -266,6 +302,8 @@ static bool chart(om_out *o, const svg_chart *c, const cli_point *pts, int n, co
         s[ns].y = ys[ns];
         s[ns].n = np;
         s[ns].labels = labels[ns];
+        s[ns].xlo = xkind == 1 ? NULL : lo[ns];
+        s[ns].xhi = xkind == 1 ? NULL : hi[ns];
         ns++;
     }
     return svg_write(o->f, c, s, ns);
@@ -338,25 +376,27 @@ static int write_outputs(const char *dir, char **names, size_t nn, const cli_poi
         FILE *f = outs[k].f;
         fprintf(f, "scene,method,setting,width,height,time_ms,init_ms,eye_ms,observe_ms,build_ms,"
                    "resolve_ms,shade_ms,bytes,samples,false_lit,false_shadowed,mismatch_share,"
-                   "edge_samples,edge_mismatch_share,stats\n");
+                   "edge_samples,edge_mismatch_share,time_min_ms,time_max_ms,stats\n");
         for (int i = 0; i < np; i++) {
             const cli_point *p = &pts[i];
             double share = 1.0 - om_metrics_match(&p->m);
             double edge = p->m.edge_samples ? (double)(p->m.edge_false_lit + p->m.edge_false_shadowed) /
                                                   (double)p->m.edge_samples : 0.0;
-            fprintf(f, "%s,%s,%s,%u,%u,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%zu,%llu,%llu,%llu,%.6f,%llu,%.6f,%s\n",
+            fprintf(f, "%s,%s,%s,%u,%u,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%zu,%llu,%llu,%llu,%.6f,%llu,%.6f,%.3f,%.3f,%s\n",
                     p->scene, p->method, p->setting, p->w, p->h, p->total, p->init, p->eye,
                     p->observe, p->build, p->resolve, p->shade, p->bytes,
                     (unsigned long long)p->m.samples, (unsigned long long)p->m.false_lit,
                     (unsigned long long)p->m.false_shadowed, share,
-                    (unsigned long long)p->m.edge_samples, edge, p->stats);
+                    (unsigned long long)p->m.edge_samples, edge, p->tmin, p->tmax, p->stats);
         }
         k++;
     }
     /* the charts, three per scene */
     static const char *const suffix[3] = {"time", "bytes", "first"};
-    static const char *const xlabel[3] = {"time per frame, ms", "method bytes",
-                                          "first frame: init + frame, ms"};
+    static const char *const xlabel[3] = {"time per frame (median; bar: fastest to slowest frame)",
+                                          "method memory: the arena's peak bytes",
+                                          "first frame: the method's init + one frame"};
+    static const svg_unit xunit[3] = {SVG_MS, SVG_BYTES, SVG_MS};
     static const char *const what[3] = {"accuracy against speed", "accuracy against memory",
                                         "accuracy against the first frame's time"};
     for (size_t i = 0; i < nn && st == OM_OK; i++) {
@@ -367,7 +407,8 @@ static int write_outputs(const char *dir, char **names, size_t nn, const cli_poi
             char file[300], title[300];
             snprintf(file, sizeof file, "%s-%s.svg", base_name(names[i]), suffix[c]);
             snprintf(title, sizeof title, "%s at %ux%u: %s", base_name(names[i]), W, H, what[c]);
-            svg_chart ch = {title, xlabel[c], "mismatch share against ref", true, true, true, false};
+            svg_chart ch = {title, xlabel[c], "samples wrong against ref", true, true, true, false,
+                            xunit[c], SVG_SHARE};
             if (!(paths[k] = cli_path(dir, file))) st = cli_oom(&d);
             else if ((st = om_out_open(&outs[k], paths[k], &d)) == OM_OK) chart(&outs[k++], &ch, pts, np, names[i], c);
         }
@@ -381,9 +422,10 @@ static int write_outputs(const char *dir, char **names, size_t nn, const cli_poi
             s[i].y = tri_y[i];
             s[i].n = tri_n[i];
             s[i].labels = NULL;
+            s[i].xlo = s[i].xhi = NULL;
         }
         svg_chart c = {"exact methods on the random scenes: time against triangles", "triangles",
-                       "first frame: init + frame, ms", true, true, false, true};
+                       "first frame: init + frame", true, true, false, true, SVG_PLAIN, SVG_MS};
         if (!(paths[k] = cli_path(dir, "triangles.svg"))) st = cli_oom(&d);
         else if ((st = om_out_open(&outs[k], paths[k], &d)) == OM_OK) svg_write(outs[k++].f, &c, s, ntri);
     }

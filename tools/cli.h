@@ -53,6 +53,7 @@ typedef struct cli_point {
     uint32_t w, h;         /* the image size it was measured at */
     double init;           /* the method's init, ms (once per point; ref builds its BVH) */
     double total, eye, observe, build, resolve, shade;   /* per frame, ms (medians) */
+    double tmin, tmax;     /* the fastest and slowest of the frames (total, ms): the spread */
     size_t bytes;
     om_metrics m;
     char stats[256];       /* the method's counters of the last frame: "name=value; ..." */

@@ -1,15 +1,21 @@
-/* svg.c — see svg.h. Layout: 720 x 440, plot area inset for the axes and the legend. */
+/* svg.c — see svg.h. Layout: 800 x 460, the plot inset for the axes on the left and
+ * below and the legend on the right. Point labels are placed greedily, nearest spot
+ * first, never over another label or a point: a dense cluster gets leader lines
+ * rather than a pile of text. */
 #include "svg.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
-#define WIDTH 720
-#define HEIGHT 440
+#define WIDTH 800
+#define HEIGHT 460
 #define LEFT 78
-#define RIGHT 170
+#define RIGHT 190
 #define TOP 40
 #define BOTTOM 58
+#define LABEL_FONT 10
+#define MAX_BOXES 1024
 
 static const char *const colors[] = {"#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd",
                                      "#8c564b", "#e377c2", "#17becf"};
@@ -25,32 +31,91 @@ void svg_escape(FILE *f, const char *t)
     }
 }
 
-typedef struct axis { double lo, hi; bool log; } axis;
+/* An integer with thousands separators: 1,234,567. */
+static void thousands(char *buf, size_t n, double v)
+{
+    char digits[32];
+    snprintf(digits, sizeof digits, "%.0f", fabs(v));
+    size_t len = strlen(digits), o = 0;
+    if (v < 0 && o + 1 < n) buf[o++] = '-';
+    for (size_t i = 0; i < len && o + 2 < n; i++) {
+        buf[o++] = digits[i];
+        if ((len - 1 - i) % 3 == 0 && i + 1 < len) buf[o++] = ',';
+    }
+    buf[o] = 0;
+}
+
+/* %g, but never in e-notation for the ranges charts show */
+static void plain(char *buf, size_t n, double v)
+{
+    if (fabs(v) >= 1000 && fabs(v - floor(v)) < 1e-9) thousands(buf, n, v);
+    else if (fabs(v) >= 10 || v == 0) snprintf(buf, n, "%.0f", v);
+    else if (fabs(v) >= 1) snprintf(buf, n, "%.3g", v);
+    else {
+        int dec = (int)ceil(-log10(fabs(v))) + 1;   /* two significant digits */
+        snprintf(buf, n, "%.*f", dec > 8 ? 8 : dec, v);
+        /* drop trailing zeros: 0.050 -> 0.05 */
+        char *e = buf + strlen(buf) - 1;
+        while (e > buf && *e == '0' && strchr(buf, '.')) *e-- = 0;
+        if (*e == '.') *e = 0;
+    }
+}
+
+void svg_format(char *buf, size_t n, double v, svg_unit u)
+{
+    char num[48];
+    if (u == SVG_SHARE) {
+        plain(num, sizeof num, 100 * v);
+        snprintf(buf, n, "%s%%", num);
+    } else if (u == SVG_MS) {
+        plain(num, sizeof num, v);
+        snprintf(buf, n, "%s ms", num);
+    } else if (u == SVG_BYTES) {
+        static const char *const units[] = {"B", "KiB", "MiB", "GiB"};
+        int k = 0;
+        while (fabs(v) >= 1024 && k < 3) { v /= 1024; k++; }
+        plain(num, sizeof num, v);
+        snprintf(buf, n, "%s %s", num, units[k]);
+    } else {
+        plain(buf, n, v);
+    }
+}
+
+/* lo, hi: the axis' range, in log10 units on a log axis. zero: a log axis carries a row
+ * for the values at 0, at zpos, under the decades from dlo up (a gap between). */
+typedef struct axis { double lo, hi, dlo, zpos; bool log, zero; svg_unit unit; } axis;
 
 static double tr(const axis *a, double v)
 {
-    if (a->log) {
-        double floor_v = pow(10.0, a->lo);
-        return log10(v > floor_v ? v : floor_v);
-    }
+    if (a->log) return v > 0 ? log10(v) : a->zpos;
     return v;
 }
 
 static void fit(axis *a, const svg_series *s, size_t ns, bool is_x)
 {
     double lo = INFINITY, hi = -INFINITY;
+    a->zero = false;
     for (size_t k = 0; k < ns; k++)
         for (size_t i = 0; i < s[k].n; i++) {
             double v = is_x ? s[k].x[i] : s[k].y[i];
-            if (a->log && !(v > 0)) continue;
+            if (a->log && !(v > 0)) { a->zero = true; continue; }
             if (v < lo) lo = v;
             if (v > hi) hi = v;
+            if (is_x && s[k].xlo && s[k].xlo[i] > 0 && s[k].xlo[i] < lo) lo = s[k].xlo[i];
+            if (is_x && s[k].xhi && s[k].xhi[i] > hi) hi = s[k].xhi[i];
         }
-    if (!(lo <= hi)) { lo = a->log ? 1e-3 : 0; hi = a->log ? 1 : 1; }
+    if (!(lo <= hi)) { lo = a->log ? 1e-3 : 0; hi = 1; }
     if (a->log) {
-        a->lo = floor(log10(lo));
-        a->hi = ceil(log10(hi));
-        if (a->hi <= a->lo) a->hi = a->lo + 1;
+        /* the data's own range, padded a little: whole decades left half a chart empty */
+        double l = log10(lo), h = log10(hi), pad = (h - l) * 0.06;
+        if (pad < 0.08) pad = 0.08;
+        a->lo = a->dlo = l - pad;
+        a->hi = h + pad;
+        if (a->zero) {
+            double gap = (a->hi - a->lo) * 0.10;
+            a->zpos = a->lo - gap;
+            a->lo = a->zpos - gap * 0.5;
+        }
     } else {
         double span = hi - lo;
         if (span <= 0) span = fabs(hi) > 0 ? fabs(hi) : 1;
@@ -66,40 +131,185 @@ static double px(const axis *a, double v, double p0, double p1)
     return p0 + (tr(a, v) - a->lo) / (a->hi - a->lo) * (p1 - p0);
 }
 
-static void tick_label(char *buf, size_t n, double v)
+/* The tick values of an axis: on a log axis 1-2-5 in each decade (fewer as the range
+ * widens; powers of two for bytes), five steps on a linear one. */
+static int tick_values(const axis *a, double *out, int max)
 {
-    if (v != 0 && (fabs(v) >= 1e5 || fabs(v) < 1e-3)) snprintf(buf, n, "%.0e", v);
-    else snprintf(buf, n, "%g", v);
+    int n = 0;
+    if (!a->log) {
+        for (int i = 0; i <= 5 && n < max; i++) out[n++] = a->lo + (a->hi - a->lo) * i / 5;
+        return n;
+    }
+    double lo = a->dlo, span = a->hi - a->dlo;
+    if (a->unit == SVG_BYTES) {
+        double l2 = lo / log10(2.0), h2 = a->hi / log10(2.0);
+        int step = 1;
+        while ((h2 - l2) / step > 7) step *= 2;
+        for (int e = (int)ceil(l2); e <= (int)floor(h2) && n < max; e++)
+            if (e % step == 0) out[n++] = pow(2.0, e);
+        return n;
+    }
+    static const double m125[] = {1, 2, 5}, m13[] = {1, 3}, m1[] = {1};
+    const double *m = span <= 3.5 ? m125 : span <= 6 ? m13 : m1;
+    int nm = span <= 3.5 ? 3 : span <= 6 ? 2 : 1;
+    for (int e = (int)floor(lo) - 1; e <= (int)ceil(a->hi) && n < max; e++)
+        for (int j = 0; j < nm && n < max; j++) {
+            double v = m[j] * pow(10.0, e), t = log10(v);
+            if (t >= lo - 1e-9 && t <= a->hi + 1e-9) out[n++] = v;
+        }
+    return n;
 }
 
 static void ticks(FILE *f, const axis *a, bool is_x)
 {
     const double x0 = LEFT, x1 = WIDTH - RIGHT, y0 = HEIGHT - BOTTOM, y1 = TOP;
-    char buf[32];
-    int steps = a->log ? (int)(a->hi - a->lo) : 5;
-    for (int i = 0; i <= steps; i++) {
-        double v = a->log ? pow(10.0, a->lo + i) : a->lo + (a->hi - a->lo) * i / steps;
-        tick_label(buf, sizeof buf, v);
+    char buf[48];
+    double v[64];
+    int n = tick_values(a, v, 63);
+    if (a->log && a->zero) v[n++] = 0;
+    for (int i = 0; i < n; i++) {
+        svg_format(buf, sizeof buf, v[i], a->unit);
         if (is_x) {
-            double x = px(a, v, x0, x1);
-            fprintf(f, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#ddd\"/>\n", x, y0, x, y1);
-            fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\" font-size=\"11\">%s</text>\n", x, y0 + 16, buf);
+            double x = px(a, v[i], x0, x1);
+            fprintf(f, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#e4e4e4\"/>\n", x, y0, x, y1);
+            fprintf(f, "<text class=\"tick\" x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\" font-size=\"11\">%s</text>\n",
+                    x, y0 + 16, buf);
         } else {
-            double y = px(a, v, y0, y1);
-            fprintf(f, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#ddd\"/>\n", x0, y, x1, y);
-            fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"end\" font-size=\"11\">%s</text>\n", x0 - 6, y + 4, buf);
+            double y = px(a, v[i], y0, y1);
+            fprintf(f, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#e4e4e4\"/>\n", x0, y, x1, y);
+            fprintf(f, "<text class=\"tick\" x=\"%.1f\" y=\"%.1f\" text-anchor=\"end\" font-size=\"11\">%s</text>\n",
+                    x0 - 6, y + 4, buf);
         }
+    }
+    if (a->log && a->zero) {   /* the break between the zero row and the decades */
+        if (is_x) {
+            double x = (px(a, 0, x0, x1) + px(a, pow(10.0, a->dlo), x0, x1)) / 2;
+            fprintf(f, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#999\" stroke-dasharray=\"2,3\"/>\n",
+                    x, y0, x, y1);
+        } else {
+            double y = (px(a, 0, y0, y1) + px(a, pow(10.0, a->dlo), y0, y1)) / 2;
+            fprintf(f, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#999\" stroke-dasharray=\"2,3\"/>\n",
+                    x0, y, x1, y);
+        }
+    }
+}
+
+typedef struct box { double x0, y0, x1, y1; } box;
+
+static bool overlaps(const box *a, const box *b)
+{
+    return a->x0 < b->x1 && b->x0 < a->x1 && a->y0 < b->y1 && b->y0 < a->y1;
+}
+
+/* Places one label near (x, y): the first of the candidate spots, nearest first, that
+ * stays inside the plot and clear of every box so far; writes it (with a leader line
+ * when it sits away from its point). Returns false when no spot is free. */
+static bool place_label(FILE *f, const char *text, double x, double y, const char *col, box *boxes,
+                        size_t *nb)
+{
+    static const double dirs[8][2] = {{1, 0}, {-1, 0}, {0, -1}, {0, 1},
+                                      {1, -1}, {1, 1}, {-1, -1}, {-1, 1}};
+    const double w = 0.58 * LABEL_FONT * (double)strlen(text), h = LABEL_FONT + 1;
+    for (int ring = 1; ring <= 6; ring++)
+        for (int d = 0; d < 8; d++) {
+            double r = 7.0 + 12.0 * (ring - 1), cx = x + dirs[d][0] * r, cy = y + dirs[d][1] * r * 0.9;
+            box b;
+            /* the box's edge nearest the point sits at the candidate spot */
+            b.x0 = dirs[d][0] > 0 ? cx : dirs[d][0] < 0 ? cx - w : cx - w / 2;
+            b.y0 = dirs[d][1] > 0 ? cy : dirs[d][1] < 0 ? cy - h : cy - h / 2;
+            b.x1 = b.x0 + w;
+            b.y1 = b.y0 + h;
+            if (b.x0 < LEFT + 2 || b.x1 > WIDTH - RIGHT - 2 || b.y0 < TOP + 2 || b.y1 > HEIGHT - BOTTOM - 2)
+                continue;
+            bool clear = true;
+            for (size_t i = 0; i < *nb && clear; i++) clear = !overlaps(&b, &boxes[i]);
+            if (!clear) continue;
+            if (ring > 1) {
+                double lx = b.x0 > x ? b.x0 : b.x1 < x ? b.x1 : (b.x0 + b.x1) / 2;
+                double ly = b.y0 > y ? b.y0 : b.y1 < y ? b.y1 : (b.y0 + b.y1) / 2;
+                fprintf(f, "<line class=\"leader\" x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" "
+                           "stroke=\"%s\" stroke-width=\"0.6\" opacity=\"0.7\"/>\n", x, y, lx, ly, col);
+            }
+            fprintf(f, "<text class=\"label\" x=\"%.1f\" y=\"%.1f\" font-size=\"%d\" fill=\"%s\">",
+                    b.x0, b.y1 - 2, LABEL_FONT, col);
+            svg_escape(f, text);
+            fprintf(f, "</text>\n");
+            if (*nb < MAX_BOXES) boxes[(*nb)++] = b;
+            return true;
+        }
+    return false;
+}
+
+typedef struct pt { double x, y; } pt;
+
+static int cmp_pt(const void *a, const void *b)
+{
+    const pt *p = a, *q = b;
+    return p->x < q->x ? -1 : p->x > q->x ? 1 : p->y < q->y ? -1 : p->y > q->y;
+}
+
+/* The front over every series, as a staircase: whatever lies above and right of it
+ * is beaten by a point on it. */
+static void front(FILE *f, const axis *ax, const axis *ay, const svg_series *s, size_t ns)
+{
+    static pt all[MAX_BOXES];
+    size_t n = 0;
+    for (size_t k = 0; k < ns; k++)
+        for (size_t i = 0; i < s[k].n && n < MAX_BOXES; i++) all[n++] = (pt){s[k].x[i], s[k].y[i]};
+    if (n < 2) return;
+    qsort(all, n, sizeof all[0], cmp_pt);
+    const double x0 = LEFT, x1 = WIDTH - RIGHT, y0 = HEIGHT - BOTTOM, y1 = TOP;
+    double best = INFINITY, prev_y = 0;
+    bool first = true;
+    fprintf(f, "<polyline class=\"front\" fill=\"none\" stroke=\"#333\" stroke-width=\"2\" "
+               "stroke-opacity=\"0.45\" points=\"");
+    for (size_t i = 0; i < n; i++) {
+        if (!(all[i].y < best)) continue;
+        best = all[i].y;
+        double X = px(ax, all[i].x, x0, x1), Y = px(ay, all[i].y, y0, y1);
+        if (!first) fprintf(f, "%.1f,%.1f ", X, prev_y);
+        fprintf(f, "%.1f,%.1f ", X, Y);
+        prev_y = Y;
+        first = false;
+    }
+    fprintf(f, "\"/>\n");
+}
+
+static void legend(FILE *f, const svg_chart *c, const svg_series *s, size_t ns)
+{
+    double ly = TOP + 14;
+    for (size_t k = 0; k < ns; k++, ly += 18) {
+        const char *col = colors[k % (sizeof colors / sizeof colors[0])];
+        fprintf(f, "<circle cx=\"%d\" cy=\"%.1f\" r=\"5\" fill=\"%s\"/>\n", WIDTH - RIGHT + 16, ly - 4, col);
+        fprintf(f, "<text x=\"%d\" y=\"%.1f\" font-size=\"12\">", WIDTH - RIGHT + 26, ly);
+        svg_escape(f, s[k].name);
+        fprintf(f, "</text>\n");
+    }
+    ly += 8;
+    if (c->pareto) {
+        fprintf(f, "<line x1=\"%d\" y1=\"%.1f\" x2=\"%d\" y2=\"%.1f\" stroke=\"#333\" stroke-width=\"2\" "
+                   "stroke-opacity=\"0.45\"/>\n", WIDTH - RIGHT + 8, ly - 4, WIDTH - RIGHT + 22, ly - 4);
+        fprintf(f, "<text class=\"front-name\" x=\"%d\" y=\"%.1f\" font-size=\"11\">Pareto front (all methods)</text>\n",
+                WIDTH - RIGHT + 26, ly);
+        ly += 18;
+    }
+    bool spread = false;
+    for (size_t k = 0; k < ns; k++) spread |= s[k].xlo != NULL;
+    if (spread) {
+        fprintf(f, "<line x1=\"%d\" y1=\"%.1f\" x2=\"%d\" y2=\"%.1f\" stroke=\"#555\"/>\n", WIDTH - RIGHT + 8,
+                ly - 4, WIDTH - RIGHT + 22, ly - 4);
+        fprintf(f, "<text x=\"%d\" y=\"%.1f\" font-size=\"11\">min-max of the runs</text>\n", WIDTH - RIGHT + 26, ly);
     }
 }
 
 bool svg_write(FILE *f, const svg_chart *c, const svg_series *s, size_t ns)
 {
-    axis ax = {0, 1, c->logx}, ay = {0, 1, c->logy};
+    axis ax = {0, 1, 0, 0, c->logx, false, c->xunit}, ay = {0, 1, 0, 0, c->logy, false, c->yunit};
     fit(&ax, s, ns, true);
     fit(&ay, s, ns, false);
     const double x0 = LEFT, x1 = WIDTH - RIGHT, y0 = HEIGHT - BOTTOM, y1 = TOP;
     fprintf(f, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
-    fprintf(f, "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%d\" height=\"%d\" "
+    fprintf(f, "<svg xmlns=\"http://www.w3.org/2000/svg\" class=\"chart\" width=\"%d\" height=\"%d\" "
                "viewBox=\"0 0 %d %d\" font-family=\"sans-serif\">\n", WIDTH, HEIGHT, WIDTH, HEIGHT);
     fprintf(f, "<rect width=\"%d\" height=\"%d\" fill=\"white\"/>\n", WIDTH, HEIGHT);
     fprintf(f, "<text x=\"%d\" y=\"22\" text-anchor=\"middle\" font-size=\"15\">", (LEFT + WIDTH - RIGHT) / 2);
@@ -111,11 +321,15 @@ bool svg_write(FILE *f, const svg_chart *c, const svg_series *s, size_t ns)
             LEFT, TOP, WIDTH - LEFT - RIGHT, HEIGHT - TOP - BOTTOM);
     fprintf(f, "<text x=\"%d\" y=\"%d\" text-anchor=\"middle\" font-size=\"12\">", (LEFT + WIDTH - RIGHT) / 2, HEIGHT - 18);
     svg_escape(f, c->xlabel);
-    fprintf(f, "%s</text>\n", c->logx ? " (log)" : "");
+    fprintf(f, "%s</text>\n", c->logx ? " (log scale)" : "");
     fprintf(f, "<text x=\"16\" y=\"%d\" text-anchor=\"middle\" font-size=\"12\" transform=\"rotate(-90 16 %d)\">",
             (TOP + HEIGHT - BOTTOM) / 2, (TOP + HEIGHT - BOTTOM) / 2);
     svg_escape(f, c->ylabel);
-    fprintf(f, "%s</text>\n", c->logy ? " (log)" : "");
+    fprintf(f, "%s</text>\n", c->logy ? " (log scale)" : "");
+    if (c->pareto) front(f, &ax, &ay, s, ns);
+    /* the points first (so labels keep clear of all of them), lines and whiskers under */
+    static box boxes[MAX_BOXES];
+    size_t nb = 0;
     for (size_t k = 0; k < ns; k++) {
         const char *col = colors[k % (sizeof colors / sizeof colors[0])];
         if (c->lines && s[k].n > 1) {
@@ -124,45 +338,41 @@ bool svg_write(FILE *f, const svg_chart *c, const svg_series *s, size_t ns)
                 fprintf(f, "%.1f,%.1f ", px(&ax, s[k].x[i], x0, x1), px(&ay, s[k].y[i], y0, y1));
             fprintf(f, "\"/>\n");
         }
-        if (c->pareto && s[k].n > 1) {
-            /* sweep by x ascending, keep points that lower the best y so far */
-            size_t order[256], n = s[k].n < 256 ? s[k].n : 256;
-            for (size_t i = 0; i < n; i++) order[i] = i;
-            for (size_t i = 1; i < n; i++)
-                for (size_t j = i; j > 0 && s[k].x[order[j - 1]] > s[k].x[order[j]]; j--) {
-                    size_t t = order[j]; order[j] = order[j - 1]; order[j - 1] = t;
-                }
-            double best = INFINITY;
-            fprintf(f, "<polyline fill=\"none\" stroke=\"%s\" stroke-dasharray=\"5,3\" points=\"", col);
-            for (size_t i = 0; i < n; i++) {
-                size_t p = order[i];
-                if (s[k].y[p] < best) {
-                    best = s[k].y[p];
-                    fprintf(f, "%.1f,%.1f ", px(&ax, s[k].x[p], x0, x1), px(&ay, s[k].y[p], y0, y1));
-                }
-            }
-            fprintf(f, "\"/>\n");
-        }
         for (size_t i = 0; i < s[k].n; i++) {
-            fprintf(f, "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"4\" fill=\"%s\">",
+            double X = px(&ax, s[k].x[i], x0, x1), Y = px(&ay, s[k].y[i], y0, y1);
+            if (s[k].xlo && s[k].xhi) {
+                double a = px(&ax, s[k].xlo[i], x0, x1), b = px(&ax, s[k].xhi[i], x0, x1);
+                fprintf(f, "<path class=\"spread\" stroke=\"%s\" stroke-width=\"1.2\" fill=\"none\" "
+                           "d=\"M%.1f %.1fH%.1fM%.1f %.1fV%.1fM%.1f %.1fV%.1f\"/>\n",
+                        col, a, Y, b, a, Y - 3, Y + 3, b, Y - 3, Y + 3);
+                if (nb < MAX_BOXES) boxes[nb++] = (box){a - 1, Y - 3.5, b + 1, Y + 3.5};
+            }
+            if (nb < MAX_BOXES) boxes[nb++] = (box){X - 4.5, Y - 4.5, X + 4.5, Y + 4.5};
+        }
+    }
+    for (size_t k = 0; k < ns; k++) {
+        const char *col = colors[k % (sizeof colors / sizeof colors[0])];
+        for (size_t i = 0; i < s[k].n; i++) {
+            fprintf(f, "<circle class=\"point\" cx=\"%.1f\" cy=\"%.1f\" r=\"4\" fill=\"%s\">",
                     px(&ax, s[k].x[i], x0, x1), px(&ay, s[k].y[i], y0, y1), col);
+            char bx[48], by[48];
+            svg_format(bx, sizeof bx, s[k].x[i], c->xunit);
+            svg_format(by, sizeof by, s[k].y[i], c->yunit);
             fprintf(f, "<title>");
             svg_escape(f, s[k].name);
             if (s[k].labels && s[k].labels[i]) { fputc(' ', f); svg_escape(f, s[k].labels[i]); }
-            fprintf(f, ": %g, %g</title></circle>\n", s[k].x[i], s[k].y[i]);
+            fprintf(f, ": %s, %s</title></circle>\n", bx, by);
         }
-        double ly = TOP + 14 + 18.0 * (double)k;
-        fprintf(f, "<circle cx=\"%d\" cy=\"%.1f\" r=\"5\" fill=\"%s\"/>\n", WIDTH - RIGHT + 16, ly - 4, col);
-        fprintf(f, "<text x=\"%d\" y=\"%.1f\" font-size=\"12\">", WIDTH - RIGHT + 26, ly);
-        svg_escape(f, s[k].name);
-        fprintf(f, "</text>\n");
     }
-    if (c->pareto)
-        fprintf(f, "<text x=\"%d\" y=\"%d\" font-size=\"10\" fill=\"#555\">dashed: Pareto front</text>\n",
-                WIDTH - RIGHT + 10, HEIGHT - BOTTOM);
-    if (c->logy)
-        fprintf(f, "<text x=\"%d\" y=\"%d\" font-size=\"10\" fill=\"#555\">on the bottom edge: 0</text>\n",
-                WIDTH - RIGHT + 10, HEIGHT - BOTTOM - 14);
+    /* labels after every point is known, series by series */
+    for (size_t k = 0; k < ns; k++) {
+        const char *col = colors[k % (sizeof colors / sizeof colors[0])];
+        for (size_t i = 0; s[k].labels && i < s[k].n; i++)
+            if (s[k].labels[i] && s[k].labels[i][0])
+                place_label(f, s[k].labels[i], px(&ax, s[k].x[i], x0, x1), px(&ay, s[k].y[i], y0, y1), col,
+                            boxes, &nb);
+    }
+    legend(f, c, s, ns);
     fprintf(f, "</svg>\n");
     return !ferror(f);
 }
