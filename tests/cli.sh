@@ -323,6 +323,10 @@ has "$dir/bench/bench.csv" ",stats$" "bench.csv ends with the methods' counters"
 has "$dir/bench/bench.csv" "bsp nodes=" "bench.csv carries izb's counters"
 if awk -F, 'NR > 1 && ($4 != 64 || $5 != 48) {exit 1}' "$dir/bench/bench.csv"; then ok; else bad "bench ignored the scene's 64x48"; fi
 if [ -s "$dir/bench/ok.scene-first.svg" ]; then ok; else bad "no first-frame (init + frame) chart"; fi
+expect 0 "bench --scenes NAME@WxH" -- "$OMBRA" bench --scenes "default@32x24,$dir/ok.scene" --size 48x36 --runs 1 --methods izb --out "$dir/bench-at"
+if awk -F, '$1 == "default" && ($4 != 32 || $5 != 24) {exit 1} $1 != "default" && NR > 1 && ($4 != 48 || $5 != 36) {exit 1}' "$dir/bench-at/bench.csv"; then ok; else bad "bench ignored a scene's @WxH"; fi
+expect 2 "bench --scenes default@big" -- "$OMBRA" bench --scenes "default@big" --out "$dir/bench-at"
+has "$dir/err" "@ takes WxH" "a bad @ size is a usage error"
 expect 0 "render --method ref" -- "$OMBRA" render --size 16x12 --method ref --out "$dir/z.ppm"
 has "$dir/out" "^time: total [0-9.]* ms (init [0-9.]*, eye" "the time line shows init"
 

@@ -26,7 +26,8 @@ static const char bench_help[] =
     "a CSV table and SVG charts of accuracy against speed and memory.\n"
     "\n"
     "  --scenes LIST     comma-separated: default, random-1K, random-10K, random-100K,\n"
-    "                    random-1M, or scene files (default: default,random-10K)\n"
+    "                    random-1M, or scene files (default: default,random-10K); NAME@WxH\n"
+    "                    measures that scene at its own size\n"
     "  --methods LIST    comma-separated method names (default: every swept method)\n"
     "  --size WxH        image size (default: each scene's own camera size)\n"
     "  --runs N          frames per point; times are their median (default 3)\n"
@@ -49,6 +50,16 @@ static const char *random_scene(const char *name, char *buf, size_t n)
              "plane size 14 14 albedo 0.7 0.7 0.7\n"
              "triangles count %u seed 7 area 20 in -5 0.5 -5 5 3 5\n", count);
     return buf;
+}
+
+bool cli_scene_size(char *entry, uint32_t *w, uint32_t *h)
+{
+    char *at = strrchr(entry, '@');
+    *w = *h = 0;
+    if (!at) return true;
+    if (!cli_parse_size(at + 1, w, h)) return false;
+    *at = 0;
+    return true;
 }
 
 bool cli_builtin_scene(const char *name)
@@ -468,7 +479,12 @@ int cmd_bench(int argc, char **argv)
     }
     memcpy(list, scenes, strlen(scenes) + 1);
     size_t nn = split(list, names, cap);
-    int rc = check_names(argv[0], names, nn, methods);
+    uint32_t *sw = calloc(nn, sizeof *sw), *sh = calloc(nn, sizeof *sh);
+    int rc = sw && sh ? 0 : 1;
+    for (size_t i = 0; i < nn && !rc; i++)
+        if (!cli_scene_size(names[i], &sw[i], &sh[i]))
+            rc = cli_usage_error(argv[0], "a scene's @ takes WxH: '%s'", names[i]);
+    if (!rc) rc = check_names(argv[0], names, nn, methods);
     /* the directory first, so that an unwritable one fails before the work */
     char *path = rc ? NULL : malloc(strlen(dir) + 1);
     if (!rc && path) {
@@ -498,7 +514,7 @@ int cmd_bench(int argc, char **argv)
         uint32_t W = 0, H = 0;
         uint8_t *ref = NULL, *mask = NULL;
         om_status st = cli_load_named(name, &cs, &d);
-        if (st == OM_OK && (st = cli_scene_view(&cs, w, h, &v, &d)) == OM_OK) {
+        if (st == OM_OK && (st = cli_scene_view(&cs, sw[si] ? sw[si] : w, sw[si] ? sh[si] : h, &v, &d)) == OM_OK) {
             W = v.cam.width;
             H = v.cam.height;
             ref = malloc((size_t)W * H);
@@ -604,6 +620,8 @@ int cmd_bench(int argc, char **argv)
     if (!rc) printf("wrote %s/bench.csv and the charts beside it\n", dir);
     free(pts);
     free(names);
+    free(sw);
+    free(sh);
     free(list);
     return rc;
 }

@@ -72,6 +72,9 @@ int cmd_report(int argc, char **argv);
 
 /* "dir/file", malloc'd (NULL when out of memory): paths are never cut short. */
 char *cli_path(const char *dir, const char *file);
+/* Cuts a trailing "@WxH" (the size to measure that scene at) off a --scenes entry
+ * into w, h (0 when there is none); false when what follows the @ is not a size. */
+bool cli_scene_size(char *entry, uint32_t *w, uint32_t *h);
 /* Whether NAME is a built-in scene ("default", "random-1K" ...). */
 bool cli_builtin_scene(const char *name);
 /* The view a sweep measures: the scene at time 0, at --size w x h when given (w > 0),
