@@ -2,7 +2,7 @@
 # report_check.sh — after `make run`: the report's SVG charts and its HTML page are
 # well-formed XML (xmllint); the page's charts read as the report promises (every
 # sweep point labelled, mismatch in percent, the Pareto front named, no script from
-# elsewhere); and headless Chromium renders the page to a screenshot that is not
+# elsewhere; table headers in words, numbers with separators); and headless Chromium renders the page to a screenshot that is not
 # blank, with every chart's points drawn and nothing wider than a 1280 px window.
 # Run by .ci/run; skips a check whose tool is missing, saying so.
 set -u
@@ -50,13 +50,24 @@ for i, c in enumerate(charts):
         bad.append('chart %r does not name its Pareto front' % title)
 if not sweeps:
     bad.append('no accuracy chart with a Pareto front')
+import re
+H = '{http://www.w3.org/1999/xhtml}'
+for th in page.iter(H + 'th'):
+    if '_' in ''.join(th.itertext()):
+        bad.append('a table header reads as a CSV name: %r' % ''.join(th.itertext()))
+for td in page.iter(H + 'td'):
+    if re.fullmatch(r'-?\d{5,}', ''.join(td.itertext()).strip()):
+        bad.append('a number without thousands separators: %s' % ''.join(td.itertext()))
+        break
+if not any(True for _ in page.iter(H + 'table')):
+    bad.append('the page has no table')
 for b in bad:
     print('report: FAIL ' + b)
 print('report: %d charts, %d with a Pareto front' % (len(charts), sweeps))
 sys.exit(1 if bad else 0)
 PY
     then
-        echo "report: the charts carry labels, percent axes and a named front"
+        echo "report: the charts carry labels, percent axes and a named front; the tables read"
     else
         status=1
     fi

@@ -1,11 +1,14 @@
 /* report.c — `ombra report`: one self-contained HTML page (no scripts, no files from
- * elsewhere; pictures as PNG data URIs, charts as inline SVG) with the sweep's charts,
- * the table behind them, and per scene a strip of crops where the methods disagree
- * most with the reference: the reference's mask, and each method's mask and its
- * difference image (false lit red, false shadowed blue). */
+ * elsewhere; pictures as PNG data URIs, charts as inline SVG). Per scene: what it is,
+ * the sweep's charts each with a line on how to read it, the table behind them, and
+ * the frame with the window where the methods disagree most with the reference
+ * outlined, then that window's crops: the reference's mask, and each method's mask
+ * and its difference image (false lit red, false shadowed blue). The tables and CSV
+ * reading are report_table.c's. */
 #define _POSIX_C_SOURCE 200809L
 #include "cli.h"
 #include "png.h"
+#include "report.h"
 #include "svg.h"
 
 #include <stdlib.h>
@@ -14,9 +17,11 @@
 static const char report_help[] =
     "usage: ombra report [--scenes LIST] [--size WxH] [--runs N] [--out DIR] [--tri-sweep]\n"
     "\n"
-    "Runs 'ombra bench' with the same options, then writes DIR/index.html: the charts,\n"
-    "the table, and crops of each scene where the methods disagree most (default: the\n"
-    "default scene at its own size into out/report).\n";
+    "Runs 'ombra bench' with the same options, then writes DIR/index.html: per scene the\n"
+    "charts, the table and crops where the methods disagree most (default: the default\n"
+    "scene at its own size into out/report). A scene NAME@WxH is measured at that size\n"
+    "(say, a big scene smaller than the rest); DIR/stability.csv, when there, adds the\n"
+    "stability section.\n";
 
 #define CROP_MAX 64
 #define ZOOM 3
@@ -59,36 +64,23 @@ static void inline_svg(FILE *f, const char *path)
     fclose(g);
 }
 
-static void table(FILE *f, const char *csv)
+/* A yellow frame two pixels wide just outside the window, so the crops can be found
+ * on the full frame (clipped at its edges). */
+static void outline(uint8_t *rgb, uint32_t W, uint32_t H, uint32_t x0, uint32_t y0, uint32_t crop)
 {
-    FILE *g = fopen(csv, "r");
-    if (!g) return;
-    char line[2048];
-    fprintf(f, "<table>\n");
-    int skip = -1;   /* the methods' counters (the CSV's stats column) stay in the CSV */
-    for (int row = 0; fgets(line, sizeof line, g); row++) {
-        line[strcspn(line, "\n")] = 0;
-        fprintf(f, "<tr>");
-        int col = 0;
-        for (char *c = line, *e; c; c = e ? e + 1 : NULL, col++) {
-            e = strchr(c, ',');
-            if (e) *e = 0;
-            if (row == 0 && !strcmp(c, "stats")) skip = col;
-            if (col == skip) continue;
-            fprintf(f, row ? "<td>" : "<th>");
-            svg_escape(f, c);
-            fprintf(f, row ? "</td>" : "</th>");
+    for (int y = (int)y0 - 2; y < (int)(y0 + crop) + 2; y++)
+        for (int x = (int)x0 - 2; x < (int)(x0 + crop) + 2; x++) {
+            bool inside = x >= (int)x0 && x < (int)(x0 + crop) && y >= (int)y0 && y < (int)(y0 + crop);
+            if (inside || x < 0 || y < 0 || x >= (int)W || y >= (int)H) continue;
+            uint8_t *o = rgb + 3 * ((size_t)y * W + (size_t)x);
+            o[0] = 255; o[1] = 210; o[2] = 0;
         }
-        fprintf(f, "</tr>\n");
-    }
-    fprintf(f, "</table>\n");
-    fclose(g);
 }
 
 /* Renders every swept method at its defaults beside the reference and writes the
- * scene's section: the reference frame, then crops at the window where the methods'
- * masks disagree most with the reference's. */
-static int scene_section(FILE *f, const char *name, uint32_t w, uint32_t h)
+ * frame with the window where the methods' masks disagree most with the reference's
+ * outlined, then that window's crops. */
+static int scene_crops(FILE *f, const char *name, uint32_t w, uint32_t h)
 {
     om_diag d;
     memset(&d, 0, sizeof d);
@@ -99,7 +91,12 @@ static int scene_section(FILE *f, const char *name, uint32_t w, uint32_t h)
     if ((st = cli_scene_view(&cs, w, h, &v, &d))) { cli_scene_free(&cs); return cli_error(name, &d, st); }
     const uint32_t W = v.cam.width, H = v.cam.height;
     size_t n = (size_t)W * H;
-    uint8_t *ref = malloc(n), *frame = malloc(n * 3);
+    uint8_t *ref = malloc(n), *frame = malloc(n * 3), *dm = malloc(n * 3);
+    if (!ref || !frame || !dm) {
+        free(ref); free(frame); free(dm);
+        cli_scene_free(&cs);
+        return cli_error(name, &d, cli_oom(&d));
+    }
     const om_method *ms[16];
     uint8_t *masks[16];
     size_t nm = 0;
@@ -107,6 +104,7 @@ static int scene_section(FILE *f, const char *name, uint32_t w, uint32_t h)
     om_method_cfg cfg;
     om_method_cfg_default(&cfg);
     if (cli_measure(om_method_find("ref"), &cfg, &cs, &v, 1, ref, frame, &p, &d)) {
+        free(ref); free(frame); free(dm);
         cli_scene_free(&cs);
         return cli_error(name, &d, OM_E_INVALID);
     }
@@ -114,7 +112,7 @@ static int scene_section(FILE *f, const char *name, uint32_t w, uint32_t h)
         const om_method *m = om_method_at(k);
         const char *sw = om_method_sweep(m);
         if ((sw && !sw[0]) || !strcmp(m->name, "ref")) continue;
-        masks[nm] = malloc(n);
+        if (!(masks[nm] = malloc(n))) continue;
         if (cli_measure(m, &cfg, &cs, &v, 1, masks[nm], NULL, &p, &d) == OM_OK) ms[nm++] = m;
         else free(masks[nm]);
     }
@@ -133,15 +131,19 @@ static int scene_section(FILE *f, const char *name, uint32_t w, uint32_t h)
                     }
             if (s > best) { best = s; bx = x0; by = y0; }
         }
-    const char *base = strrchr(name, '/') ? strrchr(name, '/') + 1 : name;
-    fprintf(f, "<h2>");
-    svg_escape(f, base);
-    fprintf(f, " at %ux%u</h2>\n<p>The reference frame; the crops below are its %ux%u pixels at "
-               "(%u, %u), where the methods disagree most with the reference.</p>\n", W, H, crop, crop, bx, by);
-    img(f, frame, W, H, 1, "reference frame");
-    uint8_t rgb[CROP_MAX * CROP_MAX * 3], *dm = malloc(n * 3);
-    fprintf(f, "\n<div class=\"strip\">\n<figure>");
-    crop_rgb(frame, W, bx, by, crop, rgb);
+    fprintf(f, "<h3>Where the methods disagree</h3>\n<p>The reference frame at %ux%u; the yellow "
+               "frame marks the %ux%u pixels at (%u, %u) where the methods, each at its defaults, "
+               "disagree most with the reference. Below, that window %u times larger: the frame, "
+               "the reference's shadow mask, and per method its mask and its difference (red: lit "
+               "where the reference is shadowed; blue: the other way round).</p>\n",
+            W, H, crop, crop, bx, by, ZOOM);
+    uint8_t rgb[CROP_MAX * CROP_MAX * 3];
+    crop_rgb(frame, W, bx, by, crop, rgb);   /* before the outline is drawn over the frame */
+    memcpy(dm, frame, n * 3);
+    outline(dm, W, H, bx, by, crop);
+    fprintf(f, "<div class=\"frame\">");
+    img(f, dm, W, H, 1, "reference frame, the crops' window outlined");
+    fprintf(f, "</div>\n<div class=\"strip\">\n<figure>");
     img(f, rgb, crop, crop, ZOOM, "frame crop");
     fprintf(f, "<figcaption>frame</figcaption></figure>\n<figure>");
     mask_rgb(ref, W, bx, by, crop, rgb);
@@ -157,8 +159,8 @@ static int scene_section(FILE *f, const char *name, uint32_t w, uint32_t h)
         om_diff_image(ref, masks[k], W, H, dm);
         crop_rgb(dm, W, bx, by, crop, rgb);
         img(f, rgb, crop, crop, ZOOM, "difference");
-        fprintf(f, "<figcaption>%s diff, %.3f%% of the frame wrong</figcaption></figure>\n",
-                ms[k]->name, 100.0 * (1.0 - om_metrics_match(&mt)));
+        fprintf(f, "<figcaption>%s: %.3f%% wrong</figcaption></figure>\n", ms[k]->name,
+                100.0 * (1.0 - om_metrics_match(&mt)));
         free(masks[k]);
     }
     fprintf(f, "</div>\n");
@@ -175,6 +177,129 @@ static void inline_file(FILE *f, const char *dir, const char *file, void (*put)(
     char *path = cli_path(dir, file);
     if (path) put(f, path);
     free(path);
+}
+
+static const char *base_name(const char *path)
+{
+    return strrchr(path, '/') ? strrchr(path, '/') + 1 : path;
+}
+
+/* What a scene is, in a sentence: the built-in ones described, a file by the comment
+ * lines that open it (a stability case says there what it provokes). */
+static void scene_about(FILE *f, const char *name)
+{
+    if (!strcmp(name, "default")) {
+        fprintf(f, "<p>The built-in default scene: a few solids on a plane under a spot light.</p>\n");
+        return;
+    }
+    if (!strncmp(name, "random-", 7)) {
+        fprintf(f, "<p><code>%s</code>: random triangles of one constant total area in a box above a "
+                   "plane (the Alias-Free Shadow Maps paper's Table 1): the more there are, the "
+                   "smaller each, and the finer the shadows.</p>\n", name);
+        return;
+    }
+    char *text;
+    size_t len;
+    om_diag d;
+    if (om_file_read(name, &text, &len, &d) != OM_OK) return;
+    fprintf(f, "<p><code>");
+    svg_escape(f, name);
+    fprintf(f, "</code>:");
+    for (char *l = text; l && *l == '#'; l = strchr(l, '\n') ? strchr(l, '\n') + 1 : NULL) {
+        size_t n = strcspn(l, "\n");
+        if (!strncmp(l, "# ombra-set", 11)) continue;
+        l[n] = 0;
+        fputc(' ', f);
+        svg_escape(f, l + 1 + (l[1] == ' '));
+        if (l + n < text + len) l[n] = '\n';
+    }
+    fprintf(f, "</p>\n");
+    free(text);
+}
+
+static bool same_scene(const rcsv *c, size_t r, const void *scene)
+{
+    return !strcmp(rcsv_get(c, r, "scene"), (const char *)scene);
+}
+
+static const rcol bench_cols[] = {
+    {"method", "method", R_TEXT, NULL},
+    {"setting", "setting", R_TEXT, NULL},
+    {"time_ms", "frame, ms (median)", R_MS, NULL},
+    {"time_min_ms", "fastest\xe2\x80\x93slowest, ms", R_RANGE, "time_max_ms"},
+    {"init_ms", "init, ms", R_MS, NULL},
+    {"build_ms", "map build, ms", R_MS, NULL},
+    {"resolve_ms", "lookup, ms", R_MS, NULL},
+    {"bytes", "memory, bytes", R_INT, NULL},
+    {"samples", "samples", R_INT, NULL},
+    {"mismatch_share", "wrong, %", R_SHARE, NULL},
+    {"edge_mismatch_share", "wrong near edges, %", R_SHARE, NULL},
+};
+
+static const rcol stability_cols[] = {
+    {"case", "case", R_TEXT, NULL},
+    {"method", "method", R_TEXT, NULL},
+    {"frames", "frames", R_INT, NULL},
+    {"mean_mismatch", "wrong, mean %", R_SHARE, NULL},
+    {"worst_mismatch", "wrong, worst frame %", R_SHARE, NULL},
+    {"mean_edge_mismatch", "wrong near edges, %", R_SHARE, NULL},
+    {"flicker", "flicker, %", R_SHARE, NULL},
+    {"median_ms", "frame, ms (median)", R_MS, NULL},
+    {"bytes", "memory, bytes", R_INT, NULL},
+};
+
+/* One scene's part of the page: what it is, its three charts each with how to read it,
+ * its rows of the table, and its crops. */
+static int scene_part(FILE *f, const char *dir, const char *name, uint32_t w, uint32_t h,
+                      const rcsv *bench, const char *runs)
+{
+    const char *base = base_name(name);
+    uint32_t W = w, H = h;
+    for (size_t r = 0; r < bench->rows; r++)
+        if (same_scene(bench, r, name)) {
+            W = (uint32_t)rcsv_num(bench, r, "width");
+            H = (uint32_t)rcsv_num(bench, r, "height");
+            break;
+        }
+    fprintf(f, "<h2 id=\"scene-");
+    svg_escape(f, base);
+    fprintf(f, "\">");
+    svg_escape(f, base);
+    fprintf(f, " at %ux%u</h2>\n", W, H);
+    scene_about(f, name);
+    static const char *const charts[3] = {"time", "bytes", "first"};
+    static const char *const read[3] = {
+        "Down is more accurate, left is faster. Each point is one setting of a method; the grey "
+        "staircase is the Pareto front over all methods: every point above or right of it is beaten "
+        "on both counts by a point on it. A bar spans the fastest to the slowest of the %s frames: "
+        "points whose bars overlap are not reliably different in speed.",
+        "Down is more accurate, left needs less memory (the method's own arena at its peak, the "
+        "frame's samples not counted). Read across at the memory you can spare: the lowest point "
+        "left of it is the best accuracy that memory buys. %s",
+        "The first frame after the scene changes: the method's init (the reference builds its BVH "
+        "here; a map's memory is cleared) plus one frame. Methods that pay a lot up front move "
+        "right. The bars are the spread of the %s frames."};
+    for (int c = 0; c < 3; c++) {
+        char file[300];
+        snprintf(file, sizeof file, "%s-%s.svg", base, charts[c]);
+        fprintf(f, "<p class=\"read\">");
+        fprintf(f, read[c], c == 1 ? "" : runs);
+        fprintf(f, "</p>\n");
+        inline_file(f, dir, file, inline_svg);
+    }
+    fprintf(f, "<h3>The numbers</h3>\n<p>Per point: the median frame and the spread of the %s frames, "
+               "the method's init, the map's build and the lookup per sample (a frame's other "
+               "stages, the eye pass and shading, are the same for every method and in "
+               "<code>bench.csv</code>), the arena's peak bytes, and the share of the visible "
+               "samples whose shadow differs from the reference, overall and near shadow edges.</p>\n",
+            runs);
+    report_table(f, bench, bench_cols, sizeof bench_cols / sizeof bench_cols[0], same_scene, name);
+    return scene_crops(f, name, w, h);
+}
+
+static void step(int i, int n, const char *what, const char *name)
+{
+    fprintf(stderr, "report: [%d/%d] %s%s\n", i, n, what, name ? name : "");
 }
 
 int cmd_report(int argc, char **argv)
@@ -195,6 +320,10 @@ int cmd_report(int argc, char **argv)
     }
     uint32_t W = 0, H = 0;
     if (size && !cli_parse_size(size, &W, &H)) return cli_usage_error("report", "--size takes WxH, not '%s'", size);
+    size_t nscenes = 1;
+    for (const char *p = scenes; *p; p++) nscenes += *p == ',';
+    const int nsteps = 2 + (int)nscenes;
+    step(1, nsteps, "the sweep: ombra bench", NULL);
     char *bargv[12] = {"report", "--scenes", (char *)scenes, "--runs", (char *)runs, "--out", (char *)dir};
     int bargc = 7;
     if (size) { bargv[bargc++] = "--size"; bargv[bargc++] = (char *)size; }
@@ -204,59 +333,81 @@ int cmd_report(int argc, char **argv)
     om_diag d;
     memset(&d, 0, sizeof d);
     om_out page;
+    rcsv bench;
     char *path = cli_path(dir, "index.html"), *list = malloc(strlen(scenes) + 1);
-    om_status st = path && list ? om_out_open(&page, path, &d) : cli_oom(&d);
-    if (st != OM_OK) { free(path); free(list); return cli_error(NULL, &d, st); }
+    char *csv = cli_path(dir, "bench.csv");
+    om_status st = path && list && csv ? om_out_open(&page, path, &d) : cli_oom(&d);
+    if (st != OM_OK) { free(path); free(list); free(csv); return cli_error(NULL, &d, st); }
+    if (!rcsv_load(&bench, csv)) memset(&bench, 0, sizeof bench);
     FILE *f = page.f;
     fprintf(f, "<!DOCTYPE html>\n<html xmlns=\"http://www.w3.org/1999/xhtml\" lang=\"en\">\n<head>\n"
                "<meta charset=\"utf-8\"/>\n<title>ombra report</title>\n<style>\n"
-               "body { font-family: sans-serif; margin: 2em; color: #222; }\n"
-               "table { border-collapse: collapse; font-size: 12px; display: block; overflow-x: auto; }\n"
+               "body { font-family: sans-serif; margin: 2em; color: #222; max-width: 1180px; }\n"
+               ".scroll { overflow-x: auto; max-width: 100%%; }\n"
+               "table { border-collapse: collapse; font-size: 12px; }\n"
                "td, th { border: 1px solid #ccc; padding: 2px 6px; text-align: right; }\n"
-               "img { image-rendering: pixelated; border: 1px solid #888; }\n"
-               ".strip { display: flex; flex-wrap: wrap; gap: 8px; }\n"
+               "th { background: #f3f3f3; vertical-align: bottom; }\n"
+               "td.t { text-align: left; white-space: nowrap; }\n"
+               "svg { max-width: 100%%; height: auto; }\n"
+               "p.read { max-width: 800px; margin-bottom: 0.3em; }\n"
+               "img { image-rendering: pixelated; border: 1px solid #888; max-width: 100%%; height: auto; }\n"
+               ".strip { display: flex; flex-wrap: wrap; gap: 8px; margin-top: 8px; }\n"
                "figure { margin: 0; font-size: 12px; text-align: center; }\n"
                "</style>\n</head>\n<body>\n<h1>ombra: hard shadows, accuracy against speed</h1>\n"
                "<p>Every method renders the same visible samples; accuracy is the share of samples "
                "whose binary shadow state differs from the exact reference (<code>ref</code>). "
-               "Times are medians of %s frames on one core at %s; a method's init (where "
+               "Times are medians of %s frames on one core; a method's init (where "
                "<code>ref</code> builds its BVH) is its own stage, paid again whenever the scene "
-               "changes.</p>\n", runs, size ? size : "each scene's own size");
+               "changes. All the numbers are in <code>bench.csv</code> beside this page.</p>\n", runs);
     memcpy(list, scenes, strlen(scenes) + 1);
-    fprintf(f, "<h2>Charts</h2>\n");
-    static const char *const charts[3] = {"time", "bytes", "first"};
+    fprintf(f, "<p>Scenes:");
     for (char *name = strtok(list, ","); name; name = strtok(NULL, ",")) {
-        const char *base = strrchr(name, '/') ? strrchr(name, '/') + 1 : name;
-        for (int c = 0; c < 3; c++) {
-            char file[300];
-            snprintf(file, sizeof file, "%s-%s.svg", base, charts[c]);
-            inline_file(f, dir, file, inline_svg);
-        }
+        uint32_t sw, sh;
+        cli_scene_size(name, &sw, &sh);
+        fprintf(f, " <a href=\"#scene-");
+        svg_escape(f, base_name(name));
+        fprintf(f, "\">");
+        svg_escape(f, base_name(name));
+        fprintf(f, "</a>");
     }
-    if (tri) inline_file(f, dir, "triangles.svg", inline_svg);
-    fprintf(f, "<h2>The table</h2>\n");
-    inline_file(f, dir, "bench.csv", table);
+    fprintf(f, ".</p>\n");
     memcpy(list, scenes, strlen(scenes) + 1);
+    int k = 2;
+    for (char *name = strtok(list, ","); name && !rc; name = strtok(NULL, ","), k++) {
+        uint32_t sw, sh;
+        cli_scene_size(name, &sw, &sh);   /* bench has checked it */
+        step(k, nsteps, "charts, table and crops of ", name);
+        rc = scene_part(f, dir, name, sw ? sw : W, sw ? sh : H, &bench, runs);
+    }
+    if (tri && !rc) {
+        fprintf(f, "<h2>The exact methods against scene size</h2>\n<p class=\"read\">The first frame "
+                   "(init and one frame) of each exact method on 1K to 1M random triangles: how its "
+                   "cost grows with the scene. <code>ref</code> rebuilds its BVH whenever the "
+                   "triangles change; the irregular z-buffer's cost follows the visible samples and "
+                   "the triangles that reach them.</p>\n");
+        inline_file(f, dir, "triangles.svg", inline_svg);
+    }
     char *stab = cli_path(dir, "stability.csv");
-    FILE *sf = stab ? fopen(stab, "r") : NULL;
-    if (sf) {
-        fclose(sf);
+    rcsv sc;
+    if (!rc && stab && rcsv_load(&sc, stab)) {
         fprintf(f, "<h2>Stability: where each method is known to fail</h2>\n"
                    "<p>Every method along the 30-frame camera and light paths of the cases in "
-                   "<code>tests/stability/</code> (<code>make stability</code>): mismatch share "
-                   "against the reference (mean and worst frame), the same near shadow edges, "
+                   "<code>tests/stability/</code> (<code>make stability</code>): the share of samples "
+                   "wrong against the reference (mean and worst frame), the same near shadow edges, "
                    "flicker (state changes the reference does not have), median frame time and "
                    "arena bytes.</p>\n");
-        table(f, stab);
+        report_table(f, &sc, stability_cols, sizeof stability_cols / sizeof stability_cols[0], NULL, NULL);
+        rcsv_free(&sc);
     }
     free(stab);
-    for (char *name = strtok(list, ","); name && !rc; name = strtok(NULL, ","))
-        rc = scene_section(f, name, W, H);
+    step(nsteps, nsteps, "the page", NULL);
     fprintf(f, "</body>\n</html>\n");
     om_out *outs[1] = {&page};
     if (rc) om_out_discard(&page);
     else if ((st = om_out_commit(outs, 1, &d)) != OM_OK) rc = cli_error(NULL, &d, st);
     if (!rc) printf("wrote %s\n", path);
+    rcsv_free(&bench);
+    free(csv);
     free(path);
     free(list);
     return rc;

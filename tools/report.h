@@ -1,0 +1,42 @@
+/* report.h — what the files of `ombra report` share: a CSV read whole by its header's
+ * column names (so a column added to bench.csv moves nothing), and tables written
+ * from it with human headers and numbers in a unit. The page itself is report.c's. */
+#ifndef OM_REPORT_H
+#define OM_REPORT_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdio.h>
+
+typedef struct rcsv {
+    char *text;          /* the file, its commas and newlines cut to NULs */
+    char **cell;         /* rows x cols; a short row's missing cells are "" */
+    size_t rows, cols;   /* rows: data rows, the header not counted */
+    char **head;
+} rcsv;
+
+/* Reads a CSV; false (nothing to free) when it is missing or empty. */
+bool rcsv_load(rcsv *c, const char *path);
+void rcsv_free(rcsv *c);
+/* The column named `name`, or -1. */
+int rcsv_col(const rcsv *c, const char *name);
+/* Row r's cell in the column named `name`; "" when there is no such column. */
+const char *rcsv_get(const rcsv *c, size_t r, const char *name);
+double rcsv_num(const rcsv *c, size_t r, const char *name);
+
+/* How a table cell reads: as it is, an integer with separators, ms, a share in
+ * percent, WxH from width and height, min-max of two ms columns. */
+typedef enum rkind { R_TEXT, R_INT, R_MS, R_SHARE, R_SIZE, R_RANGE } rkind;
+typedef struct rcol {
+    const char *csv;     /* the column (R_SIZE: width; R_RANGE: the min's) */
+    const char *head;    /* the header a reader sees, unit included */
+    rkind kind;
+    const char *csv2;    /* R_SIZE: height; R_RANGE: the max's */
+} rcol;
+
+/* A table of the rows for which keep(c, r, user) holds (NULL: every row), in a box
+ * of its own that scrolls sideways when the window is narrow. */
+void report_table(FILE *f, const rcsv *c, const rcol *cols, size_t ncols,
+                  bool (*keep)(const rcsv *c, size_t r, const void *user), const void *user);
+
+#endif
