@@ -248,31 +248,37 @@ static int cmp_pt(const void *a, const void *b)
     return p->x < q->x ? -1 : p->x > q->x ? 1 : p->y < q->y ? -1 : p->y > q->y;
 }
 
-/* The front over every series, as a staircase: whatever lies above and right of it
- * is beaten by a point on it. */
+/* The front over every series, as a staircase from the top edge to the right one
+ * (whatever lies above and right of it is beaten by a point on it), each of its points
+ * ringed: a front of one point still shows. */
 static void front(FILE *f, const axis *ax, const axis *ay, const svg_series *s, size_t ns)
 {
     static pt all[MAX_BOXES];
     size_t n = 0;
     for (size_t k = 0; k < ns; k++)
         for (size_t i = 0; i < s[k].n && n < MAX_BOXES; i++) all[n++] = (pt){s[k].x[i], s[k].y[i]};
-    if (n < 2) return;
+    if (n < 1) return;
     qsort(all, n, sizeof all[0], cmp_pt);
     const double x0 = LEFT, x1 = WIDTH - RIGHT, y0 = HEIGHT - BOTTOM, y1 = TOP;
-    double best = INFINITY, prev_y = 0;
-    bool first = true;
+    double best = INFINITY, prev_y = y1;
     fprintf(f, "<polyline class=\"front\" fill=\"none\" stroke=\"#333\" stroke-width=\"2\" "
                "stroke-opacity=\"0.45\" points=\"");
     for (size_t i = 0; i < n; i++) {
         if (!(all[i].y < best)) continue;
         best = all[i].y;
         double X = px(ax, all[i].x, x0, x1), Y = px(ay, all[i].y, y0, y1);
-        if (!first) fprintf(f, "%.1f,%.1f ", X, prev_y);
-        fprintf(f, "%.1f,%.1f ", X, Y);
+        fprintf(f, "%.1f,%.1f %.1f,%.1f ", X, prev_y, X, Y);
         prev_y = Y;
-        first = false;
     }
-    fprintf(f, "\"/>\n");
+    fprintf(f, "%.1f,%.1f\"/>\n", x1, prev_y);
+    best = INFINITY;
+    for (size_t i = 0; i < n; i++) {
+        if (!(all[i].y < best)) continue;
+        best = all[i].y;
+        fprintf(f, "<circle class=\"front\" cx=\"%.1f\" cy=\"%.1f\" r=\"7\" fill=\"none\" stroke=\"#333\" "
+                   "stroke-width=\"1.5\" stroke-opacity=\"0.6\"/>\n",
+                px(ax, all[i].x, x0, x1), px(ay, all[i].y, y0, y1));
+    }
 }
 
 static void legend(FILE *f, const svg_chart *c, const svg_series *s, size_t ns)
@@ -288,7 +294,9 @@ static void legend(FILE *f, const svg_chart *c, const svg_series *s, size_t ns)
     ly += 8;
     if (c->pareto) {
         fprintf(f, "<line x1=\"%d\" y1=\"%.1f\" x2=\"%d\" y2=\"%.1f\" stroke=\"#333\" stroke-width=\"2\" "
-                   "stroke-opacity=\"0.45\"/>\n", WIDTH - RIGHT + 8, ly - 4, WIDTH - RIGHT + 22, ly - 4);
+                   "stroke-opacity=\"0.45\"/>\n", WIDTH - RIGHT + 6, ly - 4, WIDTH - RIGHT + 24, ly - 4);
+        fprintf(f, "<circle cx=\"%d\" cy=\"%.1f\" r=\"5\" fill=\"none\" stroke=\"#333\" stroke-width=\"1.5\" "
+                   "stroke-opacity=\"0.6\"/>\n", WIDTH - RIGHT + 15, ly - 4);
         fprintf(f, "<text class=\"front-name\" x=\"%d\" y=\"%.1f\" font-size=\"11\">Pareto front (all methods)</text>\n",
                 WIDTH - RIGHT + 26, ly);
         ly += 18;
