@@ -2,7 +2,8 @@
 # report_check.sh — after `make run`: the report's SVG charts and its HTML page are
 # well-formed XML (xmllint); the page's charts read as the report promises (every
 # sweep point labelled, mismatch in percent, the Pareto front named, no script from
-# elsewhere; table headers in words, numbers with separators); and headless Chromium renders the page to a screenshot that is not
+# elsewhere; table headers in words, numbers with separators; the stability strips
+# and a flicker crop when stability.csv is there); and headless Chromium renders the page to a screenshot that is not
 # blank, with every chart's points drawn and nothing wider than a 1280 px window.
 # Run by .ci/run; skips a check whose tool is missing, saying so.
 set -u
@@ -61,6 +62,14 @@ for td in page.iter(H + 'td'):
         break
 if not any(True for _ in page.iter(H + 'table')):
     bad.append('the page has no table')
+import os
+stab = os.path.join(os.path.dirname(sys.argv[1]), 'stability.csv')
+if os.path.exists(stab) and 'frame_mismatch' in open(stab).readline():
+    strips = [c for c in charts if 'multiple' in (c.get('class') or '')]
+    if not strips:
+        bad.append('stability.csv is there but the page has no stability strips')
+    elif not any('flickers most' in ''.join(p.itertext()) for p in page.iter(H + 'p')):
+        bad.append('the stability section shows no flicker crops')
 for b in bad:
     print('report: FAIL ' + b)
 print('report: %d charts, %d with a Pareto front' % (len(charts), sweeps))

@@ -28,7 +28,7 @@ static const char report_help[] =
 
 /* mask -> grey RGB: lit light, shadowed dark, background black; crops are crop x crop
  * (CROP_MAX, or less for a smaller image) */
-static void mask_rgb(const uint8_t *mask, uint32_t W, uint32_t x0, uint32_t y0, uint32_t crop,
+void report_mask_rgb(const uint8_t *mask, uint32_t W, uint32_t x0, uint32_t y0, uint32_t crop,
                      uint8_t *rgb)
 {
     for (uint32_t y = 0; y < crop; y++)
@@ -40,14 +40,14 @@ static void mask_rgb(const uint8_t *mask, uint32_t W, uint32_t x0, uint32_t y0, 
         }
 }
 
-static void crop_rgb(const uint8_t *full, uint32_t W, uint32_t x0, uint32_t y0, uint32_t crop,
+void report_crop_rgb(const uint8_t *full, uint32_t W, uint32_t x0, uint32_t y0, uint32_t crop,
                      uint8_t *rgb)
 {
     for (uint32_t y = 0; y < crop; y++)
         memcpy(rgb + (size_t)y * crop * 3, full + ((size_t)(y0 + y) * W + x0) * 3, crop * 3);
 }
 
-static void img(FILE *f, const uint8_t *rgb, uint32_t w, uint32_t h, uint32_t zoom, const char *alt)
+void report_img(FILE *f, const uint8_t *rgb, uint32_t w, uint32_t h, uint32_t zoom, const char *alt)
 {
     fprintf(f, "<img alt=\"%s\" width=\"%u\" height=\"%u\" src=\"", alt, w * zoom, h * zoom);
     png_data_uri(f, rgb, w, h);
@@ -66,7 +66,7 @@ static void inline_svg(FILE *f, const char *path)
 
 /* A yellow frame two pixels wide just outside the window, so the crops can be found
  * on the full frame (clipped at its edges). */
-static void outline(uint8_t *rgb, uint32_t W, uint32_t H, uint32_t x0, uint32_t y0, uint32_t crop)
+void report_outline(uint8_t *rgb, uint32_t W, uint32_t H, uint32_t x0, uint32_t y0, uint32_t crop)
 {
     for (int y = (int)y0 - 2; y < (int)(y0 + crop) + 2; y++)
         for (int x = (int)x0 - 2; x < (int)(x0 + crop) + 2; x++) {
@@ -138,27 +138,27 @@ static int scene_crops(FILE *f, const char *name, uint32_t w, uint32_t h)
                "where the reference is shadowed; blue: the other way round).</p>\n",
             W, H, crop, crop, bx, by, ZOOM);
     uint8_t rgb[CROP_MAX * CROP_MAX * 3];
-    crop_rgb(frame, W, bx, by, crop, rgb);   /* before the outline is drawn over the frame */
+    report_crop_rgb(frame, W, bx, by, crop, rgb);   /* before the outline is drawn over the frame */
     memcpy(dm, frame, n * 3);
-    outline(dm, W, H, bx, by, crop);
+    report_outline(dm, W, H, bx, by, crop);
     fprintf(f, "<div class=\"frame\">");
-    img(f, dm, W, H, 1, "reference frame, the crops' window outlined");
+    report_img(f, dm, W, H, 1, "reference frame, the crops' window outlined");
     fprintf(f, "</div>\n<div class=\"strip\">\n<figure>");
-    img(f, rgb, crop, crop, ZOOM, "frame crop");
+    report_img(f, rgb, crop, crop, ZOOM, "frame crop");
     fprintf(f, "<figcaption>frame</figcaption></figure>\n<figure>");
-    mask_rgb(ref, W, bx, by, crop, rgb);
-    img(f, rgb, crop, crop, ZOOM, "reference mask");
+    report_mask_rgb(ref, W, bx, by, crop, rgb);
+    report_img(f, rgb, crop, crop, ZOOM, "reference mask");
     fprintf(f, "<figcaption>ref</figcaption></figure>\n");
     for (size_t k = 0; k < nm; k++) {
         om_metrics mt;
         om_compare_masks(ref, masks[k], W, H, &mt);
         fprintf(f, "<figure>");
-        mask_rgb(masks[k], W, bx, by, crop, rgb);
-        img(f, rgb, crop, crop, ZOOM, ms[k]->name);
+        report_mask_rgb(masks[k], W, bx, by, crop, rgb);
+        report_img(f, rgb, crop, crop, ZOOM, ms[k]->name);
         fprintf(f, "<figcaption>%s mask</figcaption></figure>\n<figure>", ms[k]->name);
         om_diff_image(ref, masks[k], W, H, dm);
-        crop_rgb(dm, W, bx, by, crop, rgb);
-        img(f, rgb, crop, crop, ZOOM, "difference");
+        report_crop_rgb(dm, W, bx, by, crop, rgb);
+        report_img(f, rgb, crop, crop, ZOOM, "difference");
         fprintf(f, "<figcaption>%s: %.3f%% wrong</figcaption></figure>\n", ms[k]->name,
                 100.0 * (1.0 - om_metrics_match(&mt)));
         free(masks[k]);
@@ -322,7 +322,7 @@ int cmd_report(int argc, char **argv)
     if (size && !cli_parse_size(size, &W, &H)) return cli_usage_error("report", "--size takes WxH, not '%s'", size);
     size_t nscenes = 1;
     for (const char *p = scenes; *p; p++) nscenes += *p == ',';
-    const int nsteps = 2 + (int)nscenes;
+    const int nsteps = 3 + (int)nscenes;
     step(1, nsteps, "the sweep: ombra bench", NULL);
     char *bargv[12] = {"report", "--scenes", (char *)scenes, "--runs", (char *)runs, "--out", (char *)dir};
     int bargc = 7;
@@ -389,10 +389,10 @@ int cmd_report(int argc, char **argv)
     }
     char *stab = cli_path(dir, "stability.csv");
     rcsv sc;
+    if (!rc) step(nsteps - 1, nsteps, "stability strips and crops, from ", stab);
     if (!rc && stab && rcsv_load(&sc, stab)) {
-        fprintf(f, "<h2>Stability: where each method is known to fail</h2>\n"
-                   "<p>Every method along the 30-frame camera and light paths of the cases in "
-                   "<code>tests/stability/</code> (<code>make stability</code>): the share of samples "
+        report_stability(f, &sc);
+        fprintf(f, "<h3>The stability numbers</h3>\n<p>Per case and method: the share of samples "
                    "wrong against the reference (mean and worst frame), the same near shadow edges, "
                    "flicker (state changes the reference does not have), median frame time and "
                    "arena bytes.</p>\n");

@@ -6,6 +6,7 @@
 
 #include <stdbool.h>
 #include <stddef.h>
+#include <stdint.h>
 #include <stdio.h>
 
 typedef struct rcsv {
@@ -38,5 +39,20 @@ typedef struct rcol {
  * of its own that scrolls sideways when the window is narrow. */
 void report_table(FILE *f, const rcsv *c, const rcol *cols, size_t ncols,
                   bool (*keep)(const rcsv *c, size_t r, const void *user), const void *user);
+
+/* Pictures (report.c). A mask as grey RGB (lit light, shadowed dark, background
+ * black) and an RGB image, each cut to the crop x crop window at (x0, y0) of a W-wide
+ * image; an image as a PNG data URI, shown zoom times larger; a yellow frame just
+ * outside a window, so its crops can be found on the full frame. */
+void report_mask_rgb(const uint8_t *mask, uint32_t W, uint32_t x0, uint32_t y0, uint32_t crop, uint8_t *rgb);
+void report_crop_rgb(const uint8_t *full, uint32_t W, uint32_t x0, uint32_t y0, uint32_t crop, uint8_t *rgb);
+void report_img(FILE *f, const uint8_t *rgb, uint32_t w, uint32_t h, uint32_t zoom, const char *alt);
+void report_outline(uint8_t *rgb, uint32_t W, uint32_t H, uint32_t x0, uint32_t y0, uint32_t crop);
+
+/* The stability section (report_stability.c): per case of DIR's stability.csv, a strip
+ * of small charts of each method's mismatch share over the frames and the crops of
+ * the frame where the method that flickers most flickers most (re-rendered from
+ * tests/stability/CASE.scene when it is there). */
+void report_stability(FILE *f, const rcsv *sc);
 
 #endif

@@ -4,7 +4,8 @@
  * fast camera, the irregular z-buffer's hot spot with a small pool, curved edges
  * without tessellation, shadow fusion and thin geometry). Per method and case: mean and
  * worst mismatch share against the reference, the same near shadow edges, flicker, the
- * median frame time and the arena's peak bytes, to stdout and a CSV the report shows.
+ * median frame time and the arena's peak bytes, to stdout and a CSV the report shows
+ * (with each frame's mismatch share and the frame that flickers most, for its strips).
  * It asserts what must hold: exact methods have zero mismatches on every frame, every
  * frame renders, no method uses more than its arena, and a second run is bit-identical.
  * A case's "# ombra-set NAME=VALUE ..." comment lines set method settings. */
@@ -127,7 +128,8 @@ int main(int argc, char **argv)
     }
     if (frames < 2 || frames > 240) frames = 30;
     FILE *out = csv ? fopen(csv, "w") : NULL;
-    if (out) fprintf(out, "case,method,frames,mean_mismatch,worst_mismatch,mean_edge_mismatch,flicker,median_ms,bytes\n");
+    if (out) fprintf(out, "case,method,frames,mean_mismatch,worst_mismatch,mean_edge_mismatch,flicker,median_ms,bytes,"
+                          "flicker_frame,frame_mismatch\n");
     printf("%-12s %-5s %8s %8s %8s %8s %8s %10s\n", "case", "meth", "mean", "worst", "edge",
            "flicker", "ms", "bytes");
     for (int a = first; a < argc; a++) {
@@ -157,18 +159,23 @@ int main(int argc, char **argv)
                 failures++;
                 continue;
             }
-            double sum = 0, worst = 0, edge = 0;
+            double sum = 0, worst = 0, edge = 0, share[240];
             om_flicker fl = {0, 0, 0};
+            uint64_t most = 0;
+            int flicker_frame = 0;   /* the frame whose changes from the one before flicker most */
             int wrong_frames = 0;
             for (int f = 0; f < frames; f++) {
                 om_metrics mt;
                 om_compare_masks(ref + (size_t)f * n, mk + (size_t)f * n, W, H, &mt);
                 double sh = 1.0 - om_metrics_match(&mt);
+                share[f] = sh;
                 sum += sh;
                 if (sh > worst) worst = sh;
                 edge += mt.edge_samples ? (double)(mt.edge_false_lit + mt.edge_false_shadowed) / (double)mt.edge_samples : 0;
                 wrong_frames += mt.false_lit + mt.false_shadowed > 0;
+                uint64_t before = fl.flicker;
                 if (f > 0) om_flicker_add(&fl, ref + (size_t)(f - 1) * n, mk + (size_t)(f - 1) * n, ref + (size_t)f * n, mk + (size_t)f * n, n);
+                if (fl.flicker - before > most) { most = fl.flicker - before; flicker_frame = f; }
             }
             if ((m->flags & OM_METHOD_EXACT) && wrong_frames) {
                 printf("stability: FAIL %s / %s: an exact method is wrong on %d frames\n", name, m->name, wrong_frames);
@@ -183,9 +190,12 @@ int main(int argc, char **argv)
             double med = bench_median(ms, frames);
             printf("%-12s %-5s %7.3f%% %7.3f%% %7.3f%% %7.3f%% %8.2f %10zu\n", name, m->name,
                    100 * sum / frames, 100 * worst, 100 * edge / frames, 100 * om_flicker_share(&fl), med, peak);
-            if (out)
-                fprintf(out, "%s,%s,%d,%.6f,%.6f,%.6f,%.6f,%.3f,%zu\n", name, m->name, frames, sum / frames,
-                        worst, edge / frames, om_flicker_share(&fl), med, peak);
+            if (out) {
+                fprintf(out, "%s,%s,%d,%.6f,%.6f,%.6f,%.6f,%.3f,%zu,%d,", name, m->name, frames, sum / frames,
+                        worst, edge / frames, om_flicker_share(&fl), med, peak, flicker_frame);
+                for (int f = 0; f < frames; f++) fprintf(out, "%s%.6f", f ? ";" : "", share[f]);
+                fputc('\n', out);
+            }
         }
         free(ref);
         free(mk);
