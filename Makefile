@@ -61,7 +61,7 @@ run: $(O)/ombra
 	@mkdir -p out
 	$(O)/ombra render --out out/default.ppm --mask out/default-mask.pgm
 	$(MAKE) --no-print-directory stability
-	$(O)/ombra report --scenes default,random-10K@320x240,random-100K@320x240,tests/stability/closeup.scene@160x120 --size 640x480 --runs 3 --tri-sweep --out out/report
+	$(O)/ombra report --scenes default,random-10K@320x240,random-100K@320x240,tests/stability/closeup.scene@160x120 --size 640x480 --runs 3 --tri-sweep --equal-memory --out out/report
 
 # One suite, four builds: the same tests must pass under gcc and clang at -O0 and -O2.
 test:

@@ -3,7 +3,8 @@
 # well-formed XML (xmllint); the page's charts read as the report promises (every
 # sweep point labelled, mismatch in percent, the Pareto front named, no script from
 # elsewhere; table headers in words, numbers with separators; the stability strips
-# and a flicker crop when stability.csv is there); and headless Chromium renders the page to a screenshot that is not
+# and a flicker crop when stability.csv is there; the equal-memory chart when the page
+# has that section); and headless Chromium renders the page to a screenshot that is not
 # blank, with every chart's points drawn and nothing wider than a 1280 px window.
 # Run by .ci/run; skips a check whose tool is missing, saying so.
 set -u
@@ -62,6 +63,13 @@ for td in page.iter(H + 'td'):
         break
 if not any(True for _ in page.iter(H + 'table')):
     bad.append('the page has no table')
+memory = [h for h in page.iter(H + 'h2') if h.get('id') == 'memory']
+if memory:
+    eq = [c for c in charts if any('equal memory' in ''.join(t.itertext()) for t in c.iter(S + 'text'))]
+    if not eq or not [e for e in eq[0].iter(S + 'circle') if 'point' in (e.get('class') or '')]:
+        bad.append('the equal-memory section has no chart with points')
+    elif not any(''.join(t.itertext()).endswith('%') for t in eq[0].iter(S + 'text') if t.get('class') == 'tick'):
+        bad.append('the equal-memory chart has no percent axis')
 import os
 stab = os.path.join(os.path.dirname(sys.argv[1]), 'stability.csv')
 if os.path.exists(stab) and 'frame_mismatch' in open(stab).readline():

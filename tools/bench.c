@@ -107,16 +107,23 @@ static double median(double *v, int n)
     return v[n / 2];
 }
 
-/* Init once, render `runs` frames (progressive methods refine meanwhile); times are
- * medians over the frames, the mask is the last frame's. */
 om_status cli_measure(const om_method *m, const om_method_cfg *cfg, const cli_scene *cs,
                       const om_view *v, int runs, uint8_t *mask, uint8_t *rgb, cli_point *p, om_diag *d)
+{
+    return cli_measure_strips(m, cfg, cs, v, runs, 0, om_frame_bytes(v->cam.width, v->cam.height), mask,
+                              rgb, p, d);
+}
+
+/* Init once, render `runs` frames (progressive methods refine meanwhile); times are
+ * medians over the frames, the mask is the last frame's. */
+om_status cli_measure_strips(const om_method *m, const om_method_cfg *cfg, const cli_scene *cs,
+                             const om_view *v, int runs, uint32_t rows, size_t fbytes, uint8_t *mask,
+                             uint8_t *rgb, cli_point *p, om_diag *d)
 {
     uint32_t W = v->cam.width, H = v->cam.height;
     size_t mn, full;
     om_status st = m->bytes(cfg, &cs->scene, W, H, &mn, &full);
     if (st) return st;
-    size_t fbytes = om_frame_bytes(W, H);
     void *mem = malloc(full ? full : 1), *fmem = malloc(fbytes), *px = malloc((size_t)W * H * 3);
     if (!mem || !fmem || !px) {
         free(mem); free(fmem); free(px);
@@ -143,6 +150,7 @@ om_status cli_measure(const om_method *m, const om_method_cfg *cfg, const cli_sc
         memset(&fd, 0, sizeof fd);
         fd.scene = &cs->scene; fd.view = v; fd.method = m; fd.method_state = state;
         fd.shade = &shade; fd.fb = &fb; fd.on_strip = grab; fd.user = &mo; fd.clock = om_clock_ns;
+        fd.strip_rows = rows;
         om_frame_stats fs;
         st = om_render_frame(&fd, &fa, &fs, d);
         t[0][r] = (double)fs.ns_eye / 1e6;
@@ -255,7 +263,7 @@ static void progress(int i, int n, const cli_point *p)
 
 /* A point's label on a chart: its setting, short ("asm.cap=1048576" -> "cap 1M",
  * "map=512 rtw.exact=1" -> "map 512, exact 1"), the full one staying in the tooltip. */
-static void short_setting(const char *setting, char *out, size_t n)
+void cli_short_setting(const char *setting, char *out, size_t n)
 {
     size_t o = 0;
     out[0] = 0;
@@ -303,7 +311,7 @@ static bool chart(om_out *o, const svg_chart *c, const cli_point *pts, int n, co
             lo[ns][np] = first + p->tmin;
             hi[ns][np] = first + p->tmax;
             ys[ns][np] = 1.0 - om_metrics_match(&p->m);
-            short_setting(p->setting, text[ns][np], sizeof text[ns][np]);
+            cli_short_setting(p->setting, text[ns][np], sizeof text[ns][np]);
             labels[ns][np] = text[ns][np];
             np++;
         }

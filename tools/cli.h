@@ -68,7 +68,15 @@ om_status cli_load_named(const char *name, cli_scene *cs, om_diag *d);
 om_status cli_measure(const om_method *m, const om_method_cfg *cfg, const cli_scene *cs,
                       const om_view *v, int runs, uint8_t *mask, uint8_t *rgb, cli_point *p,
                       om_diag *d);
+/* The same through strips of `rows` rows (0: the whole frame at once) in a frame arena
+ * of fbytes (om_frame_bytes_scene's, or more, lets the strips use row bins). */
+om_status cli_measure_strips(const om_method *m, const om_method_cfg *cfg, const cli_scene *cs,
+                             const om_view *v, int runs, uint32_t rows, size_t fbytes, uint8_t *mask,
+                             uint8_t *rgb, cli_point *p, om_diag *d);
 int cmd_report(int argc, char **argv);
+/* A setting as a chart labels it: "asm.cap=1048576" -> "cap 1M", "map=512 rtw.exact=1"
+ * -> "map 512, exact 1". */
+void cli_short_setting(const char *setting, char *out, size_t n);
 
 /* "dir/file", malloc'd (NULL when out of memory): paths are never cut short. */
 char *cli_path(const char *dir, const char *file);

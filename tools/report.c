@@ -16,12 +16,14 @@
 
 static const char report_help[] =
     "usage: ombra report [--scenes LIST] [--size WxH] [--runs N] [--out DIR] [--tri-sweep]\n"
+    "                    [--equal-memory]\n"
     "\n"
     "Runs 'ombra bench' with the same options, then writes DIR/index.html: per scene the\n"
     "charts, the table and crops where the methods disagree most (default: the default\n"
     "scene at its own size into out/report). A scene NAME@WxH is measured at that size\n"
     "(say, a big scene smaller than the rest); DIR/stability.csv, when there, adds the\n"
-    "stability section.\n";
+    "stability section. --equal-memory adds each method's best setting within memory\n"
+    "budgets of 64 KiB to 16 MiB.\n";
 
 #define CROP_MAX 64
 #define ZOOM 3
@@ -305,11 +307,12 @@ static void step(int i, int n, const char *what, const char *name)
 int cmd_report(int argc, char **argv)
 {
     const char *scenes = "default", *dir = "out/report", *size = NULL, *runs = "3";
-    bool tri = false;
+    bool tri = false, memory = false;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) { fputs(report_help, stdout); return 0; }
         if (!strcmp(a, "--tri-sweep")) { tri = true; continue; }
+        if (!strcmp(a, "--equal-memory")) { memory = true; continue; }
         if (!v) return cli_usage_error("report", "unknown option or missing value: '%s'", a);
         if (!strcmp(a, "--scenes")) scenes = v;
         else if (!strcmp(a, "--out")) dir = v;
@@ -322,7 +325,7 @@ int cmd_report(int argc, char **argv)
     if (size && !cli_parse_size(size, &W, &H)) return cli_usage_error("report", "--size takes WxH, not '%s'", size);
     size_t nscenes = 1;
     for (const char *p = scenes; *p; p++) nscenes += *p == ',';
-    const int nsteps = 3 + (int)nscenes;
+    const int nsteps = 3 + (int)nscenes + memory;
     step(1, nsteps, "the sweep: ombra bench", NULL);
     char *bargv[12] = {"report", "--scenes", (char *)scenes, "--runs", (char *)runs, "--out", (char *)dir};
     int bargc = 7;
@@ -348,6 +351,7 @@ int cmd_report(int argc, char **argv)
                "td, th { border: 1px solid #ccc; padding: 2px 6px; text-align: right; }\n"
                "th { background: #f3f3f3; vertical-align: bottom; }\n"
                "td.t { text-align: left; white-space: nowrap; }\n"
+               "td.m { text-align: left; }\n"
                "svg { max-width: 100%%; height: auto; }\n"
                "p.read { max-width: 800px; margin-bottom: 0.3em; }\n"
                "img { image-rendering: pixelated; border: 1px solid #888; max-width: 100%%; height: auto; }\n"
@@ -386,6 +390,11 @@ int cmd_report(int argc, char **argv)
                    "triangles change; the irregular z-buffer's cost follows the visible samples and "
                    "the triangles that reach them.</p>\n");
         inline_file(f, dir, "triangles.svg", inline_svg);
+    }
+    if (memory && !rc) {
+        step(nsteps - 2, nsteps, "accuracy at equal memory", NULL);
+        /* two frames a point: its time is a median of two, the section's cost half the sweep's */
+        rc = report_memory(f, atoi(runs) < 2 ? atoi(runs) : 2);
     }
     char *stab = cli_path(dir, "stability.csv");
     rcsv sc;

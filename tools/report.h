@@ -55,4 +55,9 @@ void report_outline(uint8_t *rgb, uint32_t W, uint32_t H, uint32_t x0, uint32_t 
  * tests/stability/CASE.scene when it is there). */
 void report_stability(FILE *f, const rcsv *sc);
 
+/* The equal-memory section (report_memory.c): per budget of 64 KiB to 16 MiB, each
+ * method's best setting that fits, its mismatch share and time (medians of `runs`
+ * frames), as a chart and a table. Returns 0, or the exit status of a failure. */
+int report_memory(FILE *f, int runs);
+
 #endif

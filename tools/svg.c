@@ -107,8 +107,9 @@ static void fit(axis *a, const svg_series *s, size_t ns, bool is_x)
     if (!(lo <= hi)) { lo = a->log ? 1e-3 : 0; hi = 1; }
     if (a->log) {
         /* the data's own range, padded a little: whole decades left half a chart empty */
-        double l = log10(lo), h = log10(hi), pad = (h - l) * 0.06;
-        if (pad < 0.08) pad = 0.08;
+        /* room above and below the outermost points for their labels */
+        double l = log10(lo), h = log10(hi), pad = (h - l) * 0.08;
+        if (pad < 0.1) pad = 0.1;
         a->lo = a->dlo = l - pad;
         a->hi = h + pad;
         if (a->zero) {
@@ -194,7 +195,9 @@ static void ticks(FILE *f, const axis *a, bool is_x)
     }
 }
 
-typedef struct box { double x0, y0, x1, y1; } box;
+/* What a label must keep clear of: other labels and points, and (softly: given up
+ * before a label is) the spread whiskers. */
+typedef struct box { double x0, y0, x1, y1; bool soft; } box;
 
 static bool overlaps(const box *a, const box *b)
 {
@@ -202,42 +205,47 @@ static bool overlaps(const box *a, const box *b)
 }
 
 /* Places one label near (x, y): the first of the candidate spots, nearest first, that
- * stays inside the plot and clear of every box so far; writes it (with a leader line
- * when it sits away from its point). Returns false when no spot is free. */
-static bool place_label(FILE *f, const char *text, double x, double y, const char *col, box *boxes,
+ * stays inside the plot and clear of every box so far (then clear of all but the
+ * whiskers; at last, the nearest spot inside the plot, so no point goes unlabelled);
+ * writes it, with a leader line when it sits away from its point. */
+static void place_label(FILE *f, const char *text, double x, double y, const char *col, box *boxes,
                         size_t *nb)
 {
-    static const double dirs[8][2] = {{1, 0}, {-1, 0}, {0, -1}, {0, 1},
-                                      {1, -1}, {1, 1}, {-1, -1}, {-1, 1}};
+    enum { NDIR = 16, NRING = 10 };
     const double w = 0.58 * LABEL_FONT * (double)strlen(text), h = LABEL_FONT + 1;
-    for (int ring = 1; ring <= 6; ring++)
-        for (int d = 0; d < 8; d++) {
-            double r = 7.0 + 12.0 * (ring - 1), cx = x + dirs[d][0] * r, cy = y + dirs[d][1] * r * 0.9;
-            box b;
-            /* the box's edge nearest the point sits at the candidate spot */
-            b.x0 = dirs[d][0] > 0 ? cx : dirs[d][0] < 0 ? cx - w : cx - w / 2;
-            b.y0 = dirs[d][1] > 0 ? cy : dirs[d][1] < 0 ? cy - h : cy - h / 2;
-            b.x1 = b.x0 + w;
-            b.y1 = b.y0 + h;
-            if (b.x0 < LEFT + 2 || b.x1 > WIDTH - RIGHT - 2 || b.y0 < TOP + 2 || b.y1 > HEIGHT - BOTTOM - 2)
-                continue;
-            bool clear = true;
-            for (size_t i = 0; i < *nb && clear; i++) clear = !overlaps(&b, &boxes[i]);
-            if (!clear) continue;
-            if (ring > 1) {
-                double lx = b.x0 > x ? b.x0 : b.x1 < x ? b.x1 : (b.x0 + b.x1) / 2;
-                double ly = b.y0 > y ? b.y0 : b.y1 < y ? b.y1 : (b.y0 + b.y1) / 2;
-                fprintf(f, "<line class=\"leader\" x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" "
-                           "stroke=\"%s\" stroke-width=\"0.6\" opacity=\"0.7\"/>\n", x, y, lx, ly, col);
+    for (int pass = 0; pass < 3; pass++)
+        for (int ring = 1; ring <= NRING; ring++)
+            for (int d = 0; d < NDIR; d++) {
+                /* right, left, up, down first; then the diagonals and between */
+                static const int order[NDIR] = {0, 8, 12, 4, 14, 2, 10, 6, 15, 1, 13, 3, 9, 7, 11, 5};
+                double a = order[d] * 6.283185307179586 / NDIR, dx = cos(a), dy = sin(a);
+                double r = 7.0 + 11.0 * (ring - 1), cx = x + dx * r, cy = y + dy * r * 0.8;
+                box b;
+                /* the box's edge nearest the point sits at the candidate spot */
+                b.x0 = dx > 0.3 ? cx : dx < -0.3 ? cx - w : cx - w / 2;
+                b.y0 = dy > 0.3 ? cy : dy < -0.3 ? cy - h : cy - h / 2;
+                b.x1 = b.x0 + w;
+                b.y1 = b.y0 + h;
+                b.soft = false;
+                if (b.x0 < LEFT + 2 || b.x1 > WIDTH - RIGHT - 2 || b.y0 < TOP + 2 || b.y1 > HEIGHT - BOTTOM - 2)
+                    continue;
+                bool clear = true;
+                for (size_t i = 0; i < *nb && clear && pass < 2; i++)
+                    clear = (pass == 1 && boxes[i].soft) || !overlaps(&b, &boxes[i]);
+                if (!clear) continue;
+                if (ring > 1) {
+                    double lx = b.x0 > x ? b.x0 : b.x1 < x ? b.x1 : (b.x0 + b.x1) / 2;
+                    double ly = b.y0 > y ? b.y0 : b.y1 < y ? b.y1 : (b.y0 + b.y1) / 2;
+                    fprintf(f, "<line class=\"leader\" x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" "
+                               "stroke=\"%s\" stroke-width=\"0.6\" opacity=\"0.7\"/>\n", x, y, lx, ly, col);
+                }
+                fprintf(f, "<text class=\"label\" x=\"%.1f\" y=\"%.1f\" font-size=\"%d\" fill=\"%s\">",
+                        b.x0, b.y1 - 2, LABEL_FONT, col);
+                svg_escape(f, text);
+                fprintf(f, "</text>\n");
+                if (*nb < MAX_BOXES) boxes[(*nb)++] = b;
+                return;
             }
-            fprintf(f, "<text class=\"label\" x=\"%.1f\" y=\"%.1f\" font-size=\"%d\" fill=\"%s\">",
-                    b.x0, b.y1 - 2, LABEL_FONT, col);
-            svg_escape(f, text);
-            fprintf(f, "</text>\n");
-            if (*nb < MAX_BOXES) boxes[(*nb)++] = b;
-            return true;
-        }
-    return false;
 }
 
 typedef struct pt { double x, y; } pt;
@@ -312,11 +320,16 @@ static void legend(FILE *f, const svg_chart *c, const svg_series *s, size_t ns)
 
 bool svg_write(FILE *f, const svg_chart *c, const svg_series *s, size_t ns)
 {
+    fprintf(f, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
+    return svg_write_inline(f, c, s, ns);
+}
+
+bool svg_write_inline(FILE *f, const svg_chart *c, const svg_series *s, size_t ns)
+{
     axis ax = {0, 1, 0, 0, c->logx, false, c->xunit}, ay = {0, 1, 0, 0, c->logy, false, c->yunit};
     fit(&ax, s, ns, true);
     fit(&ay, s, ns, false);
     const double x0 = LEFT, x1 = WIDTH - RIGHT, y0 = HEIGHT - BOTTOM, y1 = TOP;
-    fprintf(f, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
     fprintf(f, "<svg xmlns=\"http://www.w3.org/2000/svg\" class=\"chart\" width=\"%d\" height=\"%d\" "
                "viewBox=\"0 0 %d %d\" font-family=\"sans-serif\">\n", WIDTH, HEIGHT, WIDTH, HEIGHT);
     fprintf(f, "<rect width=\"%d\" height=\"%d\" fill=\"white\"/>\n", WIDTH, HEIGHT);
@@ -353,9 +366,9 @@ bool svg_write(FILE *f, const svg_chart *c, const svg_series *s, size_t ns)
                 fprintf(f, "<path class=\"spread\" stroke=\"%s\" stroke-width=\"1.2\" fill=\"none\" "
                            "d=\"M%.1f %.1fH%.1fM%.1f %.1fV%.1fM%.1f %.1fV%.1f\"/>\n",
                         col, a, Y, b, a, Y - 3, Y + 3, b, Y - 3, Y + 3);
-                if (nb < MAX_BOXES) boxes[nb++] = (box){a - 1, Y - 3.5, b + 1, Y + 3.5};
+                if (nb < MAX_BOXES) boxes[nb++] = (box){a - 1, Y - 3.5, b + 1, Y + 3.5, true};
             }
-            if (nb < MAX_BOXES) boxes[nb++] = (box){X - 4.5, Y - 4.5, X + 4.5, Y + 4.5};
+            if (nb < MAX_BOXES) boxes[nb++] = (box){X - 4.5, Y - 4.5, X + 4.5, Y + 4.5, false};
         }
     }
     for (size_t k = 0; k < ns; k++) {

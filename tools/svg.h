@@ -31,6 +31,8 @@ typedef struct svg_chart {
  * (or below) sit on a row of their own labelled 0 under the axis' lowest decade.
  * Returns false on a write error. */
 bool svg_write(FILE *f, const svg_chart *c, const svg_series *s, size_t ns);
+/* The same without the XML declaration: an <svg> element inside a page. */
+bool svg_write_inline(FILE *f, const svg_chart *c, const svg_series *s, size_t ns);
 
 /* A tick's or a cell's text: "12 ms", "64 KiB", "0.05%", "1,000". */
 void svg_format(char *buf, size_t n, double v, svg_unit u);
