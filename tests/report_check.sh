@@ -4,7 +4,7 @@
 # sweep point labelled, mismatch in percent, the Pareto front named, no script from
 # elsewhere; table headers in words, numbers with separators; the stability strips
 # and a flicker crop when stability.csv is there; the equal-memory chart when the page
-# has that section); and headless Chromium renders the page to a screenshot that is not
+# has that section; the small-machines section, naming make cross-test); and headless Chromium renders the page to a screenshot that is not
 # blank, with every chart's points drawn and nothing wider than a 1280 px window.
 # Run by .ci/run; skips a check whose tool is missing, saying so.
 set -u
@@ -70,6 +70,18 @@ if memory:
         bad.append('the equal-memory section has no chart with points')
     elif not any(''.join(t.itertext()).endswith('%') for t in eq[0].iter(S + 'text') if t.get('class') == 'tick'):
         bad.append('the equal-memory chart has no percent axis')
+body = list(page.find(H + 'body'))
+at = [i for i, e in enumerate(body) if e.tag == H + 'h2' and e.get('id') == 'machines']
+if not at:
+    bad.append('the page has no small-machines section')
+else:
+    part = []
+    for e in body[at[0] + 1:]:
+        if e.tag == H + 'h2':
+            break
+        part.append(''.join(e.itertext()))
+    if 'make cross-test' not in ' '.join(part) and not any(e.tag == H + 'div' for e in body[at[0] + 1:]):
+        bad.append('the small-machines section has neither its tables nor the command that writes them')
 import os
 stab = os.path.join(os.path.dirname(sys.argv[1]), 'stability.csv')
 if os.path.exists(stab) and 'frame_mismatch' in open(stab).readline():

@@ -16,14 +16,15 @@
 
 static const char report_help[] =
     "usage: ombra report [--scenes LIST] [--size WxH] [--runs N] [--out DIR] [--tri-sweep]\n"
-    "                    [--equal-memory]\n"
+    "                    [--equal-memory] [--cross DIR]\n"
     "\n"
     "Runs 'ombra bench' with the same options, then writes DIR/index.html: per scene the\n"
     "charts, the table and crops where the methods disagree most (default: the default\n"
     "scene at its own size into out/report). A scene NAME@WxH is measured at that size\n"
     "(say, a big scene smaller than the rest); DIR/stability.csv, when there, adds the\n"
     "stability section. --equal-memory adds each method's best setting within memory\n"
-    "budgets of 64 KiB to 16 MiB.\n";
+    "budgets of 64 KiB to 16 MiB. The small-machines section reads what 'make cross-test'\n"
+    "wrote into the --cross directory (default out/cross).\n";
 
 #define CROP_MAX 64
 #define ZOOM 3
@@ -289,7 +290,7 @@ static int scene_part(FILE *f, const char *dir, const char *name, uint32_t w, ui
         fprintf(f, "</p>\n");
         inline_file(f, dir, file, inline_svg);
     }
-    fprintf(f, "<h3>The numbers</h3>\n<p>Per point: the median frame and the spread of the %s frames, "
+    fprintf(f, "<h3>The numbers</h3>\n<p>Per point (%s frames each): the median frame and their spread, "
                "the method's init, the map's build and the lookup per sample (a frame's other "
                "stages, the eye pass and shading, are the same for every method and in "
                "<code>bench.csv</code>), the arena's peak bytes, and the share of the visible "
@@ -306,7 +307,7 @@ static void step(int i, int n, const char *what, const char *name)
 
 int cmd_report(int argc, char **argv)
 {
-    const char *scenes = "default", *dir = "out/report", *size = NULL, *runs = "3";
+    const char *scenes = "default", *dir = "out/report", *size = NULL, *runs = "3", *cross = "out/cross";
     bool tri = false, memory = false;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -318,6 +319,7 @@ int cmd_report(int argc, char **argv)
         else if (!strcmp(a, "--out")) dir = v;
         else if (!strcmp(a, "--size")) size = v;
         else if (!strcmp(a, "--runs")) runs = v;
+        else if (!strcmp(a, "--cross")) cross = v;
         else return cli_usage_error("report", "unknown option '%s'", a);
         i++;
     }
@@ -396,6 +398,7 @@ int cmd_report(int argc, char **argv)
         /* two frames a point: its time is a median of two, the section's cost half the sweep's */
         rc = report_memory(f, atoi(runs) < 2 ? atoi(runs) : 2);
     }
+    if (!rc) report_machines(f, cross);
     char *stab = cli_path(dir, "stability.csv");
     rcsv sc;
     if (!rc) step(nsteps - 1, nsteps, "stability strips and crops, from ", stab);

@@ -60,4 +60,9 @@ void report_stability(FILE *f, const rcsv *sc);
  * frames), as a chart and a table. Returns 0, or the exit status of a failure. */
 int report_memory(FILE *f, int runs);
 
+/* The small-machines section (report_machines.c), from CROSS/m4.csv and
+ * CROSS/m4-size.csv as make cross-test writes them; a line naming that command for
+ * each file that is not there. */
+void report_machines(FILE *f, const char *cross);
+
 #endif

@@ -169,7 +169,14 @@ static void ticks(FILE *f, const axis *a, bool is_x)
     int n = tick_values(a, v, 63);
     if (a->log && a->zero) v[n++] = 0;
     for (int i = 0; i < n; i++) {
-        svg_format(buf, sizeof buf, v[i], a->unit);
+        /* a tick has no room for 50,000,000: 50M */
+        if (a->unit == SVG_PLAIN && fabs(v[i]) >= 1e4) {
+            double m = fabs(v[i]) >= 1e6 ? 1e6 : 1e3;
+            plain(buf, sizeof buf - 1, v[i] / m);
+            strcat(buf, m > 1e3 ? "M" : "K");
+        } else {
+            svg_format(buf, sizeof buf, v[i], a->unit);
+        }
         if (is_x) {
             double x = px(a, v[i], x0, x1);
             fprintf(f, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#e4e4e4\"/>\n", x, y0, x, y1);

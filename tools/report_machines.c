@@ -1,0 +1,101 @@
+/* report_machines.c — the report's "small machines" section (see report.h): what
+ * `make cross-test` measured on the Cortex-M4 firmware under QEMU, read from the CSVs
+ * it writes (never typed in): per method and scene the instructions of a frame and
+ * the bytes of each arena, and the engine's code size per build. Where the files are
+ * not there, the page says which command writes them. */
+#define _POSIX_C_SOURCE 200809L
+#include "cli.h"
+#include "report.h"
+#include "svg.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+static const rcol m4_cols[] = {
+    {"scene", "scene", R_TEXT, NULL},
+    {"method", "method", R_TEXT, NULL},
+    {"width", "size", R_SIZE, "height"},
+    {"strip_rows", "strip rows", R_INT, NULL},
+    {"instructions", "instructions a frame", R_INT, NULL},
+    {"method_bytes", "method arena, bytes", R_INT, NULL},
+    {"frame_bytes", "frame arena, bytes", R_INT, NULL},
+    {"scene_bytes", "scene arena, bytes", R_INT, NULL},
+};
+
+static const rcol size_cols[] = {
+    {"build", "build", R_TEXT, NULL},
+    {"text", "code (.text), bytes", R_INT, NULL},
+    {"data", "initialised data (.data), bytes", R_INT, NULL},
+    {"bss", "zeroed data (.bss), bytes", R_INT, NULL},
+};
+
+static void missing(FILE *f, const char *path, const char *what)
+{
+    fprintf(f, "<p class=\"missing\">No <code>");
+    svg_escape(f, path);
+    fprintf(f, "</code> yet: <code>make cross-test</code> writes it (%s).</p>\n", what);
+}
+
+/* Instructions a frame against all the arenas' bytes, a series per method. */
+static void chart(FILE *f, const rcsv *c)
+{
+    enum { MAXM = 16, MAXP = 32 };
+    static double xs[MAXM][MAXP], ys[MAXM][MAXP];
+    static char text[MAXM][MAXP][48];
+    static const char *labels[MAXM][MAXP];
+    svg_series s[MAXM];
+    const char *names[MAXM];
+    size_t ns = 0;
+    for (size_t r = 0; r < c->rows; r++) {
+        const char *m = rcsv_get(c, r, "method");
+        double ins = rcsv_num(c, r, "instructions");
+        if (!(ins > 0)) continue;
+        size_t k = 0;
+        while (k < ns && strcmp(names[k], m)) k++;
+        if (k == ns) {
+            if (ns == MAXM) continue;
+            names[ns] = m;
+            s[ns] = (svg_series){m, xs[ns], ys[ns], 0, labels[ns], NULL, NULL};
+            ns++;
+        }
+        if (s[k].n == MAXP) continue;
+        xs[k][s[k].n] = rcsv_num(c, r, "method_bytes") + rcsv_num(c, r, "frame_bytes") +
+                        rcsv_num(c, r, "scene_bytes");
+        ys[k][s[k].n] = ins;
+        snprintf(text[k][s[k].n], sizeof text[k][s[k].n], "%s", rcsv_get(c, r, "scene"));
+        labels[k][s[k].n] = text[k][s[k].n];
+        s[k].n++;
+    }
+    if (!ns) return;
+    svg_chart ch = {"Cortex-M4: instructions a frame against memory", "scene + frame + method arenas",
+                    "instructions a frame", true, true, false, false, SVG_BYTES, SVG_PLAIN};
+    fprintf(f, "<p class=\"read\">Left needs less memory, down less work a frame (instructions "
+               "retired under QEMU; at a few cycles each on a Cortex-M4, tens of millions are "
+               "seconds at 100 MHz).</p>\n");
+    svg_write_inline(f, &ch, s, ns);
+}
+
+void report_machines(FILE *f, const char *cross)
+{
+    fprintf(f, "<h2 id=\"machines\">Small machines</h2>\n<p class=\"read\">The same methods built for "
+               "a Cortex-M4 (<code>-Os</code>) and run under QEMU by <code>make cross-test</code>: per "
+               "method and scene the instructions of one frame and the bytes of each arena (strips "
+               "keep the frame's small), and the engine's code size per build.</p>\n");
+    char *m4 = cli_path(cross, "m4.csv"), *size = cli_path(cross, "m4-size.csv");
+    rcsv c;
+    if (m4 && rcsv_load(&c, m4)) {
+        chart(f, &c);
+        report_table(f, &c, m4_cols, sizeof m4_cols / sizeof m4_cols[0], NULL, NULL);
+        rcsv_free(&c);
+    } else if (m4) {
+        missing(f, m4, "instructions a frame and arena bytes per method on the Cortex-M4 build");
+    }
+    if (size && rcsv_load(&c, size)) {
+        report_table(f, &c, size_cols, sizeof size_cols / sizeof size_cols[0], NULL, NULL);
+        rcsv_free(&c);
+    } else if (size) {
+        missing(f, size, "the code size of each Cortex-M4 build");
+    }
+    free(m4);
+    free(size);
+}
