@@ -37,6 +37,31 @@ static om_vec4 at(double X, double Y, uint32_t w, uint32_t h, float z)
     return v;
 }
 
+#ifdef __SIZEOF_INT128__
+__extension__ typedef __int128 i128;
+/* Whether depth d at grid point (px, py) is what raster.h promises for the plane
+ * through the vertices (x, y, z), given in any order: the exact plane's value z(p)
+ * rounded to the nearest integer but for the two steps' roundings, |d - z(p)| <=
+ * 1/2 + 2^-33 (|dx| + |dy|) with dx, dy the point's offsets from vertex 0 (at most 3/4
+ * in om__tri2's range). In exact rationals: the plane's numerator over twice the
+ * signed area, in 128 bits. */
+static bool depth_near_plane(const int64_t x[3], const int64_t y[3], const uint32_t z[3], int64_t px, int64_t py,
+                             uint32_t d)
+{
+    const i128 x1 = x[1] - x[0], y1 = y[1] - y[0], x2 = x[2] - x[0], y2 = y[2] - y[0];
+    const i128 z0 = z[0], z1 = (i128)z[1] - z0, z2 = (i128)z[2] - z0;
+    const i128 D = x1 * y2 - x2 * y1, A = z1 * y2 - z2 * y1, B = z2 * x1 - z1 * x2;
+    const i128 gx = px - x[0], gy = py - y[0];
+    const i128 N = z0 * D + A * gx + B * gy, aD = D < 0 ? -D : D;
+    i128 err = (i128)d * D - N;   /* (d - z(p)) * D */
+    if (err < 0) err = -err;
+    if (err > aD) return false;   /* beyond one unit: never allowed (and keeps what follows in range) */
+    return (err << 34) <= aD * (((i128)1 << 33) + 2 * ((gx < 0 ? -gx : gx) + (gy < 0 ? -gy : gy)));
+}
+#else
+#error "test_raster.c checks depths in 128-bit integers: build the tests with gcc or clang on a 64-bit host"
+#endif
+
 /* Rasterizes one triangle alone and adds its coverage to count_buf. */
 static void add_coverage(const om_vec4 c[3], uint32_t w, uint32_t h)
 {
@@ -405,14 +430,14 @@ static void snapped_matches_clipped(void)
     int bad = 0;
     for (int k = 0; k < 300; k++) {
         int64_t x[3], y[3];
-        double z[3];
+        uint32_t z[3];
         om_vec4 c[3];
         for (int i = 0; i < 3; i++) {
             x[i] = (int64_t)(rnd() % (2 * TW * 256)) - TW * 128;
             y[i] = (int64_t)(rnd() % (2 * TH * 256)) - TH * 128;
             /* depths of 1/1024 steps: z/w * 2^32 is a whole number, as om__zdepth gives */
             c[i] = at((double)x[i], (double)y[i], TW, TH, (float)(rnd() % 1000) / 1024.0f);
-            z[i] = (double)c[i].z * 4294967296.0;
+            z[i] = (uint32_t)((double)c[i].z * 4294967296.0);
         }
         om_target t = target(TW, TH);
         om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL, NULL, NULL, 0, false, NULL, NULL, NULL, NULL, 0, 0};
@@ -439,8 +464,10 @@ static void grid_matches_point_tests(void)
     static int64_t gx[GW], gy[GH];
     static int32_t xs[2048], ys[2048];
     static om__rtri tris[NT];
+    static int64_t vx[NT][3], vy[NT][3];
+    static uint32_t vz[NT][3];
     rng_state = 77;
-    int bad = 0, covered = 0;
+    int bad = 0, covered = 0, inexact = 0;
     for (int round = 0; round < 20; round++) {
         /* steps of 0..600 grid units: some points repeat, some lie far apart */
         int64_t g = (int64_t)(rnd() % 500);
@@ -462,17 +489,17 @@ static void grid_matches_point_tests(void)
         om__target_clear(&t);
         int nt = 0;
         for (int k = 0; k < NT; k++) {
-            int64_t x[3], y[3];
-            double z[3];
+            int64_t *x = vx[nt], *y = vy[nt];
+            uint32_t *z = vz[nt];
             for (int i = 0; i < 3; i++) {
                 /* a third of the vertices exactly on grid points */
                 x[i] = rnd() % 3 ? (int64_t)(rnd() % 30000) - 2000 : gx[rnd() % GW];
                 y[i] = rnd() % 3 ? (int64_t)(rnd() % 26000) - 2000 : gy[rnd() % GH];
-                z[i] = (double)(rnd() % 1000000) * 4000.0;
+                z[i] = (uint32_t)(rnd() % 1000000) * 4000u + (uint32_t)(rnd() % 4000);
             }
             if (om__raster_snapped(&r, x, y, z, 0)) {
                 CHECK(om__tri2_setup(&tris[nt].e, x, y, true));
-                om__rtri_plane(&tris[nt], z);
+                om__rtri_zplane(&tris[nt], z);
                 nt++;
             }
         }
@@ -481,7 +508,8 @@ static void grid_matches_point_tests(void)
                 uint32_t d = 0xFFFFFFFFu;
                 for (int k = 0; k < nt; k++)
                     if (om__tri2_covers(&tris[k].e, gx[i], gy[j])) {
-                        uint32_t z = (uint32_t)om__rtri_depth(&tris[k], gx[i], gy[j]);
+                        uint32_t z = om__rtri_zat(&tris[k], gx[i], gy[j]);
+                        inexact += !depth_near_plane(vx[k], vy[k], vz[k], gx[i], gy[j], z);
                         if (z < d) d = z;
                     }
                 covered += d != 0xFFFFFFFFu;
@@ -489,42 +517,44 @@ static void grid_matches_point_tests(void)
             }
     }
     CHECK_EQ_U(bad, 0);
+    CHECK_EQ_U(inexact, 0);
     CHECK(covered > 20 * GW * GH / 4);
 }
 
 /* The plain fill (depth and id, as the eye pass) gives every pixel the nearest depth
- * of the triangles covering its centre, by the point-in-triangle test and the plane,
- * and the id of the first triangle drawn at that depth: random layered triangles whose
- * depths span [0, 2^32) and cross 2^31 inside rows, and flat ones at depths where the
- * conversion to uint32 is easiest to get wrong (just below and above 2^31 and integers,
- * the far end). Wide spans run four pixels at a time where the compiler has SSE2. */
+ * of the triangles covering its centre, by the point-in-triangle test and the plane
+ * (as near the exact plane as raster.h promises), and the id of the first triangle drawn at
+ * that depth: random layered triangles whose depths span [0, 2^32), and flat ones at
+ * the ends of the range and around 2^31, where a wrap or a sign would show. */
 static void fill_matches_point_tests(void)
 {
     enum { W = 61, H = 37, NT = 30 };
     static om__rtri tris[NT];
     static uint32_t ids[NT];
-    static const double flat[] = {2147483647.0, 2147483647.5, 2147483647.9999998, 2147483648.0,
-                                  2147483648.5, 4294967294.75, 4294967295.0, 0.25, 1.0};
+    static int64_t vx[NT][3], vy[NT][3];
+    static uint32_t vz[NT][3];
+    static const uint32_t flat[] = {2147483647u, 2147483648u, 4294967294u, 4294967295u, 0u, 1u};
     rng_state = 31;
-    int bad = 0, covered = 0;
+    int bad = 0, covered = 0, inexact = 0;
     for (int round = 0; round < 30; round++) {
         om_target t = target(W, H);
         om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL, NULL, NULL, 0, false, NULL, NULL, NULL, NULL, 0, 0};
         om__target_clear(&t);
         int nt = 0;
         for (int k = 0; k < NT; k++) {
-            int64_t x[3], y[3];
-            double z[3];
-            const bool is_flat = k % 3 == 0;
-            const double zf = flat[(size_t)(rnd() % (sizeof flat / sizeof flat[0]))];
+            int64_t *x = vx[nt], *y = vy[nt];
+            uint32_t *z = vz[nt];
+            const int kind = k % 3;   /* flat, random, or from one end of the range to the other */
+            const uint32_t zf = flat[(size_t)(rnd() % (sizeof flat / sizeof flat[0]))];
             for (int i = 0; i < 3; i++) {
                 x[i] = (int64_t)(rnd() % (W * 256 + 2000)) - 1000;
                 y[i] = (int64_t)(rnd() % (H * 256 + 2000)) - 1000;
-                z[i] = is_flat ? zf : (double)(rnd() % 4294967) * 1000.0 + (double)(rnd() % 1000) * 0.001;
+                z[i] = kind == 0 ? zf : kind == 1 ? (uint32_t)(rnd() % 4294967) * 1000u + (uint32_t)(rnd() % 1000)
+                                                  : (rnd() % 2 ? 0xFFFFFFFFu : 0u);
             }
             if (om__raster_snapped(&r, x, y, z, (uint32_t)k)) {
                 CHECK(om__tri2_setup(&tris[nt].e, x, y, true));
-                om__rtri_plane(&tris[nt], z);
+                om__rtri_zplane(&tris[nt], z);
                 ids[nt++] = (uint32_t)k;
             }
         }
@@ -534,7 +564,8 @@ static void fill_matches_point_tests(void)
                 uint32_t d = 0xFFFFFFFFu, id = OM_NO_TRI;
                 for (int k = 0; k < nt; k++)
                     if (om__tri2_covers(&tris[k].e, px, py)) {
-                        uint32_t z = (uint32_t)om__rtri_depth(&tris[k], px, py);
+                        uint32_t z = om__rtri_zat(&tris[k], px, py);
+                        inexact += !depth_near_plane(vx[k], vy[k], vz[k], px, py, z);
                         if (z < d) { d = z; id = ids[k]; }
                     }
                 covered += id != OM_NO_TRI;
@@ -542,7 +573,52 @@ static void fill_matches_point_tests(void)
             }
     }
     CHECK_EQ_U(bad, 0);
+    CHECK_EQ_U(inexact, 0);
     CHECK(covered > 30 * W * H / 2);
+}
+
+/* The fixed-point plane at the ends of its range: triangles with coordinates up to
+ * om__tri2's limit (areas far beyond 2^32, where the steps' fractions come bit by
+ * bit), slivers whose steps wrap modulo 2^64, depths from 0 to 2^32 - 1; at random
+ * points inside each, the depth is as near the exact plane as raster.h promises and
+ * lies between the vertex depths. */
+static void plane_nearest_at_extremes(void)
+{
+    rng_state = 2024;
+    int tested = 0, inexact = 0, outside = 0;
+    for (int k = 0; k < 4000; k++) {
+        const int64_t M = k % 2 ? OM_TRI2_MAX_COORD : (int64_t)1 << (8 + k % 22);
+        int64_t x[3], y[3];
+        uint32_t z[3];
+        for (int i = 0; i < 3; i++) {
+            x[i] = (int64_t)(((uint64_t)rnd() << 31 ^ rnd()) % (uint64_t)(2 * M + 1)) - M;
+            y[i] = (int64_t)(((uint64_t)rnd() << 31 ^ rnd()) % (uint64_t)(2 * M + 1)) - M;
+            z[i] = k % 4 < 2 ? (rnd() % 2 ? 0xFFFFFFFFu : 0u) : (uint32_t)((uint64_t)rnd() << 16 ^ rnd());
+        }
+        if (k % 8 == 7) {   /* a sliver: the third vertex next to the line of the others */
+            x[2] = x[0] + (x[1] - x[0]) / 2 + (int64_t)(rnd() % 3) - 1;
+            y[2] = y[0] + (y[1] - y[0]) / 2 + (int64_t)(rnd() % 3) - 1;
+        }
+        om__rtri t;
+        if (!om__tri2_setup(&t.e, x, y, true)) continue;
+        om__rtri_zplane(&t, z);
+        const uint32_t lo = z[0] < z[1] ? (z[0] < z[2] ? z[0] : z[2]) : (z[1] < z[2] ? z[1] : z[2]);
+        const uint32_t hi = z[0] > z[1] ? (z[0] > z[2] ? z[0] : z[2]) : (z[1] > z[2] ? z[1] : z[2]);
+        for (int n = 0; n < 16; n++) {
+            /* a random point of the triangle: the vertices and barycentric mixes */
+            const uint32_t a = rnd() % 1024, b = rnd() % (1025 - a);
+            const int64_t px = x[0] + ((x[1] - x[0]) * (int64_t)a + (x[2] - x[0]) * (int64_t)b) / 1024;
+            const int64_t py = y[0] + ((y[1] - y[0]) * (int64_t)a + (y[2] - y[0]) * (int64_t)b) / 1024;
+            if (!om__tri2_covers(&t.e, px, py)) continue;
+            const uint32_t d = om__rtri_zat(&t, px, py);
+            tested++;
+            inexact += !depth_near_plane(x, y, z, px, py, d);
+            outside += d < lo || d > hi;
+        }
+    }
+    CHECK_EQ_U(inexact, 0);
+    CHECK_EQ_U(outside, 0);
+    CHECK(tested > 10000);
 }
 
 typedef struct cons_ctx { int *count; uint32_t w; } cons_ctx;
@@ -693,6 +769,7 @@ void suite_raster(void)
     RUN(snapped_matches_clipped);
     RUN(grid_matches_point_tests);
     RUN(fill_matches_point_tests);
+    RUN(plane_nearest_at_extremes);
     RUN(conservative_superset);
     RUN(conservative_centres_match_depth_pass);
     RUN(strips_match_whole);

@@ -253,33 +253,40 @@ static void warped_map_has_no_cracks(void)
     }
 }
 
-/* The exact map, texel by texel, against the occlusion predicate's own triangles: the
- * nearest depth of any triangle covering the texel's point (gridx[x], gridy[y]) on the
- * light's grid, by the same edge functions, tie rule and plane. Back faces of closed
+/* The exact map, texel by texel, against the triangles on the light's grid (clipped and
+ * projected as the occlusion predicate's): the nearest depth of any triangle covering
+ * the texel's point (gridx[x], gridy[y]), by the same edge functions, tie rule and
+ * fixed-point plane (om__rtri_zat). Back faces of closed
  * shapes count too: culling them must change no texel. */
 typedef struct exact_probe { uint64_t texels, wrong, covered; uint32_t distinct_x; } exact_probe;
 
 static void check_exact(const om__rtw *m, void *user)
 {
     exact_probe *p = (exact_probe *)user;
-    om__lspace ls;
-    om__lspace_init_lean(&ls, m->scene);
-    om__lspace_begin(&ls, &m->view);
     static uint32_t want[128 * 128];
     const uint32_t S = m->size;
     if (S > 128) { CHECK(S <= 128); return; }
     for (uint32_t i = 0; i < S * S; i++) want[i] = 0xFFFFFFFFu;
     for (uint32_t t = 0; t < m->scene->ntris; t++) {
-        om__ltri lt;
-        if (!om__lspace_tri(&ls, t, &lt)) continue;
-        for (uint32_t y = 0; y < S; y++)
-            for (uint32_t x = 0; x < S; x++)
-                for (int k = 0; k < lt.n; k++)
-                    if (om__tri2_covers(&lt.sub[k].e, m->gridx[x], m->gridy[y])) {
-                        uint32_t d = (uint32_t)om__rtri_depth(&lt.sub[k], m->gridx[x], m->gridy[y]);
-                        if (d < want[y * S + x]) want[y * S + x] = d;
-                        break;
+        /* the triangle clipped and projected on the light's grid, as the predicate's */
+        om_vec4 c[3];
+        for (int k = 0; k < 3; k++) c[k] = om__mat_apply(&m->view.light_vp, m->scene->verts[m->scene->idx[t * 3 + k]]);
+        int64_t gx[9], gy[9];
+        uint32_t gz[9];
+        const int n = om__clip_project(c, OM_LIGHT_GRID, OM_LIGHT_GRID, gx, gy, gz);
+        for (int k = 1; k + 1 < n; k++) {
+            const int64_t x[3] = {gx[0], gx[k], gx[k + 1]}, y[3] = {gy[0], gy[k], gy[k + 1]};
+            const uint32_t z[3] = {gz[0], gz[k], gz[k + 1]};
+            om__rtri r;
+            if (!om__tri2_setup(&r.e, x, y, true)) continue;
+            om__rtri_zplane(&r, z);
+            for (uint32_t yy = 0; yy < S; yy++)
+                for (uint32_t xx = 0; xx < S; xx++)
+                    if (om__tri2_covers(&r.e, m->gridx[xx], m->gridy[yy])) {
+                        uint32_t d = om__rtri_zat(&r, m->gridx[xx], m->gridy[yy]);
+                        if (d < want[yy * S + xx]) want[yy * S + xx] = d;
                     }
+        }
     }
     for (uint32_t i = 0; i < S * S; i++) {
         p->texels++;

@@ -74,7 +74,7 @@ static void conservative_is_exact_overlap(void)
             c[i].w = 1.0f;
         }
         int64_t gx[9], gy[9];
-        double gz[9];
+        uint32_t gz[9];
         if (om__clip_project(c, CW, CW, gx, gy, gz) != 3) continue;   /* whole triangles only */
         cov cv;
         memset(&cv, 0, sizeof cv);
@@ -134,12 +134,12 @@ static void texel_packs_and_unpacks(void)
     for (int k = 0; k < 2000; k++) {
         int32_t tx = (int32_t)(rnd() % 2048), ty = (int32_t)(rnd() % 2048);
         int64_t X[3], Y[3];
-        double Z[3];
+        uint32_t Z[3];
         int64_t reach = k % 2 ? 3000 : 300000;   /* near vertices exact, far ones not */
         for (int i = 0; i < 3; i++) {
             X[i] = (int64_t)tx * 256 + (int64_t)(rnd() % (2 * reach)) - reach;
             Y[i] = (int64_t)ty * 256 + (int64_t)(rnd() % (2 * reach)) - reach;
-            Z[i] = (double)(rnd() % 0xFFFFFF) * 200.0;
+            Z[i] = (uint32_t)(rnd() % 0xFFFFFF) * 200u;
         }
         om__rtri t;
         if (!om__tri2_setup(&t.e, X, Y, false) || t.e.area2 == 0) continue;

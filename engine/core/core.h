@@ -7,6 +7,7 @@
 #include "ombra.h"
 
 #include <float.h>
+#include <math.h>
 
 /* ---- determinism (README, Determinism): every engine file includes this header.
  * Float arithmetic must be evaluated in float (FLT_EVAL_METHOD 0): x87 (2) and s390x
@@ -54,6 +55,37 @@ static inline int om__ctz32(uint32_t x)
     while (!((x >> k) & 1u)) k++;
     return k;
 #endif
+}
+
+/* sqrtf and fabsf as the compiler's own instructions where it has them: a firmware
+ * built freestanding (-ffreestanding implies -fno-builtin) would otherwise call the
+ * library for each. The same correctly rounded results either way. */
+static inline float om__sqrtf(float x)
+{
+#if defined(__GNUC__) || defined(__clang__)
+    return __builtin_sqrtf(x);
+#else
+    return sqrtf(x);
+#endif
+}
+
+static inline float om__fabsf(float x)
+{
+#if defined(__GNUC__) || defined(__clang__)
+    return __builtin_fabsf(x);
+#else
+    return fabsf(x);
+#endif
+}
+
+/* floor(f) for |f| < 2^31, through a 32-bit conversion (one instruction on a CPU
+ * with a float unit; floorf and a conversion to 64 bits are library routines on a
+ * Cortex-M4F, the latter through double). Exact: (float)i is f itself once |f| >=
+ * 2^23, where every float is an integer, and exact below. */
+static inline int32_t om__floorf_i32(float f)
+{
+    const int32_t i = (int32_t)f;   /* towards zero */
+    return i - ((float)i > f);
 }
 
 /* ---- vectors */

@@ -10,7 +10,7 @@ om_vec3 om__normalize(om_vec3 a)
 {
     float l2 = om__dot(a, a);
     if (!(l2 > 0.0f)) return om__v3(0, 0, 0);
-    float inv = 1.0f / sqrtf(l2);
+    float inv = 1.0f / om__sqrtf(l2);
     return om__scale(a, inv);
 }
 
@@ -48,7 +48,7 @@ bool om__mat_look_at(om_mat4 *out, om_vec3 eye, om_vec3 target, om_vec3 up)
     om_vec3 s = om__normalize(om__cross(f, up));
     if (om__dot(f, f) == 0.0f || om__dot(s, s) == 0.0f) {
         /* up parallel to the view direction: pick any perpendicular up */
-        om_vec3 alt = fabsf(f.y) < 0.9f ? om__v3(0, 1, 0) : om__v3(1, 0, 0);
+        om_vec3 alt = om__fabsf(f.y) < 0.9f ? om__v3(0, 1, 0) : om__v3(1, 0, 0);
         s = om__normalize(om__cross(f, alt));
         if (om__dot(f, f) == 0.0f || om__dot(s, s) == 0.0f) return false;
     }

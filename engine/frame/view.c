@@ -101,7 +101,7 @@ om_status om_view_init(om_view *v, const om_camera *cam, const om_light *light,
     /* Stand the light outside the scene's bounding sphere, looking along dir. */
     om_vec3 c = om__scale(om__add(s->lo, s->hi), 0.5f);
     om_vec3 h = om__sub(s->hi, c);
-    float r = sqrtf(om__dot(h, h)) + 1.0f;
+    float r = om__sqrtf(om__dot(h, h)) + 1.0f;
     om__mat_look_at(&v->light_view, om__sub(c, om__scale(dir, 2.0f * r)), c, om__v3(0, 1, 0));
     om_vec3 lo, hi;
     light_box(&v->light_view, s, &lo, &hi);

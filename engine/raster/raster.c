@@ -1,15 +1,10 @@
 /* raster.c — clipping, snapping and filling of triangles; the rule is written at the
- * top of raster.h. Everything after the snap is integer except the depth plane, which
- * is evaluated in double from one fixed origin per triangle (so strips agree). */
+ * top of raster.h. Everything after the snap is integer, the depth plane included:
+ * fixed point from one origin per triangle (so strips agree). */
 #include "raster.h"
 #include "../core/core.h"
 
 #include <math.h>
-
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#define OM_RASTER_SSE2 1
-#endif
 
 static int64_t floordiv(int64_t a, int64_t b)   /* b > 0 */
 {
@@ -104,7 +99,7 @@ static cvert cut(const cvert *in, const cvert *out, float din, float dout)
 }
 
 int om__clip_project(const om_vec4 clip[3], uint32_t width, uint32_t height,
-                     int64_t *gx_out, int64_t *gy_out, double *gz_out)
+                     int64_t *gx_out, int64_t *gy_out, uint32_t *gz_out)
 {
     cvert buf[2][10];
     int n = 3;
@@ -147,7 +142,7 @@ int om__clip_project(const om_vec4 clip[3], uint32_t width, uint32_t height,
 
 /* ---- filling */
 
-void om__rtri_plane(om__rtri *t, const double z[3])
+void om__rtri_plane(om__rtri *t, const uint32_t z[3])
 {
     const om__tri2 *e = &t->e;
     double z0 = z[e->perm[0]], z1 = z[e->perm[1]], z2 = z[e->perm[2]];
@@ -163,6 +158,45 @@ void om__rtri_plane(om__rtri *t, const double z[3])
     }
     t->zmin = fmin(z0, fmin(z1, z2));
     t->zmax = fmax(z0, fmax(z1, z2));
+}
+
+/* n * 2^32 / d rounded to the nearest integer (halves away from zero), modulo 2^64;
+ * d > 0. The quotient's integer part comes from one 64-bit division, its 32 fraction
+ * bits from a second where d < 2^32 (the remainder times 2^32 then fits 64 bits) and
+ * otherwise bit by bit, as long division does on paper: the same value either way. */
+static uint64_t div_q32(int64_t n, int64_t d)
+{
+    const uint64_t a = n < 0 ? 0u - (uint64_t)n : (uint64_t)n, D = (uint64_t)d;
+    uint64_t q = a / D, r = a % D, f;
+    if (D <= 0xFFFFFFFFu) {
+        f = ((r << 32) + D / 2) / D;
+    } else {
+        f = 0;
+        for (int i = 0; i < 32; i++) {   /* r < D < 2^61: r << 1 fits */
+            r <<= 1;
+            f <<= 1;
+            if (r >= D) { r -= D; f |= 1; }
+        }
+        f += 2 * r >= D;
+    }
+    const uint64_t v = (q << 32) + f;
+    return n < 0 ? 0u - v : v;
+}
+
+void om__rtri_zplane(om__rtri *t, const uint32_t z[3])
+{
+    const om__tri2 *e = &t->e;
+    const int64_t z0 = z[e->perm[0]], dz1 = (int64_t)z[e->perm[1]] - z0, dz2 = (int64_t)z[e->perm[2]] - z0;
+    t->zq0 = ((uint64_t)z0 << 32) + (1u << 31);
+    if (e->area2 > 0) {
+        /* |dz| < 2^32 and offsets <= 2^30: each product < 2^62, the differences fit */
+        const int64_t x1 = e->x[1] - e->x[0], y1 = e->y[1] - e->y[0];
+        const int64_t x2 = e->x[2] - e->x[0], y2 = e->y[2] - e->y[0];
+        t->zqx = div_q32(dz1 * y2 - dz2 * y1, e->area2);
+        t->zqy = div_q32(dz2 * x1 - dz1 * x2, e->area2);
+    } else {
+        t->zqx = t->zqy = 0;
+    }
 }
 
 /* The snapped triangle's bounding box on the grid. */
@@ -228,93 +262,18 @@ static bool row_span(const int64_t E[3], const int64_t step[3], int64_t w, int64
     return l <= h;
 }
 
-/* The depth of one pixel whose grid point lies g units (along x) from the plane's
- * origin, on a row whose y term is ztail: the rule of raster.h, evaluated alike by
- * every fill. */
-static inline uint32_t depth_at(const om__rtri *t, int64_t g, double ztail)
-{
-    double z = (t->z0 + t->zx * (double)g) + ztail;
-    z = z < t->zmin ? t->zmin : z > t->zmax ? t->zmax : z;
-    return (uint32_t)z;
-}
-
-#ifdef OM_RASTER_SSE2
-/* Four pixels at once with SSE2, where the compiler has it (every x86-64): each lane
- * is the very value depth_at gives. The same double operations in the same order; the
- * clamp as max then min (the bounds are the triangle's vertex depths, z is never NaN,
- * and where the two could differ, in the sign of a zero, the integer is the same); and
- * the truncation to uint32 in two exact halves, since SSE2 converts to int32 only:
- * z < 2^31 directly, z >= 2^31 as z - 2^31 (exact there) with the top bit put back. */
-typedef struct zlanes { __m128d z0, zx, ztail, zmin, zmax, two31; __m128i top; } zlanes;
-
-static inline zlanes zlanes_of(const om__rtri *t, double ztail)
-{
-    zlanes k;
-    k.z0 = _mm_set1_pd(t->z0);
-    k.zx = _mm_set1_pd(t->zx);
-    k.ztail = _mm_set1_pd(ztail);
-    k.zmin = _mm_set1_pd(t->zmin);
-    k.zmax = _mm_set1_pd(t->zmax);
-    k.two31 = _mm_set1_pd(2147483648.0);
-    k.top = _mm_set1_epi32((int32_t)0x80000000u);
-    return k;
-}
-
-/* The depth test of dep[0..3] (and ids, when idr is given) for pixels whose offsets g
- * are ga (pixels 0, 1) and gb (2, 3), as doubles. */
-static inline void depth4(const zlanes *k, __m128d ga, __m128d gb, uint32_t *dep, uint32_t *idr, uint32_t id)
-{
-    __m128d za = _mm_add_pd(_mm_add_pd(k->z0, _mm_mul_pd(k->zx, ga)), k->ztail);
-    __m128d zb = _mm_add_pd(_mm_add_pd(k->z0, _mm_mul_pd(k->zx, gb)), k->ztail);
-    za = _mm_min_pd(_mm_max_pd(za, k->zmin), k->zmax);
-    zb = _mm_min_pd(_mm_max_pd(zb, k->zmin), k->zmax);
-    const __m128i lo = _mm_unpacklo_epi64(_mm_cvttpd_epi32(za), _mm_cvttpd_epi32(zb));
-    const __m128i hi = _mm_xor_si128(_mm_unpacklo_epi64(_mm_cvttpd_epi32(_mm_sub_pd(za, k->two31)),
-                                                        _mm_cvttpd_epi32(_mm_sub_pd(zb, k->two31))),
-                                     k->top);
-    const __m128i ma = _mm_shuffle_epi32(_mm_castpd_si128(_mm_cmpge_pd(za, k->two31)), _MM_SHUFFLE(2, 0, 2, 0));
-    const __m128i mb = _mm_shuffle_epi32(_mm_castpd_si128(_mm_cmpge_pd(zb, k->two31)), _MM_SHUFFLE(2, 0, 2, 0));
-    const __m128i m = _mm_unpacklo_epi64(ma, mb);
-    const __m128i d = _mm_or_si128(_mm_andnot_si128(m, lo), _mm_and_si128(m, hi));
-    /* d < old, unsigned: compare with the top bits flipped */
-    const __m128i old = _mm_loadu_si128((const __m128i *)dep);
-    const __m128i win = _mm_cmpgt_epi32(_mm_xor_si128(old, k->top), _mm_xor_si128(d, k->top));
-    _mm_storeu_si128((__m128i *)dep, _mm_or_si128(_mm_andnot_si128(win, old), _mm_and_si128(win, d)));
-    if (idr) {
-        const __m128i oid = _mm_loadu_si128((const __m128i *)idr);
-        _mm_storeu_si128((__m128i *)idr, _mm_or_si128(_mm_andnot_si128(win, oid), _mm_and_si128(win, _mm_set1_epi32((int32_t)id))));
-    }
-}
-#endif
-
 /* The depth test along row y from texel x0 to x1, writing id too when `id_row` is
  * given (that row of the id buffer). */
 static void depth_row(const om__rtri *t, const om_target *tg, int32_t y, int32_t x0, int32_t x1,
                       uint32_t *id_row, uint32_t id)
 {
-    const om__tri2 *e = &t->e;
     const int64_t S = OM_SUBPIX, H = OM_SUBPIX / 2;
-    int64_t py = (int64_t)y * S + H;
-    double ztail = t->zy * (double)(py - e->y[0]);
+    uint64_t z = t->zq0 + t->zqx * (uint64_t)((int64_t)x0 * S + H - t->e.x[0]) +
+                 t->zqy * (uint64_t)((int64_t)y * S + H - t->e.y[0]);
+    const uint64_t step = t->zqx * (uint64_t)S;
     uint32_t *dep = tg->depth + (size_t)(y - (int32_t)tg->y0) * tg->width;
-    int32_t x = x0;
-#ifdef OM_RASTER_SSE2
-    if (x1 - x0 >= 3) {
-        /* offsets fit in int32: pixel centres lie below 2^22 (a 16384-wide target:
-         * spsm.fine at map 8192), vertices within 2^29 */
-        const zlanes k = zlanes_of(t, ztail);
-        __m128i g = _mm_add_epi32(_mm_set1_epi32((int32_t)((int64_t)x0 * S + H - e->x[0])),
-                                  _mm_setr_epi32(0, (int32_t)S, 2 * (int32_t)S, 3 * (int32_t)S));
-        const __m128i step = _mm_set1_epi32(4 * (int32_t)S);
-        for (; x + 3 <= x1; x += 4) {
-            depth4(&k, _mm_cvtepi32_pd(g), _mm_cvtepi32_pd(_mm_shuffle_epi32(g, _MM_SHUFFLE(3, 2, 3, 2))), dep + x,
-                   id_row ? id_row + x : NULL, id);
-            g = _mm_add_epi32(g, step);
-        }
-    }
-#endif
-    for (; x <= x1; x++) {
-        uint32_t d = depth_at(t, (int64_t)x * S + H - e->x[0], ztail);
+    for (int32_t x = x0; x <= x1; x++, z += step) {
+        const uint32_t d = (uint32_t)(z >> 32);
         if (d < dep[x]) {
             dep[x] = d;
             if (id_row) id_row[x] = id;
@@ -486,34 +445,19 @@ static void fill_grid(const om_raster *r, const om__rtri *t)
             else if (x - 1 < hi) hi = x - 1;
         }
         if (lo > hi) continue;
-        const double ztail = t->zy * (double)(py - e->y[0]);
+        const uint64_t zrow = t->zq0 + t->zqy * (uint64_t)(py - e->y[0]);
         uint32_t *dep = tg->depth + (size_t)(y - (int32_t)tg->y0) * tg->width;
 #if defined(__GNUC__) || defined(__clang__)
         if (y < t->maxy) __builtin_prefetch(dep + tg->width + lo, 1);
 #endif
-        int32_t x = lo;
-#ifdef OM_RASTER_SSE2
-        /* four at a time where the offsets fit in int32 (the grid rises, so its ends
-         * decide) */
-        if (hi - lo >= 3 && gx[lo] - e->x[0] >= INT32_MIN && gx[hi] - e->x[0] <= INT32_MAX) {
-            const zlanes k = zlanes_of(t, ztail);
-            const __m128i origin = _mm_set1_epi64x(e->x[0]);
-            for (; x + 3 <= hi; x += 4) {
-                const __m128i g01 = _mm_sub_epi64(_mm_loadu_si128((const __m128i *)(gx + x)), origin);
-                const __m128i g23 = _mm_sub_epi64(_mm_loadu_si128((const __m128i *)(gx + x + 2)), origin);
-                depth4(&k, _mm_cvtepi32_pd(_mm_shuffle_epi32(g01, _MM_SHUFFLE(2, 0, 2, 0))),
-                       _mm_cvtepi32_pd(_mm_shuffle_epi32(g23, _MM_SHUFFLE(2, 0, 2, 0))), dep + x, NULL, 0);
-            }
-        }
-#endif
-        for (; x <= hi; x++) {
-            uint32_t d = depth_at(t, gx[x] - e->x[0], ztail);
+        for (int32_t x = lo; x <= hi; x++) {
+            const uint32_t d = (uint32_t)((zrow + t->zqx * (uint64_t)(gx[x] - e->x[0])) >> 32);
             if (d < dep[x]) dep[x] = d;
         }
     }
 }
 
-bool om__raster_snapped(const om_raster *r, const int64_t x[3], const int64_t y[3], const double z[3],
+bool om__raster_snapped(const om_raster *r, const int64_t x[3], const int64_t y[3], const uint32_t z[3],
                         uint32_t id)
 {
     const bool cons = r->mode == OM_RASTER_CONSERVATIVE;
@@ -527,14 +471,18 @@ bool om__raster_snapped(const om_raster *r, const int64_t x[3], const int64_t y[
     if (!om__tri2_setup(&t.e, x, y, !cons)) return false;
     if (r->grid_x) {
         if (!bounds_grid(&t, r)) return false;
-        om__rtri_plane(&t, z);
+        om__rtri_zplane(&t, z);
         fill_grid(r, &t);
         return true;
     }
     if (!bounds(&t, r->target, cons)) return false;
-    om__rtri_plane(&t, z);
-    if (cons) fill_conservative(r, &t);
-    else fill(r, &t, id);
+    om__rtri_zplane(&t, z);
+    if (cons) {
+        om__rtri_plane(&t, z);   /* the spans' callers test the plane beyond the triangle */
+        fill_conservative(r, &t);
+    } else {
+        fill(r, &t, id);
+    }
     return true;
 }
 
@@ -547,7 +495,7 @@ int om__raster_tri_on(const om_raster *r, const om_vec4 clip[3], uint32_t id, ui
                       uint32_t height)
 {
     int64_t gx[9], gy[9];
-    double gz[9];
+    uint32_t gz[9];
     for (int i = 0; i < 3; i++)
         if (!om__finite(clip[i].x) || !om__finite(clip[i].y) || !om__finite(clip[i].z) ||
             !om__finite(clip[i].w))
@@ -556,7 +504,7 @@ int om__raster_tri_on(const om_raster *r, const om_vec4 clip[3], uint32_t id, ui
     int filled = 0;
     for (int k = 1; k + 1 < n; k++) {
         int64_t tx[3] = {gx[0], gx[k], gx[k + 1]}, ty[3] = {gy[0], gy[k], gy[k + 1]};
-        double tz[3] = {gz[0], gz[k], gz[k + 1]};
+        uint32_t tz[3] = {gz[0], gz[k], gz[k + 1]};
         filled += om__raster_snapped(r, tx, ty, tz, id);
     }
     return filled;

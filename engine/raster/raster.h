@@ -17,10 +17,21 @@
  *    Both windings are accepted (they are put in one order first); zero-area triangles
  *    after snapping cover nothing.
  *  - Depth is z/w, affine in screen space, stored as uint32: 0 at the near plane,
- *    0xFFFFFFFF at the far plane (z/w * 2^32, clamped to the triangle's own vertex
- *    depths). The plane is evaluated per pixel in double directly from one origin, so
- *    a pixel's depth does not depend on the strip it is rendered in. The depth test is
- *    strict (<): among equal depths the first triangle drawn wins.
+ *    0xFFFFFFFF at the far plane (z/w * 2^32). Vertex depths are integers (om__zdepth
+ *    truncates). A fill evaluates the plane in fixed point from one origin per triangle,
+ *    the stored vertex 0, so a pixel's depth does not depend on the strip it is rendered
+ *    in (om__rtri_zplane): the plane's slopes per sub-pixel unit along x and y, times
+ *    2^32, are rounded to the nearest integers zqx, zqy and kept modulo 2^64, and a
+ *    pixel's depth is the top 32 bits of  zq0 + zqx * dx + zqy * dy  (mod 2^64), with
+ *    zq0 = z0 * 2^32 + 2^31 and dx, dy its offsets from the origin: the exact plane's
+ *    value rounded to the nearest integer, but for the two steps' roundings (each
+ *    within 2^-33 of a unit per sub-pixel unit). Offsets inside a triangle are below
+ *    2^30 (om__tri2's range), so those move the sum by at most 1/4 of a unit: a depth
+ *    is within 3/4 of the exact plane (within 1/2 + 2^-33 (|dx| + |dy|)), never
+ *    outside the triangle's vertex depths, and the sum never wraps, whatever the
+ *    wrapped terms were. Integer multiplies and adds only, no clamp: on a 32-bit CPU
+ *    the top half is a register. The depth test is strict (<): among equal depths
+ *    the first triangle drawn wins.
  *  - Conservative mode reports every pixel whose closed square the snapped triangle
  *    touches at all (an exact separating-axis test: bounding boxes and three edges).
  *  - A depth pass may sample a rectilinear grid instead of pixel centres (om_raster's
@@ -84,21 +95,34 @@ void om__target_clear(const om_target *t);
 /* A triangle ready to fill: snapped screen coordinates, edges, depth plane, bounds. */
 typedef struct om__rtri {
     om__tri2 e;
-    double z0, zx, zy;     /* depth (0..2^32) at stored vertex 0, and per sub-pixel unit */
+    uint64_t zq0, zqx, zqy; /* the fixed-point plane the fills use (the rule above) */
+    /* The plane in double, for the occlusion predicate and the callers of conservative
+     * mode, which test it at points outside the triangle too (om__rtri_plane): depth
+     * (0..2^32) at stored vertex 0, per sub-pixel unit, and the vertex depth range. */
+    double z0, zx, zy;
     double zmin, zmax;
     int32_t minx, maxx, miny, maxy;   /* pixel bounds (inclusive), clamped to the image */
 } om__rtri;
 
-/* Sets the depth plane from the depths of the vertices as given to om__tri2_setup
- * (input order; the setup's permutation is applied). */
-void om__rtri_plane(om__rtri *t, const double z[3]);
+/* Sets the fixed-point plane from the depths of the vertices as given to
+ * om__tri2_setup (input order; the setup's permutation is applied). */
+void om__rtri_zplane(om__rtri *t, const uint32_t z[3]);
+/* Sets the double plane likewise. */
+void om__rtri_plane(om__rtri *t, const uint32_t z[3]);
 
-/* Depth of the triangle's plane at a grid position (sub-pixel units), clamped to the
- * triangle's vertex depth range. */
+/* Depth of the triangle's double plane at a grid position (sub-pixel units), clamped
+ * to the triangle's vertex depth range. */
 static inline double om__rtri_depth(const om__rtri *t, int64_t px, int64_t py)
 {
     double z = t->z0 + t->zx * (double)(px - t->e.x[0]) + t->zy * (double)(py - t->e.y[0]);
     return z < t->zmin ? t->zmin : z > t->zmax ? t->zmax : z;
+}
+
+/* The fixed-point plane's depth at a grid position inside the triangle (the rule at
+ * the top). */
+static inline uint32_t om__rtri_zat(const om__rtri *t, int64_t px, int64_t py)
+{
+    return (uint32_t)((t->zq0 + t->zqx * (uint64_t)(px - t->e.x[0]) + t->zqy * (uint64_t)(py - t->e.y[0])) >> 32);
 }
 
 typedef enum om_raster_mode {
@@ -173,7 +197,7 @@ int om__raster_tri_on(const om_raster *r, const om_vec4 clip[3], uint32_t id, ui
 /* Rasterizes one triangle already on the sub-pixel grid (coordinates within the
  * guard band, OM_TRI2_MAX_COORD) with depths z/w * 2^32: what om__raster_tri does
  * after clipping, for a caller that places vertices itself. False: nothing to fill. */
-bool om__raster_snapped(const om_raster *r, const int64_t x[3], const int64_t y[3], const double z[3],
+bool om__raster_snapped(const om_raster *r, const int64_t x[3], const int64_t y[3], const uint32_t z[3],
                         uint32_t id);
 
 /* Which of the six clip planes (near, far, four guard-band sides) a vertex is outside
@@ -194,10 +218,10 @@ static inline bool om__snap_xy(double x, double y, int64_t *gx, int64_t *gy)
     return true;
 }
 
-static inline bool om__snap(double x, double y, double z, int64_t *gx, int64_t *gy, double *gz)
+static inline bool om__snap(double x, double y, double z, int64_t *gx, int64_t *gy, uint32_t *gz)
 {
     if (!om__snap_xy(x, y, gx, gy)) return false;
-    *gz = z < 0.0 ? 0.0 : z > 4294967295.0 ? 4294967295.0 : z;
+    *gz = z > 0.0 ? (z < 4294967295.0 ? (uint32_t)z : 0xFFFFFFFFu) : 0u;   /* truncated, NaN to 0 */
     return true;
 }
 
@@ -217,34 +241,39 @@ static inline bool om__project_xy(const om_vec4 *v, uint32_t width, uint32_t hei
     const float sx = (float)width * (OM_SUBPIX / 2), sy = (float)height * (OM_SUBPIX / 2), lim = 67108864.0f;
     if (!(v->w > 0.0f)) return false;
     const float iw = 1.0f / v->w;
-    const float X = floorf((v->x * iw + 1.0f) * sx + 0.5f), Y = floorf((1.0f - v->y * iw) * sy + 0.5f);
+    const float X = (v->x * iw + 1.0f) * sx + 0.5f, Y = (1.0f - v->y * iw) * sy + 0.5f;
+    /* the same test on X as on floor(X): no float lies strictly between -2^26 and
+     * -2^26 + 4 */
     if (!(X > -lim && X < lim && Y > -lim && Y < lim)) return false;
-    *gx = (int64_t)X;
-    *gy = (int64_t)Y;
+    *gx = om__floorf_i32(X);
+    *gy = om__floorf_i32(Y);
     return true;
 }
 
 /* z/w * 2^32, truncated: exact, from the floats' significands divided as integers (a
  * 64-by-32-bit integer division, far cheaper than an emulated double one); 0 for
  * z <= 0 (or NaN), 2^32 - 1 for z >= w. */
-static inline double om__zdepth(float z, float w)
+static inline uint32_t om__zdepth(float z, float w)
 {
-    if (!(z > 0.0f)) return 0.0;
-    if (!(z < w)) return 4294967295.0;
-    uint32_t bz, bw;
-    memcpy(&bz, &z, sizeof bz);
-    memcpy(&bw, &w, sizeof bw);
+    if (!(z > 0.0f)) return 0;
+    if (!(z < w)) return 0xFFFFFFFFu;
+    /* the bits through a union (C99 reads the stored float's representation): a
+     * freestanding firmware would call memcpy for each */
+    union { float f; uint32_t u; } fz, fw;
+    fz.f = z;
+    fw.f = w;
+    const uint32_t bz = fz.u, bw = fw.u;
     int ez = (int)(bz >> 23), ew = (int)(bw >> 23);   /* positive: no sign bit */
     const uint64_t mz = (bz & 0x7FFFFFu) | (ez ? 0x800000u : 0u), mw = (bw & 0x7FFFFFu) | (ew ? 0x800000u : 0u);
     ez += !ez;   /* a subnormal's exponent is the least normal one's */
     ew += !ew;
     const int s = ez - ew + 32;   /* z/w * 2^32 = mz / mw * 2^s, s <= 32 as z < w */
-    if (s < -24) return 0.0;      /* mz / mw < 2^24: below one unit */
-    return (double)(s >= 0 ? (mz << s) / mw : mz / (mw << -s));
+    if (s < -24) return 0;        /* mz / mw < 2^24: below one unit */
+    return (uint32_t)(s >= 0 ? (mz << s) / mw : mz / (mw << -s));
 }
 
 static inline bool om__project(const om_vec4 *v, uint32_t width, uint32_t height, int64_t *gx, int64_t *gy,
-                               double *gz)
+                               uint32_t *gz)
 {
     if (!om__project_xy(v, width, height, gx, gy)) return false;
     *gz = om__zdepth(v->z, v->w);
@@ -255,6 +284,6 @@ static inline bool om__project(const om_vec4 *v, uint32_t width, uint32_t height
  * viewport and projects it: up to 9 vertices of a convex polygon in sub-pixel grid
  * coordinates with depth z/w * 2^32. Returns the vertex count (0: nothing left). */
 int om__clip_project(const om_vec4 clip[3], uint32_t width, uint32_t height,
-                     int64_t *gx, int64_t *gy, double *gz);
+                     int64_t *gx, int64_t *gy, uint32_t *gz);
 
 #endif

@@ -75,7 +75,7 @@ void om__lspace_begin(om__lspace *ls, const om_view *v)
         om_vec4 c = om__mat_apply(&ls->vp, s->verts[i]);
         om__lvert *o = &ls->verts[i];
         int64_t X, Y;
-        double Z;
+        uint32_t Z;
         /* A vertex inside every plane projects exactly as clipping would project it. */
         if (om__outcode(&c, OM_LIGHT_GRID, OM_LIGHT_GRID) == 0 &&
             om__project(&c, OM_LIGHT_GRID, OM_LIGHT_GRID, &X, &Y, &Z)) {
@@ -85,7 +85,7 @@ void om__lspace_begin(om__lspace *ls, const om_view *v)
         } else {
             o->x = INT32_MIN;
             o->y = 0;
-            o->z = 0.0;
+            o->z = 0;
         }
     }
 }
@@ -93,12 +93,15 @@ void om__lspace_begin(om__lspace *ls, const om_view *v)
 bool om__lspace_point(const om__lspace *ls, const om_sample *smp, om__lpoint *out)
 {
     om_vec4 c = om__mat_apply(&ls->vp, om__v3(smp->p[0], smp->p[1], smp->p[2]));
+    uint32_t z = 0;
     out->tri = smp->tri;
-    return om__project(&c, OM_LIGHT_GRID, OM_LIGHT_GRID, &out->x, &out->y, &out->z);
+    const bool ok = om__project(&c, OM_LIGHT_GRID, OM_LIGHT_GRID, &out->x, &out->y, &z);
+    out->z = z;
+    return ok;
 }
 
 static void add_sub(const om__lspace *ls, om__ltri *lt, const int64_t x[3], const int64_t y[3],
-                    const double z[3])
+                    const uint32_t z[3])
 {
     om__rtri *r = &lt->sub[lt->n];
     if (!om__tri2_setup(&r->e, x, y, true)) return;
@@ -126,7 +129,7 @@ bool om__lspace_tri(const om__lspace *ls, uint32_t t, om__ltri *lt)
     const om__lvert *b = ls->verts ? &ls->verts[ix[1]] : NULL, *c = ls->verts ? &ls->verts[ix[2]] : NULL;
     if (a && a->x != INT32_MIN && b->x != INT32_MIN && c->x != INT32_MIN) {
         int64_t x[3] = {a->x, b->x, c->x}, y[3] = {a->y, b->y, c->y};
-        double z[3] = {a->z, b->z, c->z};
+        uint32_t z[3] = {a->z, b->z, c->z};
         add_sub(ls, lt, x, y, z);
         return lt->n > 0;
     }
@@ -137,11 +140,11 @@ bool om__lspace_tri(const om__lspace *ls, uint32_t t, om__ltri *lt)
             !om__finite(clip[k].w))
             return false;
     int64_t gx[9], gy[9];
-    double gz[9];
+    uint32_t gz[9];
     int n = om__clip_project(clip, OM_LIGHT_GRID, OM_LIGHT_GRID, gx, gy, gz);
     for (int k = 1; k + 1 < n; k++) {
         int64_t x[3] = {gx[0], gx[k], gx[k + 1]}, y[3] = {gy[0], gy[k], gy[k + 1]};
-        double z[3] = {gz[0], gz[k], gz[k + 1]};
+        uint32_t z[3] = {gz[0], gz[k], gz[k + 1]};
         add_sub(ls, lt, x, y, z);
     }
     return lt->n > 0;

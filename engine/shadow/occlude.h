@@ -59,7 +59,7 @@ typedef struct om__lpoint {
 } om__lpoint;
 
 /* A vertex projected once per frame; x == INT32_MIN marks one that needs clipping. */
-typedef struct om__lvert { int32_t x, y; double z; } om__lvert;
+typedef struct om__lvert { int32_t x, y; uint32_t z; } om__lvert;
 
 typedef struct om__lspace {
     const om_scene *scene;

@@ -281,7 +281,7 @@ static void emit(tess_ctx *x, const tvert *a, const tvert *b, const tvert *c)
     const tvert *t[3] = {a, b, c};
     const double s = (double)x->m->size * OM_SUBPIX;
     int64_t gx[3], gy[3];
-    double gz[3];
+    uint32_t gz[3];
     for (int k = 0; k < 3; k++)
         if (!om__snap(t[k]->u * s, t[k]->v * s, (double)t[k]->c.z * (1.0 / (double)t[k]->c.w) * 4294967296.0,
                       &gx[k], &gy[k], &gz[k]))

@@ -21,7 +21,7 @@ static float texel_world(const om__smlook *L, float dist)
 {
     const om_view *v = L->view;
     float span = v->light.kind == OM_LIGHT_SPOT ? dist * L->span_per_dist
-                                                : 2.0f / fabsf(v->light_proj.m[0]);
+                                                : 2.0f / om__fabsf(v->light_proj.m[0]);
     return span / (float)L->size;
 }
 
@@ -39,10 +39,31 @@ static inline void warp(const om__smlook *L, double *u, double *v, double *densi
     *density = dmin > 1.0 / 64.0 ? dmin : 1.0 / 64.0;
 }
 
+/* floor(f) for a texel coordinate, limited to 16 texels beyond either side of the
+ * map: every PCF tap (k <= 9) of a texel further out clamps to the same edge texel. */
+static inline int64_t texel_floor(float f, uint32_t size)
+{
+    const float hi = (float)size + 16.0f;
+    return f > -16.0f ? (f < hi ? om__floorf_i32(f) : (int64_t)size + 16) : -16;
+}
+
 /* Where one sample's test looks: its biased depth and the texel under it (before the
  * clamp to the map); for a warped map also where it lies before the warp (normalized
  * coordinates), from which unwarped PCF taps are placed. */
-typedef struct tap { double z; int64_t cx, cy; double u, v; } tap;
+typedef struct tap { uint64_t zlit; int64_t cx, cy; double u, v; } tap;
+
+/* The least stored depth a biased sample depth z is not behind: z <= D for a stored
+ * integer D exactly when ceil(z) <= D (a NaN never is: 2^32 + 1). Integer compares per
+ * tap rather than conversions to double, which a Cortex-M4F runs in software. The
+ * ceiling through a 32-bit conversion is exact: (float)t is z itself once z >= 2^23. */
+static inline uint64_t depth_threshold(float z)
+{
+    if (z != z) return (1ull << 32) + 1;
+    if (!(z > 0.0f)) return 0;
+    if (!(z < 4294967296.0f)) return 1ull << 32;
+    const uint32_t t = (uint32_t)z;
+    return (uint64_t)t + ((float)t < z);
+}
 
 /* All of the test's arithmetic; false when the sample is behind the light. */
 static bool locate(const om__smlook *L, const om_sample *smp, tap *out)
@@ -74,7 +95,7 @@ static bool locate(const om__smlook *L, const om_sample *smp, tap *out)
             texel = (float)((double)texel / dens);
     }
     float cosang = om__dot(n, l);
-    float tanang = cosang > 0.0995f ? sqrtf(1.0f - cosang * cosang) / cosang : 10.0f;
+    float tanang = cosang > 0.0995f ? om__sqrtf(1.0f - cosang * cosang) / cosang : 10.0f;
     float bias = L->bias_const + L->bias_slope * texel * tanang;
     om_vec4 q;
     if (L->warp_x && L->normal_offset == 0.0f) {
@@ -105,8 +126,8 @@ static bool locate(const om__smlook *L, const om_sample *smp, tap *out)
         out->u = out->v = 0.0;   /* no warp: taps are the map's texels */
         const float uf = (q.x * iw + 1.0f) * (0.5f * (float)L->size);
         const float wf = (1.0f - q.y * iw) * (0.5f * (float)L->size);
-        out->cx = (int64_t)floorf(uf);
-        out->cy = (int64_t)floorf(wf);
+        out->cx = texel_floor(uf, L->size);
+        out->cy = texel_floor(wf, L->size);
     }
     float z = q.z * iw * 4294967296.0f;
     /* bias from world units to depth units: d(z/w)/d(distance) at this sample */
@@ -115,9 +136,9 @@ static bool locate(const om__smlook *L, const om_sample *smp, tap *out)
         float f = v->light.zfar, nn = v->light.znear, e = dist > nn * 0.5f ? dist : nn * 0.5f;
         dz = f * nn / ((f - nn) * e * e) * 4294967296.0f;
     } else {
-        dz = 4294967296.0f * fabsf(v->light_proj.m[10]);
+        dz = 4294967296.0f * om__fabsf(v->light_proj.m[10]);
     }
-    out->z = (double)(z - bias * dz);
+    out->zlit = depth_threshold(z - bias * dz);
     return true;
 }
 
@@ -132,7 +153,7 @@ static int64_t unwarped_tap(const int32_t *P, uint32_t n, uint32_t size, double 
  * sample's unwarped position), each clamped to the map. */
 static uint8_t test(const om__smlook *L, const tap *tp)
 {
-    const double z = tp->z;
+    const uint64_t z = tp->zlit;
     int k = (int)L->pcf, half = k / 2, lit = 0;
     int64_t tx[9], ty[9];   /* pcf <= 9 */
     for (int d = -half; d < k - half; d++) {
@@ -147,7 +168,7 @@ static uint8_t test(const om__smlook *L, const tap *tp)
             if (y < 0) y = 0;
             if (x >= L->size) x = L->size - 1;
             if (y >= L->size) y = L->size - 1;
-            lit += z <= (double)L->depth[(size_t)y * L->size + (size_t)x];
+            lit += z <= L->depth[(size_t)y * L->size + (size_t)x];
         }
     uint8_t val = (uint8_t)((255 * lit + k * k / 2) / (k * k));
     if (lit < k * k && val == 255) val = 254;   /* partly shadowed is never "lit" */

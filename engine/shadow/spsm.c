@@ -133,7 +133,9 @@ static sample_pt project(const spsm_state *m, om_vec3 p)
 {
     sample_pt s;
     om_vec4 q = om__mat_apply(&m->view.light_vp, p);
-    s.ok = om__project(&q, m->size, m->size, &s.x, &s.y, &s.z);
+    uint32_t z = 0;
+    s.ok = om__project(&q, m->size, m->size, &s.x, &s.y, &z);
+    s.z = z;
     return s;
 }
 
