@@ -9,7 +9,7 @@
 #include <float.h>
 #include <math.h>
 
-/* ---- determinism (README, Determinism): every engine file includes this header.
+/* ---- determinism (engine/DESIGN.md, Determinism): every engine file includes this header.
  * Float arithmetic must be evaluated in float (FLT_EVAL_METHOD 0): x87 (2) and s390x
  * gcc's standard mode (1) compute in a wider type, and the frames differ in their last
  * bits from every other CPU's. OM_ALLOW_EXCESS_PRECISION builds anyway, outside that

@@ -31,7 +31,7 @@ void om_host_puts(const char *line);
  * eye pass projects every triangle, which a board without a double FPU pays dearly
  * for), of 60 at 640x480. Every target renders a size through the same strips, so
  * that only the CPU and compiler differ (frames are meant to be the same through any
- * strips, but with spsm.aa they are not yet: README, On small machines). */
+ * strips, but with spsm.aa they are not yet: tests/README.md, make cross-test). */
 #ifndef OM_CROSS_ROWS
 #define OM_CROSS_ROWS 40
 #endif
@@ -50,6 +50,7 @@ void om_host_puts(const char *line);
 #ifndef OM_CROSS_ONLY
 #define OM_CROSS_ONLY 0xfffu
 #endif
+#ifndef OM_CROSS_COUNT
 #ifndef OM_CROSS_STAB
 #define OM_CROSS_STAB "stab_scene.h"
 #endif
@@ -61,9 +62,17 @@ static const char cloud_text[] =
     "plane size 12 12\n"
     "triangles count 10000 seed 4 area 20 in -4 0.3 -4 4 3 4\n";
 
+#endif
+
 static unsigned char scene_mem[OM_CROSS_SCENE_MEM];
 static unsigned char method_mem[OM_CROSS_METHOD_MEM];
+/* counting: strips of 160 pixels, and room for the default scene's row bins (4 bytes a
+ * triangle), without which every strip would walk the whole scene */
+#ifdef OM_CROSS_COUNT
+static unsigned char frame_mem[160 * OM_CROSS_ROWS * 48 + (96u << 10)];
+#else
 static unsigned char frame_mem[FRAME_PIXELS * 48];
+#endif
 static uint8_t pixels[FRAME_PIXELS * 2];
 
 typedef struct hashes { uint64_t img, mask; } hashes;
@@ -91,6 +100,7 @@ static void put_s(line *l, const char *s)
     l->buf[l->n] = '\0';
 }
 
+#ifndef OM_CROSS_COUNT
 static void put_hex(line *l, uint64_t v)
 {
     char t[17];
@@ -101,6 +111,7 @@ static void put_hex(line *l, uint64_t v)
     t[16] = '\0';
     put_s(l, t);
 }
+#endif
 
 static void put_dec(line *l, uint64_t v)
 {
@@ -148,6 +159,103 @@ static void method_cfg(om_method_cfg *c, const size_cfg *sz, int aa)
     }
 }
 
+#ifdef OM_CROSS_COUNT
+/* Instructions per frame on the Cortex-M4 board (`make cross-test`, OM_CROSS_COUNT):
+ * each method renders the small and the default scene at 160x120 through strips of
+ * OM_CROSS_ROWS rows into RGB565, with the embedded configuration, and prints
+ *   count SCENE METHOD INSTRUCTIONS EYE OBSERVE BUILD RESOLVE SHADE METHOD_B FRAME_B SCENE_B
+ * (instructions of the frame and of its stages; the arenas' peak bytes). asm is
+ * counted on its second frame, when its tiles are cached, as a frame of a running
+ * application would be. Under qemu-system-arm -icount shift=0 the board's clock ticks
+ * one nanosecond per instruction; the MPS2's CMSDK timer 0 (0x40000000) counts down
+ * at 25 MHz, so one tick is 40 instructions. */
+#define CMSDK_TIMER0 ((volatile uint32_t *)0x40000000u)
+
+static uint64_t count_now(void *user)
+{
+    (void)user;
+    return (uint64_t)(0xFFFFFFFFu - CMSDK_TIMER0[1]) * 40u;
+}
+
+static void count_scene(const char *tag, const char *text, int *bad)
+{
+    static const size_cfg sz = {160, 120, OM_CROSS_ROWS, 1, "@160x120"};
+    om_arena sa;
+    om_scene s;
+    om_diag d;
+    om_camera cam;
+    om_light light;
+    om_view v;
+    om_arena_init(&sa, scene_mem, sizeof scene_mem, "scene");
+    if (om_scene_parse(text, strlen(text), NULL, &sa, &s, &d) != OM_OK) { *bad |= fail(tag, "-", "scene", &d); return; }
+    om_scene_at(&s, 0.0f, &cam, &light);
+    cam.width = sz.w;
+    cam.height = sz.h;
+    if (om_view_init(&v, &cam, &light, &s, &d) != OM_OK) { *bad |= fail(tag, "-", "view", &d); return; }
+    for (size_t k = 0; k < om_method_count(); k++) {
+        const om_method *m = om_method_at(k);
+        om_method_cfg cfg;
+        method_cfg(&cfg, &sz, 0);
+        size_t mn, full;
+        om_arena ma, fa;
+        void *state;
+        if (m->bytes(&cfg, &s, sz.w, sz.h, &mn, &full) != OM_OK || mn > sizeof method_mem) {
+            line l = {{0}, 0};
+            put_s(&l, "too big: ");
+            put_s(&l, tag);
+            put_s(&l, " ");
+            put_s(&l, m->name);
+            om_host_puts(l.buf);
+            *bad = 1;
+            continue;
+        }
+        om_arena_init(&ma, method_mem, full < sizeof method_mem ? full : sizeof method_mem, "method");
+        if (m->init(&state, &ma, &cfg, &s, sz.w, sz.h, &d) != OM_OK) { *bad |= fail(tag, m->name, "init", &d); continue; }
+        om_shade_cfg shade;
+        om_shade_cfg_default(&shade);
+        om_framebuffer fb = {OM_RGB565, sz.w, sz.rows, sz.w * 2, pixels};
+        hashes h;
+        om_frame_desc fd;
+        memset(&fd, 0, sizeof fd);
+        fd.scene = &s; fd.view = &v; fd.method = m; fd.method_state = state; fd.shade = &shade;
+        fd.strip_rows = sz.rows; fd.fb = &fb; fd.on_strip = on_strip; fd.user = &h; fd.clock = count_now;
+        om_frame_stats fs;
+        uint64_t n = 0;
+        size_t frame_peak = 0;
+        for (int f = 0; f < (strcmp(m->name, "asm") ? 1 : 2); f++) {
+            om_arena_init(&fa, frame_mem, sizeof frame_mem, "frame");
+            const uint64_t t0 = count_now(NULL);
+            if (om_render_frame(&fd, &fa, &fs, &d) != OM_OK) { *bad |= fail(tag, m->name, "render", &d); n = 0; break; }
+            n = count_now(NULL) - t0;
+            frame_peak = fa.peak;
+        }
+        if (!n) continue;
+        line l = {{0}, 0};
+        const uint64_t fig[] = {n, fs.ns_eye, fs.ns_observe, fs.ns_build, fs.ns_resolve, fs.ns_shade,
+                                ma.peak, frame_peak, sa.peak};
+        put_s(&l, "count ");
+        put_s(&l, tag);
+        put_s(&l, " ");
+        put_s(&l, m->name);
+        for (size_t i = 0; i < sizeof fig / sizeof fig[0]; i++) {
+            put_s(&l, " ");
+            put_dec(&l, fig[i]);
+        }
+        om_host_puts(l.buf);
+    }
+}
+
+int om_cross_main(void)
+{
+    int bad = 0;
+    CMSDK_TIMER0[2] = 0xFFFFFFFFu;   /* reload */
+    CMSDK_TIMER0[1] = 0xFFFFFFFFu;   /* value */
+    CMSDK_TIMER0[0] = 1;             /* enable */
+    count_scene("small", om_scene_small_text(), &bad);
+    count_scene("default", om_scene_default_text(), &bad);
+    return bad;
+}
+#else
 /* Whether a method has AA or PCF settings (the default-aa case repeats only those). */
 static int has_aa(const om_method *m)
 {
@@ -285,3 +393,4 @@ int om_cross_main(void)
             if ((OM_CROSS_ONLY >> (4 * z + c)) & 1u) bad |= run_case(&cases[c], &sizes[z]);
     return bad;
 }
+#endif

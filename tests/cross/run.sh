@@ -6,7 +6,7 @@
 #
 # A toolchain or emulator that is missing fails the run, unless CROSS_SKIP_MISSING=1
 # (then it is reported and skipped); .ci/run installs them all. Builds marked "loose"
-# are outside the promise (README, On small machines): they must render every case and end,
+# are outside the promise (tests/README.md, make cross-test): they must render every case and end,
 # and their differing frames are counted, not failed. CROSS_ONLY=REGEX runs only the
 # builds whose names match (and the reference), for working on one target.
 set -u
@@ -78,7 +78,7 @@ cortex-m7-clang-Os|board|clang|-Os $M7|mps2-an500|0x1"
 # s390x clang at -O1 and above runs only where the emulator multiplies two floats into
 # a double (mdebr, mdeb) right: QEMU 7.2 does not, and clang's optimised code uses the
 # instruction (asm.c) where gcc's does not, so the frames would differ through the
-# emulator's fault, not the engine's (README, On small machines). A probe decides.
+# emulator's fault, not the engine's (tests/README.md, make cross-test). A probe decides.
 
 # The board build: the same driver, the firmware of platform/cortex-m, every method in
 # an arena of 256 KiB (the target for small machines; a method whose minimum is
@@ -267,6 +267,54 @@ for c in $configs; do
 done
 IFS=' 	
 '
+
+# Instructions per frame on the Cortex-M4 (driver.c's OM_CROSS_COUNT): every method on
+# the small and the default scene at 160x120, strips of 8 rows, counted under
+# qemu-system-arm -icount shift=0. Written to out/cross/m4.csv (the report reads it)
+# with the firmware's sizes in out/cross/m4-size.csv; a table here.
+count_m4() {
+    csv=out/cross/m4.csv
+    mkdir -p out/cross
+    # shellcheck disable=SC2086
+    arm-none-eabi-gcc $BFLAGS -O2 $M4 -DOM_CROSS_COUNT -DOM_CROSS_ROWS=8 $BSRC -T platform/cortex-m/mps2.ld \
+        -nostartfiles -Wl,--gc-sections -lm -lc -lgcc -o "$out/m4-count" 2>"$out/m4-count.err" || {
+        echo "cross: FAIL the Cortex-M4 counting firmware does not build: $(head -c 600 "$out/m4-count.err")"
+        return 1
+    }
+    timeout 900 qemu-system-arm -M mps2-an386 -icount shift=0 -nographic -monitor none -serial none \
+        -semihosting-config enable=on,target=native -kernel "$out/m4-count" >"$out/m4-count.txt" 2>&1 || {
+        echo "cross: FAIL the Cortex-M4 counting firmware: $(tail -c 600 "$out/m4-count.txt")"
+        return 1
+    }
+    { echo "scene,method,width,height,strip_rows,instructions,eye,observe,build,resolve,shade,method_bytes,frame_bytes,scene_bytes"
+      awk '$1 == "count" {printf "%s,%s,160,120,8,%s,%s,%s,%s,%s,%s,%s,%s,%s\n", $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, $12}' \
+          "$out/m4-count.txt"; } >"$csv.tmp" && mv "$csv.tmp" "$csv"
+    arm-none-eabi-size "$out/m4-count" | awk 'NR == 2 {print "build,text,data,bss"; print "cortex-m4-gcc-O2," $1 "," $2 "," $3}' \
+        >out/cross/m4-size.csv
+    echo "cross: Cortex-M4 instructions per frame, 160x120, strips of 8 rows (out/cross/m4.csv):"
+    awk -F, 'function k(n,  s) { s = sprintf("%.0f", n); while (s ~ /[0-9][0-9][0-9][0-9]/) sub(/[0-9][0-9][0-9]($|,)/, ",&", s); return s }
+        NR > 1 {
+        if ($1 != last) { printf "    %-8s %-7s %14s %12s %12s %12s  %s\n", "scene", "method", "instructions", "eye", "shadow", "shade", "bytes (scene + method + frame)"; last = $1 }
+        printf "    %-8s %-7s %14s %12s %12s %12s  %s\n", $1, $2, k($6), k($7), k($8 + $9 + $10), k($11), k($14 + $12 + $13) }' "$csv"
+    awk -F, 'NR == 2 {printf "    firmware (every method, both scenes): .text %d, .data %d, .bss %d bytes\n", $2, $3, $4}' out/cross/m4-size.csv
+}
+if [ -z "${CROSS_ONLY:-}" ] || echo "m4-count" | grep -Eq -- "$CROSS_ONLY"; then
+    if command -v arm-none-eabi-gcc >/dev/null 2>&1 && command -v qemu-system-arm >/dev/null 2>&1; then
+        t0=$(date +%s)
+        if count_m4; then
+            note m4-count "instructions per frame counted ($(($(date +%s) - t0)) s)"
+        else
+            fail=$((fail + 1))
+            note m4-count "FAIL"
+        fi
+    elif [ "$skip_missing" = 1 ]; then
+        skip=$((skip + 1))
+        note m4-count "skipped: not installed"
+    else
+        fail=$((fail + 1))
+        note m4-count "FAIL: arm-none-eabi-gcc or qemu-system-arm not installed"
+    fi
+fi
 
 # Code size: .text of each part of the engine for Cortex-M3 at -Os.
 if command -v arm-none-eabi-gcc >/dev/null 2>&1; then
