@@ -422,9 +422,10 @@ typedef struct om_frame_desc {
 /* Bytes the frame arena needs for width x strip_rows (samples, terms and the eye
  * pass's depth and triangle-ID buffers). */
 size_t om_frame_bytes(uint32_t width, uint32_t strip_rows);
-/* The same plus the row bins of scene s (4 bytes a triangle): with strips, each strip
- * then clips and sets up only the triangles that reach its rows, instead of all of
- * them. A frame arena of om_frame_bytes gives the same pixels, more slowly. */
+/* The same plus the bins of scene s (4 bytes a triangle and 12 a vertex): with strips,
+ * each strip then sets up only the triangles that reach its rows, from vertices
+ * projected once per frame, instead of clipping and setting up all of them. A frame
+ * arena of om_frame_bytes gives the same pixels, more slowly. */
 size_t om_frame_bytes_scene(const om_scene *s, uint32_t width, uint32_t strip_rows);
 /* Renders one frame. The frame arena is rewound on return; the method's arena keeps
  * what the method keeps. */

@@ -91,9 +91,10 @@ static void failure_injection(void)
         uint32_t method_carves = ma.carves, frame_carves = fa.carves;
         CHECK_OK(frame(&f, state, &fa, good));
         method_carves = ma.carves;
-        /* the frame: depth, ids, samples, terms, and the row bins its strips use (a
-         * carve that may fail: the strips then walk every triangle, same pixels) */
-        CHECK_MSG(method_carves >= 1 && frame_carves == 5, "%s: %u method and %u frame carves",
+        /* the frame: depth, ids, samples, terms, and the bins its strips use, rows and
+         * vertices (carves that may fail: the strips then walk every triangle, or clip
+         * every vertex, for the same pixels) */
+        CHECK_MSG(method_carves >= 1 && frame_carves == 6, "%s: %u method and %u frame carves",
                   f.m->name, method_carves, frame_carves);
         int bad = 0;
         for (uint32_t n = 1; n <= method_carves + frame_carves; n++) {

@@ -16,7 +16,7 @@ size_t om_frame_bytes(uint32_t width, uint32_t strip_rows)
 
 size_t om_frame_bytes_scene(const om_scene *s, uint32_t width, uint32_t strip_rows)
 {
-    return om_frame_bytes(width, strip_rows) + om__row_bins_bytes(s);
+    return om_frame_bytes(width, strip_rows) + om__bins_rows_bytes(s) + om__bins_verts_bytes(s);
 }
 
 static uint64_t now(const om_frame_desc *fd)
@@ -90,16 +90,20 @@ om_status om_render_frame(const om_frame_desc *fd, om_arena *fa, om_frame_stats 
 
     om_view view = *fd->view;
     const bool single = rows == H;
-    /* Row bins when the frame has strips and the arena has room: each strip then sets
-     * up only its own triangles (the same pixels; without room, every strip walks
-     * every triangle). The camera's matrix does not change within the frame. */
-    uint32_t *bins = NULL;
-    if (!single && om_arena_left(fa) >= om__row_bins_bytes(s) && s->ntris) {
-        void *pb;
+    /* Bins when the frame has strips and the arena has room (om__bins): each strip
+     * then sets up only its own triangles, from vertices projected once (the same
+     * pixels; without room, every strip walks every triangle). The camera's matrix
+     * does not change within the frame. */
+    om__bins bins = {NULL, NULL};
+    if (!single && s->ntris && om_arena_left(fa) >= om__bins_rows_bytes(s)) {
+        void *pb, *pv;
         if (om_arena_alloc(fa, (size_t)s->ntris * sizeof(uint32_t), 8, &pb, NULL) == OM_OK) {
-            bins = (uint32_t *)pb;
+            bins.rows = (uint32_t *)pb;
+            if (om_arena_left(fa) >= om__bins_verts_bytes(s) &&
+                om_arena_alloc(fa, (size_t)s->nverts * sizeof(om__vsnap), 8, &pv, NULL) == OM_OK)
+                bins.verts = (om__vsnap *)pv;
             uint64_t tb = now(fd);
-            om__row_bins(s, &view.cam_vp, W, H, bins);
+            om__bins_make(s, &view.cam_vp, W, H, &bins);
             fs->ns_eye += now(fd) - tb;
         }
     }
@@ -114,7 +118,7 @@ om_status om_render_frame(const om_frame_desc *fd, om_arena *fa, om_frame_stats 
         strip.y0 = tg.y0 = (y);                                                  \
         strip.rows = tg.rows = (y) + rows > H ? H - (y) : rows;                  \
         t0 = now(fd);                                                            \
-        om__eye_pass(s, &view, &tg, &strip, bins);                               \
+        om__eye_pass(s, &view, &tg, &strip, bins.rows ? &bins : NULL);           \
         fs->ns_eye += now(fd) - t0;                                              \
         fs->eye_passes++;                                                        \
     } while (0)

@@ -27,28 +27,41 @@ typedef struct om__cull {
 void om__cull_begin(om__cull *c, const om_scene *s, const om_mat4 *vp);
 bool om__cull_next(om__cull *c, uint32_t t);
 
+/* Strips without repetition: the frame's bins, made once per frame through the
+ * camera (om__bins_make) so that a strip's eye pass neither sets up the triangles that
+ * miss its rows nor clips and projects again the vertices that need no clipping.
+ *  rows[t]:  the image rows triangle t's pixels can lie in (first | last << 16,
+ *            conservative by a row; 0x0000FFFF for one that covers nothing; all rows
+ *            for one that needs clipping);
+ *  verts[v]: vertex v snapped alone (om__project) when it is inside every clip plane,
+ *            x = INT32_MIN when not: a triangle of three such vertices goes straight
+ *            to om__raster_snapped, as om__raster_tri would send it.
+ * verts may be NULL (the arena had room for the rows only). */
+typedef struct om__vsnap { int32_t x, y; uint32_t z; } om__vsnap;
+typedef struct om__bins {
+    uint32_t *rows;
+    om__vsnap *verts;
+} om__bins;
+
+size_t om__bins_rows_bytes(const om_scene *s);
+size_t om__bins_verts_bytes(const om_scene *s);
+/* Fills b->verts (when not NULL) and then b->rows for the camera matrix vp. */
+void om__bins_make(const om_scene *s, const om_mat4 *vp, uint32_t width, uint32_t height, const om__bins *b);
+
 /* Clears `tg` and rasterizes every triangle of the scene through `vp` into it: the
  * eye pass (OM_RASTER_DEPTH_ID) and the light depth passes (OM_RASTER_DEPTH); with
- * `cull`, the back faces of closed shapes are skipped (om__cull). With `rows` (from
- * om__row_bins), triangles whose rows miss the target's are skipped before any setup. */
+ * `cull`, the back faces of closed shapes are skipped (om__cull). With bins (made for
+ * this vp and image), triangles whose rows miss the target's are skipped before any
+ * setup; NULL walks every triangle. The same pixels either way. */
 void om__scene_raster(const om_scene *s, const om_mat4 *vp, const om_target *tg,
-                      om_raster_mode mode, bool cull, const uint32_t *rows);
-
-/* Strips without repetition: for each triangle, the image rows its pixels can lie in
- * through `vp` onto a width x height image (first | last << 16, conservative by a row;
- * 0x0000FFFF for one that covers nothing; all rows for one that needs clipping), so a
- * strip's eye pass sets up only the triangles that reach it. One pass of vertex
- * projections per frame instead of a clip and setup of every triangle per strip. */
-size_t om__row_bins_bytes(const om_scene *s);
-void om__row_bins(const om_scene *s, const om_mat4 *vp, uint32_t width, uint32_t height,
-                  uint32_t *rows);
+                      om_raster_mode mode, bool cull, const om__bins *bins);
 
 /* Renders rows [st->y0, st->y0 + st->rows) of the camera view into `tg` (depth and
  * triangle id, strip-sized) and resolves st->samples: the exact point of the visible
- * triangle under each pixel centre, by perspective-correct barycentrics. `rows` may be
- * NULL (every triangle is walked) or om__row_bins' for this view. */
+ * triangle under each pixel centre, by perspective-correct barycentrics. `bins` may be
+ * NULL (every triangle is walked) or om__bins_make's for this view. */
 void om__eye_pass(const om_scene *s, const om_view *v, const om_target *tg, om_strip *st,
-                  const uint32_t *rows);
+                  const om__bins *bins);
 
 /* The exact point of a triangle under an image position, by perspective-correct
  * barycentrics in homogeneous clip space (no division by w, so triangles crossing the

@@ -66,10 +66,10 @@ static const char cloud_text[] =
 
 static unsigned char scene_mem[OM_CROSS_SCENE_MEM];
 static unsigned char method_mem[OM_CROSS_METHOD_MEM];
-/* counting: strips of 160 pixels, and room for the default scene's row bins (4 bytes a
- * triangle), without which every strip would walk the whole scene */
+/* counting: strips of 160 pixels, and room for the default scene's bins (4 bytes a
+ * triangle, 12 a vertex), without which every strip would walk the whole scene */
 #ifdef OM_CROSS_COUNT
-static unsigned char frame_mem[160 * OM_CROSS_ROWS * 48 + (96u << 10)];
+static unsigned char frame_mem[160 * OM_CROSS_ROWS * 48 + (320u << 10)];
 #else
 static unsigned char frame_mem[FRAME_PIXELS * 48];
 #endif
