@@ -36,6 +36,11 @@ static size_t node_bound(size_t n, uint32_t leaf)
     return 2 * (leaves ? leaves : 1);
 }
 
+size_t om__bvh_nodes_max(const om_scene *s, uint32_t leaf)
+{
+    return node_bound(s->ntris ? s->ntris : 1, leaf);
+}
+
 size_t om__bvh_bytes(const om_scene *s, uint32_t leaf)
 {
     size_t n = s->ntris ? s->ntris : 1;

@@ -20,6 +20,8 @@ typedef struct om__bvh {
     uint32_t nnodes, depth;
 } om__bvh;
 
+/* The most nodes a BVH over s with leaves of `leaf` can have. */
+size_t om__bvh_nodes_max(const om_scene *s, uint32_t leaf);
 /* Bytes the BVH keeps, and the scratch its build needs on top (released after). */
 size_t om__bvh_bytes(const om_scene *s, uint32_t leaf);
 size_t om__bvh_scratch_bytes(const om_scene *s);

@@ -5,15 +5,20 @@
  *
  * The BVH's boxes are grown by the light grid's snapping tolerance so the walk never
  * skips a triangle the predicate would accept: the walk is only a filter, the
- * predicate decides. */
+ * predicate decides. With the memory for it, the walk runs on the light's grid instead
+ * (ref_light.h), over packets of neighbouring samples: the same filter's answer for
+ * the triangles that matter, in fewer steps. */
 #include "shadow.h"
 #include "occlude.h"
 #include "bvh.h"
+#include "ref_light.h"
 
 typedef struct ref_state {
     const om_scene *scene;
     om__lspace ls;
     om__bvh bvh;
+    om__lbvh lb;           /* one-pass memory: the BVH on the light's grid, per frame */
+    struct packet *pk;     /* one-pass memory: the tile being resolved */
     om__odepth *mat_od;
     om_view view;
     float margin;
@@ -21,15 +26,33 @@ typedef struct ref_state {
     uint32_t samples, candidates, blocked;
 } ref_state;
 
-/* Two sizes: one pass (the per-frame vertex projection and a BVH with leaves of 4, the
- * fastest) and the least (no projection cache, leaves of 32: a fraction of the nodes,
- * for small machines). Both give the same bits; only the speed differs. */
+/* Two sizes: one pass (the per-frame vertex projection, a BVH with leaves of 4 and its
+ * per-frame bounds on the light's grid, the fastest) and the least (no projection
+ * cache, leaves of 32: a fraction of the nodes, for small machines, walked along the
+ * segment in 3-D). Both give the same bits; only the speed differs. */
 #define LEAF_FAST 4
 #define LEAF_SMALL 32
 
+/* Packets (one pass): a TILE x TILE block of the strip's samples on the light's grid,
+ * and per level of blocks inside it (TILE, TILE / 2, ... 1) the list of BVH nodes the
+ * block can need. A block whose list cannot be opened down to leaves within LIST
+ * entries (samples on different surfaces, far apart on the light's grid) passes it on
+ * to its four quarters; a single sample walks under what is left. */
+#define TILE 16
+#define LEVELS 5     /* block sides 16, 8, 4, 2, 1 */
+#define LIST 16
+
+typedef struct packet {
+    om__lpoint p[TILE * TILE];  /* row-major in the tile */
+    uint8_t on[TILE * TILE];    /* 1: an exposed sample in front of the light */
+    uint32_t list[LEVELS][LIST];
+} packet;
+
 static size_t state_bytes(const om_scene *s, bool fast)
 {
-    return om_arena_need(sizeof(ref_state), 16) + (fast ? om__lspace_bytes(s) : 0) +
+    return om_arena_need(sizeof(ref_state), 16) +
+           (fast ? om__lspace_bytes(s) + om__lbvh_bytes(s, LEAF_FAST) +
+                   om_arena_need(sizeof(packet), 16) : 0) +
            om__bvh_bytes(s, fast ? LEAF_FAST : LEAF_SMALL) +
            om_arena_need((size_t)(s->nmats ? s->nmats : 1) * sizeof(om__odepth), 4);
 }
@@ -57,6 +80,12 @@ static om_status ref_init(void **state, om_arena *a, const om_method_cfg *c, con
     r->fast = fast;
     if (fast && (st = om__lspace_init(&r->ls, a, s, d))) return st;
     if (!fast) om__lspace_init_lean(&r->ls, s);
+    r->pk = NULL;
+    if (fast) {
+        if ((st = om__lbvh_init(&r->lb, a, s, LEAF_FAST, d))) return st;
+        if ((st = om_arena_alloc(a, sizeof(packet), 16, &p, d))) return st;
+        r->pk = (packet *)p;
+    }
     if ((st = om_arena_alloc(a, (size_t)(s->nmats ? s->nmats : 1) * sizeof(om__odepth), 4, &p, d)))
         return st;
     r->mat_od = (om__odepth *)p;
@@ -92,9 +121,13 @@ static om_status ref_observe(void *state, const om_strip *st, om_diag *d)
     return OM_OK;
 }
 
+/* One pass: the BVH's boxes on this frame's light grid (a stage of its own, so the
+ * frame's clock counts it). */
 static om_status ref_build(void *state, om_diag *d)
 {
-    (void)state; (void)d;
+    (void)d;
+    ref_state *r = (ref_state *)state;
+    if (r->pk) om__lbvh_fit(&r->lb, &r->bvh, &r->ls);
     return OM_OK;
 }
 
@@ -116,7 +149,14 @@ static bool visit(void *user, uint32_t tri)
     return om__odepth_opaque(&w->od);
 }
 
-/* The shadow term of one sample against every triangle (the walk is a filter). */
+static void finish(ref_state *r, const walk_ctx *w, om_term *t)
+{
+    om__odepth_term(&w->od, t);
+    if (t->r != 255 || t->g != 255 || t->b != 255) r->blocked++;
+}
+
+/* The shadow term of one sample against every triangle (the walk is a filter): the
+ * least memory's way, along the segment in 3-D. */
 static void shade_sample(ref_state *r, const om_sample *smp, om_term *t)
 {
     walk_ctx w;
@@ -134,14 +174,81 @@ static void shade_sample(ref_state *r, const om_sample *smp, om_term *t)
         tmax = 2.0f * (fabsf(ext.x) + fabsf(ext.y) + fabsf(ext.z)) + 1.0f;
     }
     om__bvh_walk(&r->bvh, p, dir, tmax, r->margin, visit, &w);
-    om__odepth_term(&w.od, t);
-    if (t->r != 255 || t->g != 255 || t->b != 255) r->blocked++;
+    finish(r, &w, t);
+}
+
+/* One pass: the samples of the block of side `size` at (bx, by) in the tile at (x0, y0),
+ * with the nodes its enclosing block listed (ref_light.h). It recurses at most LEVELS
+ * deep. */
+static void shade_block(ref_state *r, om_strip *st, uint32_t x0, uint32_t y0, uint32_t bx,
+                        uint32_t by, uint32_t size, const uint32_t *in, uint32_t nin, int level)
+{
+    packet *pk = r->pk;
+    om__lrect q = {INT64_MAX, INT64_MAX, INT64_MIN, INT64_MIN, 0.0};
+    bool any = false;
+    for (uint32_t y = by; y < by + size; y++)
+        for (uint32_t x = bx; x < bx + size; x++) {
+            const om__lpoint *p = &pk->p[y * TILE + x];
+            if (!pk->on[y * TILE + x]) continue;
+            any = true;
+            if (p->x < q.lox) q.lox = p->x;
+            if (p->x > q.hix) q.hix = p->x;
+            if (p->y < q.loy) q.loy = p->y;
+            if (p->y > q.hiy) q.hiy = p->y;
+            if (p->z > q.zmax) q.zmax = p->z;
+        }
+    if (!any) return;
+    bool open;
+    uint32_t *list = pk->list[level];
+    uint32_t n = om__lbvh_narrow(&r->lb, in, nin, &q, list, LIST, &open);
+    if (open && size > 1) {
+        uint32_t h = size / 2;
+        shade_block(r, st, x0, y0, bx, by, h, list, n, level + 1);
+        shade_block(r, st, x0, y0, bx + h, by, h, list, n, level + 1);
+        shade_block(r, st, x0, y0, bx, by + h, h, list, n, level + 1);
+        shade_block(r, st, x0, y0, bx + h, by + h, h, list, n, level + 1);
+        return;
+    }
+    for (uint32_t y = by; y < by + size; y++)
+        for (uint32_t x = bx; x < bx + size; x++) {
+            if (!pk->on[y * TILE + x]) continue;
+            walk_ctx w;
+            w.r = r;
+            w.p = pk->p[y * TILE + x];
+            memset(&w.od, 0, sizeof w.od);
+            om__lbvh_walk_list(&r->lb, &r->bvh, list, n, &w.p, visit, &w);
+            finish(r, &w, &st->terms[(size_t)(y0 + y) * st->width + x0 + x]);
+        }
+}
+
+/* Projects the tile's exposed samples, then shades it as one block. */
+static void shade_tile(ref_state *r, om_strip *st, uint32_t x0, uint32_t y0)
+{
+    packet *pk = r->pk;
+    for (uint32_t y = 0; y < TILE; y++)
+        for (uint32_t x = 0; x < TILE; x++) {
+            pk->on[y * TILE + x] = 0;
+            if (y0 + y >= st->rows || x0 + x >= st->width) continue;
+            size_t i = (size_t)(y0 + y) * st->width + x0 + x;
+            om_term *t = &st->terms[i];
+            t->r = t->g = t->b = 255;
+            if (!(t->flags & OM_TERM_EXPOSED)) continue;
+            r->samples++;
+            pk->on[y * TILE + x] = om__lspace_point(&r->ls, &st->samples[i], &pk->p[y * TILE + x]);
+        }
+    const uint32_t root = 0;
+    shade_block(r, st, x0, y0, 0, 0, TILE, &root, r->bvh.nnodes ? 1 : 0, 0);
 }
 
 static om_status ref_resolve(void *state, om_strip *st, om_diag *d)
 {
     (void)d;
     ref_state *r = (ref_state *)state;
+    if (r->pk) {
+        for (uint32_t y = 0; y < st->rows; y += TILE)
+            for (uint32_t x = 0; x < st->width; x += TILE) shade_tile(r, st, x, y);
+        return OM_OK;
+    }
     size_t n = (size_t)st->rows * st->width;
     for (size_t i = 0; i < n; i++) {
         om_term *t = &st->terms[i];
