@@ -54,8 +54,12 @@ typedef struct asm_state {
     bool built;
     bool prepared;         /* this frame's projections are done */
     bool lean;             /* no per-vertex or per-triangle arrays: see render */
-    asm_dvec *vclip;       /* per vertex: light clip coordinates, in double (not lean) */
     float *tbox;           /* per triangle: base-texel bounds u0, v0, u1, v1 (not lean) */
+    /* Per triangle, a bit: its bounds hold a texel centre of level 0's grid (centre[0])
+     * or level 1's (centre[1]): box_holds_centre once per frame for the levels every
+     * rebuild renders whole, so their gathers read no bounds of triangles that would
+     * write nothing (not lean). */
+    uint32_t *centre[2];
     uint32_t *cull;        /* triangles that meet the region being rendered (not lean) */
     /* A grid of cells over the base texels, each listing the triangles whose bounds
      * meet it, made once per frame, so that a tile gathers from its cells instead of
@@ -103,8 +107,8 @@ static uint32_t grid_cap(const om_scene *s) { return 2 * (s->ntris ? s->ntris : 
 static size_t scene_bytes(const om_scene *s)
 {
     const size_t n = s->ntris ? s->ntris : 1, g = grid_side(s);
-    return om_arena_need((size_t)(s->nverts ? s->nverts : 1) * sizeof(asm_dvec), 8) +
-           om_arena_need(n * 4 * sizeof(float), 8) + om_arena_need(n * sizeof(uint32_t), 8) +
+    return om_arena_need(n * 4 * sizeof(float), 8) + om_arena_need(n * sizeof(uint32_t), 8) +
+           2 * om_arena_need((n + 31) / 32 * sizeof(uint32_t), 8) +
            om_arena_need((g * g + 1) * sizeof(uint32_t), 8) +
            om_arena_need((size_t)grid_cap(s) * sizeof(uint32_t), 8) +
            om_arena_need((n + 31) / 32 * sizeof(uint32_t), 8);
@@ -170,18 +174,21 @@ static om_status asm_init(void **state, om_arena *a, const om_method_cfg *c, con
     m->scene = s;
     m->cfg = *c;
     m->lean = lean;
-    m->vclip = NULL;
     m->tbox = NULL;
+    m->centre[0] = m->centre[1] = NULL;
     m->cull = NULL;
     m->gready = false;
     if ((st = om__asm_tree_init(&m->tree, a, &l, d))) return st;
     const size_t t2 = (size_t)l.tile * l.tile;
     uint64_t nc = cand_count(&l);
     if (!lean) {
-        if ((st = om_arena_alloc(a, (size_t)(s->nverts ? s->nverts : 1) * sizeof(asm_dvec), 8, &p, d))) return st;
-        m->vclip = (asm_dvec *)p;
         if ((st = om_arena_alloc(a, (size_t)(s->ntris ? s->ntris : 1) * 4 * sizeof(float), 8, &p, d))) return st;
         m->tbox = (float *)p;
+        for (int i = 0; i < 2; i++) {
+            if ((st = om_arena_alloc(a, ((size_t)(s->ntris ? s->ntris : 1) + 31) / 32 * sizeof(uint32_t), 8, &p, d)))
+                return st;
+            m->centre[i] = (uint32_t *)p;
+        }
         if ((st = om_arena_alloc(a, (size_t)(s->ntris ? s->ntris : 1) * sizeof(uint32_t), 8, &p, d))) return st;
         m->cull = (uint32_t *)p;
         const size_t g = grid_side(s);
@@ -268,6 +275,30 @@ static inline bool box_meets(const float *b, float u0, float v0, float u1, float
     return !((b[2] < u0) | (b[0] > u1) | (b[3] < v0) | (b[1] > v1));
 }
 
+/* Whether [lo, hi] holds an integer: exact, without libm (|lo| < 1e15 converts to an
+ * integer and back unchanged); wide or huge ranges hold one. */
+static inline bool holds_integer(double lo, double hi)
+{
+    if (!(hi - lo < 1.0) || !(lo > -1e15 && lo < 1e15)) return true;
+    double c = (double)(int64_t)lo;   /* towards zero: lo's ceiling, or one below it */
+    if (c < lo) c += 1.0;
+    return c <= hi;
+}
+
+/* Whether bounds b (base texels) hold a texel centre of a grid `sc` times finer on both
+ * axes. The rasterizer samples a tile at its texel centres only, and a snapped triangle
+ * covers none outside its vertices' box, so one whose bounds hold no centre writes
+ * nothing: most of a big scene's triangles in the base and many in a root tile, each a
+ * fraction of a texel there. Skipping them leaves every tile as it was. The bounds are
+ * already wider than the rasterizer's snap and float x/w can move a vertex (tri_box);
+ * another 1/32 texel here keeps the test from deciding on rounding at all. */
+static inline bool box_holds_centre(const float *b, double sc)
+{
+    const double e = 1.0 / 32;
+    return holds_integer((double)b[0] * sc - 0.5 - e, (double)b[2] * sc - 0.5 + e) &&
+           holds_integer((double)b[1] * sc - 0.5 - e, (double)b[3] * sc - 0.5 + e);
+}
+
 /* One triangle into the tile: its clip coordinates composed with the tile's window. */
 static void render_tri(om_raster *r, const asm_dvec q[3], double s_, double kx, double ky,
                        uint32_t t)
@@ -282,14 +313,25 @@ static void render_tri(om_raster *r, const asm_dvec q[3], double s_, double kx, 
     om__raster_tri(r, c, t);
 }
 
-/* The triangles whose bounds meet the region, in index order, into m->cull: every
- * triangle's bounds tested, without branches (most miss a deep node's region). */
-static uint32_t gather_all(asm_state *m, float u0, float v0, float u1, float v1)
+/* The triangles whose bounds meet the region and hold a texel centre, in index order,
+ * into m->cull: every triangle's bounds tested (most miss a deep node's region). */
+static uint32_t gather_all(asm_state *m, float u0, float v0, float u1, float v1, double sc,
+                           const uint32_t *centre)
 {
     uint32_t n = 0;
+    if (centre) {   /* a word of bits at a time: in a big scene most are clear */
+        for (uint32_t w = 0; w < (m->scene->ntris + 31) / 32; w++)
+            for (uint32_t bits = centre[w]; bits; bits &= bits - 1) {
+                const uint32_t k = w * 32 + om__ctz32(bits);
+                m->cull[n] = k;
+                n += box_meets(&m->tbox[(size_t)k * 4], u0, v0, u1, v1);
+            }
+        return n;
+    }
     for (uint32_t k = 0; k < m->scene->ntris; k++) {
+        const float *b = &m->tbox[(size_t)k * 4];
         m->cull[n] = k;
-        n += box_meets(&m->tbox[(size_t)k * 4], u0, v0, u1, v1);
+        n += box_meets(b, u0, v0, u1, v1) && box_holds_centre(b, sc);
     }
     return n;
 }
@@ -332,9 +374,10 @@ static void grid_make(asm_state *m)
 }
 
 /* gather_all's result from the cells the region meets: their triangles marked in a
- * bit set (a triangle in several cells once), collected in index order and tested as
- * gather_all tests them. */
-static uint32_t gather_cells(asm_state *m, float u0, float v0, float u1, float v1)
+ * bit set (a triangle in several cells once; with `centre`, only those it has),
+ * collected in index order and tested as gather_all tests them. */
+static uint32_t gather_cells(asm_state *m, float u0, float v0, float u1, float v1, double sc,
+                             const uint32_t *centre)
 {
     const uint32_t G = m->gside;
     uint32_t lo = UINT32_MAX, hi = 0, n = 0;
@@ -342,7 +385,7 @@ static uint32_t gather_cells(asm_state *m, float u0, float v0, float u1, float v
         for (uint32_t cx = cell_of(m, u0); cx <= cell_of(m, u1); cx++)
             for (uint32_t i = m->gstart[cy * G + cx]; i < m->gstart[cy * G + cx + 1]; i++) {
                 uint32_t k = m->glist[i];
-                m->gbits[k >> 5] |= 1u << (k & 31);
+                m->gbits[k >> 5] |= (centre ? centre[k >> 5] : ~0u) & 1u << (k & 31);
                 if (k < lo) lo = k;
                 if (k > hi) hi = k;
             }
@@ -350,12 +393,11 @@ static uint32_t gather_cells(asm_state *m, float u0, float v0, float u1, float v
         uint32_t bits = m->gbits[w];
         m->gbits[w] = 0;
         while (bits) {
-            uint32_t j = 0;
-            while (!(bits & (1u << j))) j++;
+            uint32_t k = w * 32 + om__ctz32(bits);
             bits &= bits - 1;
-            uint32_t k = w * 32 + j;
+            const float *b = &m->tbox[(size_t)k * 4];
             m->cull[n] = k;
-            n += box_meets(&m->tbox[(size_t)k * 4], u0, v0, u1, v1);
+            n += box_meets(b, u0, v0, u1, v1) && (centre || box_holds_centre(b, sc));
         }
     }
     return n;
@@ -394,16 +436,30 @@ static void render(asm_state *m, uint32_t level, uint32_t ox, uint32_t oy, uint3
             float b[4];
             for (int i = 0; i < 3; i++) q[i] = dapply(&m->view.light_vp, s->verts[ix[i]]);
             tri_box(q, T, b);
-            if (!box_meets(b, u0, v0, u1, v1)) continue;
+            if (!box_meets(b, u0, v0, u1, v1) || !box_holds_centre(b, l->scale[level])) continue;
             r.cull_back = om__cull_next(&cl, t);
             render_tri(&r, q, s_, kx, ky, t);
         }
     } else {
-        uint32_t n = m->gready ? gather_cells(m, u0, v0, u1, v1) : gather_all(m, u0, v0, u1, v1);
+        const double sc = l->scale[level];
+        const uint32_t *centre = level < 2 ? m->centre[level] : NULL;
+        /* the base covers every cell: its centre bits alone are the shorter walk */
+        uint32_t n = m->gready && level > 0 ? gather_cells(m, u0, v0, u1, v1, sc, centre)
+                                            : gather_all(m, u0, v0, u1, v1, sc, centre);
         for (uint32_t k = 0; k < n; k++) {
             const uint32_t t = m->cull[k];
             const uint32_t *ix = s->idx + (size_t)t * 3;
-            const asm_dvec q[3] = {m->vclip[ix[0]], m->vclip[ix[1]], m->vclip[ix[2]]};
+#if defined(__GNUC__) || defined(__clang__)
+            /* a big scene's triangles in a tile lie far apart in memory: ask for the
+             * next ones' vertices early (a hint: no effect on what is computed) */
+            if (k + 4 < n) {
+                const uint32_t *nx = s->idx + (size_t)m->cull[k + 4] * 3;
+                for (int i = 0; i < 3; i++) __builtin_prefetch(&s->verts[nx[i]]);
+            }
+            if (k + 8 < n) __builtin_prefetch(s->idx + (size_t)m->cull[k + 8] * 3);
+#endif
+            asm_dvec q[3];
+            for (int i = 0; i < 3; i++) q[i] = dapply(&m->view.light_vp, s->verts[ix[i]]);
             r.cull_back = om__cull_next(&cl, t);
             render_tri(&r, q, s_, kx, ky, t);
         }
@@ -431,11 +487,19 @@ static void prepare(asm_state *m)
     m->prepared = true;
     const om_scene *s = m->scene;
     if (!m->lean) {
-        for (uint32_t i = 0; i < s->nverts; i++) m->vclip[i] = dapply(&m->view.light_vp, s->verts[i]);
+        /* Projections per triangle, kept only as bounds: a tile projects again the few
+         * it renders (the same bits), which costs less than keeping every vertex's. */
+        const size_t words = ((size_t)s->ntris + 31) / 32;
+        memset(m->centre[0], 0, words * sizeof(uint32_t));
+        memset(m->centre[1], 0, words * sizeof(uint32_t));
         for (uint32_t k = 0; k < s->ntris; k++) {
             const uint32_t *ix = s->idx + (size_t)k * 3;
-            const asm_dvec q[3] = {m->vclip[ix[0]], m->vclip[ix[1]], m->vclip[ix[2]]};
-            tri_box(q, m->tree.lay.tile, &m->tbox[(size_t)k * 4]);
+            asm_dvec q[3];
+            for (int i = 0; i < 3; i++) q[i] = dapply(&m->view.light_vp, s->verts[ix[i]]);
+            float *b = &m->tbox[(size_t)k * 4];
+            tri_box(q, m->tree.lay.tile, b);
+            for (int i = 0; i < 2; i++)
+                m->centre[i][k >> 5] |= (uint32_t)box_holds_centre(b, m->tree.lay.scale[i]) << (k & 31);
         }
         grid_make(m);
     }
