@@ -95,13 +95,25 @@ fuzz-regress: $(FUZZ_TARGETS:%=$(O)/fuzz-replay-%)
 $(O)/embed-render-once: tests/embed/render_once.c $(O)/libombra.a include/ombra.h
 	$(Q)$(CC) $(CFLAGS_ALL) -o $@ $(filter %.c %.a,$^) $(LDLIBS)
 
-check: $(O)/run-tests $(O)/ombra $(FUZZ_TARGETS:%=$(O)/fuzz-replay-%) $(O)/embed-render-once
+# The same example in a firmware with only `sm`: registry.c (the only file that reads
+# OM_WITH_*) compiled with every other method off and linked ahead of the library;
+# tests/methods.sh checks that no other method's code came along and that the frame
+# is the full library's.
+ONLY_SM = -DOM_WITH_NONE=0 -DOM_WITH_REF=0 -DOM_WITH_ASM=0 -DOM_WITH_RTW=0 -DOM_WITH_SPSM=0 \
+          -DOM_WITH_IZB=0 -DOM_WITH_HYBRID=0
+$(O)/embed-only-sm: tests/embed/render_once.c engine/shadow/registry.c $(O)/libombra.a \
+                    include/ombra.h $(wildcard engine/*/*.h)
+	$(Q)$(CC) $(CFLAGS_ALL) $(ONLY_SM) -o $@ $(filter %.c %.a,$^) $(LDLIBS)
+
+check: $(O)/run-tests $(O)/ombra $(FUZZ_TARGETS:%=$(O)/fuzz-replay-%) $(O)/embed-render-once \
+       $(O)/embed-only-sm
 	@echo "== $(O)"
 	$(O)/run-tests
 	sh tests/cli.sh $(O)/ombra
 	$(Q)$(REPLAY)
 	$(O)/embed-render-once
 	sh tests/embed/readme.sh
+	sh tests/methods.sh $(O)
 
 test-sanitize:
 	$(MAKE) --no-print-directory check CC=clang OPT=-O1 O=build/san \

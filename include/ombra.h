@@ -267,73 +267,54 @@ uint32_t om_format_bpp(om_format f);   /* bytes per pixel */
 
 /* ---------------------------------------------------------------- methods */
 
-/* Every method's settings in one struct; each method reads its own fields. Defaults
- * come from om_method_cfg_default; om_method_cfg_fields lists them by name for hosts
- * (the CLI's --set NAME=VALUE). */
+/* Settings belong to their method: each method lists its own (om_method.settings) over
+ * a configuration struct private to its file, so adding a setting changes that file
+ * alone. A host holds one method's values in an om_method_cfg and sets them by name. */
+typedef enum om_setting_kind {
+    OM_SETTING_U32 = 0,    /* a whole number, stored as uint32_t */
+    OM_SETTING_U64,        /* a whole number, stored as uint64_t (byte counts) */
+    OM_SETTING_F32         /* a number, stored as float */
+} om_setting_kind;
+
+typedef struct om_setting {
+    const char *name;      /* "METHOD.NAME" for a method's own; a plain name ("map")
+                              for one that several methods take */
+    const char *doc;       /* one line */
+    om_setting_kind kind;
+    size_t offset;         /* where the value lies in the method's configuration */
+    double min, max;       /* what om_method_cfg_set accepts */
+    double def;            /* the default */
+} om_setting;
+
+/* Room for the largest method's configuration (a method that outgrows it does not
+ * compile). */
+#define OM_METHOD_CFG_BYTES 128
+
+struct om_method;
+
+/* One method's settings, by value: plain memory the host keeps where it likes (the
+ * stack, a static) and copies freely. Made by om_method_cfg_default for a method,
+ * changed by om_method_cfg_set, read by that method's bytes and init, which refuse
+ * a configuration made for another method. */
 typedef struct om_method_cfg {
-    uint32_t map_size;     /* sm, rtw, spsm: shadow-map side in texels */
-    float bias_const;      /* sm, rtw: constant bias, world units along the light ray */
-    float bias_slope;      /* sm, rtw: slope-scaled bias, in texels */
-    float normal_offset;   /* sm, rtw: offset along the normal, in texels */
-    uint32_t pcf;          /* sm, rtw: k for k x k PCF, 1 = none */
-    /* asm */
-    uint64_t asm_cap;      /* bytes the node structure may hold, at most */
-    uint32_t asm_tile;     /* texels per side of every node's tile */
-    uint32_t asm_cells;    /* cells per side of a node; a cell may hold a child node */
-    uint32_t asm_root;     /* texels per side of the root's view of the light frustum */
-    uint32_t asm_work;     /* per-frame work budget, in cost units */
-    uint32_t asm_stride;   /* analyse one visible sample in asm_stride (the paper: 8) */
-    float asm_cost_a, asm_cost_b;   /* cost of a node: a * texels required + b */
-    /* izb */
-    uint32_t izb_leaf;     /* most samples in a BSP leaf (the paper: 64) */
-    uint32_t izb_pool;     /* samples the pool holds; 0 = the whole frame in one pass */
-    /* rtw */
-    uint32_t rtw_importance;  /* importance map side; 0 = 512, or the map's side when that
-                                 is smaller (at least 8): a small budget's small map
-                                 gets a small importance map */
-    uint32_t rtw_analysis;    /* 0 backward (visible samples), 1 forward, 2 hybrid */
-    uint32_t rtw_funcs;       /* importance functions: 1 desired view, 2 distance to eye,
-                                 4 shadow edge, 8 surface normal */
-    float rtw_sigma;          /* Gaussian blur, in super-cells */
-    float rtw_tess;           /* longest warped edge as a fraction of the map, 0 = off */
-    uint32_t rtw_exact;       /* 1: each texel samples the scene at its inverse-warped
-                                 centre (exact; no tessellation needed); 0: warped
-                                 vertices, straight edges, rtw_tess (the paper's) */
-    uint32_t rtw_footprint;   /* PCF taps (pcf > 1): 0 one warped texel apart (the
-                                 filter follows the map's local resolution: anti-
-                                 aliasing), 1 one texel of a conventional map of the
-                                 same size apart, warped at the last moment (constant
-                                 area in the light's image: soft shadows; section 6.2) */
-    /* spsm */
-    uint32_t spsm_aa;      /* sub-samples at uncertain samples, 0 or 1 = off */
-    uint32_t spsm_records; /* which texel records the build makes: 1 every one (the
-                              paper's build), 2 only those the view reads (observe
-                              marks them), 0 = 2 when the map has more than twice as
-                              many texels as the image has pixels, else 1. The same
-                              frames either way; only the time differs. */
-    uint32_t spsm_fine;    /* 1: the plain-map fallback at 2 x 2 points per texel (16
-                              more bytes per texel and a second pass; fewer false-lit
-                              samples along fine rims), 0: at texel centres */
-    /* hybrid (also izb_leaf, izb_pool for the samples its map leaves uncertain) */
-    uint32_t hybrid_map;   /* side of its conservative map, 20 bytes per texel; 0 =
-                              the largest power of two at most half the image's side */
+    const struct om_method *method;   /* whose settings these are; NULL: none */
+    union {                /* private: the method's configuration struct */
+        unsigned char bytes[OM_METHOD_CFG_BYTES];
+        uint64_t align_u64;
+        double align_f64;
+    } store;
 } om_method_cfg;
 
-/* One settable field of om_method_cfg. */
-typedef struct om_cfg_field {
-    const char *name;      /* "map", "asm.cap", ... */
-    const char *help;
-    char kind;             /* 'u' uint32_t, 'z' uint64_t, 'f' float */
-    size_t offset;         /* offsetof(om_method_cfg, field) */
-    double min, max;
-} om_cfg_field;
-
-const om_cfg_field *om_method_cfg_fields(size_t *count);
-/* Sets a field by name; OM_E_NOTFOUND for an unknown name, OM_E_RANGE outside
- * [min, max] or not whole for an integer field. */
+/* The defaults of method m (m may be NULL: an empty configuration no method takes). */
+void om_method_cfg_default(om_method_cfg *c, const struct om_method *m);
+/* Sets a setting of c's method by name: OM_E_NOTFOUND when the method has no such
+ * setting, OM_E_RANGE outside [min, max] or not whole for a whole-number setting. */
 om_status om_method_cfg_set(om_method_cfg *c, const char *name, double value, om_diag *d);
-
-void om_method_cfg_default(om_method_cfg *c);
+/* Reads a setting's value: OM_E_NOTFOUND when c's method has no such setting. */
+om_status om_method_cfg_get(const om_method_cfg *c, const char *name, double *value);
+/* m's defaults with the value of every setting of `from` (may be NULL) that m takes
+ * too: to compare methods at the same "map", say. `from` may be c's own storage. */
+void om_method_cfg_from(om_method_cfg *c, const struct om_method *m, const om_method_cfg *from);
 
 typedef struct om_method_stats {
     size_t bytes_used;     /* arena bytes held by the method this frame (peak) */
@@ -372,15 +353,21 @@ typedef struct om_method {
      * configuration may not need the samples first); when not, the frame skips the
      * observe pass and, with strips, the eye pass it would run again for it. */
     bool (*observes)(const void *state);
+    /* Its settings, and the size of the configuration they lie in. */
+    const om_setting *settings;
+    uint32_t nsettings;
+    size_t cfg_bytes;
 } om_method;
 
+/* The methods built in. Each can be left out when the engine is compiled:
+ * -DOM_WITH_SPSM=0 (likewise OM_WITH_NONE, _REF, _SM, _ASM, _RTW, _IZB, _HYBRID; 0 or 1,
+ * all 1 by default) drops it from this list, so a program linked against the library
+ * carries none of its code. */
 size_t om_method_count(void);
 const om_method *om_method_at(size_t i);
 const om_method *om_method_find(const char *name);
-/* The settings `ombra bench` sweeps for a method (listed beside it in the registry), as
- * space-separated NAME=V1,V2,... lists whose product is swept; NULL = the defaults
- * only, "" = left out of sweeps. */
-const char *om_method_sweep(const om_method *m);
+/* A setting of method m by name; NULL when m has none of that name. */
+const om_setting *om_method_setting(const om_method *m, const char *name);
 
 /* ---------------------------------------------------------------- rendering */
 

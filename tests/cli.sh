@@ -225,6 +225,12 @@ for c in render info compare bench report methods scene; do
     has "$dir/out" "usage: ombra $c" "$c --help prints its usage"
 done
 expect 2 "methods with an argument" -- "$OMBRA" methods sm
+expect 0 "methods, again" -- "$OMBRA" methods
+has "$dir/out" "^  izb.pool .*(izb, hybrid)$" "methods lists who takes a setting"
+expect 0 "a setting of another method" -- "$OMBRA" render --size 16x12 --method sm --set spsm.aa=2 --out "$dir/z.ppm"
+has "$dir/err" "sm takes no setting 'spsm.aa' (ignored)" "render says a setting of another method is ignored"
+expect 2 "a setting out of range" -- "$OMBRA" render --size 16x12 --method spsm --set spsm.aa=65 --out "$dir/z.ppm"
+has "$dir/err" "spsm.aa takes a whole number from 0 to 64" "a setting out of range names its range"
 
 # Meshes: each read once (a FIFO works), any number of them, long directories.
 awk 'BEGIN {print "camera eye 0 2 5 target 0 0 0 size 32 24"; for (i = 0; i < 70; i++) printf "mesh m%d.obj translate %d 0 0\n", i, i % 5}' >"$dir/many.scene"

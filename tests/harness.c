@@ -47,6 +47,29 @@ static om_status on_strip(void *user, const om_strip *st, const om_framebuffer *
     return OM_OK;
 }
 
+om_method_cfg h_cfg(const char *method, const char *list)
+{
+    const om_method *m = om_method_find(method);
+    om_method_cfg c;
+    om_method_cfg_default(&c, m);
+    CHECK_MSG(m != NULL, "h_cfg: no method %s", method);
+    for (const char *p = list; p && *p;) {
+        char name[64];
+        double v;
+        int used = 0;
+        if (sscanf(p, " %63[^= ]=%lf%n", name, &v, &used) != 2) {
+            CHECK_MSG(0, "h_cfg: '%s' is not NAME=VALUE ...", p);
+            break;
+        }
+        p += used;
+        while (*p == ' ') p++;
+        if (!om_method_setting(m, name)) continue;
+        om_diag d;
+        CHECK_MSG(om_method_cfg_set(&c, name, v, &d) == OM_OK, "h_cfg %s %s: %s", method, name, d.msg);
+    }
+    return c;
+}
+
 om_status h_render(const om_scene *s, const char *name, const om_method_cfg *cfg, uint32_t w,
                    uint32_t h, float t, uint32_t strip_rows, uint8_t *mask, om_term *terms,
                    om_sample *samples)
@@ -69,8 +92,7 @@ om_status h_render_in(const om_scene *s, const char *name, const om_method_cfg *
     const om_method *m = om_method_find(name);
     if (!m) return OM_E_NOTFOUND;
     om_method_cfg c;
-    if (cfg) c = *cfg;
-    else om_method_cfg_default(&c);
+    om_method_cfg_from(&c, m, cfg);
     size_t mn, full;
     if ((st = m->bytes(&c, s, cam.width, cam.height, &mn, &full))) return st;
     if (method_bytes) full = method_bytes;

@@ -16,7 +16,13 @@ bool h_scene_parse(h_scene *hs, const char *text);
 bool h_scene_parse_ld(h_scene *hs, const char *text, const om_loader *ld);
 void h_scene_free(h_scene *hs);
 
-/* Renders with method `name` and configuration `cfg` (NULL: defaults) at the scene's
+/* Method `method`'s defaults with those settings of `list` ("map=256 asm.cap=1048576")
+ * that it takes, so that one list serves a test that loops over the methods. A value
+ * out of its range fails the check. */
+om_method_cfg h_cfg(const char *method, const char *list);
+
+/* Renders with method `name` and configuration `cfg` (NULL: defaults; one made for
+ * another method: the settings they share, om_method_cfg_from) at the scene's
  * camera (w x h when non-zero) and time t; fills mask[w*h] and, if given, terms and
  * samples. strip_rows 0 = whole frame. Returns the frame's status. */
 om_status h_render(const om_scene *s, const char *name, const om_method_cfg *cfg, uint32_t w,

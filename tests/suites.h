@@ -19,6 +19,7 @@
     X(suite_spsm) \
     X(suite_oracle) \
     X(suite_hybrid) \
+    X(suite_settings) \
     /* end of list */
 #endif
 #define X(suite) void suite(void);

@@ -6,10 +6,26 @@
  * minimum, and bit-identical frames (strips included). */
 #include "test.h"
 #include "harness.h"
+#include "../engine/shadow/shadow.h"
 #include "../engine/shadow/asm.h"
 
 #include <stdlib.h>
 #include <math.h>
+
+/* The tree's layout for a configuration of the method (asm.c reads it the same way). */
+static om_status layout_of(om__asm_layout *l, const om_method_cfg *c, uint32_t ntris)
+{
+    om__asm_cfg t;
+    om_status st = om__method_cfg_of(c, om_method_find("asm"), &t, NULL);
+    return st ? st : om__asm_layout_of(l, &t, ntris, NULL);
+}
+
+static uint64_t cap_of(const om_method_cfg *c)
+{
+    double v = 0;
+    CHECK_OK(om_method_cfg_get(c, "asm.cap", &v));
+    return (uint64_t)v;
+}
 
 /* One ASM state kept across frames, as a host keeps it. */
 typedef struct arun {
@@ -111,21 +127,21 @@ static uint32_t counter(const om_method_stats *ms, const char *name)
 
 static void small_cfg(om_method_cfg *c, uint32_t nodes)
 {
-    om_method_cfg_default(c);
-    c->asm_root = 64;
-    c->asm_tile = 16;
-    c->asm_cells = 4;
+    om_method_cfg_default(c, om_method_find("asm"));
+    CHECK_OK(om_method_cfg_set(c, "asm.root", 64, NULL));
+    CHECK_OK(om_method_cfg_set(c, "asm.tile", 16, NULL));
+    CHECK_OK(om_method_cfg_set(c, "asm.cells", 4, NULL));
     om__asm_layout l;
-    om__asm_layout_of(&l, c, 100, NULL);
-    c->asm_cap = l.root_bytes + (uint64_t)nodes * l.node_bytes;
+    layout_of(&l, c, 100);
+    CHECK_OK(om_method_cfg_set(c, "asm.cap", l.root_bytes + (uint64_t)nodes * l.node_bytes, NULL));
 }
 
 static void tree_layout(void)
 {
     om_method_cfg c;
-    om_method_cfg_default(&c);
+    om_method_cfg_default(&c, om_method_find("asm"));
     om__asm_layout l;
-    CHECK_OK(om__asm_layout_of(&l, &c, 22984, NULL));
+    CHECK_OK(layout_of(&l, &c, 22984));
     CHECK_EQ_U(l.cp, 8);
     CHECK_EQ_U(l.base_cells, 16);   /* 16 x 16 root tiles of 64 make the 1024 root */
     CHECK_EQ_U(l.base_cp, 4);
@@ -133,17 +149,17 @@ static void tree_layout(void)
     CHECK(om__asm_grid(&l, 0) == 64 && om__asm_grid(&l, 1) == 1024 && om__asm_grid(&l, 4) == 524288);
     CHECK(l.min_cap < (64u << 10));   /* the base and one tile: small devices can run it */
     CHECK(l.id16);
-    CHECK(l.count > 100 && l.root_bytes + (uint64_t)l.count * l.node_bytes <= c.asm_cap);
-    CHECK(l.root_bytes + (uint64_t)(l.count + 1) * l.node_bytes > c.asm_cap);
-    CHECK_OK(om__asm_layout_of(&l, &c, 70000, NULL));
+    CHECK(l.count > 100 && l.root_bytes + (uint64_t)l.count * l.node_bytes <= cap_of(&c));
+    CHECK(l.root_bytes + (uint64_t)(l.count + 1) * l.node_bytes > cap_of(&c));
+    CHECK_OK(layout_of(&l, &c, 70000));
     CHECK(!l.id16);
-    c.asm_cells = 5;   /* 64 is not a multiple of 5 */
-    CHECK(om__asm_layout_of(&l, &c, 10, NULL) == OM_E_INVALID);
-    c.asm_cells = 8;
-    c.asm_root = 1000;   /* not a multiple of the tile */
-    CHECK(om__asm_layout_of(&l, &c, 10, NULL) == OM_E_INVALID);
-    c.asm_root = 64 * 3;   /* 3 root tiles a side do not divide a 64-texel base */
-    CHECK(om__asm_layout_of(&l, &c, 10, NULL) == OM_E_INVALID);
+    CHECK_OK(om_method_cfg_set(&c, "asm.cells", 5, NULL));   /* 64 is not a multiple of 5 */
+    CHECK(layout_of(&l, &c, 10) == OM_E_INVALID);
+    CHECK_OK(om_method_cfg_set(&c, "asm.cells", 8, NULL));
+    CHECK_OK(om_method_cfg_set(&c, "asm.root", 1000, NULL));   /* not a multiple of the tile */
+    CHECK(layout_of(&l, &c, 10) == OM_E_INVALID);
+    CHECK_OK(om_method_cfg_set(&c, "asm.root", 64 * 3, NULL));   /* 3 root tiles a side do not divide a 64-texel base */
+    CHECK(layout_of(&l, &c, 10) == OM_E_INVALID);
 }
 
 static void tree_rules(void)
@@ -151,7 +167,7 @@ static void tree_rules(void)
     om_method_cfg c;
     small_cfg(&c, 3);
     om__asm_layout l;
-    CHECK_OK(om__asm_layout_of(&l, &c, 100, NULL));
+    CHECK_OK(layout_of(&l, &c, 100));
     CHECK_EQ_U(l.count, 3);
     CHECK_EQ_U(l.base_cells, 4);   /* a 16-texel base of 4 x 4 cells; root tiles make 64 */
     CHECK_EQ_U(l.max_level, 8);    /* 64 * 4^7 <= 2^21 */
@@ -171,7 +187,7 @@ static void tree_rules(void)
     CHECK(n2 != OM__ASM_NONE);
     CHECK_EQ_U(om__asm_node_at(&t, n2)->level, 2);
     CHECK_EQ_U(om__asm_depth(&t), 2);
-    CHECK_EQ_U(om__asm_bytes_in_use(&t), c.asm_cap);
+    CHECK_EQ_U(om__asm_bytes_in_use(&t), cap_of(&c));
     /* n0 covers base texels [4, 8) x [4, 8): texels [16, 32) of the 64-texel root */
     CHECK_EQ_U(om__asm_node_at(&t, n0)->ox, 16);
     CHECK_EQ_U(om__asm_node_at(&t, n0)->oy, 16);
@@ -208,7 +224,7 @@ static void tree_rules(void)
     CHECK(n4 != OM__ASM_NONE);
     CHECK(om__asm_find(&t, 5.5, 5.25, false, &tx, &ty) == OM__ASM_ROOT);   /* n0 is gone */
     CHECK_EQ_U(t.evicted, 1);
-    CHECK(om__asm_bytes_in_use(&t) <= c.asm_cap);
+    CHECK(om__asm_bytes_in_use(&t) <= cap_of(&c));
 
     /* A subtree leaves with its root node. */
     om__asm_evict(&t, n1);
@@ -225,7 +241,7 @@ static void tree_candidates_order(void)
     om_method_cfg c;
     small_cfg(&c, 4);
     om__asm_layout l;
-    CHECK_OK(om__asm_layout_of(&l, &c, 100, NULL));
+    CHECK_OK(layout_of(&l, &c, 100));
     unsigned char *mem = malloc(l.arena_bytes);
     om_arena a;
     om_arena_init(&a, mem, l.arena_bytes, "tree");
@@ -274,11 +290,11 @@ static void budgets_name_minimum(void)
     const om_method *m = om_method_find("asm");
     if (!m) { CHECK_MSG(0, "asm is not registered"); return; }
     om_method_cfg c;
-    om_method_cfg_default(&c);
+    om_method_cfg_default(&c, om_method_find("asm"));
     om__asm_layout l;
-    CHECK_OK(om__asm_layout_of(&l, &c, hs.s.ntris, NULL));
+    CHECK_OK(layout_of(&l, &c, hs.s.ntris));
     /* a cap below one root node (and one child) */
-    c.asm_cap = l.min_cap - 1;
+    CHECK_OK(om_method_cfg_set(&c, "asm.cap", l.min_cap - 1, NULL));
     size_t mn, full;
     CHECK_OK(m->bytes(&c, &hs.s, 160, 120, &mn, &full));
     void *buf = malloc(full), *state;
@@ -293,7 +309,7 @@ static void budgets_name_minimum(void)
     free(buf);
     /* the smallest cap works; an arena below the minimum names the minimum, which the
      * lean mode needs: the cap and a tile of scratch, nothing per vertex or triangle */
-    c.asm_cap = l.min_cap;
+    CHECK_OK(om_method_cfg_set(&c, "asm.cap", l.min_cap, NULL));
     CHECK_OK(m->bytes(&c, &hs.s, 160, 120, &mn, &full));
     CHECK(mn < full);
     CHECK(mn < l.arena_bytes + 64 * 1024);
@@ -349,17 +365,17 @@ static void cap_holds_along_path(void)
     h_scene hs;
     if (!h_scene_parse(&hs, light_scene)) return;
     om_method_cfg c;
-    om_method_cfg_default(&c);
-    c.asm_root = 512;   /* the paper's; a quarter of the root to re-render per frame */
+    om_method_cfg_default(&c, om_method_find("asm"));
+    CHECK_OK(om_method_cfg_set(&c, "asm.root", 512, NULL));   /* the paper's; a quarter of the root to re-render per frame */
     om__asm_layout l;
-    CHECK_OK(om__asm_layout_of(&l, &c, hs.s.ntris, NULL));
+    CHECK_OK(layout_of(&l, &c, hs.s.ntris));
     const uint64_t caps[4] = {l.min_cap, l.min_cap + 8 * l.node_bytes, l.min_cap + 64 * l.node_bytes,
                               64u << 20};
     static uint8_t mask[160 * 120];
     for (int held = 0; held < 2; held++)
         for (int k = 0; k < 4; k++) {
             if (!held && (k == 1 || k == 2)) continue;   /* the tree is dropped every frame */
-            c.asm_cap = caps[k];
+            CHECK_OK(om_method_cfg_set(&c, "asm.cap", caps[k], NULL));
             arun r;
             if (!arun_init(&r, &hs.s, &c, 160, 120, false)) continue;
             uint32_t worst = 0, evicted = 0, most = 0, failed = 0;
@@ -394,15 +410,13 @@ static void still_view_converges(void)
     for (int view = 0; view < 2; view++) {
         float t = view ? 2.0f : 0.0f;
         CHECK_OK(h_render(&hs.s, "ref", NULL, SW, SH, t, 0, ref, NULL, NULL));
-        om_method_cfg c;
-        om_method_cfg_default(&c);
-        c.map_size = 2048;
-        CHECK_OK(h_render(&hs.s, "sm", &c, SW, SH, t, 0, sm, NULL, NULL));
+        om_method_cfg smc = h_cfg("sm", "map=2048"), c = h_cfg("asm", "");
+        CHECK_OK(h_render(&hs.s, "sm", &smc, SW, SH, t, 0, sm, NULL, NULL));
         om_metrics mt;
         om_compare_masks(ref, sm, SW, SH, &mt);
         uint64_t sm_bad = mt.false_lit + mt.false_shadowed;
-        CHECK_EQ_U(c.asm_cap, (uint64_t)2048 * 2048 * 4);
-        c.asm_work = 8;   /* a few nodes a frame, so refinement spans several frames */
+        CHECK_EQ_U(cap_of(&c), (uint64_t)2048 * 2048 * 4);
+        CHECK_OK(om_method_cfg_set(&c, "asm.work", 8, NULL));   /* a few nodes a frame, so refinement spans several frames */
         arun r;
         if (!arun_init(&r, &hs.s, &c, SW, SH, false)) continue;
         uint64_t prev = UINT64_MAX, first = 0;
@@ -438,8 +452,8 @@ static void runs_are_bit_identical(void)
     enum { BW = 200, BH = 150 };
     static om_term terms[3][BW * BH];
     om_method_cfg c;
-    om_method_cfg_default(&c);
-    c.asm_cap = 8u << 20;
+    om_method_cfg_default(&c, om_method_find("asm"));
+    CHECK_OK(om_method_cfg_set(&c, "asm.cap", 8u << 20, NULL));
     arun r[3];
     for (int k = 0; k < 3; k++)
         if (!arun_init(&r[k], &hs.s, &c, BW, BH, k == 1)) return;
@@ -472,17 +486,17 @@ static void odd_settings_render(void)
     static uint8_t mask[80 * 60];
     for (int k = 0; k < 6; k++) {
         om_method_cfg c;
-        om_method_cfg_default(&c);
-        c.asm_cap = 4u << 20;
-        c.asm_tile = 16;
-        c.asm_root = 64;
+        om_method_cfg_default(&c, om_method_find("asm"));
+        CHECK_OK(om_method_cfg_set(&c, "asm.cap", 4u << 20, NULL));
+        CHECK_OK(om_method_cfg_set(&c, "asm.tile", 16, NULL));
+        CHECK_OK(om_method_cfg_set(&c, "asm.root", 64, NULL));
         CHECK_OK(om_method_cfg_set(&c, sets[k][0], atof(sets[k][1]), NULL));
         arun r;
         if (!arun_init(&r, &hs.s, &c, 80, 60, false)) continue;
         for (int f = 0; f < 4; f++) {
             om_method_stats ms;
             CHECK_OK(arun_frame(&r, 0.0f, 0.3f * (float)f, 0, mask, NULL, &ms));
-            CHECK(counter(&ms, "bytes in use") <= c.asm_cap);
+            CHECK(counter(&ms, "bytes in use") <= cap_of(&c));
         }
         arun_free(&r);
     }

@@ -67,7 +67,7 @@ static om_status render(const om_scene *s, const om_light *light, uint32_t strip
     if (om_view_init(&v, &s->camera, light, s, &d) != OM_OK) return d.status;
     const om_method *m = om_method_find("none");
     om_method_cfg cfg;
-    om_method_cfg_default(&cfg);
+    om_method_cfg_default(&cfg, m);
     om_arena ma, fa;
     om_arena_init(&ma, method_mem, sizeof method_mem, "method");
     om_arena_init(&fa, frame_mem, frame_size, "frame");
@@ -223,7 +223,7 @@ static void frame_budget(void)
     om_arena ma, fa;
     om_arena_init(&ma, method_mem, sizeof method_mem, "method");
     om_method_cfg cfg;
-    om_method_cfg_default(&cfg);
+    om_method_cfg_default(&cfg, m);
     CHECK_OK(m->init(&state, &ma, &cfg, &s, 80, 60, NULL));
     static unsigned char pix[80 * 3 * 4];
     om_framebuffer fb = {OM_RGB888, 80, 4, 240, pix};

@@ -74,11 +74,11 @@ static void equals_ref(const char *text, const char *what, double least_certain)
     if (!h_scene_parse(&hs, text)) return;
     CHECK_OK(h_render(&hs.s, "ref", NULL, W, H, 0, 0, NULL, ref_t, smp));
     om_method_cfg c;
-    om_method_cfg_default(&c);
+    om_method_cfg_default(&c, om_method_find("hybrid"));
     /* maps from far coarser than the image to far finer */
     static const uint32_t maps[] = {1, 16, 96, 512, 2048};
     for (int k = 0; k < 5; k++) {
-        c.hybrid_map = maps[k];
+        CHECK_OK(om_method_cfg_set(&c, "hybrid.map", maps[k], NULL));
         CHECK_OK(h_render(&hs.s, "hybrid", &c, W, H, 0, 0, NULL, hyb_t, NULL));
         CHECK_MSG(term_diff() == 0, "%s, map %u: %d samples differ", what, maps[k], term_diff());
         uint32_t decided = certain_agree(&hs.s, &c, what);
@@ -91,7 +91,7 @@ static void equals_ref(const char *text, const char *what, double least_certain)
         }
     }
     /* strips of 7 rows, and the least memory it renders in (tiles of the uncertain) */
-    c.hybrid_map = 96;
+    CHECK_OK(om_method_cfg_set(&c, "hybrid.map", 96, NULL));
     CHECK_OK(h_render(&hs.s, "hybrid", &c, W, H, 0, 7, NULL, hyb_t, NULL));
     CHECK_MSG(term_diff() == 0, "%s, strips: %d samples differ", what, term_diff());
     const om_method *m = om_method_find("hybrid");

@@ -35,16 +35,16 @@ static void equals_ref(const char *text, const char *what, int min_blocked)
     CHECK_OK(h_render(&hs.s, "ref", NULL, W, H, 0, 0, NULL, ref_t, NULL));
     CHECK_MSG(blocked() >= min_blocked, "%s: only %d samples blocked", what, blocked());
     om_method_cfg c;
-    om_method_cfg_default(&c);
+    om_method_cfg_default(&c, om_method_find("izb"));
     /* one pass, then pools of 40, 7 and 2 rows' worth of samples, and a leaf of 1 */
     static const uint32_t pools[] = {0, W * 40, W * 7, W * 2};
     for (int k = 0; k < 4; k++) {
-        c.izb_pool = pools[k];
+        CHECK_OK(om_method_cfg_set(&c, "izb.pool", pools[k], NULL));
         CHECK_OK(h_render(&hs.s, "izb", &c, W, H, 0, 0, NULL, izb_t, NULL));
         CHECK_MSG(term_diff() == 0, "%s, pool %u: %d samples differ", what, pools[k], term_diff());
     }
-    c.izb_pool = 0;
-    c.izb_leaf = 1;
+    CHECK_OK(om_method_cfg_set(&c, "izb.pool", 0, NULL));
+    CHECK_OK(om_method_cfg_set(&c, "izb.leaf", 1, NULL));
     CHECK_OK(h_render(&hs.s, "izb", &c, W, H, 0, 9, NULL, izb_t, NULL));
     CHECK_MSG(term_diff() == 0, "%s, leaf 1 in strips: %d samples differ", what, term_diff());
     h_scene_free(&hs);
@@ -99,7 +99,7 @@ static void budgets(void)
     if (!h_scene_parse(&hs, om_scene_default_text())) return;
     const om_method *m = om_method_find("izb");
     om_method_cfg c;
-    om_method_cfg_default(&c);
+    om_method_cfg_default(&c, om_method_find("izb"));
     size_t mn, full;
     CHECK_OK(m->bytes(&c, &hs.s, W, H, &mn, &full));
     CHECK(mn < full);

@@ -20,15 +20,8 @@ static const char *small_scene =
     "sphere radius 0.4 segments 12 rings 6 translate 1.2 0.6 0.5 opacity 0.5 albedo 0.2 0.5 0.9\n"
     "triangles count 30 seed 4 area 1 in -2 1 -2 2 2 2\n";
 
-static om_method_cfg small_cfg(void)
-{
-    om_method_cfg c;
-    om_method_cfg_default(&c);
-    c.map_size = 128;
-    c.asm_cap = 1u << 20;
-    c.rtw_importance = 64;
-    return c;
-}
+/* Small maps and structures, for whichever method takes them (h_cfg). */
+#define SMALL "map=128 asm.cap=1048576 rtw.importance=64"
 
 typedef struct frame_ctx {
     const om_scene *s;
@@ -69,7 +62,6 @@ static void failure_injection(void)
     if (!h_scene_parse(&hs, small_scene)) return;
     frame_ctx f;
     f.s = &hs.s;
-    f.cfg = small_cfg();
     om_camera cam;
     om_light light;
     om_scene_at(&hs.s, 0, &cam, &light);
@@ -77,6 +69,7 @@ static void failure_injection(void)
     static unsigned char fmem[W * 9 * 48];
     for (size_t k = 0; k < om_method_count(); k++) {
         f.m = om_method_at(k);
+        f.cfg = h_cfg(f.m->name, SMALL);
         size_t mn, full;
         CHECK_OK(f.m->bytes(&f.cfg, &hs.s, W, H, &mn, &full));
         unsigned char *mem = malloc(full);
@@ -163,9 +156,9 @@ static void hand_scene(om_scene *s, uint32_t ntris)
 
 static void every_method_survives(const om_scene *s, const char *what)
 {
-    om_method_cfg c = small_cfg();
     static uint8_t mask[W * H];
     for (size_t k = 0; k < om_method_count(); k++) {
+        om_method_cfg c = h_cfg(om_method_at(k)->name, SMALL);
         om_status st = h_render(s, om_method_at(k)->name, &c, W, H, 0, 7, mask, NULL, NULL);
         CHECK_MSG(st == OM_OK, "%s: %s gave %s", what, om_method_at(k)->name, om_status_str(st));
     }
@@ -234,9 +227,10 @@ static void pathological_views(void)
     CHECK(strstr(d.msg, "8192") != NULL);
     cam.width = cam.height = 8193;
     CHECK(om_view_init(&v, &cam, &s.light, &s, &d) == OM_E_INVALID);
-    om_method_cfg c = small_cfg();
-    for (size_t k = 0; k < om_method_count(); k++)
+    for (size_t k = 0; k < om_method_count(); k++) {
+        om_method_cfg c = h_cfg(om_method_at(k)->name, SMALL);
         CHECK_OK(h_render(&s, om_method_at(k)->name, &c, 1, 1, 0, 0, mask, NULL, NULL));
+    }
 }
 
 /* The largest image, through strips, with the cheapest methods (the others follow the
@@ -247,9 +241,9 @@ static void largest_image(void)
     om_scene s;
     hand_scene(&s, 2);
     static const char *names[] = {"none", "sm"};
-    om_method_cfg c = small_cfg();
     for (int k = 0; k < 2; k++) {
         const om_method *m = om_method_find(names[k]);
+        om_method_cfg c = h_cfg(names[k], SMALL);
         om_camera cam = s.camera;
         cam.width = cam.height = 8192;
         om_view v;

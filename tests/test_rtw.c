@@ -237,15 +237,15 @@ static void warped_map_has_no_cracks(void)
         if (!h_scene_parse(&hs, scenes[k])) return;
         for (int t = 0; t < 5; t++) {
             om_method_cfg c;
-            om_method_cfg_default(&c);
-            c.map_size = 256;
-            c.rtw_importance = 128;
-            c.rtw_tess = tess[t];
-            c.rtw_exact = t == 4;
+            om_method_cfg_default(&c, om_method_find("rtw"));
+            CHECK_OK(om_method_cfg_set(&c, "map", 256, NULL));
+            CHECK_OK(om_method_cfg_set(&c, "rtw.importance", 128, NULL));
+            CHECK_OK(om_method_cfg_set(&c, "rtw.tess", tess[t], NULL));
+            CHECK_OK(om_method_cfg_set(&c, "rtw.exact", t == 4, NULL));
             crack_probe p;
             memset(&p, 0, sizeof p);
             CHECK_OK(run_rtw(&hs.s, &c, 160, 120, 0, NULL, count_holes, &p));
-            CHECK_MSG(p.holes == 0, "scene %d tess %g exact %u: %u empty texels", k, tess[t], c.rtw_exact, p.holes);
+            CHECK_MSG(p.holes == 0, "scene %d tess %g exact %u: %u empty texels", k, tess[t], t == 4, p.holes);
             CHECK_MSG(p.dens > 2.0, "scene %d: the warp is too weak to test (%g)", k, p.dens);
             if (t > 0 && t < 4) CHECK(p.drawn > hs.s.ntris);
         }
@@ -320,9 +320,9 @@ static void exact_map_is_the_predicate(void)
         h_scene hs;
         if (!h_scene_parse(&hs, scenes[k])) return;
         om_method_cfg c;
-        om_method_cfg_default(&c);
-        c.map_size = 128;
-        c.rtw_importance = 64;
+        om_method_cfg_default(&c, om_method_find("rtw"));
+        CHECK_OK(om_method_cfg_set(&c, "map", 128, NULL));
+        CHECK_OK(om_method_cfg_set(&c, "rtw.importance", 64, NULL));
         exact_probe p;
         memset(&p, 0, sizeof p);
         CHECK_OK(run_rtw(&hs.s, &c, 160, 120, 0, NULL, check_exact, &p));
@@ -363,15 +363,15 @@ static void rtw512_matches_sm2048(void)
     uint8_t *ref = claim_ref, *m = claim_m;
     CHECK_OK(h_render(&hs.s, "ref", NULL, w, h, 0, 0, ref, NULL, NULL));
     om_method_cfg c;
-    om_method_cfg_default(&c);
-    c.map_size = 2048;
+    om_method_cfg_default(&c, om_method_find("rtw"));
+    CHECK_OK(om_method_cfg_set(&c, "map", 2048, NULL));
     uint64_t sm2048 = miss_of(&hs, "sm", &c, w, h, ref, m);
-    c.map_size = 512;
+    CHECK_OK(om_method_cfg_set(&c, "map", 512, NULL));
     uint64_t sm512 = miss_of(&hs, "sm", &c, w, h, ref, m);
     uint64_t rtw = miss_of(&hs, "rtw", &c, w, h, ref, m);
-    c.rtw_exact = 0;
+    CHECK_OK(om_method_cfg_set(&c, "rtw.exact", 0, NULL));
     uint64_t rtw_tess = miss_of(&hs, "rtw", &c, w, h, ref, m);
-    c.rtw_tess = 0.0f;
+    CHECK_OK(om_method_cfg_set(&c, "rtw.tess", 0.0f, NULL));
     uint64_t rtw_flat = miss_of(&hs, "rtw", &c, w, h, ref, m);
     CHECK_MSG(rtw <= sm2048, "rtw 512: %llu mismatches, sm 2048: %llu", (unsigned long long)rtw,
               (unsigned long long)sm2048);
@@ -392,12 +392,12 @@ static void rtw512_matches_sm2048(void)
      * one with the shadow-edge function (section 5.3) keeps the promise. */
     enum { W = 1024, H = 768 };
     CHECK_OK(h_render(&hs.s, "ref", NULL, W, H, 0, 0, ref, NULL, NULL));
-    om_method_cfg_default(&c);
-    c.map_size = 2048;
+    om_method_cfg_default(&c, om_method_find("rtw"));
+    CHECK_OK(om_method_cfg_set(&c, "map", 2048, NULL));
     sm2048 = miss_of(&hs, "sm", &c, W, H, ref, m);
-    c.map_size = 512;
-    c.rtw_analysis = OM_RTW_HYBRID;
-    c.rtw_funcs = OM_RTW_DV | OM_RTW_DIST | OM_RTW_EDGE | OM_RTW_NORMAL;
+    CHECK_OK(om_method_cfg_set(&c, "map", 512, NULL));
+    CHECK_OK(om_method_cfg_set(&c, "rtw.analysis", OM_RTW_HYBRID, NULL));
+    CHECK_OK(om_method_cfg_set(&c, "rtw.funcs", OM_RTW_DV | OM_RTW_DIST | OM_RTW_EDGE | OM_RTW_NORMAL, NULL));
     rtw = miss_of(&hs, "rtw", &c, W, H, ref, m);
     CHECK_MSG(rtw <= sm2048, "at 1024x768, rtw 512 hybrid: %llu mismatches, sm 2048: %llu",
               (unsigned long long)rtw, (unsigned long long)sm2048);
@@ -426,8 +426,8 @@ static void analyses_and_functions(void)
     static uint8_t ref[w * h], m[w * h];
     CHECK_OK(h_render(&hs.s, "ref", NULL, w, h, 0, 0, ref, NULL, NULL));
     om_method_cfg c;
-    om_method_cfg_default(&c);
-    c.map_size = 512;
+    om_method_cfg_default(&c, om_method_find("rtw"));
+    CHECK_OK(om_method_cfg_set(&c, "map", 512, NULL));
     CHECK_OK(h_render(&hs.s, "sm", &c, w, h, 0, 0, m, NULL, NULL));
     uint64_t sm = mismatches(ref, m, w, h);
     static const struct { uint32_t analysis, funcs; } runs[] = {
@@ -435,19 +435,19 @@ static void analyses_and_functions(void)
         {2, 1 | 2 | 4}, {2, 1 | 2 | 4 | 8},
     };
     for (size_t k = 0; k < sizeof runs / sizeof runs[0]; k++) {
-        c.rtw_analysis = runs[k].analysis;
-        c.rtw_funcs = runs[k].funcs;
+        CHECK_OK(om_method_cfg_set(&c, "rtw.analysis", runs[k].analysis, NULL));
+        CHECK_OK(om_method_cfg_set(&c, "rtw.funcs", runs[k].funcs, NULL));
         CHECK_OK(h_render(&hs.s, "rtw", &c, w, h, 0, 0, m, NULL, NULL));
         uint64_t bad = mismatches(ref, m, w, h);
         CHECK_MSG(bad < sm, "analysis %u funcs %u: %llu mismatches, sm 512 %llu", runs[k].analysis,
                   runs[k].funcs, (unsigned long long)bad, (unsigned long long)sm);
     }
     table_probe p;
-    c.rtw_analysis = 0;
-    c.rtw_funcs = 0;
+    CHECK_OK(om_method_cfg_set(&c, "rtw.analysis", 0, NULL));
+    CHECK_OK(om_method_cfg_set(&c, "rtw.funcs", 0, NULL));
     CHECK_OK(run_rtw(&hs.s, &c, w, h, 0, NULL, probe_tables, &p));
     CHECK_EQ_U(p.off, 0);
-    c.rtw_funcs = 1;
+    CHECK_OK(om_method_cfg_set(&c, "rtw.funcs", 1, NULL));
     CHECK_OK(run_rtw(&hs.s, &c, w, h, 0, NULL, probe_tables, &p));
     CHECK(p.off > 0 && p.dens_x > 1.5 && p.dens_y > 1.5);
     h_scene_free(&hs);
@@ -463,10 +463,10 @@ static void budget_and_determinism(void)
     if (!m) return;
     for (uint32_t analysis = 0; analysis < 3; analysis++) {
         om_method_cfg c;
-        om_method_cfg_default(&c);
-        c.map_size = 256;
-        c.rtw_importance = 64;
-        c.rtw_analysis = analysis;
+        om_method_cfg_default(&c, om_method_find("rtw"));
+        CHECK_OK(om_method_cfg_set(&c, "map", 256, NULL));
+        CHECK_OK(om_method_cfg_set(&c, "rtw.importance", 64, NULL));
+        CHECK_OK(om_method_cfg_set(&c, "rtw.analysis", analysis, NULL));
         size_t mn, full;
         CHECK_OK(m->bytes(&c, &hs.s, w, h, &mn, &full));
         CHECK(mn == full && mn >= 256 * 256 * 4);
@@ -489,34 +489,34 @@ static void budget_and_determinism(void)
     /* identical runs, and the frame through strips, give the same bits */
     static om_term t1[w * h], t2[w * h], t3[w * h];
     om_method_cfg c;
-    om_method_cfg_default(&c);
-    c.map_size = 512;
+    om_method_cfg_default(&c, om_method_find("rtw"));
+    CHECK_OK(om_method_cfg_set(&c, "map", 512, NULL));
     for (uint32_t k = 0; k < 6; k++) {
-        c.rtw_analysis = k % 3;
-        c.rtw_exact = k / 3;
-        c.rtw_funcs = 15;
+        CHECK_OK(om_method_cfg_set(&c, "rtw.analysis", k % 3, NULL));
+        CHECK_OK(om_method_cfg_set(&c, "rtw.exact", k / 3, NULL));
+        CHECK_OK(om_method_cfg_set(&c, "rtw.funcs", 15, NULL));
         CHECK_OK(run_rtw(&hs.s, &c, w, h, 0, t1, NULL, NULL));
         CHECK_OK(run_rtw(&hs.s, &c, w, h, 0, t2, NULL, NULL));
         CHECK_OK(run_rtw(&hs.s, &c, w, h, 7, t3, NULL, NULL));
         CHECK(!memcmp(t1, t2, sizeof t1));
         CHECK(!memcmp(t1, t3, sizeof t1));
     }
-    /* settings out of range are refused cleanly */
+    /* settings out of range are refused cleanly, and keep the value they had */
+    double v = 0;
+    CHECK(om_method_cfg_set(&c, "rtw.sigma", NAN, NULL) == OM_E_RANGE);
+    CHECK(om_method_cfg_get(&c, "rtw.sigma", &v) == OM_OK && v == 3.0);
+    CHECK(om_method_cfg_set(&c, "rtw.analysis", 3, NULL) == OM_E_RANGE);
+    CHECK(om_method_cfg_set(&c, "rtw.exact", 2, NULL) == OM_E_RANGE);
+    CHECK(om_method_cfg_set(&c, "rtw.footprint", 2, NULL) == OM_E_RANGE);
+    CHECK(om_method_cfg_set(&c, "rtw.sigma", 0.5, NULL) == OM_OK);
+    /* as is a configuration made for another method */
     void *state;
     om_arena a;
     static unsigned char small[64];
     om_arena_init(&a, small, sizeof small, "method");
-    c.rtw_sigma = NAN;
-    CHECK(m->init(&state, &a, &c, &hs.s, w, h, NULL) == OM_E_INVALID);
-    c.rtw_sigma = 3.0f;
-    c.rtw_analysis = 3;
-    CHECK(m->init(&state, &a, &c, &hs.s, w, h, NULL) == OM_E_INVALID);
-    c.rtw_analysis = 0;
-    c.rtw_exact = 2;
-    CHECK(m->init(&state, &a, &c, &hs.s, w, h, NULL) == OM_E_INVALID);
-    c.rtw_exact = 1;
-    c.rtw_footprint = 2;
-    CHECK(m->init(&state, &a, &c, &hs.s, w, h, NULL) == OM_E_INVALID);
+    om_method_cfg other;
+    om_method_cfg_default(&other, om_method_find("sm"));
+    CHECK(m->init(&state, &a, &other, &hs.s, w, h, NULL) == OM_E_INVALID);
     h_scene_free(&hs);
 }
 
@@ -541,17 +541,17 @@ static void pcf_footprints(void)
     h_scene hs;
     if (!h_scene_parse(&hs, om_scene_default_text())) return;
     om_method_cfg c;
-    om_method_cfg_default(&c);
-    c.map_size = 1024;
-    c.pcf = 1;
-    c.rtw_footprint = 1;
+    om_method_cfg_default(&c, om_method_find("rtw"));
+    CHECK_OK(om_method_cfg_set(&c, "map", 1024, NULL));
+    CHECK_OK(om_method_cfg_set(&c, "pcf", 1, NULL));
+    CHECK_OK(om_method_cfg_set(&c, "rtw.footprint", 1, NULL));
     CHECK_OK(run_rtw(&hs.s, &c, w, h, 0, pcf_terms[0], NULL, NULL));
-    c.rtw_footprint = 0;
+    CHECK_OK(om_method_cfg_set(&c, "rtw.footprint", 0, NULL));
     CHECK_OK(run_rtw(&hs.s, &c, w, h, 0, pcf_terms[1], NULL, NULL));
     CHECK(memcmp(pcf_terms[0], pcf_terms[1], sizeof pcf_terms[0]) == 0);
-    c.pcf = 3;
+    CHECK_OK(om_method_cfg_set(&c, "pcf", 3, NULL));
     CHECK_OK(run_rtw(&hs.s, &c, w, h, 0, pcf_terms[0], NULL, NULL));
-    c.rtw_footprint = 1;
+    CHECK_OK(om_method_cfg_set(&c, "rtw.footprint", 1, NULL));
     CHECK_OK(run_rtw(&hs.s, &c, w, h, 0, pcf_terms[1], NULL, NULL));
     CHECK_OK(h_render(&hs.s, "sm", &c, w, h, 0, 0, NULL, pcf_terms[2], NULL));
     uint32_t warped = partly_lit(pcf_terms[0], w * h), unwarped = partly_lit(pcf_terms[1], w * h),
@@ -578,13 +578,14 @@ static void importance_follows_small_maps(void)
     static const uint32_t sides[] = {8, 128, 512, 512};
     for (int i = 0; i < 4; i++) {
         om_method_cfg c;
-        om_method_cfg_default(&c);
-        CHECK_EQ_U(c.rtw_importance, 0);
-        c.map_size = maps[i];
+        om_method_cfg_default(&c, om_method_find("rtw"));
+        double side = -1;
+        CHECK(om_method_cfg_get(&c, "rtw.importance", &side) == OM_OK && side == 0);
+        CHECK_OK(om_method_cfg_set(&c, "map", maps[i], NULL));
         size_t mn0, full0, mn1, full1;
         CHECK_OK(m->bytes(&c, &hs.s, w, h, &mn0, &full0));
         if (maps[i] <= 128) CHECK_OK(run_rtw(&hs.s, &c, w, h, 0, pcf_terms[0], NULL, NULL));
-        c.rtw_importance = sides[i];
+        CHECK_OK(om_method_cfg_set(&c, "rtw.importance", sides[i], NULL));
         CHECK_OK(m->bytes(&c, &hs.s, w, h, &mn1, &full1));
         CHECK_MSG(mn0 == mn1, "map %u: %zu bytes by default, %zu with importance %u", maps[i], mn0, mn1, sides[i]);
         if (maps[i] <= 128) {

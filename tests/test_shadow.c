@@ -183,9 +183,8 @@ static void sm_improves_with_resolution(void)
     CHECK_OK(h_render(&hs.s, "ref", NULL, 320, 240, 0, 0, ref, NULL, NULL));
     uint64_t prev = UINT64_MAX;
     for (uint32_t size = 512; size <= 4096; size *= 2) {
-        om_method_cfg c;
-        om_method_cfg_default(&c);
-        c.map_size = size;
+        om_method_cfg c = h_cfg("sm", "");
+        CHECK_OK(om_method_cfg_set(&c, "map", size, NULL));
         CHECK_OK(h_render(&hs.s, "sm", &c, 320, 240, 0, 0, sm, NULL, NULL));
         om_metrics m;
         om_compare_masks(ref, sm, 320, 240, &m);
@@ -224,9 +223,7 @@ static void budgets_name_the_minimum(void)
     static const char *names[] = {"ref", "sm"};
     for (int k = 0; k < 2; k++) {
         const om_method *m = om_method_find(names[k]);
-        om_method_cfg c;
-        om_method_cfg_default(&c);
-        c.map_size = 256;
+        om_method_cfg c = h_cfg(names[k], "map=256");
         size_t mn, full;
         CHECK_OK(m->bytes(&c, &hs.s, W, H, &mn, &full));
         unsigned char *buf = malloc(mn + 64);
@@ -281,7 +278,7 @@ static void ref_small_equals_fast(void)
     CHECK_OK(h_render(&hs.s, "ref", NULL, W, H, 0, 0, NULL, fast, NULL));
     const om_method *m = om_method_find("ref");
     om_method_cfg c;
-    om_method_cfg_default(&c);
+    om_method_cfg_default(&c, m);
     size_t mn, full;
     CHECK_OK(m->bytes(&c, &hs.s, W, H, &mn, &full));
     CHECK(mn < full / 4);

@@ -235,9 +235,9 @@ static uint64_t mismatches_fine(const om_scene *s, const char *name, uint32_t ma
                                 uint32_t h)
 {
     om_method_cfg c;
-    om_method_cfg_default(&c);
-    c.map_size = map;
-    c.spsm_fine = fine;
+    om_method_cfg_default(&c, om_method_find("spsm"));
+    CHECK_OK(om_method_cfg_set(&c, "map", map, NULL));
+    CHECK_OK(om_method_cfg_set(&c, "spsm.fine", fine, NULL));
     CHECK_OK(h_render(s, name, &c, w, h, 0, 0, msk, NULL, NULL));
     om_metrics m;
     om_compare_masks(ref, msk, w, h, &m);
@@ -317,10 +317,10 @@ static void identical_runs_identical_frames(void)
     h_scene hs;
     if (!h_scene_parse(&hs, om_scene_default_text())) return;
     om_method_cfg c;
-    om_method_cfg_default(&c);
-    c.map_size = 512;
+    om_method_cfg_default(&c, om_method_find("spsm"));
+    CHECK_OK(om_method_cfg_set(&c, "map", 512, NULL));
     for (uint32_t aa = 0; aa <= 8; aa += 8) {
-        c.spsm_aa = aa;
+        CHECK_OK(om_method_cfg_set(&c, "spsm.aa", aa, NULL));
         CHECK_OK(h_render(&hs.s, "spsm", &c, 320, 240, 0, 0, msk, terms, NULL));
         CHECK_OK(h_render(&hs.s, "spsm", &c, 320, 240, 0, 0, msk2, terms2, NULL));
         CHECK(!memcmp(terms, terms2, sizeof(om_term) * 320 * 240));
@@ -340,17 +340,17 @@ static void records_made_where_read(void)
     h_scene hs;
     if (!h_scene_parse(&hs, om_scene_default_text())) return;
     om_method_cfg c;
-    om_method_cfg_default(&c);
+    om_method_cfg_default(&c, om_method_find("spsm"));
     int differ = 0, runs = 0;
     for (uint32_t map = 128; map <= 2048; map *= 16)
         for (uint32_t aa = 0; aa <= 4; aa += 4)
             for (uint32_t strip = 0; strip <= 7; strip += 7) {
-                c.map_size = map;
-                c.spsm_aa = aa;
-                c.spsm_fine = strip == 0 ? (map == 128 ? 0u : 1u) : (map == 128 ? 1u : 0u);
-                c.spsm_records = 2;
+                CHECK_OK(om_method_cfg_set(&c, "map", map, NULL));
+                CHECK_OK(om_method_cfg_set(&c, "spsm.aa", aa, NULL));
+                CHECK_OK(om_method_cfg_set(&c, "spsm.fine", strip == 0 ? (map == 128 ? 0u : 1u) : (map == 128 ? 1u : 0u), NULL));
+                CHECK_OK(om_method_cfg_set(&c, "spsm.records", 2, NULL));
                 CHECK_OK(h_render(&hs.s, "spsm", &c, 320, 240, 0, strip, msk, terms, NULL));
-                c.spsm_records = 1;
+                CHECK_OK(om_method_cfg_set(&c, "spsm.records", 1, NULL));
                 CHECK_OK(h_render(&hs.s, "spsm", &c, 320, 240, 0, strip, msk2, terms2, NULL));
                 differ += memcmp(terms, terms2, sizeof(om_term) * 320 * 240) != 0;
                 runs++;
@@ -395,8 +395,8 @@ static void marks_only_when_they_pay(void)
     static unsigned char mem[(1024 * 1024 * 41) + (1 << 16)];   /* 40.75 bytes per texel */
     for (uint32_t map = 128; map <= 1024; map *= 8) {
         om_method_cfg c;
-        om_method_cfg_default(&c);
-        c.map_size = map;
+        om_method_cfg_default(&c, om_method_find("spsm"));
+        CHECK_OK(om_method_cfg_set(&c, "map", map, NULL));
         size_t mn, full;
         CHECK_OK(m->bytes(&c, &hs.s, 160, 120, &mn, &full));
         CHECK(full <= sizeof mem);
@@ -424,10 +424,10 @@ static void aa_only_at_uncertain_samples(void)
     h_scene hs;
     if (!h_scene_parse(&hs, om_scene_default_text())) return;
     om_method_cfg c;
-    om_method_cfg_default(&c);
-    c.map_size = 512;
+    om_method_cfg_default(&c, om_method_find("spsm"));
+    CHECK_OK(om_method_cfg_set(&c, "map", 512, NULL));
     CHECK_OK(h_render(&hs.s, "spsm", &c, 320, 240, 0, 0, msk, terms, NULL));
-    c.spsm_aa = 16;
+    CHECK_OK(om_method_cfg_set(&c, "spsm.aa", 16, NULL));
     CHECK_OK(h_render(&hs.s, "spsm", &c, 320, 240, 0, 0, msk2, terms2, NULL));
     int partial = 0, changed_binary = 0, changed = 0;
     for (int i = 0; i < 320 * 240; i++) {
@@ -451,8 +451,8 @@ static void stats_and_budget(void)
     CHECK(m != NULL);
     if (!m) return;
     om_method_cfg c;
-    om_method_cfg_default(&c);
-    c.map_size = 300;
+    om_method_cfg_default(&c, om_method_find("spsm"));
+    CHECK_OK(om_method_cfg_set(&c, "map", 300, NULL));
     size_t mn, full;
     CHECK_OK(m->bytes(&c, &hs.s, 160, 120, &mn, &full));
     CHECK(mn == full && mn >= (size_t)300 * 300 * 24);
@@ -485,26 +485,28 @@ static void stats_and_budget(void)
     /* records are made where the lookup reads: here 2/3 of the map is never read */
     CHECK(s.ncounters >= 8);
     CHECK_MSG(s.counters[7] > 1000 && s.counters[7] < 300u * 300u / 3, "%u texels needed", s.counters[7]);
-    /* settings out of range are refused cleanly */
-    c.map_size = 0;
-    CHECK(m->bytes(&c, &hs.s, 160, 120, &mn, &full) == OM_E_INVALID);
-    c.map_size = 64;
-    c.spsm_aa = 65;
+    /* settings out of range are refused cleanly, with the range */
+    CHECK(om_method_cfg_set(&c, "map", 0, &d) == OM_E_RANGE);
+    CHECK_MSG(strstr(d.msg, "map takes a whole number from 1 to 8192") != NULL, "%s", d.msg);
+    CHECK(om_method_cfg_set(&c, "spsm.aa", 65, NULL) == OM_E_RANGE);
+    CHECK(om_method_cfg_set(&c, "spsm.aa", 1.5, NULL) == OM_E_RANGE);
+    CHECK(om_method_cfg_set(&c, "spsm.records", 3, NULL) == OM_E_RANGE);
+    CHECK(om_method_cfg_set(&c, "spsm.fine", 2, NULL) == OM_E_RANGE);
+    CHECK(om_method_cfg_set(&c, "asm.cap", 1, &d) == OM_E_NOTFOUND);
+    CHECK_MSG(strstr(d.msg, "spsm has no setting 'asm.cap'") != NULL, "%s", d.msg);
+    CHECK_OK(om_method_cfg_set(&c, "map", 64, NULL));
+    /* a configuration made for another method is refused by bytes and init */
+    om_method_cfg other;
+    om_method_cfg_default(&other, om_method_find("rtw"));
+    CHECK(m->bytes(&other, &hs.s, 160, 120, &mn, &full) == OM_E_INVALID);
     om_arena_init(&a, buf + 32, mn, "method");
-    CHECK(m->init(&state, &a, &c, &hs.s, 160, 120, &d) == OM_E_INVALID);
-    c.spsm_aa = 0;
-    c.spsm_records = 3;
-    om_arena_init(&a, buf + 32, mn, "method");
-    CHECK(m->init(&state, &a, &c, &hs.s, 160, 120, &d) == OM_E_INVALID);
-    c.spsm_records = 0;
-    c.spsm_fine = 2;
-    om_arena_init(&a, buf + 32, mn, "method");
-    CHECK(m->init(&state, &a, &c, &hs.s, 160, 120, &d) == OM_E_INVALID);
+    CHECK(m->init(&state, &a, &other, &hs.s, 160, 120, &d) == OM_E_INVALID);
+    CHECK_MSG(strstr(d.msg, "made for rtw") != NULL, "%s", d.msg);
     /* the fine plain map: 16 bytes per texel and half a bit for its needs */
     size_t mn1, full1;
-    c.spsm_fine = 0;
+    CHECK_OK(om_method_cfg_set(&c, "spsm.fine", 0, NULL));
     CHECK_OK(m->bytes(&c, &hs.s, 160, 120, &mn, &full));
-    c.spsm_fine = 1;
+    CHECK_OK(om_method_cfg_set(&c, "spsm.fine", 1, NULL));
     CHECK_OK(m->bytes(&c, &hs.s, 160, 120, &mn1, &full1));
     CHECK_MSG(mn1 - mn >= 64u * 64u * 16u + 128u * 128u / 8u && mn1 - mn <= 64u * 64u * 16u + 128u * 128u / 8u + 64u,
               "fine adds %zu bytes", mn1 - mn);
@@ -528,12 +530,12 @@ static void odd_inputs(void)
         if (!h_scene_parse(&hs, scenes[k])) return;
         for (uint32_t map = 1; map <= 4096; map *= 64) {
             om_method_cfg c;
-            om_method_cfg_default(&c);
-            c.map_size = map;
-            c.spsm_aa = 4;
+            om_method_cfg_default(&c, om_method_find("spsm"));
+            CHECK_OK(om_method_cfg_set(&c, "map", map, NULL));
+            CHECK_OK(om_method_cfg_set(&c, "spsm.aa", 4, NULL));
             CHECK_OK(h_render(&hs.s, "spsm", &c, 0, 0, 0, 0, msk, NULL, NULL));
-            c.spsm_aa = 0;
-            c.spsm_fine = 1;
+            CHECK_OK(om_method_cfg_set(&c, "spsm.aa", 0, NULL));
+            CHECK_OK(om_method_cfg_set(&c, "spsm.fine", 1, NULL));
             CHECK_OK(h_render(&hs.s, "spsm", &c, 0, 0, 0, 0, msk, NULL, NULL));
         }
         h_scene_free(&hs);

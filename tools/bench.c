@@ -1,11 +1,12 @@
-/* bench.c — `ombra bench`: sweeps every method over the settings its registry entry
- * names (om_method_sweep) on a set of scenes, and for each point prints and writes to
+/* bench.c — `ombra bench`: sweeps every method over the settings listed for it below
+ * (cli_sweep) on a set of scenes, and for each point prints and writes to
  * CSV the median frame time per stage, the method's peak arena bytes and its accuracy
  * against the reference on the same visible samples; then draws the charts: mismatch
  * share against time per frame and against bytes (each method a series, its Pareto
  * front dashed), against the first frame's time (the method's init, where ref builds
  * its BVH, plus a frame) and, for the exact methods, the first frame's time against
- * triangle count. A method joins every table and chart by its registry entry alone.
+ * triangle count. A method joins every table and chart by its registry entry alone (at
+ * its defaults until it has a line in `sweeps`).
  * Names are checked before any work; a run that fails writes nothing, and the files
  * of one that succeeds replace the old ones together (om_out). */
 #define _POSIX_C_SOURCE 200809L
@@ -189,6 +190,24 @@ om_status cli_measure_strips(const om_method *m, const om_method_cfg *cfg, const
     return st;
 }
 
+/* What each method sweeps, by name (see cli_sweep). */
+static const struct { const char *method, *sweep; } sweeps[] = {
+    {"none", ""},
+    {"sm", "map=256,512,1024,2048,4096,8192"},
+    {"izb", "izb.pool=0,65536,16384"},
+    {"asm", "asm.cap=1048576,4194304,8388608,16777216"},
+    {"rtw", "map=512,1024,2048 rtw.exact=1,0"},
+    {"spsm", "map=512,1024,2048,4096"},
+    {"hybrid", "hybrid.map=256,512,1024"},
+};
+
+const char *cli_sweep(const om_method *m)
+{
+    for (size_t i = 0; m && i < sizeof sweeps / sizeof sweeps[0]; i++)
+        if (!strcmp(sweeps[i].method, m->name)) return sweeps[i].sweep;
+    return NULL;
+}
+
 /* The points of a sweep string: the product of its NAME=V1,V2 lists. */
 static int expand(const char *sweep, char out[][96], int max)
 {
@@ -369,7 +388,7 @@ static int check_names(const char *cmd, char **names, size_t n, const char *meth
         snprintf(name, sizeof name, "%.*s", (int)(l < 31 ? l : 31), p);
         const om_method *m = om_method_find(name);
         if (!m) return cli_unknown_method(cmd, "--methods", name);
-        if (om_method_sweep(m) && !om_method_sweep(m)[0])
+        if (cli_sweep(m) && !cli_sweep(m)[0])
             return cli_usage_error(cmd, "'%s' is left out of sweeps (nothing to compare)", name);
         p += l + (p[l] == ',');
     }
@@ -509,8 +528,8 @@ int cmd_bench(int argc, char **argv)
     for (size_t k = 0; k < om_method_count() && !rc; k++) {
         const om_method *m = om_method_at(k);
         char tmp[64][96];
-        if (om_method_sweep(m) && !om_method_sweep(m)[0]) continue;
-        if (in_list(methods, m->name)) total += expand(om_method_sweep(m), tmp, 64) * (int)nn;
+        if (cli_sweep(m) && !cli_sweep(m)[0]) continue;
+        if (in_list(methods, m->name)) total += expand(cli_sweep(m), tmp, 64) * (int)nn;
     }
     /* Any scene that does not load, view or measure fails the run: nothing is written. */
     for (size_t si = 0; si < nn && !rc; si++) {
@@ -532,14 +551,14 @@ int cmd_bench(int argc, char **argv)
         cli_point rp;
         memset(&rp, 0, sizeof rp);
         om_method_cfg rc_cfg;
-        om_method_cfg_default(&rc_cfg);
+        om_method_cfg_default(&rc_cfg, om_method_find("ref"));
         if (st == OM_OK) st = cli_measure(om_method_find("ref"), &rc_cfg, &cs, &v, 1, ref, NULL, &rp, &d);
         if (st != OM_OK) rc = cli_error(name, &d, st);
         for (size_t k = 0; k < om_method_count() && np < MAXP && !rc; k++) {
             const om_method *m = om_method_at(k);
-            if ((om_method_sweep(m) && !om_method_sweep(m)[0]) || !in_list(methods, m->name)) continue;
+            if ((cli_sweep(m) && !cli_sweep(m)[0]) || !in_list(methods, m->name)) continue;
             char settings[64][96];
-            int ns = expand(om_method_sweep(m), settings, 64);
+            int ns = expand(cli_sweep(m), settings, 64);
             if (ns == 0) { settings[0][0] = 0; ns = 1; }
             for (int j = 0; j < ns && np < MAXP; j++) {
                 cli_point *p = &pts[np];
@@ -551,7 +570,7 @@ int cmd_bench(int argc, char **argv)
                 p->setting[ll] = '\0';
                 progress(++done, total, p);
                 om_method_cfg cfg;
-                om_method_cfg_default(&cfg);
+                om_method_cfg_default(&cfg, m);
                 if (settings[j][0] && !apply(&cfg, settings[j])) continue;
                 st = cli_measure(m, &cfg, &cs, &v, (int)runs, mask, NULL, p, &d);
                 if (st) {
@@ -589,7 +608,7 @@ int cmd_bench(int argc, char **argv)
             om_view v;
             if (st == OM_OK && (st = cli_scene_view(&cs, w, h, &v, &d)) == OM_OK) {
                 om_method_cfg cfg;
-                om_method_cfg_default(&cfg);
+                om_method_cfg_default(&cfg, m);
                 cli_point p;
                 memset(&p, 0, sizeof p);
                 p.scene = counts[j];

@@ -66,20 +66,11 @@ int cli_unknown_method(const char *cmd, const char *option, const char *name)
 
 void cli_method_hint(const om_method *m, char *buf, size_t n)
 {
-    /* The settings that size this method's memory: `map` where its help names the
-     * method, else the method's own settings about bytes or a pool. */
-    size_t nf;
-    const om_cfg_field *f = om_method_cfg_fields(&nf);
-    size_t ml = strlen(m->name);
-    for (size_t i = 0; i < nf; i++) {
-        const char *h = f[i].help, *p = strchr(h, '(');
-        bool own = !strncmp(f[i].name, m->name, ml) && f[i].name[ml] == '.';
-        bool names = false;
-        for (; p && (p = strstr(p, m->name)) != NULL; p += ml)
-            names |= (p[-1] == '(' || p[-1] == ' ') && (p[ml] == ',' || p[ml] == ')');
-        if ((!strcmp(f[i].name, "map") && names) ||
-            (own && (strstr(h, "bytes") || strstr(h, "pool")))) {
-            snprintf(buf, n, ", or ask the method for less (--set %s=N: %s)", f[i].name, h);
+    /* The first of its settings that sizes its memory: the map, bytes, a pool. */
+    for (uint32_t i = 0; i < m->nsettings; i++) {
+        const om_setting *f = &m->settings[i];
+        if (!strcmp(f->name, "map") || strstr(f->doc, "bytes") || strstr(f->doc, "pool")) {
+            snprintf(buf, n, ", or ask the method for less (--set %s=N: %s)", f->name, f->doc);
             return;
         }
     }
@@ -234,11 +225,11 @@ om_status cli_oom(om_diag *d)
     return OM_E_BUDGET;
 }
 
-bool cli_set(om_method_cfg *c, const char *setting)
+/* "NAME=VALUE" into name and value; prints what is wrong and returns false. */
+static bool split(const char *setting, char *name, size_t n, double *v)
 {
-    char name[64];
     const char *eq = strchr(setting, '=');
-    if (!eq || (size_t)(eq - setting) >= sizeof name) {
+    if (!eq || eq == setting || (size_t)(eq - setting) >= n) {
         fprintf(stderr, "ombra: --set takes NAME=VALUE, not '%s' (see 'ombra methods')\n", setting);
         return false;
     }
@@ -246,18 +237,60 @@ bool cli_set(om_method_cfg *c, const char *setting)
     name[eq - setting] = '\0';
     char *end;
     errno = 0;
-    double v = strtod(eq + 1, &end);
+    *v = strtod(eq + 1, &end);
     if (errno || end == eq + 1 || *end) {
         fprintf(stderr, "ombra: %s takes a number, not '%s'\n", name, eq + 1);
         return false;
     }
+    return true;
+}
+
+bool cli_set(om_method_cfg *c, const char *setting)
+{
+    char name[64];
+    double v;
+    if (!split(setting, name, sizeof name, &v)) return false;
     om_diag d;
     om_status st = om_method_cfg_set(c, name, v, &d);
     if (st != OM_OK) {
-        /* the engine's message may already point at the list */
-        fprintf(stderr, "ombra: setting '%s': %s%s\n", name, d.msg,
-                strstr(d.msg, "ombra methods") ? "" : " (see 'ombra methods')");
+        fprintf(stderr, "ombra: setting '%s': %s (see 'ombra methods')\n", name, d.msg);
         return false;
+    }
+    return true;
+}
+
+bool cli_settings_add(cli_settings *s, const char *setting)
+{
+    char name[64];
+    double v;
+    if (!split(setting, name, sizeof name, &v)) return false;
+    bool taken = false;
+    for (size_t i = 0; i < om_method_count() && !taken; i++)
+        taken = om_method_setting(om_method_at(i), name) != NULL;
+    if (!taken) {
+        fprintf(stderr, "ombra: unknown setting '%s': no method takes it (see 'ombra methods')\n", name);
+        return false;
+    }
+    if (s->n == (int)(sizeof s->item / sizeof s->item[0]) || strlen(setting) >= sizeof s->item[0]) {
+        fprintf(stderr, "ombra: too many settings, or '%s' is too long\n", setting);
+        return false;
+    }
+    memcpy(s->item[s->n++], setting, strlen(setting) + 1);
+    return true;
+}
+
+bool cli_cfg(const om_method *m, const cli_settings *s, om_method_cfg *c, const char *note)
+{
+    om_method_cfg_default(c, m);
+    for (int i = 0; s && i < s->n; i++) {
+        char name[64];
+        double v;
+        if (!split(s->item[i], name, sizeof name, &v)) return false;
+        if (!om_method_setting(m, name)) {
+            if (note) fprintf(stderr, "ombra %s: %s takes no setting '%s' (ignored)\n", note, m->name, name);
+            continue;
+        }
+        if (!cli_set(c, s->item[i])) return false;
     }
     return true;
 }

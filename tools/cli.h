@@ -41,6 +41,24 @@ bool cli_parse_float(const char *s, float *out);
 /* Applies "NAME=VALUE" to a method configuration; prints the error and returns false. */
 bool cli_set(om_method_cfg *c, const char *setting);
 
+/* The settings given on a command line (--set NAME=VALUE and its short forms), kept
+ * until the methods they go to are known: each applies to every method that takes it. */
+typedef struct cli_settings {
+    char item[32][128];
+    int n;
+} cli_settings;
+
+/* Records "NAME=VALUE"; prints the error and returns false unless VALUE is a number
+ * and some method takes NAME. */
+bool cli_settings_add(cli_settings *s, const char *setting);
+/* m's defaults with every recorded setting m takes (s may be NULL). The others are
+ * skipped, each with a line on stderr when `note` names the command. Prints the error
+ * and returns false on a value out of m's range. */
+bool cli_cfg(const om_method *m, const cli_settings *s, om_method_cfg *c, const char *note);
+/* What `ombra bench` sweeps for m (bench.c): space-separated NAME=V1,V2,... lists
+ * whose product is swept; NULL = the defaults only, "" = left out of sweeps. */
+const char *cli_sweep(const om_method *m);
+
 int cmd_render(int argc, char **argv);
 int cmd_info(int argc, char **argv);
 int cmd_compare(int argc, char **argv);

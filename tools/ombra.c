@@ -36,37 +36,52 @@ static const char scene_help[] =
 
 /* A setting's default as it would be written: the shortest decimal that reads back
  * as the same float (0.01, not 0.00999999978). */
-static void format_value(const om_cfg_field *f, const om_method_cfg *c, char *buf, size_t n)
+static void format_value(const om_setting *f, char *buf, size_t n)
 {
-    const unsigned char *p = (const unsigned char *)c + f->offset;
-    if (f->kind == 'u') { uint32_t u; memcpy(&u, p, sizeof u); snprintf(buf, n, "%lu", (unsigned long)u); return; }
-    if (f->kind == 'z') { uint64_t u; memcpy(&u, p, sizeof u); snprintf(buf, n, "%llu", (unsigned long long)u); return; }
-    float x;
-    memcpy(&x, p, sizeof x);
+    if (f->kind != OM_SETTING_F32) { snprintf(buf, n, "%.0f", f->def); return; }
+    const float x = (float)f->def;
     for (int prec = 1; prec <= 9; prec++) {
         snprintf(buf, n, "%.*g", prec, (double)x);
         if (strtof(buf, NULL) == x) return;
     }
 }
 
+/* Whether setting i of method k is the first of that name (several methods take "map"). */
+static bool first_of_name(size_t k, uint32_t i)
+{
+    const char *name = om_method_at(k)->settings[i].name;
+    for (size_t j = 0; j < k; j++)
+        if (om_method_setting(om_method_at(j), name)) return false;
+    return true;
+}
+
 static int list_methods(void)
 {
-    for (size_t i = 0; i < om_method_count(); i++)
-        printf("%-6s %s\n", om_method_at(i)->name, om_method_at(i)->summary);
-    size_t n, wn = 0, wv = 0;
-    const om_cfg_field *f = om_method_cfg_fields(&n);
-    om_method_cfg c;
-    om_method_cfg_default(&c);
+    size_t wn = 0, wv = 0;
     char v[32];
-    for (size_t i = 0; i < n; i++) {
-        format_value(&f[i], &c, v, sizeof v);
-        if (strlen(f[i].name) > wn) wn = strlen(f[i].name);
-        if (strlen(v) > wv) wv = strlen(v);
+    for (size_t k = 0; k < om_method_count(); k++) {
+        const om_method *m = om_method_at(k);
+        printf("%-6s %s\n", m->name, m->summary);
+        for (uint32_t i = 0; i < m->nsettings; i++) {
+            format_value(&m->settings[i], v, sizeof v);
+            if (strlen(m->settings[i].name) > wn) wn = strlen(m->settings[i].name);
+            if (strlen(v) > wv) wv = strlen(v);
+        }
     }
+    /* every setting once, with its default and the methods that take it */
     printf("\nsettings (--set NAME=VALUE):\n");
-    for (size_t i = 0; i < n; i++) {
-        format_value(&f[i], &c, v, sizeof v);
-        printf("  %-*s  %-*s  %s\n", (int)wn, f[i].name, (int)wv, v, f[i].help);
+    for (size_t k = 0; k < om_method_count(); k++) {
+        const om_method *m = om_method_at(k);
+        for (uint32_t i = 0; i < m->nsettings; i++) {
+            const om_setting *f = &m->settings[i];
+            if (!first_of_name(k, i)) continue;
+            format_value(f, v, sizeof v);
+            printf("  %-*s  %-*s  %s (", (int)wn, f->name, (int)wv, v, f->doc);
+            for (size_t j = k, sep = 0; j < om_method_count(); j++)
+                if (om_method_setting(om_method_at(j), f->name))
+                    printf("%s%s", sep++ ? ", " : "", om_method_at(j)->name);
+            printf(")\n");
+        }
     }
     return 0;
 }

@@ -166,7 +166,8 @@ int cmd_render(int argc, char **argv)
     run main_run, ref_run;
     memset(&main_run, 0, sizeof main_run);
     memset(&ref_run, 0, sizeof ref_run);
-    om_method_cfg_default(&main_run.cfg);
+    static cli_settings settings;   /* 4 KB: off the stack */
+    settings.n = 0;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -199,7 +200,7 @@ int cmd_render(int argc, char **argv)
             int n = !strcmp(a, "--set") ? snprintf(setting, sizeof setting, "%s", v)
                                         : snprintf(setting, sizeof setting, "%s=%s", a + 2, v);
             if (n < 0 || (size_t)n >= sizeof setting) return cli_usage_error("render", "setting too long: '%s'", v);
-            if (!cli_set(&main_run.cfg, setting)) return 2;
+            if (!cli_settings_add(&settings, setting)) return 2;
         }
         i++;
     }
@@ -210,7 +211,8 @@ int cmd_render(int argc, char **argv)
     if (!main_run.m) return cli_unknown_method("render", "--method", mname);
     if (against && !(ref_run.m = om_method_find(against)))
         return cli_unknown_method("render", "--against", against);
-    om_method_cfg_default(&ref_run.cfg);
+    if (!cli_cfg(main_run.m, &settings, &main_run.cfg, quiet ? NULL : "render")) return 2;
+    om_method_cfg_default(&ref_run.cfg, ref_run.m);
     {
         const char *paths[4] = {scene_path, out, mask, diff};
         const char *names[4] = {"the scene", "--out", "--mask", "--diff"};
@@ -375,8 +377,8 @@ int cmd_info(int argc, char **argv)
 {
     const char *scene_path = NULL;
     uint32_t w = 0, h = 0;
-    om_method_cfg cfg;
-    om_method_cfg_default(&cfg);
+    static cli_settings settings;
+    settings.n = 0;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) { fputs(info_help, stdout); return 0; }
@@ -388,7 +390,7 @@ int cmd_info(int argc, char **argv)
             if (!v) return cli_usage_error("info", "%s needs a value", a);
             if (!strcmp(a, "--set")) snprintf(setting, sizeof setting, "%s", v);
             else snprintf(setting, sizeof setting, "map=%s", v);
-            if (!cli_set(&cfg, setting)) return 2;
+            if (!cli_settings_add(&settings, setting)) return 2;
             i++;
         } else if (a[0] == '-') return cli_usage_error("info", "unknown option '%s'", a);
         else if (!scene_path) scene_path = a;
@@ -413,6 +415,8 @@ int cmd_info(int argc, char **argv)
     for (size_t i = 0; i < om_method_count(); i++) {
         const om_method *m = om_method_at(i);
         size_t mn, full;
+        om_method_cfg cfg;
+        if (!cli_cfg(m, &settings, &cfg, NULL)) { cli_scene_free(&cs); return 2; }
         st = m->bytes(&cfg, s, W, H, &mn, &full);
         if (st == OM_OK) printf("  %-6s min %zu, one pass %zu\n", m->name, mn, full);
         else printf("  %-6s %s\n", m->name, om_status_str(st));

@@ -105,7 +105,7 @@ static int scene_crops(FILE *f, const char *name, uint32_t w, uint32_t h)
     size_t nm = 0;
     cli_point p;
     om_method_cfg cfg;
-    om_method_cfg_default(&cfg);
+    om_method_cfg_default(&cfg, om_method_find("ref"));
     if (cli_measure(om_method_find("ref"), &cfg, &cs, &v, 1, ref, frame, &p, &d)) {
         free(ref); free(frame); free(dm);
         cli_scene_free(&cs);
@@ -113,9 +113,10 @@ static int scene_crops(FILE *f, const char *name, uint32_t w, uint32_t h)
     }
     for (size_t k = 0; k < om_method_count() && nm < 16; k++) {
         const om_method *m = om_method_at(k);
-        const char *sw = om_method_sweep(m);
+        const char *sw = cli_sweep(m);
         if ((sw && !sw[0]) || !strcmp(m->name, "ref")) continue;
         if (!(masks[nm] = malloc(n))) continue;
+        om_method_cfg_default(&cfg, m);
         if (cli_measure(m, &cfg, &cs, &v, 1, masks[nm], NULL, &p, &d) == OM_OK) ms[nm++] = m;
         else free(masks[nm]);
     }

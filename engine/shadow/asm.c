@@ -43,11 +43,14 @@
 
 #include <float.h>
 
+OM__CFG_FITS(om__asm_cfg);
+extern const om_method om__method_asm;
+
 typedef struct asm_dvec { double x, y, z, w; } asm_dvec;
 
 typedef struct asm_state {
     const om_scene *scene;
-    om_method_cfg cfg;
+    om__asm_cfg cfg;
     om__asm_tree tree;
     om_view view;
     om_mat4 built_vp;      /* the light the tiles hold */
@@ -133,12 +136,14 @@ static size_t asm_need(const om_scene *s, const om__asm_layout *l, bool lean)
            (lean ? 0 : scene_bytes(s));
 }
 
-static om_status asm_bytes(const om_method_cfg *c, const om_scene *s, uint32_t w, uint32_t h,
+static om_status asm_bytes(const om_method_cfg *mc, const om_scene *s, uint32_t w, uint32_t h,
                            size_t *min, size_t *full)
 {
     (void)w; (void)h;
     om__asm_layout l;
-    om_status st = om__asm_layout_of(&l, c, s->ntris, NULL);
+    om__asm_cfg c;
+    if (om__method_cfg_of(mc, &om__method_asm, &c, NULL)) return OM_E_INVALID;
+    om_status st = om__asm_layout_of(&l, &c, s->ntris, NULL);
     if (st) return st;
     /* Below the smallest cap the figure is what the state needs to say so (init fails
      * with OM_E_BUDGET naming the smallest cap). The lean mode renders the same frame. */
@@ -147,13 +152,16 @@ static om_status asm_bytes(const om_method_cfg *c, const om_scene *s, uint32_t w
     return OM_OK;
 }
 
-static om_status asm_init(void **state, om_arena *a, const om_method_cfg *c, const om_scene *s,
+static om_status asm_init(void **state, om_arena *a, const om_method_cfg *mc, const om_scene *s,
                           uint32_t w, uint32_t h, om_diag *d)
 {
     om_status st;
     om__asm_layout l;
     void *p;
     *state = NULL;   /* a host that ignores a failed init gets OM_E_INVALID, not a crash */
+    om__asm_cfg cv;
+    const om__asm_cfg *c = &cv;
+    if ((st = om__method_cfg_of(mc, &om__method_asm, &cv, d))) return st;
     if ((st = om__asm_layout_of(&l, c, s->ntris, d))) return st;
     if (l.count == 0) {
         char tmp[8];
@@ -782,8 +790,25 @@ static void asm_stats(const void *state, om_method_stats *out)
     out->ncounters = 8;
 }
 
+#define SET(field, name, kind, lo, hi, def, doc) OM__SETTING(om__asm_cfg, field, name, kind, lo, hi, def, doc)
+
+static const om_setting settings[] = {
+    OM__SET_BIAS(om__asm_cfg), OM__SET_SLOPE(om__asm_cfg),
+    SET(asm_cap, "asm.cap", OM_SETTING_U64, 0, 1e15, 16 << 20, "bytes the node structure may hold"),
+    SET(asm_tile, "asm.tile", OM_SETTING_U32, 4, 1024, 64, "texels per side of a node's tile"),
+    SET(asm_cells, "asm.cells", OM_SETTING_U32, 1, 64, 8, "cells per side of a node"),
+    SET(asm_root, "asm.root", OM_SETTING_U32, 16, OM_MAX_DIM, 1024, "texels per side of the root"),
+    SET(asm_work, "asm.work", OM_SETTING_U32, 0, 1e9, 64, "per-frame work budget, cost units"),
+    SET(asm_stride, "asm.stride", OM_SETTING_U32, 1, 1024, 8, "analyse one visible sample in N"),
+    SET(asm_cost_a, "asm.a", OM_SETTING_F32, 0, 1e6, 1.0 / 4096.0, "node cost per required texel"),
+    SET(asm_cost_b, "asm.b", OM_SETTING_F32, 0, 1e6, 1, "node cost, constant part"),
+};
+
+#undef SET
+
 const om_method om__method_asm = {
     "asm", "adaptive shadow map: a tree of tiles refined where the eye needs it, within asm.cap",
     OM_METHOD_OBSERVES,
     asm_bytes, asm_init, asm_begin, asm_observe, asm_build, asm_resolve, asm_stats, NULL,
+    settings, sizeof settings / sizeof settings[0], sizeof(om__asm_cfg),
 };

@@ -29,6 +29,19 @@
 #define OM__ASM_ROOT 0xFFFFFFFEu   /* the root's index: it is not in the pool */
 #define OM__ASM_MAX_LEVEL 12u
 
+/* What asm's settings (asm.c) set. */
+typedef struct om__asm_cfg {
+    uint64_t asm_cap;      /* bytes the node structure may hold, at most */
+    float bias_const;      /* the conventional map's bias (sm.c), in the node's texels */
+    float bias_slope;
+    uint32_t asm_tile;     /* texels per side of every node's tile */
+    uint32_t asm_cells;    /* cells per side of a node; a cell may hold a child node */
+    uint32_t asm_root;     /* texels per side of the root's view of the light frustum */
+    uint32_t asm_work;     /* per-frame work budget, in cost units */
+    uint32_t asm_stride;   /* analyse one visible sample in asm_stride (the paper: 8) */
+    float asm_cost_a, asm_cost_b;   /* cost of a node: a * texels required + b */
+} om__asm_cfg;
+
 /* The head of every pool item (and of the root). */
 typedef struct om__asm_node {
     uint32_t parent;       /* index of the parent node (OM__ASM_ROOT for level 1) */
@@ -90,7 +103,7 @@ typedef struct om__asm_tree {
 /* Fills `l` for cfg and a scene of ntris triangles: OM_E_INVALID (with a message in d)
  * when tile, cells and root do not fit together; cap below min_cap is not an error
  * here (count is 0), so hosts can still ask for the bytes and init names the minimum. */
-om_status om__asm_layout_of(om__asm_layout *l, const om_method_cfg *c, uint32_t ntris,
+om_status om__asm_layout_of(om__asm_layout *l, const om__asm_cfg *c, uint32_t ntris,
                             om_diag *d);
 /* Carves the root and the pool (lay.count nodes) from `a`; the root starts cleared. */
 om_status om__asm_tree_init(om__asm_tree *t, om_arena *a, const om__asm_layout *l,

@@ -8,7 +8,7 @@
 
 static size_t up8(size_t n) { return (n + 7u) & ~(size_t)7u; }
 
-om_status om__asm_layout_of(om__asm_layout *l, const om_method_cfg *c, uint32_t ntris,
+om_status om__asm_layout_of(om__asm_layout *l, const om__asm_cfg *c, uint32_t ntris,
                             om_diag *d)
 {
     memset(l, 0, sizeof *l);

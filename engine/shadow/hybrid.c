@@ -48,9 +48,18 @@ typedef struct htexel { float z, gx, gy, near; uint32_t cid; } htexel;
 
 #define MRU 4
 
+/* hybrid's configuration: the sample pool's settings and its map's side. */
+typedef struct hybrid_cfg {
+    om__izb_cfg izb;
+    uint32_t hybrid_map;   /* 0: auto (map_side) */
+} hybrid_cfg;
+OM__CFG_FITS(hybrid_cfg);
+
+extern const om_method om__method_hybrid;
+
 typedef struct hybrid_state {
     om__izb z;             /* first: the irregular z-buffer for the uncertain samples */
-    om_method_cfg cfg;
+    hybrid_cfg cfg;
     htexel *map;
     uint32_t side;         /* texels per side */
     int64_t T;             /* grid units per texel side */
@@ -65,7 +74,7 @@ typedef struct hybrid_state {
  * image's larger side (at least 16): texels of about 2 x 2 pixels where the light's
  * image and the camera's agree, and memory that scales with the image (512 at
  * 1024x768, 64 at 160x120). */
-static uint32_t map_side(const om_method_cfg *c, uint32_t w, uint32_t h)
+static uint32_t map_side(const hybrid_cfg *c, uint32_t w, uint32_t h)
 {
     if (c->hybrid_map) return c->hybrid_map;
     uint32_t half = (w > h ? w : h) / 2, side = 16;
@@ -79,27 +88,38 @@ static size_t fixed_bytes(uint32_t side, const om_scene *s, bool cache)
            om_arena_need((size_t)side * side * sizeof(htexel), 16);
 }
 
-static om_status hybrid_bytes(const om_method_cfg *c, const om_scene *s, uint32_t w, uint32_t h,
-                              size_t *min, size_t *full)
+static om_status need(const hybrid_cfg *c, const om_scene *s, uint32_t w, uint32_t h,
+                      size_t *min, size_t *full)
 {
-    if (c->izb_leaf < 1 || c->hybrid_map > OM_LIGHT_GRID) return OM_E_INVALID;
+    if (c->izb.izb_leaf < 1 || c->hybrid_map > OM_LIGHT_GRID) return OM_E_INVALID;
     uint32_t one_pass = w * h, smallest = w, side = map_side(c, w, h);
-    if (c->izb_pool) one_pass = smallest = c->izb_pool;
-    *min = fixed_bytes(side, s, false) + om__izb_pool_bytes(smallest, c->izb_leaf);
-    *full = fixed_bytes(side, s, true) + om__izb_pool_bytes(one_pass, c->izb_leaf);
+    if (c->izb.izb_pool) one_pass = smallest = c->izb.izb_pool;
+    *min = fixed_bytes(side, s, false) + om__izb_pool_bytes(smallest, c->izb.izb_leaf);
+    *full = fixed_bytes(side, s, true) + om__izb_pool_bytes(one_pass, c->izb.izb_leaf);
     return OM_OK;
 }
 
-static om_status hybrid_init(void **state, om_arena *a, const om_method_cfg *c, const om_scene *s,
+static om_status hybrid_bytes(const om_method_cfg *mc, const om_scene *s, uint32_t w, uint32_t h,
+                              size_t *min, size_t *full)
+{
+    hybrid_cfg c;
+    if (om__method_cfg_of(mc, &om__method_hybrid, &c, NULL)) return OM_E_INVALID;
+    return need(&c, s, w, h, min, full);
+}
+
+static om_status hybrid_init(void **state, om_arena *a, const om_method_cfg *mc, const om_scene *s,
                              uint32_t w, uint32_t h, om_diag *d)
 {
     om_status st;
     void *p;
     size_t mn, full;
-    if (c->izb_leaf < 1) return om__fail(d, OM_E_INVALID, "hybrid: izb.leaf must be at least 1");
+    hybrid_cfg cv;
+    const hybrid_cfg *c = &cv;
+    if ((st = om__method_cfg_of(mc, &om__method_hybrid, &cv, d))) return st;
+    if (c->izb.izb_leaf < 1) return om__fail(d, OM_E_INVALID, "hybrid: izb.leaf must be at least 1");
     if (c->hybrid_map > OM_LIGHT_GRID)
         return om__fail(d, OM_E_INVALID, "hybrid: hybrid.map must be 0 (auto) to 8192");
-    if ((st = hybrid_bytes(c, s, w, h, &mn, &full))) return st;
+    if ((st = need(c, s, w, h, &mn, &full))) return st;
     if ((st = om__need(a, mn, "hybrid", d))) return st;
     if ((st = om_arena_alloc(a, sizeof(hybrid_state), 16, &p, d))) return st;
     hybrid_state *m = (hybrid_state *)p;
@@ -109,7 +129,7 @@ static om_status hybrid_init(void **state, om_arena *a, const om_method_cfg *c, 
     size_t tex = (size_t)m->side * m->side;
     if ((st = om_arena_alloc(a, tex * sizeof(htexel), 16, &p, d))) return st;
     m->map = (htexel *)p;
-    if ((st = om__izb_setup(&m->z, a, c, s, w * h, w, d))) return st;
+    if ((st = om__izb_setup(&m->z, a, &c->izb, s, w * h, w, d))) return st;
     *state = m;
     return OM_OK;
 }
@@ -305,8 +325,15 @@ static void hybrid_stats(const void *state, om_method_stats *out)
     out->ncounters = 7;
 }
 
+static const om_setting settings[] = {
+    OM__SET_IZB_LEAF(hybrid_cfg, izb.izb_leaf), OM__SET_IZB_POOL(hybrid_cfg, izb.izb_pool),
+    OM__SETTING(hybrid_cfg, hybrid_map, "hybrid.map", OM_SETTING_U32, 0, OM_MAX_DIM, 0,
+                "side of its conservative map (20 bytes a texel), 0 = half the image's side"),
+};
+
 const om_method om__method_hybrid = {
     "hybrid", "exact: a conservative map decides most samples, the irregular z-buffer the rest",
     OM_METHOD_EXACT, hybrid_bytes, hybrid_init, hybrid_begin, hybrid_observe, hybrid_build,
-    hybrid_resolve, hybrid_stats, NULL,
+    hybrid_resolve, hybrid_stats, NULL, settings, sizeof settings / sizeof settings[0],
+    sizeof(hybrid_cfg),
 };

@@ -22,9 +22,11 @@
 
 #include <float.h>
 
+extern const om_method om__method_izb;
+
 typedef struct izb_state {
     om__izb z;
-    om_method_cfg cfg;
+    om__izb_cfg cfg;
     uint32_t width, height;
 } izb_state;
 
@@ -57,8 +59,8 @@ static size_t fixed_bytes(const om_scene *s, bool cache)
     return om_arena_need(sizeof(izb_state), 16) + om__izb_parts_bytes(s, cache);
 }
 
-static om_status izb_bytes(const om_method_cfg *c, const om_scene *s, uint32_t w, uint32_t h,
-                           size_t *min, size_t *full)
+static om_status pool_bytes(const om__izb_cfg *c, const om_scene *s, uint32_t w, uint32_t h,
+                            size_t *min, size_t *full)
 {
     if (c->izb_leaf < 1) return OM_E_INVALID;
     uint32_t one_pass = w * h, smallest = w;   /* the smallest tile: one row */
@@ -68,7 +70,15 @@ static om_status izb_bytes(const om_method_cfg *c, const om_scene *s, uint32_t w
     return OM_OK;
 }
 
-om_status om__izb_setup(om__izb *z, om_arena *a, const om_method_cfg *c, const om_scene *s,
+static om_status izb_bytes(const om_method_cfg *mc, const om_scene *s, uint32_t w, uint32_t h,
+                           size_t *min, size_t *full)
+{
+    om__izb_cfg c;
+    if (om__method_cfg_of(mc, &om__method_izb, &c, NULL)) return OM_E_INVALID;
+    return pool_bytes(&c, s, w, h, min, full);
+}
+
+om_status om__izb_setup(om__izb *z, om_arena *a, const om__izb_cfg *c, const om_scene *s,
                         uint32_t want, uint32_t least, om_diag *d)
 {
     om_status st;
@@ -106,14 +116,17 @@ om_status om__izb_setup(om__izb *z, om_arena *a, const om_method_cfg *c, const o
     return OM_OK;
 }
 
-static om_status izb_init(void **state, om_arena *a, const om_method_cfg *c, const om_scene *s,
+static om_status izb_init(void **state, om_arena *a, const om_method_cfg *mc, const om_scene *s,
                           uint32_t w, uint32_t h, om_diag *d)
 {
     om_status st;
     void *p;
     size_t mn, full;
+    om__izb_cfg cv;
+    const om__izb_cfg *c = &cv;
+    if ((st = om__method_cfg_of(mc, &om__method_izb, &cv, d))) return st;
     if (c->izb_leaf < 1) return om__fail(d, OM_E_INVALID, "izb: leaf size must be at least 1");
-    if ((st = izb_bytes(c, s, w, h, &mn, &full))) return st;
+    if ((st = pool_bytes(c, s, w, h, &mn, &full))) return st;
     if ((st = om__need(a, mn, "izb", d))) return st;
     if ((st = om_arena_alloc(a, sizeof(izb_state), 16, &p, d))) return st;
     izb_state *m = (izb_state *)p;
@@ -436,8 +449,12 @@ static void izb_stats(const void *state, om_method_stats *out)
     out->ncounters = 7;
 }
 
+static const om_setting settings[] = {
+    OM__SET_IZB_LEAF(om__izb_cfg, izb_leaf), OM__SET_IZB_POOL(om__izb_cfg, izb_pool),
+};
+
 const om_method om__method_izb = {
     "izb", "irregular z-buffer (alias-free shadow maps): exact, BSP over the visible samples",
     OM_METHOD_EXACT, izb_bytes, izb_init, izb_begin, izb_observe, izb_build, izb_resolve,
-    izb_stats, NULL,
+    izb_stats, NULL, settings, sizeof settings / sizeof settings[0], sizeof(om__izb_cfg),
 };

@@ -55,6 +55,20 @@ typedef struct om__izb {
 
 /* The izb method's state begins with an om__izb, so a state pointer converts to one. */
 
+/* The sample pool's settings: izb's whole configuration, and a part of hybrid's. */
+typedef struct om__izb_cfg {
+    uint32_t izb_leaf;     /* most samples in a BSP leaf */
+    uint32_t izb_pool;     /* samples the pool holds; 0 = the whole frame in one pass */
+} om__izb_cfg;
+
+/* Their entries in the settings of a method whose struct T holds them at `f` (a field
+ * designator: izb_leaf, or part.izb_leaf). */
+#define OM__SET_IZB_LEAF(T, f) \
+    OM__SETTING(T, f, "izb.leaf", OM_SETTING_U32, 1, 65536, 64, "most samples in a BSP leaf (the paper: 64)")
+#define OM__SET_IZB_POOL(T, f) \
+    OM__SETTING(T, f, "izb.pool", OM_SETTING_U32, 0, 1e9, 0, \
+                "samples the pool holds, 0 = the whole frame in one pass")
+
 /* Arena bytes of om__izb_setup's parts: the material depths and, with `cache`, the
  * per-frame vertex projection; and of a pool of `samples` with its BSP nodes. */
 size_t om__izb_parts_bytes(const om_scene *s, bool cache);
@@ -62,7 +76,7 @@ size_t om__izb_pool_bytes(uint32_t samples, uint32_t leaf);
 /* Carves z's parts from `a`: the vertex projection when the arena also holds a pool of
  * `want` samples beside it, then the pool: c->izb_pool samples when set, else the
  * largest from `least` up to `want` that fits. The caller has checked the minimum. */
-om_status om__izb_setup(om__izb *z, om_arena *a, const om_method_cfg *c, const om_scene *s,
+om_status om__izb_setup(om__izb *z, om_arena *a, const om__izb_cfg *c, const om_scene *s,
                         uint32_t want, uint32_t least, om_diag *d);
 
 /* Decides a sample without the BSP when it can: writes its term and returns true. */

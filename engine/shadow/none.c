@@ -60,4 +60,5 @@ static void none_stats(const void *state, om_method_stats *out)
 const om_method om__method_none = {
     "none", "no occluders: every sample facing the light inside its frustum is lit", 0,
     none_bytes, none_init, none_begin, none_observe, none_build, none_resolve, none_stats, NULL,
+    NULL, 0, 0,
 };

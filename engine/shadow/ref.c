@@ -279,5 +279,5 @@ static void ref_stats(const void *state, om_method_stats *out)
 const om_method om__method_ref = {
     "ref", "exact reference: shadow segments through a BVH, the shared occlusion predicate",
     OM_METHOD_EXACT, ref_bytes, ref_init, ref_begin, ref_observe, ref_build, ref_resolve,
-    ref_stats, NULL,
+    ref_stats, NULL, NULL, 0, 0,
 };

@@ -1,30 +1,59 @@
-/* registry.c — every shadow method by name. Adding a method is its own file plus one
- * line here; every tool, chart and test finds it through this table. */
+/* registry.c — every shadow method by name, and settings by name. Adding a method is
+ * its own file plus one line of METHODS; its settings and their defaults live in its
+ * file (om_method.settings), so every tool, chart and test finds both through here. */
 #include "shadow.h"
 
-static const om_method *const methods[] = {
-    &om__method_none,
-    &om__method_ref,
-    &om__method_sm,
-    &om__method_asm,
-    &om__method_rtw,
-    &om__method_spsm,
-    &om__method_izb,
-    &om__method_hybrid,
-};
+/* Compile-time selection (ombra.h): a method left out is not named below, so the
+ * linker takes none of its files from the library. */
+#ifndef OM_WITH_NONE
+#define OM_WITH_NONE 1
+#endif
+#ifndef OM_WITH_REF
+#define OM_WITH_REF 1
+#endif
+#ifndef OM_WITH_SM
+#define OM_WITH_SM 1
+#endif
+#ifndef OM_WITH_ASM
+#define OM_WITH_ASM 1
+#endif
+#ifndef OM_WITH_RTW
+#define OM_WITH_RTW 1
+#endif
+#ifndef OM_WITH_SPSM
+#define OM_WITH_SPSM 1
+#endif
+#ifndef OM_WITH_IZB
+#define OM_WITH_IZB 1
+#endif
+#ifndef OM_WITH_HYBRID
+#define OM_WITH_HYBRID 1
+#endif
 
-/* What `ombra bench` sweeps, by method name (see om_method_sweep). */
-static const struct { const char *name, *sweep; } sweeps[] = {
-    {"none", ""},
-    {"sm", "map=256,512,1024,2048,4096,8192"},
-    {"izb", "izb.pool=0,65536,16384"},
-    {"asm", "asm.cap=1048576,4194304,8388608,16777216"},
-    {"rtw", "map=512,1024,2048 rtw.exact=1,0"},
-    {"spsm", "map=512,1024,2048,4096"},
-    {"hybrid", "hybrid.map=256,512,1024"},
-};
+/* One line a method: X(name, switch), in the order tools list them. */
+#define METHODS(X)           \
+    X(none, OM_WITH_NONE)    \
+    X(ref, OM_WITH_REF)      \
+    X(sm, OM_WITH_SM)        \
+    X(asm, OM_WITH_ASM)      \
+    X(rtw, OM_WITH_RTW)      \
+    X(spsm, OM_WITH_SPSM)    \
+    X(izb, OM_WITH_IZB)      \
+    X(hybrid, OM_WITH_HYBRID)
 
-size_t om_method_count(void) { return sizeof methods / sizeof methods[0]; }
+#define DECLARE(m, on) extern const om_method om__method_##m;
+METHODS(DECLARE)
+
+/* ENTRY(m, 1) names the method, ENTRY(m, 0) nothing: the switch must be 0 or 1. */
+#define CAT_(a, b) a##b
+#define CAT(a, b) CAT_(a, b)
+#define ENTRY_1(m) &om__method_##m,
+#define ENTRY_0(m)
+#define ENTRY(m, on) CAT(ENTRY_, on)(m)
+
+static const om_method *const methods[] = {METHODS(ENTRY) NULL};
+
+size_t om_method_count(void) { return sizeof methods / sizeof methods[0] - 1; }
 
 const om_method *om_method_at(size_t i)
 {
@@ -44,103 +73,91 @@ const om_method *om_method_find(const char *name)
     return NULL;
 }
 
-const char *om_method_sweep(const om_method *m)
+const om_setting *om_method_setting(const om_method *m, const char *name)
 {
-    for (size_t i = 0; m && i < sizeof sweeps / sizeof sweeps[0]; i++)
-        if (same_name(sweeps[i].name, m->name)) return sweeps[i].sweep;
+    for (uint32_t i = 0; m && name && i < m->nsettings; i++)
+        if (same_name(m->settings[i].name, name)) return &m->settings[i];
     return NULL;
 }
 
-void om_method_cfg_default(om_method_cfg *c)
+static void put(om_method_cfg *c, const om_setting *f, double value)
 {
-    memset(c, 0, sizeof *c);
-    c->map_size = 2048;
-    c->bias_const = 0.01f;   /* world units: 1 cm */
-    c->bias_slope = 1.5f;    /* texels: a plane's depth across 1.5 texels at its slope */
-    c->normal_offset = 0.0f;
-    c->pcf = 1;
-    c->asm_cap = 16u << 20;
-    c->asm_tile = 64;
-    c->asm_cells = 8;
-    c->asm_root = 1024;
-    c->asm_work = 64;
-    c->asm_stride = 8;
-    c->asm_cost_a = 1.0f / 4096.0f;
-    c->asm_cost_b = 1.0f;
-    c->izb_leaf = 64;
-    c->izb_pool = 0;
-    c->rtw_importance = 0;
-    c->rtw_analysis = 0;
-    c->rtw_funcs = 1 | 2 | 8;
-    c->rtw_sigma = 3.0f;
-    c->rtw_tess = 0.025f;
-    c->rtw_exact = 1;
-    c->rtw_footprint = 0;
-    c->spsm_aa = 0;
-    c->spsm_records = 0;
-    c->spsm_fine = 0;
-    c->hybrid_map = 0;
+    unsigned char *p = c->store.bytes + f->offset;
+    if (f->kind == OM_SETTING_U32) { uint32_t v = (uint32_t)value; memcpy(p, &v, sizeof v); }
+    else if (f->kind == OM_SETTING_U64) { uint64_t v = (uint64_t)value; memcpy(p, &v, sizeof v); }
+    else { float v = (float)value; memcpy(p, &v, sizeof v); }
 }
 
-#define F(name, kind, field, lo, hi, help) {name, help, kind, offsetof(om_method_cfg, field), lo, hi}
-
-static const om_cfg_field fields[] = {
-    F("map", 'u', map_size, 1, 8192, "shadow-map side in texels (sm, rtw, spsm)"),
-    F("bias", 'f', bias_const, 0, 1e6, "constant bias, world units along the light ray (sm, rtw)"),
-    F("slope", 'f', bias_slope, 0, 1e3, "slope-scaled bias in texels (sm, rtw)"),
-    F("offset", 'f', normal_offset, 0, 1e3, "normal offset in texels (sm, rtw)"),
-    F("pcf", 'u', pcf, 1, 9, "k x k percentage-closer filtering, 1 = off (sm, rtw)"),
-    F("asm.cap", 'z', asm_cap, 0, 1e15, "bytes the ASM node structure may hold"),
-    F("asm.tile", 'u', asm_tile, 4, 1024, "texels per side of an ASM node's tile"),
-    F("asm.cells", 'u', asm_cells, 1, 64, "cells per side of an ASM node"),
-    F("asm.root", 'u', asm_root, 16, 8192, "texels per side of the ASM root"),
-    F("asm.work", 'u', asm_work, 0, 1e9, "ASM per-frame work budget, cost units"),
-    F("asm.stride", 'u', asm_stride, 1, 1024, "ASM analyses one visible sample in N"),
-    F("asm.a", 'f', asm_cost_a, 0, 1e6, "ASM node cost per required texel"),
-    F("asm.b", 'f', asm_cost_b, 0, 1e6, "ASM node cost, constant part"),
-    F("izb.leaf", 'u', izb_leaf, 1, 65536, "most samples in an IZB BSP leaf (izb, hybrid)"),
-    F("izb.pool", 'u', izb_pool, 0, 1e9, "IZB sample pool, 0 = whole frame in one pass (izb, hybrid)"),
-    F("rtw.importance", 'u', rtw_importance, 0, 8192, "RTW importance map side (at least 8), 0 = 512 or the map's if smaller"),
-    F("rtw.analysis", 'u', rtw_analysis, 0, 2, "RTW analysis: 0 backward, 1 forward, 2 hybrid"),
-    F("rtw.funcs", 'u', rtw_funcs, 0, 15, "RTW importance: 1 view, 2 distance, 4 edge, 8 normal"),
-    F("rtw.sigma", 'f', rtw_sigma, 0, 64, "RTW blur sigma in super-cells"),
-    F("rtw.tess", 'f', rtw_tess, 0, 1, "RTW longest warped edge / map width, 0 = off"),
-    F("rtw.exact", 'u', rtw_exact, 0, 1, "RTW map: 1 texels sample at inverse-warped centres, 0 warped vertices"),
-    F("rtw.footprint", 'u', rtw_footprint, 0, 1, "RTW PCF taps: 0 a warped texel apart, 1 an unwarped one"),
-    F("spsm.aa", 'u', spsm_aa, 0, 64, "SPSM sub-samples at uncertain samples, 0 = off"),
-    F("spsm.records", 'u', spsm_records, 0, 2, "SPSM records made: 1 all, 2 those the view reads, 0 auto"),
-    F("spsm.fine", 'u', spsm_fine, 0, 1, "SPSM fallback: 1 the plain map at 2 x 2 points per texel, 0 at centres"),
-    F("hybrid.map", 'u', hybrid_map, 0, 8192, "hybrid's conservative map side (20 bytes a texel), 0 = auto: half the image's side"),
-};
-
-#undef F
-
-const om_cfg_field *om_method_cfg_fields(size_t *count)
+void om_method_cfg_default(om_method_cfg *c, const om_method *m)
 {
-    *count = sizeof fields / sizeof fields[0];
-    return fields;
+    memset(c, 0, sizeof *c);
+    c->method = m;
+    for (uint32_t i = 0; m && i < m->nsettings; i++) put(c, &m->settings[i], m->settings[i].def);
 }
 
 om_status om_method_cfg_set(om_method_cfg *c, const char *name, double value, om_diag *d)
 {
-    for (size_t i = 0; i < sizeof fields / sizeof fields[0]; i++) {
-        const om_cfg_field *f = &fields[i];
-        if (!same_name(f->name, name)) continue;
-        if (!(value >= f->min && value <= f->max) || (f->kind != 'f' && value != floor(value))) {
-            char tmp[8];
-            om__str s = om__diag_begin(d, OM_E_RANGE, tmp, sizeof tmp);
-            om__str_s(&s, f->name);
-            om__str_s(&s, f->kind == 'f' ? " takes a number from " : " takes a whole number from ");
-            om__str_f(&s, f->min, f->kind == 'f' ? 3 : 0);
-            om__str_s(&s, " to ");
-            om__str_f(&s, f->max, f->kind == 'f' ? 3 : 0);
-            return OM_E_RANGE;
-        }
-        unsigned char *p = (unsigned char *)c + f->offset;
-        if (f->kind == 'u') { uint32_t v = (uint32_t)value; memcpy(p, &v, sizeof v); }
-        else if (f->kind == 'z') { uint64_t v = (uint64_t)value; memcpy(p, &v, sizeof v); }
-        else { float v = (float)value; memcpy(p, &v, sizeof v); }
-        return OM_OK;
+    const om_setting *f = om_method_setting(c->method, name);
+    char tmp[8];
+    if (!f) {
+        om__str s = om__diag_begin(d, OM_E_NOTFOUND, tmp, sizeof tmp);
+        om__str_s(&s, c->method ? c->method->name : "no method");
+        om__str_s(&s, " has no setting '");
+        om__str_s(&s, name ? name : "");
+        om__str_s(&s, "'");
+        return OM_E_NOTFOUND;
     }
-    return om__fail(d, OM_E_NOTFOUND, "unknown setting (see 'ombra methods')");
+    const bool whole = f->kind != OM_SETTING_F32;
+    if (!(value >= f->min && value <= f->max) || (whole && value != floor(value))) {
+        om__str s = om__diag_begin(d, OM_E_RANGE, tmp, sizeof tmp);
+        om__str_s(&s, f->name);
+        om__str_s(&s, whole ? " takes a whole number from " : " takes a number from ");
+        om__str_f(&s, f->min, whole ? 0 : 3);
+        om__str_s(&s, " to ");
+        om__str_f(&s, f->max, whole ? 0 : 3);
+        return OM_E_RANGE;
+    }
+    put(c, f, value);
+    return OM_OK;
+}
+
+om_status om_method_cfg_get(const om_method_cfg *c, const char *name, double *value)
+{
+    const om_setting *f = om_method_setting(c->method, name);
+    if (!f) return OM_E_NOTFOUND;
+    const unsigned char *p = c->store.bytes + f->offset;
+    if (f->kind == OM_SETTING_U32) { uint32_t v; memcpy(&v, p, sizeof v); *value = v; }
+    else if (f->kind == OM_SETTING_U64) { uint64_t v; memcpy(&v, p, sizeof v); *value = (double)v; }
+    else { float v; memcpy(&v, p, sizeof v); *value = v; }
+    return OM_OK;
+}
+
+void om_method_cfg_from(om_method_cfg *c, const om_method *m, const om_method_cfg *from)
+{
+    om_method_cfg src;
+    if (from) src = *from;
+    else om_method_cfg_default(&src, NULL);
+    om_method_cfg_default(c, m);
+    for (uint32_t i = 0; src.method && i < src.method->nsettings; i++) {
+        const om_setting *f = om_method_setting(m, src.method->settings[i].name);
+        double v;
+        if (f && f->kind == src.method->settings[i].kind &&
+            om_method_cfg_get(&src, f->name, &v) == OM_OK)
+            put(c, f, v);
+    }
+}
+
+om_status om__method_cfg_of(const om_method_cfg *c, const om_method *m, void *out, om_diag *d)
+{
+    if (!c || c->method != m) {
+        char tmp[8];
+        om__str s = om__diag_begin(d, OM_E_INVALID, tmp, sizeof tmp);
+        om__str_s(&s, m->name);
+        om__str_s(&s, ": the configuration was made for ");
+        om__str_s(&s, c && c->method ? c->method->name : "no method");
+        om__str_s(&s, " (om_method_cfg_default)");
+        return OM_E_INVALID;
+    }
+    memcpy(out, c->store.bytes, m->cfg_bytes);
+    return OM_OK;
 }

@@ -19,12 +19,15 @@
 #include "rtw.h"
 #include "occlude.h"   /* OM_LIGHT_GRID */
 
+OM__CFG_FITS(om__rtw_cfg);
+extern const om_method om__method_rtw;
+
 /* ---------------------------------------------------------------- sizes */
 
 /* The importance map's side: as asked, or by default 512 (section 6's size), no finer
  * than the map itself (a super-cell narrower than a texel moves nothing); at least 8
  * either way (a side asked below 8 is 8, so every value the setting takes renders). */
-static uint32_t importance_side(const om_method_cfg *c)
+static uint32_t importance_side(const om__rtw_cfg *c)
 {
     if (c->rtw_importance) return c->rtw_importance < 8 ? 8 : c->rtw_importance;
     uint32_t n = c->map_size < 512 ? c->map_size : 512;
@@ -46,7 +49,7 @@ static uint32_t grid_buckets(uint32_t size)
     return ((OM_LIGHT_GRID * OM_SUBPIX) >> grid_shift(size)) + 1;
 }
 
-static size_t rtw_need(const om_method_cfg *c)
+static size_t rtw_need(const om__rtw_cfg *c)
 {
     size_t n = importance_side(c), nn = n * n, s = c->map_size;
     size_t b = om_arena_need(sizeof(om__rtw), 16) + om_arena_need(nn * sizeof(float), 16) +
@@ -61,7 +64,7 @@ static size_t rtw_need(const om_method_cfg *c)
     return b;
 }
 
-static const char *check_cfg(const om_method_cfg *c)
+static const char *check_cfg(const om__rtw_cfg *c)
 {
     if (c->map_size < 1 || c->map_size > OM_MAX_DIM) return "rtw: map size must be 1..8192";
     if (c->pcf < 1 || c->pcf > 9) return "rtw: pcf must be 1..9";
@@ -76,12 +79,13 @@ static const char *check_cfg(const om_method_cfg *c)
     return NULL;
 }
 
-static om_status rtw_bytes(const om_method_cfg *c, const om_scene *s, uint32_t w, uint32_t h,
+static om_status rtw_bytes(const om_method_cfg *mc, const om_scene *s, uint32_t w, uint32_t h,
                            size_t *min, size_t *full)
 {
     (void)s; (void)w; (void)h;
-    if (check_cfg(c)) return OM_E_INVALID;
-    *min = *full = rtw_need(c);
+    om__rtw_cfg c;
+    if (om__method_cfg_of(mc, &om__method_rtw, &c, NULL) || check_cfg(&c)) return OM_E_INVALID;
+    *min = *full = rtw_need(&c);
     return OM_OK;
 }
 
@@ -90,12 +94,15 @@ static om_status carve(om_arena *a, size_t bytes, void **out, om_diag *d)
     return om_arena_alloc(a, bytes, 16, out, d);
 }
 
-static om_status rtw_init(void **state, om_arena *a, const om_method_cfg *c, const om_scene *s,
+static om_status rtw_init(void **state, om_arena *a, const om_method_cfg *mc, const om_scene *s,
                           uint32_t w, uint32_t h, om_diag *d)
 {
     (void)w; (void)h;
     om_status st;
     void *p;
+    om__rtw_cfg cv;
+    const om__rtw_cfg *c = &cv;
+    if ((st = om__method_cfg_of(mc, &om__method_rtw, &cv, d))) return st;
     const char *bad = check_cfg(c);
     if (bad) return om__fail(d, OM_E_INVALID, bad);
     if ((st = om__need(a, rtw_need(c), "rtw", d))) return st;
@@ -516,8 +523,29 @@ static void rtw_stats(const void *state, om_method_stats *out)
     out->ncounters = m->clock ? 8 : 4;   /* stage times only when the host gave a clock */
 }
 
+#define SET(field, name, kind, lo, hi, def, doc) OM__SETTING(om__rtw_cfg, field, name, kind, lo, hi, def, doc)
+
+static const om_setting settings[] = {
+    OM__SET_MAP(om__rtw_cfg), OM__SET_BIAS(om__rtw_cfg), OM__SET_SLOPE(om__rtw_cfg),
+    OM__SET_OFFSET(om__rtw_cfg), OM__SET_PCF(om__rtw_cfg),
+    SET(rtw_importance, "rtw.importance", OM_SETTING_U32, 0, OM_MAX_DIM, 0,
+        "importance map side (at least 8), 0 = 512 or the map's if smaller"),
+    SET(rtw_analysis, "rtw.analysis", OM_SETTING_U32, 0, 2, 0, "analysis: 0 backward, 1 forward, 2 hybrid"),
+    SET(rtw_funcs, "rtw.funcs", OM_SETTING_U32, 0, 15, OM_RTW_DV | OM_RTW_DIST | OM_RTW_NORMAL,
+        "importance: 1 view, 2 distance, 4 edge, 8 normal"),
+    SET(rtw_sigma, "rtw.sigma", OM_SETTING_F32, 0, 64, 3, "blur sigma in super-cells"),
+    SET(rtw_tess, "rtw.tess", OM_SETTING_F32, 0, 1, 0.025, "longest warped edge / map width, 0 = off"),
+    SET(rtw_exact, "rtw.exact", OM_SETTING_U32, 0, 1, 1,
+        "map: 1 texels sample at inverse-warped centres, 0 warped vertices"),
+    SET(rtw_footprint, "rtw.footprint", OM_SETTING_U32, 0, 1, 0,
+        "PCF taps: 0 a warped texel apart, 1 an unwarped one"),
+};
+
+#undef SET
+
 const om_method om__method_rtw = {
     "rtw", "rectilinear texture warping: importance-warped shadow map with 1-D warp tables",
     OM_METHOD_OBSERVES,
     rtw_bytes, rtw_init, rtw_begin, rtw_observe, rtw_build, rtw_resolve, rtw_stats, NULL,
+    settings, sizeof settings / sizeof settings[0], sizeof(om__rtw_cfg),
 };

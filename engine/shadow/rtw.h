@@ -67,11 +67,28 @@ double om__rtw_max_density(const int32_t *P, uint32_t n);
  * tested against the camera's frustum). n need not face the camera. */
 float om__rtw_point_importance(const om_view *v, unsigned funcs, om_vec3 p, om_vec3 n);
 
-/* ---- the method's state (rtw.c) */
+/* ---- the method's configuration and state (rtw.c) */
+
+/* What rtw's settings (rtw.c) set: the depth test's, and the warp's. */
+typedef struct om__rtw_cfg {
+    uint32_t map_size;
+    float bias_const, bias_slope, normal_offset;
+    uint32_t pcf;
+    uint32_t rtw_importance;   /* importance map side; 0 = 512, or the map's side when
+                                  that is smaller (at least 8) */
+    uint32_t rtw_analysis;     /* OM_RTW_BACKWARD, _FORWARD or _HYBRID */
+    uint32_t rtw_funcs;        /* importance functions: a mask of OM_RTW_DV ... */
+    float rtw_sigma;           /* Gaussian blur, in super-cells */
+    float rtw_tess;            /* longest warped edge as a fraction of the map, 0 = off */
+    uint32_t rtw_exact;        /* 1: texels sample the scene at inverse-warped centres;
+                                  0: warped vertices, straight edges, rtw_tess */
+    uint32_t rtw_footprint;    /* PCF taps 0: a warped texel apart (anti-aliasing);
+                                  1: an unwarped one (soft shadows; section 6.2) */
+} om__rtw_cfg;
 
 typedef struct om__rtw {
     const om_scene *scene;
-    om_method_cfg cfg;
+    om__rtw_cfg cfg;
     uint32_t n;                /* importance map side = super-cells per axis */
     uint32_t size;             /* warped shadow map side */
     float *imp;                /* n * n: importance; -1 where no visible sample fell */

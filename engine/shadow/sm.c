@@ -8,9 +8,19 @@
 #include "shadow.h"
 #include "smlookup.h"
 
+/* sm's configuration: what its settings (at the end of this file) set. */
+typedef struct sm_cfg {
+    uint32_t map_size;
+    float bias_const, bias_slope, normal_offset;
+    uint32_t pcf;
+} sm_cfg;
+OM__CFG_FITS(sm_cfg);
+
+extern const om_method om__method_sm;
+
 typedef struct sm_state {
     const om_scene *scene;
-    om_method_cfg cfg;
+    sm_cfg cfg;
     uint32_t size;
     uint32_t *depth;
     om_view view;
@@ -18,27 +28,33 @@ typedef struct sm_state {
     uint32_t samples, shadowed;
 } sm_state;
 
-static size_t sm_need(const om_method_cfg *c)
+static size_t sm_need(const sm_cfg *c)
 {
     return om_arena_need(sizeof(sm_state), 16) +
            om_arena_need((size_t)c->map_size * c->map_size * sizeof(uint32_t), 16);
 }
 
-static om_status sm_bytes(const om_method_cfg *c, const om_scene *s, uint32_t w, uint32_t h,
+static om_status sm_bytes(const om_method_cfg *mc, const om_scene *s, uint32_t w, uint32_t h,
                           size_t *min, size_t *full)
 {
     (void)s; (void)w; (void)h;
+    sm_cfg cv;
+    const sm_cfg *c = &cv;
+    if (om__method_cfg_of(mc, &om__method_sm, &cv, NULL)) return OM_E_INVALID;
     if (c->map_size < 1 || c->map_size > OM_MAX_DIM) return OM_E_INVALID;
     *min = *full = sm_need(c);
     return OM_OK;
 }
 
-static om_status sm_init(void **state, om_arena *a, const om_method_cfg *c, const om_scene *s,
+static om_status sm_init(void **state, om_arena *a, const om_method_cfg *mc, const om_scene *s,
                          uint32_t w, uint32_t h, om_diag *d)
 {
     (void)w; (void)h;
     om_status st;
     void *p;
+    sm_cfg cv;
+    const sm_cfg *c = &cv;
+    if ((st = om__method_cfg_of(mc, &om__method_sm, &cv, d))) return st;
     if (c->map_size < 1 || c->map_size > OM_MAX_DIM)
         return om__fail(d, OM_E_INVALID, "sm: map size must be 1..8192");
     if (c->pcf < 1 || c->pcf > 9) return om__fail(d, OM_E_INVALID, "sm: pcf must be 1..9");
@@ -110,7 +126,13 @@ static void sm_stats(const void *state, om_method_stats *out)
     out->ncounters = 3;
 }
 
+static const om_setting settings[] = {
+    OM__SET_MAP(sm_cfg), OM__SET_BIAS(sm_cfg), OM__SET_SLOPE(sm_cfg), OM__SET_OFFSET(sm_cfg),
+    OM__SET_PCF(sm_cfg),
+};
+
 const om_method om__method_sm = {
     "sm", "conventional shadow map: depth from the light, bias, optional PCF", 0,
     sm_bytes, sm_init, sm_begin, sm_observe, sm_build, sm_resolve, sm_stats, NULL,
+    settings, sizeof settings / sizeof settings[0], sizeof(sm_cfg),
 };

@@ -34,14 +34,17 @@
  * distance from the texel centre. No bias setting is used. */
 #include "spsm_method.h"
 
+OM__CFG_FITS(om__spsm_cfg);
+extern const om_method om__method_spsm;
+
 #define LIT_CAP (64.0 * STEP)    /* a plane known this loosely proves nothing lit */
 #define PAT_CAP (16.0 * STEP)    /* the pattern's tests use at most this much slack */
 
-static bool size_ok(const om_method_cfg *c) { return c->map_size >= 1 && c->map_size <= OM_MAX_DIM; }
+static bool size_ok(const om__spsm_cfg *c) { return c->map_size >= 1 && c->map_size <= OM_MAX_DIM; }
 
 static uint32_t row_words(uint32_t size) { return (size + 31) / 32; }
 
-static size_t spsm_need(const om_method_cfg *c)
+static size_t spsm_need(const om__spsm_cfg *c)
 {
     size_t n = (size_t)c->map_size * c->map_size, bits = (size_t)c->map_size * row_words(c->map_size);
     size_t fbits = (size_t)2 * c->map_size * row_words(2 * c->map_size);
@@ -57,20 +60,24 @@ static size_t map_bytes(const spsm_state *m)
            ((size_t)m->size * m->words * 2 + (m->fine ? (size_t)2 * m->size * m->fwords : 0)) * sizeof(uint32_t);
 }
 
-static om_status spsm_bytes(const om_method_cfg *c, const om_scene *s, uint32_t w, uint32_t h,
+static om_status spsm_bytes(const om_method_cfg *mc, const om_scene *s, uint32_t w, uint32_t h,
                             size_t *min, size_t *full)
 {
     (void)s; (void)w; (void)h;
-    if (!size_ok(c)) return OM_E_INVALID;
-    *min = *full = spsm_need(c);
+    om__spsm_cfg c;
+    if (om__method_cfg_of(mc, &om__method_spsm, &c, NULL) || !size_ok(&c)) return OM_E_INVALID;
+    *min = *full = spsm_need(&c);
     return OM_OK;
 }
 
-static om_status spsm_init(void **state, om_arena *a, const om_method_cfg *c, const om_scene *s,
+static om_status spsm_init(void **state, om_arena *a, const om_method_cfg *mc, const om_scene *s,
                            uint32_t w, uint32_t h, om_diag *d)
 {
     om_status st;
     void *p;
+    om__spsm_cfg cv;
+    const om__spsm_cfg *c = &cv;
+    if ((st = om__method_cfg_of(mc, &om__method_spsm, &cv, d))) return st;
     if (!size_ok(c)) return om__fail(d, OM_E_INVALID, "spsm: map size must be 1..8192");
     if (c->spsm_aa > 64) return om__fail(d, OM_E_INVALID, "spsm: aa must be 0..64");
     if (c->spsm_records > 2) return om__fail(d, OM_E_INVALID, "spsm: records must be 0 (auto), 1 (all) or 2 (read)");
@@ -702,8 +709,19 @@ static void spsm_stats(const void *state, om_method_stats *out)
     out->ncounters = 8;
 }
 
+#define SET(field, name, lo, hi, doc) OM__SETTING(om__spsm_cfg, field, name, OM_SETTING_U32, lo, hi, 0, doc)
+
+static const om_setting settings[] = {
+    OM__SET_MAP(om__spsm_cfg),
+    SET(spsm_aa, "spsm.aa", 0, 64, "sub-samples at uncertain samples, 0 = off"),
+    SET(spsm_records, "spsm.records", 0, 2, "records made: 1 all, 2 those the view reads, 0 auto"),
+    SET(spsm_fine, "spsm.fine", 0, 1, "fallback: 1 the plain map at 2 x 2 points per texel, 0 at centres"),
+};
+
+#undef SET
+
 const om_method om__method_spsm = {
     "spsm", "sub-pixel shadow map: 128-bit texels with the nearest triangle, silhouette recovery",
     OM_METHOD_OBSERVES, spsm_bytes, spsm_init, spsm_begin, spsm_observe, om__spsm_build, spsm_resolve, spsm_stats,
-    spsm_observes,
+    spsm_observes, settings, sizeof settings / sizeof settings[0], sizeof(om__spsm_cfg),
 };

@@ -10,9 +10,23 @@
 #define TIE_DZ (LINK_DZ / 2)     /* the build's near tie: one surface to recovery */
 #define TIES 0xFFu               /* the depth buffer's low bits: ties counted (texel) */
 
+/* What spsm's settings (spsm.c) set. */
+typedef struct om__spsm_cfg {
+    uint32_t map_size;
+    uint32_t spsm_aa;      /* sub-samples at uncertain samples, 0 or 1 = off */
+    uint32_t spsm_records; /* which texel records the build makes: 1 every one (the
+                              paper's build), 2 only those the view reads (observe
+                              marks them), 0 = 2 when the map has more than twice as
+                              many texels as the image has pixels, else 1. The same
+                              frames either way; only the time differs. */
+    uint32_t spsm_fine;    /* 1: the plain-map fallback at 2 x 2 points per texel (16
+                              more bytes per texel and a second pass; fewer false-lit
+                              samples along fine rims), 0: at texel centres */
+} om__spsm_cfg;
+
 typedef struct spsm_state {
     const om_scene *scene;
-    om_method_cfg cfg;
+    om__spsm_cfg cfg;
     uint32_t size;
     om__spsm_texel *tex;
     uint32_t *depth;             /* minimum conservative depth: the build's depth test

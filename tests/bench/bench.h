@@ -29,7 +29,8 @@ double bench_median(double *v, int n);
 
 /* One method over one frame at W x H: init (timed; the reference builds its BVH there),
  * then the frame with per-stage times; the whole-frame mask goes to `mask` (may be
- * NULL). cfg NULL = defaults. */
+ * NULL). cfg NULL = defaults; one made for another
+ * method gives the settings they share (om_method_cfg_from). */
 typedef struct mrun {
     double init_ms, eye_ms, observe_ms, build_ms, resolve_ms, shade_ms;
     om_method_stats stats;

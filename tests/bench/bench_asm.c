@@ -25,10 +25,12 @@ static int brun_init(brun *r, const bscene *b, const char *name, const om_method
     om_arena a;
     memset(r, 0, sizeof *r);
     r->m = om_method_find(name);
-    if (!r->m || r->m->bytes(c, &b->s, W, H, &mn, &full)) return 1;
+    om_method_cfg mc;
+    om_method_cfg_from(&mc, r->m, c);   /* asm's cfg gives sm its bias */
+    if (!r->m || r->m->bytes(&mc, &b->s, W, H, &mn, &full)) return 1;
     r->mem = malloc(full);
     om_arena_init(&a, r->mem, full, "method");
-    if (r->m->init(&r->state, &a, c, &b->s, W, H, &d)) {
+    if (r->m->init(&r->state, &a, &mc, &b->s, W, H, &d)) {
         fprintf(stderr, "bench: %s: %s\n", name, d.msg);
         return 1;
     }
@@ -93,10 +95,10 @@ static void walkthrough(const bscene *b, bool held)
     static const char *label[NRUN] = {"asm  8 MiB", "asm 16 MiB", "sm 2048   "};
     brun ref, run[NRUN];
     om_method_cfg c[NRUN];
-    for (int k = 0; k < NRUN; k++) om_method_cfg_default(&c[k]);
-    c[0].asm_cap = 8u << 20;
-    c[1].asm_cap = 16u << 20;
-    c[2].map_size = 2048;
+    for (int k = 0; k < NRUN; k++) om_method_cfg_default(&c[k], om_method_find(k < 2 ? "asm" : "sm"));
+    om_method_cfg_set(&c[0], "asm.cap", 8u << 20, NULL);
+    om_method_cfg_set(&c[1], "asm.cap", 16u << 20, NULL);
+    om_method_cfg_set(&c[2], "map", 2048, NULL);
     if (brun_init(&ref, b, "ref", &c[2], W, H)) return;
     for (int k = 0; k < NRUN; k++)
         if (brun_init(&run[k], b, k < 2 ? "asm" : "sm", &c[k], W, H)) return;
@@ -174,11 +176,11 @@ static void closeups(const bscene *b)
         cam.width = W;
         cam.height = H;
         om_method_cfg c;
-        om_method_cfg_default(&c);
+        om_method_cfg_default(&c, om_method_find("asm"));
         brun ref, a8, a16, sm;
-        c.asm_cap = 8u << 20;
+        om_method_cfg_set(&c, "asm.cap", 8u << 20, NULL);
         if (brun_init(&ref, b, "ref", &c, W, H) || brun_init(&a8, b, "asm", &c, W, H)) return;
-        c.asm_cap = 16u << 20;
+        om_method_cfg_set(&c, "asm.cap", 16u << 20, NULL);
         if (brun_init(&a16, b, "asm", &c, W, H) || brun_init(&sm, b, "sm", &c, W, H)) return;
         om_frame_stats fs;
         om_method_stats ms;
@@ -219,12 +221,13 @@ void bench_asm_big(void)
         if (bench_load_random(&b, counts[k])) return;
         double a[3], o[3], sm[3], af[3], sf[3];
         for (int r = 0; r < 3; r++) {
-            om_method_cfg c;
-            om_method_cfg_default(&c);
-            c.asm_cap = 16u << 20;
-            c.map_size = 2048;
+            om_method_cfg c, cs;
+            om_method_cfg_default(&c, om_method_find("asm"));
+            om_method_cfg_set(&c, "asm.cap", 16u << 20, NULL);
+            om_method_cfg_default(&cs, om_method_find("sm"));
+            om_method_cfg_set(&cs, "map", 2048, NULL);
             mrun ra, rs;
-            if (bench_run(&b, "asm", &c, 1024, 768, 0, NULL, &ra) || bench_run(&b, "sm", &c, 1024, 768, 0, NULL, &rs))
+            if (bench_run(&b, "asm", &c, 1024, 768, 0, NULL, &ra) || bench_run(&b, "sm", &cs, 1024, 768, 0, NULL, &rs))
                 return;
             a[r] = ra.observe_ms + ra.build_ms + ra.resolve_ms;
             o[r] = ra.observe_ms;

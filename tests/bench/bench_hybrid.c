@@ -23,9 +23,9 @@ static void one_scene(const bscene *b)
     for (int r = 0; r < ROUNDS; r++)
         for (int k = 0; k < NCFG; k++) {
             om_method_cfg c;
-            om_method_cfg_default(&c);
-            c.map_size = maps[k];
-            c.hybrid_map = maps[k];
+            om_method_cfg_default(&c, om_method_find(names[k]));   /* each takes one of the two */
+            om_method_cfg_set(&c, "map", maps[k], NULL);
+            om_method_cfg_set(&c, "hybrid.map", maps[k], NULL);
             if (bench_run(b, names[k], &c, W, H, 0, k == 1 ? exact : mk, &last[k])) goto out;
             t[k][r] = frame_ms(&last[k]);
             bu[k][r] = last[k].build_ms;

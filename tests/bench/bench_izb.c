@@ -10,7 +10,7 @@ static void table_row(const bscene *b, uint32_t W, uint32_t H)
 {
     const om_method *m = om_method_find("izb");
     om_method_cfg cfg;
-    om_method_cfg_default(&cfg);
+    om_method_cfg_default(&cfg, m);
     om_camera cam;
     om_light light;
     om_scene_at(&b->s, 0, &cam, &light);

@@ -99,8 +99,7 @@ int bench_run_hooked(const bscene *b, const char *name, const om_method_cfg *cfg
 {
     const om_method *m = om_method_find(name);
     om_method_cfg c;
-    if (cfg) c = *cfg;
-    else om_method_cfg_default(&c);
+    om_method_cfg_from(&c, m, cfg);   /* the settings m shares with cfg's method */
     om_camera cam;
     om_light light;
     om_scene_at(&b->s, t, &cam, &light);

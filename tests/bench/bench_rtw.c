@@ -41,7 +41,7 @@ static void one_scene(const bscene *b)
     uint8_t *ref = malloc((size_t)W * H), *mk = malloc((size_t)W * H);
     mrun r;
     om_method_cfg rc;
-    om_method_cfg_default(&rc);
+    om_method_cfg_default(&rc, om_method_find("ref"));
     if (run(b, "ref", &rc, W, H, ref, &r)) goto out;
     /* the accurate 512 setting (hybrid) against the conventional 2048 map: what a user
      * who wants sm 2048's accuracy pays for it in memory and time */
@@ -52,9 +52,9 @@ static void one_scene(const bscene *b)
         om_method_stats last[C];
         int nc = size == 512 ? C : C - 1;   /* hybrid at 512 only */
         for (int k = 0; k < N; k++) {
-            om_method_cfg c;
-            om_method_cfg_default(&c);
-            c.map_size = size;
+            om_method_cfg c;   /* rtw's: sm takes its map */
+            om_method_cfg_default(&c, om_method_find("rtw"));
+            om_method_cfg_set(&c, "map", size, NULL);
             if (run(b, "sm", &c, W, H, mk, &r)) goto out;
             sm_b[k] = r.build_ms;
             sm_l[k] = r.resolve_ms;
@@ -62,10 +62,10 @@ static void one_scene(const bscene *b)
             sm_f[k] = r.eye_ms + sm_m[k] + r.shade_ms;
             sm_share = share(ref, mk, W, H);
             for (int t = 0; t < nc; t++) {
-                c.rtw_exact = cf[t].exact;
-                c.rtw_tess = cf[t].tess;
-                c.rtw_analysis = cf[t].analysis;
-                c.rtw_funcs = cf[t].funcs;
+                om_method_cfg_set(&c, "rtw.exact", cf[t].exact, NULL);
+                om_method_cfg_set(&c, "rtw.tess", cf[t].tess, NULL);
+                om_method_cfg_set(&c, "rtw.analysis", cf[t].analysis, NULL);
+                om_method_cfg_set(&c, "rtw.funcs", cf[t].funcs, NULL);
                 if (run(b, "rtw", &c, W, H, mk, &r)) goto out;
                 for (int s = 0; s < 4; s++) st[t][s][k] = r.stats.counters[4 + s] / 1e3;
                 m_ms[t][k] = r.observe_ms + r.build_ms + r.resolve_ms;

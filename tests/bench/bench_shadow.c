@@ -22,8 +22,8 @@ static void one_scene(const bscene *b)
     for (uint32_t size = 1024; size <= 4096; size *= 2) {
         double bu[3], lo[3];
         om_method_cfg c;
-        om_method_cfg_default(&c);
-        c.map_size = size;
+        om_method_cfg_default(&c, om_method_find("sm"));
+        om_method_cfg_set(&c, "map", size, NULL);
         for (int k = 0; k < 3; k++) {
             if (bench_run(b, "sm", &c, W, H, 0, sm, &r)) return;
             bu[k] = r.build_ms;

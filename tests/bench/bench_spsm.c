@@ -30,10 +30,10 @@ static void one_scene(const bscene *b, bool fine)
         mrun last, lastsp;
         om_method_cfg c[3];
         for (int k = 0; k < 3; k++) {
-            om_method_cfg_default(&c[k]);
-            c[k].map_size = size;
+            om_method_cfg_default(&c[k], om_method_find(names[k]));
+            om_method_cfg_set(&c[k], "map", size, NULL);
         }
-        c[2].spsm_fine = 1;
+        om_method_cfg_set(&c[2], "spsm.fine", 1, NULL);
         for (int run = 0; run < N; run++)
             for (int k = 0; k < series; k++) {
                 if (bench_run(b, names[k], &c[k], W, H, 0, mask, &last)) goto out;

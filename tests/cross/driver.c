@@ -140,22 +140,24 @@ static int fail(const char *cs, const char *method, const char *what, const om_d
 
 typedef struct size_cfg { uint32_t w, h, rows; int embedded; const char *tag; } size_cfg;
 
-static void method_cfg(om_method_cfg *c, const size_cfg *sz, int aa)
+/* m's settings for a case: each applies where m takes it (om_method_cfg_set says
+ * OM_E_NOTFOUND elsewhere). */
+static void method_cfg(om_method_cfg *c, const om_method *m, const size_cfg *sz, int aa)
 {
-    om_method_cfg_default(c);
+    om_method_cfg_default(c, m);
     if (sz->embedded) {
         /* small enough for small machines, the same everywhere (the hashes must agree) */
-        c->map_size = 96;
-        c->hybrid_map = 96;
-        c->asm_cap = 192u << 10;
-        c->rtw_importance = 64;
+        om_method_cfg_set(c, "map", 96, NULL);
+        om_method_cfg_set(c, "hybrid.map", 96, NULL);
+        om_method_cfg_set(c, "asm.cap", 192u << 10, NULL);
+        om_method_cfg_set(c, "rtw.importance", 64, NULL);
     } else {
-        c->map_size = 1024;
+        om_method_cfg_set(c, "map", 1024, NULL);
     }
     if (aa) {
-        c->pcf = 3;
-        c->rtw_footprint = 1;
-        c->spsm_aa = 4;
+        om_method_cfg_set(c, "pcf", 3, NULL);
+        om_method_cfg_set(c, "rtw.footprint", 1, NULL);
+        om_method_cfg_set(c, "spsm.aa", 4, NULL);
     }
 }
 
@@ -259,7 +261,7 @@ int om_cross_main(void)
 /* Whether a method has AA or PCF settings (the default-aa case repeats only those). */
 static int has_aa(const om_method *m)
 {
-    return !strcmp(m->name, "sm") || !strcmp(m->name, "rtw") || !strcmp(m->name, "spsm");
+    return om_method_setting(m, "pcf") || om_method_setting(m, "spsm.aa");
 }
 
 typedef struct xcase {
@@ -327,7 +329,7 @@ static int run_case(const xcase *c, const size_cfg *sz)
         const om_method *m = om_method_at(k);
         if (c->aa_only && !has_aa(m)) continue;
         om_method_cfg cfg;
-        method_cfg(&cfg, sz, c->aa);
+        method_cfg(&cfg, m, sz, c->aa);
         size_t mn, full;
         om_arena ma, fa;
         void *state;

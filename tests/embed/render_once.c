@@ -38,10 +38,10 @@ int render_once(void)
     if (om_view_init(&view, &cam, &light, &scene, &d) != OM_OK) return -1;
 
     const om_method *m = om_method_find("sm");
-    om_method_cfg cfg;
+    om_method_cfg cfg;                              /* sm's settings, set by name */
     void *state;
-    om_method_cfg_default(&cfg);
-    cfg.map_size = 96;                              /* 96 x 96 x 4 bytes: 37 KB */
+    om_method_cfg_default(&cfg, m);
+    om_method_cfg_set(&cfg, "map", 96, NULL);       /* 96 x 96 x 4 bytes: 37 KB */
     om_arena_init(&ma, method_mem, sizeof method_mem, "method");
     if (!m || m->init(&state, &ma, &cfg, &scene, 160, 120, &d) != OM_OK) return -1;
 

@@ -49,11 +49,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     size_t fbytes = om_frame_bytes(cam.width, rows);
     for (size_t k = 0; k < om_method_count(); k++) {
         const om_method *m = om_method_at(k);
-        om_method_cfg cfg;
-        om_method_cfg_default(&cfg);
-        cfg.map_size = 64;
-        cfg.asm_cap = 1u << 20;
-        cfg.rtw_importance = 32;
+        om_method_cfg cfg;   /* small maps and structures, where m takes them */
+        om_method_cfg_default(&cfg, m);
+        om_method_cfg_set(&cfg, "map", 64, NULL);
+        om_method_cfg_set(&cfg, "asm.cap", 1u << 20, NULL);
+        om_method_cfg_set(&cfg, "rtw.importance", 32, NULL);
         size_t mn, full;
         if (m->bytes(&cfg, &s, cam.width, cam.height, &mn, &full) != OM_OK || full > (32u << 20)) continue;
         /* an arena between below-minimum and one pass, by the control byte */

@@ -41,9 +41,10 @@ static char *read_file(const char *path)
     return data;
 }
 
-/* "# ombra-set a=1 b=2" lines -> cfg */
-static void settings(const char *text, om_method_cfg *c)
+/* "# ombra-set a=1 b=2" lines -> the settings of them that m takes */
+static void settings(const char *text, const om_method *m, om_method_cfg *c)
 {
+    om_method_cfg_default(c, m);
     for (const char *p = strstr(text, "# ombra-set "); p; p = strstr(p + 1, "# ombra-set ")) {
         const char *q = p + 12;
         while (*q && *q != '\n') {
@@ -52,7 +53,8 @@ static void settings(const char *text, om_method_cfg *c)
             int used = 0;
             if (sscanf(q, " %63[^= \n]=%lf%n", name, &v, &used) == 2) {
                 om_diag d;
-                if (om_method_cfg_set(c, name, v, &d) != OM_OK) fprintf(stderr, "stability: %s: %s\n", name, d.msg);
+                if (om_method_setting(m, name) && om_method_cfg_set(c, name, v, &d) != OM_OK)
+                    fprintf(stderr, "stability: %s: %s\n", name, d.msg);
                 q += used;
             } else {
                 break;
@@ -141,8 +143,7 @@ int main(int argc, char **argv)
         bscene b;
         if (bench_load(&b, name, text)) { failures++; free(text); continue; }
         om_method_cfg cfg;
-        om_method_cfg_default(&cfg);
-        settings(text, &cfg);
+        settings(text, om_method_find("ref"), &cfg);
         size_t n = (size_t)W * H;
         uint8_t *ref = malloc(n * (size_t)frames), *mk = malloc(n * (size_t)frames),
                 *again = malloc(n * (size_t)frames);
@@ -154,6 +155,7 @@ int main(int argc, char **argv)
         }
         for (size_t k = 0; k < om_method_count(); k++) {
             const om_method *m = om_method_at(k);
+            settings(text, m, &cfg);
             if (path(&b.s, m, &cfg, frames, mk, ms, &peak)) {
                 printf("stability: FAIL %s / %s: a frame did not render, or the arena was overrun\n", name, m->name);
                 failures++;

@@ -80,11 +80,11 @@ static double share(const uint8_t *ref, const uint8_t *m)
 
 static void stress_method(ctx *c, const om_method *m)
 {
-    om_method_cfg cfg;
-    om_method_cfg_default(&cfg);
-    cfg.map_size = 256;
-    cfg.asm_cap = 2u << 20;
-    cfg.rtw_importance = 64;
+    om_method_cfg cfg;   /* small maps and structures, where m takes them */
+    om_method_cfg_default(&cfg, m);
+    om_method_cfg_set(&cfg, "map", 256, NULL);
+    om_method_cfg_set(&cfg, "asm.cap", 2u << 20, NULL);
+    om_method_cfg_set(&cfg, "rtw.importance", 64, NULL);
     size_t mn, full;
     if (m->bytes(&cfg, &c->b->s, W, H, &mn, &full) != OM_OK) { fail(c->b->name, m->name, 0, "bytes query failed"); return; }
     om_diag d;
@@ -166,9 +166,9 @@ int main(void)
         bool guards;
         om_diag d;
         om_method_cfg cfg;
-        om_method_cfg_default(&cfg);
         size_t mn, full;
         const om_method *ref = om_method_find("ref");
+        om_method_cfg_default(&cfg, ref);
         ref->bytes(&cfg, &b.s, W, H, &mn, &full);
         if (run(c, ref, &cfg, full, c->ref, &guards, &d) != OM_OK) return 1;
         for (size_t i = 0; i < om_method_count(); i++) stress_method(c, om_method_at(i));
