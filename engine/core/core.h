@@ -124,12 +124,14 @@ om_mat4 om__mat_perspective(float fovy_deg, float aspect, float znear, float zfa
 /* Orthographic projection of the view-space box to x, y in [-1,1], z in [0,1]. */
 om_mat4 om__mat_ortho(float l, float r, float b, float t, float znear, float zfar);
 
-/* ---- deterministic trigonometry: our own polynomials in IEEE double, so that every
- * C library and CPU gives the same bits (libm's sin/cos/tan/atan need not). */
+/* ---- deterministic trigonometry and logarithms: our own polynomials in IEEE double,
+ * so that every C library and CPU gives the same bits (libm's need not). */
 double om__sin(double x);
 double om__cos(double x);
 double om__tan(double x);
 double om__atan(double x);
+double om__log2(double x);     /* x > 0 */
+double om__exp2(double x);
 #define OM_PI 3.14159265358979323846
 
 /* A cold path kept out of its caller, so that the hot path stays small enough to be

@@ -1,5 +1,5 @@
-/* math.c — vectors, 4x4 matrices, projections, and trigonometry of our own.
- * sin/cos/tan/atan are evaluated with fixed polynomials in IEEE double so their bits
+/* math.c — vectors, 4x4 matrices, projections, and trigonometry and logarithms of our
+ * own. sin/cos/tan/atan and log2/exp2 are evaluated with fixed polynomials in IEEE double so their bits
  * do not depend on the C library (libm's may differ in the last bit between systems,
  * and anything that reaches a pixel must be bit-identical everywhere). */
 #include "core.h"
@@ -158,4 +158,25 @@ double om__atan(double x)
     for (int k = 22; k >= 0; k--) sum = (k & 1 ? -1.0 : 1.0) / (2 * k + 1) + x2 * sum;
     double r = base + off + x * sum;
     return neg ? -r : r;
+}
+
+double om__log2(double x)
+{
+    /* x = m * 2^e with m in [0.5, 1); ln m = 2 atanh(u), u = (m - 1) / (m + 1). */
+    int e;
+    double m = frexp(x, &e);
+    double u = (m - 1.0) / (m + 1.0), u2 = u * u, sum = 0.0;
+    for (int k = 20; k >= 0; k--) sum = 1.0 / (2 * k + 1) + u2 * sum;
+    return (double)e + 2.0 * u * sum * 1.44269504088896340736;
+}
+
+double om__exp2(double x)
+{
+    double n = floor(x), f = (x - n) * 0.69314718055994530942;   /* e^f, f in [0, ln 2) */
+    double sum = 1.0, term = 1.0;
+    for (int k = 1; k < 20; k++) {
+        term = term * f / k;
+        sum += term;
+    }
+    return ldexp(sum, (int)n);
 }

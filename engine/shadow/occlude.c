@@ -152,27 +152,6 @@ bool om__lspace_tri(const om__lspace *ls, uint32_t t, om__ltri *lt)
 
 /* ---- transmittance */
 
-double om__log2(double x)
-{
-    /* x = m * 2^e with m in [0.5, 1); ln m = 2 atanh(u), u = (m - 1) / (m + 1). */
-    int e;
-    double m = frexp(x, &e);
-    double u = (m - 1.0) / (m + 1.0), u2 = u * u, sum = 0.0;
-    for (int k = 20; k >= 0; k--) sum = 1.0 / (2 * k + 1) + u2 * sum;
-    return (double)e + 2.0 * u * sum * 1.44269504088896340736;
-}
-
-double om__exp2(double x)
-{
-    double n = floor(x), f = (x - n) * 0.69314718055994530942;   /* e^f, f in [0, ln 2) */
-    double sum = 1.0, term = 1.0;
-    for (int k = 1; k < 20; k++) {
-        term = term * f / k;
-        sum += term;
-    }
-    return ldexp(sum, (int)n);
-}
-
 om__odepth om__material_odepth(const om_material *m)
 {
     om__odepth o;

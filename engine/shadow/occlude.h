@@ -149,8 +149,4 @@ static inline bool om__odepth_opaque(const om__odepth *o)
 /* Back to an 8-bit term, rounded: 255 * 2^(-depth / 4096). */
 void om__odepth_term(const om__odepth *o, om_term *t);
 
-/* Deterministic log2 and exp2 (libm's may differ in the last bit between systems). */
-double om__log2(double x);
-double om__exp2(double x);
-
 #endif

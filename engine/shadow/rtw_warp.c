@@ -7,7 +7,6 @@
  * float) plus the engine's deterministic exp2, so the tables are the same bits on every
  * compiler and CPU; the tables themselves are integers (OM_RTW_ONE fixed point). */
 #include "rtw.h"
-#include "occlude.h"   /* om__exp2 */
 
 /* ---------------------------------------------------------------- 1-D tables */
 

@@ -3,7 +3,6 @@
  * derivatives in 8 bits, and the 512 depth-test patterns. Everything here is integer
  * or built from the engine's deterministic functions, so every build agrees. */
 #include "spsm.h"
-#include "occlude.h"
 
 /* ---- o16 vertex offsets (section 3.3; our choice of code, see spsm.h) */
 
