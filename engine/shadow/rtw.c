@@ -170,41 +170,23 @@ static om_status rtw_init(void **state, om_arena *a, const om_method_cfg *mc, co
     return OM_OK;
 }
 
-void om__rtw_set_clock(void *state, om_clock_fn clock, void *user)
-{
-    om__rtw *m = (om__rtw *)state;
-    m->clock = clock;
-    m->clock_user = user;
-}
-
-static uint64_t now(const om__rtw *m)
-{
-    return m->clock ? m->clock(m->clock_user) : 0;
-}
-
 /* ---------------------------------------------------------------- frame */
 
 static om_status rtw_begin(void *state, const om_view *v, om_diag *d)
 {
     (void)d;
     om__rtw *m = (om__rtw *)state;
-    uint64_t t0 = now(m);
     m->view = *v;
     om__smlook_begin(&m->look, &m->view);
     m->samples = m->shadowed = m->tris_drawn = 0;
-    m->ns[0] = m->ns[1] = m->ns[2] = m->ns[3] = 0;
     om__rtw_importance_begin(m);
-    m->ns[0] += now(m) - t0;
     return OM_OK;
 }
 
 static om_status rtw_observe(void *state, const om_strip *st, om_diag *d)
 {
     (void)d;
-    om__rtw *m = (om__rtw *)state;
-    uint64_t t0 = now(m);
-    om__rtw_observe_strip(m, st);
-    m->ns[0] += now(m) - t0;
+    om__rtw_observe_strip((om__rtw *)state, st);
     return OM_OK;
 }
 
@@ -212,16 +194,9 @@ static om_status rtw_build(void *state, om_diag *d)
 {
     (void)d;
     om__rtw *m = (om__rtw *)state;
-    uint64_t t0 = now(m);
     om__rtw_importance_finish(m);
-    uint64_t t1 = now(m);
     om__rtw_build_tables(m);
-    uint64_t t2 = now(m);
     om__rtw_render_map(m);
-    uint64_t t3 = now(m);
-    m->ns[0] += t1 - t0;
-    m->ns[1] += t2 - t1;
-    m->ns[2] += t3 - t2;
     return OM_OK;
 }
 
@@ -489,9 +464,7 @@ static om_status rtw_resolve(void *state, om_strip *st, om_diag *d)
 {
     (void)d;
     om__rtw *m = (om__rtw *)state;
-    uint64_t t0 = now(m);
     om__smlook_strip(&m->look, st, &m->samples, &m->shadowed);
-    m->ns[3] += now(m) - t0;
     return OM_OK;
 }
 
@@ -511,16 +484,11 @@ static void rtw_stats(const void *state, om_method_stats *out)
      * super-cell (section 6), per axis */
     out->counters[2] = sat_u32(m->dens_x * (double)m->size);
     out->counters[3] = sat_u32(m->dens_y * (double)m->size);
-    for (int k = 0; k < 4; k++) out->counters[4 + k] = sat_u32((double)m->ns[k] / 1000.0);
     out->counter_names[0] = "samples shadowed";
     out->counter_names[1] = "triangles drawn";
     out->counter_names[2] = "mer x";
     out->counter_names[3] = "mer y";
-    out->counter_names[4] = "us importance";
-    out->counter_names[5] = "us warp";
-    out->counter_names[6] = "us map";
-    out->counter_names[7] = "us lookup";
-    out->ncounters = m->clock ? 8 : 4;   /* stage times only when the host gave a clock */
+    out->ncounters = 4;
 }
 
 #define SET(field, name, kind, lo, hi, def, doc) OM__SETTING(om__rtw_cfg, field, name, kind, lo, hi, def, doc)

@@ -106,9 +106,6 @@ typedef struct om__rtw {
     /* per frame */
     uint32_t samples, shadowed, tris_drawn;
     double dens_x, dens_y;     /* densest super-cell per axis (MER = size * density) */
-    uint64_t ns[4];            /* importance, warp, map, lookup (with a clock) */
-    om_clock_fn clock;         /* the host's, for stage times; NULL = none */
-    void *clock_user;
 } om__rtw;
 
 /* Importance map stages (rtw_warp.c). begin clears, observe_strip records the backward
@@ -119,12 +116,10 @@ typedef struct om__rtw {
 void om__rtw_importance_begin(om__rtw *m);
 void om__rtw_observe_strip(om__rtw *m, const om_strip *st);
 void om__rtw_importance_finish(om__rtw *m);
-/* The 1-D tables of this frame's importance map: collapse, blur, warp (section 4.2). */
+/* The 1-D tables of this frame's importance map: collapse, blur, warp (section 4.2).
+ * Build runs finish, tables and the map in turn; each may run again on its own (the
+ * bench times the stages so). */
 void om__rtw_build_tables(om__rtw *m);
-
-/* Gives the method a clock for its per-stage times (stats counters 4-7, in
- * microseconds; without a clock the stats stop at counter 3). */
-void om__rtw_set_clock(void *state, om_clock_fn clock, void *user);
 
 /* Renders the warped shadow map of this frame's tables (rtw.c; called by build). */
 void om__rtw_render_map(om__rtw *m);

@@ -33,14 +33,16 @@ double bench_median(double *v, int n);
  * method gives the settings they share (om_method_cfg_from). */
 typedef struct mrun {
     double init_ms, eye_ms, observe_ms, build_ms, resolve_ms, shade_ms;
+    double stage_ms[4];    /* a hook's own measures (bench_run_hooked) */
     om_method_stats stats;
 } mrun;
 int bench_run(const bscene *b, const char *method, const om_method_cfg *cfg, uint32_t W,
               uint32_t H, float t, uint8_t *mask, mrun *out);
-/* bench_run with `hook` called on the method's state after init (e.g. to give it a
- * clock for per-stage counters); hook may be NULL. */
+/* bench_run with `hook` called on the method's state after the frame (e.g. to time
+ * the method's own stages into out->stage_ms); hook may be NULL. */
 int bench_run_hooked(const bscene *b, const char *method, const om_method_cfg *cfg, uint32_t W,
-                     uint32_t H, float t, uint8_t *mask, mrun *out, void (*hook)(void *state));
+                     uint32_t H, float t, uint8_t *mask, mrun *out,
+                     void (*hook)(void *state, mrun *out));
 
 #define OM_BENCHES \
     X(bench_raster) \

@@ -95,7 +95,8 @@ int bench_run(const bscene *b, const char *name, const om_method_cfg *cfg, uint3
 }
 
 int bench_run_hooked(const bscene *b, const char *name, const om_method_cfg *cfg, uint32_t W,
-                     uint32_t H, float t, uint8_t *mask, mrun *out, void (*hook)(void *state))
+                     uint32_t H, float t, uint8_t *mask, mrun *out,
+                     void (*hook)(void *state, mrun *out))
 {
     const om_method *m = om_method_find(name);
     om_method_cfg c;
@@ -126,7 +127,6 @@ int bench_run_hooked(const bscene *b, const char *name, const om_method_cfg *cfg
     uint64_t t0 = om_clock_ns(NULL);
     om_status st = m->init(&state, &ma, &c, &b->s, W, H, &d);
     out->init_ms = (double)(om_clock_ns(NULL) - t0) / 1e6;
-    if (st == OM_OK && hook) hook(state);
     if (st == OM_OK) {
         om_framebuffer fb = {OM_RGB888, W, H, (size_t)W * 3, (uint8_t *)px};
         om_shade_cfg shade;
@@ -144,6 +144,7 @@ int bench_run_hooked(const bscene *b, const char *name, const om_method_cfg *cfg
         out->resolve_ms = (double)fs.ns_resolve / 1e6;
         out->shade_ms = (double)fs.ns_shade / 1e6;
         m->stats(state, &out->stats);
+        if (st == OM_OK && hook) hook(state, out);
     }
     if (st) fprintf(stderr, "bench: %s: %s\n", name, d.msg);
     free(mem);
