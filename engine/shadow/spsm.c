@@ -37,8 +37,8 @@
 OM__CFG_FITS(om__spsm_cfg);
 extern const om_method om__method_spsm;
 
-#define LIT_CAP (64.0 * STEP)    /* a plane known this loosely proves nothing lit */
-#define PAT_CAP (16.0 * STEP)    /* the pattern's tests use at most this much slack */
+#define LIT_CAP (64.0 * OM__SPSM_STEP)    /* a plane known this loosely proves nothing lit */
+#define PAT_CAP (16.0 * OM__SPSM_STEP)    /* the pattern's tests use at most this much slack */
 
 static bool size_ok(const om__spsm_cfg *c) { return c->map_size >= 1 && c->map_size <= OM_MAX_DIM; }
 
@@ -50,11 +50,11 @@ static size_t spsm_need(const om__spsm_cfg *c)
     size_t fbits = (size_t)2 * c->map_size * row_words(2 * c->map_size);
     size_t fine = c->spsm_fine ? om_arena_need(4 * n * sizeof(uint32_t), 16) +
                                      om_arena_need(fbits * sizeof(uint32_t), 16) : 0;
-    return om_arena_need(sizeof(spsm_state), 16) + om_arena_need(n * sizeof(om__spsm_texel), 16) +
+    return om_arena_need(sizeof(om__spsm_state), 16) + om_arena_need(n * sizeof(om__spsm_texel), 16) +
            om_arena_need(n * sizeof(uint32_t), 16) * 2 + om_arena_need(bits * sizeof(uint32_t), 16) * 2 + fine;
 }
 
-static size_t map_bytes(const spsm_state *m)
+static size_t map_bytes(const om__spsm_state *m)
 {
     return (size_t)m->size * m->size * (sizeof(om__spsm_texel) + (m->fine ? 6 : 2) * sizeof(uint32_t)) +
            ((size_t)m->size * m->words * 2 + (m->fine ? (size_t)2 * m->size * m->fwords : 0)) * sizeof(uint32_t);
@@ -83,8 +83,8 @@ static om_status spsm_init(void **state, om_arena *a, const om_method_cfg *mc, c
     if (c->spsm_records > 2) return om__fail(d, OM_E_INVALID, "spsm: records must be 0 (auto), 1 (all) or 2 (read)");
     if (c->spsm_fine > 1) return om__fail(d, OM_E_INVALID, "spsm: fine must be 0 (off) or 1 (on)");
     if ((st = om__need(a, spsm_need(c), "spsm", d))) return st;
-    if ((st = om_arena_alloc(a, sizeof(spsm_state), 16, &p, d))) return st;
-    spsm_state *m = (spsm_state *)p;
+    if ((st = om_arena_alloc(a, sizeof(om__spsm_state), 16, &p, d))) return st;
+    om__spsm_state *m = (om__spsm_state *)p;
     m->scene = s;
     m->cfg = *c;
     m->size = c->map_size;
@@ -127,7 +127,7 @@ static om_status spsm_init(void **state, om_arena *a, const om_method_cfg *mc, c
 static om_status spsm_begin(void *state, const om_view *v, om_diag *d)
 {
     (void)d;
-    spsm_state *m = (spsm_state *)state;
+    om__spsm_state *m = (om__spsm_state *)state;
     m->view = *v;
     m->samples = m->lit = m->shadowed = m->uncertain = m->recovered = m->needed = 0;
     if (m->marks) memset(m->seen, 0, (size_t)m->size * m->words * sizeof(uint32_t));
@@ -136,7 +136,7 @@ static om_status spsm_begin(void *state, const om_view *v, om_diag *d)
 
 typedef struct sample_pt { int64_t x, y; double z; bool ok; } sample_pt;
 
-static sample_pt project(const spsm_state *m, om_vec3 p)
+static sample_pt project(const om__spsm_state *m, om_vec3 p)
 {
     sample_pt s;
     om_vec4 q = om__mat_apply(&m->view.light_vp, p);
@@ -154,7 +154,7 @@ static int64_t floordiv(int64_t a, int64_t b)
 
 /* The texel holding grid position (x, y), clamped to the map (so negative positions
  * need no floor division: they clamp to 0). */
-static int64_t texel_of(const spsm_state *m, int64_t g)
+static int64_t texel_of(const om__spsm_state *m, int64_t g)
 {
     const int64_t t = g < 0 ? 0 : g / OM_SUBPIX, last = (int64_t)m->size - 1;
     return t > last ? last : t;
@@ -163,7 +163,7 @@ static int64_t texel_of(const spsm_state *m, int64_t g)
 /* For observe: the texel a sample's lookup will centre on, false when the sample does
  * not project. The lookup projects with om__project, whose position is this
  * om__project_xy's: the two agree on every sample. */
-static bool sample_texel(const spsm_state *m, const om_sample *smp, int64_t *tx, int64_t *ty)
+static bool sample_texel(const om__spsm_state *m, const om_sample *smp, int64_t *tx, int64_t *ty)
 {
     int64_t x, y;
     om_vec4 q = om__mat_apply(&m->view.light_vp, om__v3(smp->p[0], smp->p[1], smp->p[2]));
@@ -176,7 +176,7 @@ static bool sample_texel(const spsm_state *m, const om_sample *smp, int64_t *tx,
 static om_status spsm_observe(void *state, const om_strip *st, om_diag *d)
 {
     (void)d;
-    spsm_state *m = (spsm_state *)state;
+    om__spsm_state *m = (om__spsm_state *)state;
     size_t n = (size_t)st->rows * st->width;
     for (size_t i = 0; i < n; i++) {
         if (!(st->terms[i].flags & OM_TERM_EXPOSED)) continue;
@@ -192,10 +192,10 @@ static om_status spsm_observe(void *state, const om_strip *st, om_diag *d)
 
 /* Decodes texel k of the 3x3 (k = (dy + 1) * 3 + dx + 1) into t[k]: its vertices and
  * plane; the edges are set up when a test first needs them (edges). */
-static void decode(const spsm_state *m, int64_t tx, int64_t ty, dtri t[9], int k)
+static void decode(const om__spsm_state *m, int64_t tx, int64_t ty, om__spsm_dtri t[9], int k)
 {
     const int dx = k % 3 - 1, dy = k / 3 - 1;
-    dtri *o = &t[k];
+    om__spsm_dtri *o = &t[k];
     int64_t x = tx + dx, y = ty + dy;
     o->empty = true;
     o->ok = false;
@@ -217,8 +217,8 @@ static void decode(const spsm_state *m, int64_t tx, int64_t ty, dtri t[9], int k
      * at all is its area, as the setup finds it (offsets stay far inside its range) */
     o->ok = (X[1] - X[0]) * (Y[2] - Y[0]) - (X[2] - X[0]) * (Y[1] - Y[0]) != 0;
     o->have_e = false;
-    const double u = STEP * OM_SPSM_DSCALE / (double)OM_SUBPIX;   /* code -> raw per unit */
-    o->z = (double)r->z * STEP;
+    const double u = OM__SPSM_STEP * OM_SPSM_DSCALE / (double)OM_SUBPIX;   /* code -> raw per unit */
+    o->z = (double)r->z * OM__SPSM_STEP;
     o->gx = m->q.dec[r->qx] * u;
     o->gy = m->q.dec[r->qy] * u;
     o->ex = m->q.err[r->qx] * u;
@@ -235,8 +235,8 @@ static void decode(const spsm_state *m, int64_t tx, int64_t ty, dtri t[9], int k
  * at the vertices and its consistent minimum (found in the texel's own coordinates). */
 /* *to = *from, but for the parts set up only on demand (the edges, the plane at the
  * vertices) when they are not: most entries never need them, and the window moves
- * at almost every texel step. Every field of dtri is here. */
-static void move_entry(dtri *to, const dtri *from)
+ * at almost every texel step. Every field of om__spsm_dtri is here. */
+static void move_entry(om__spsm_dtri *to, const om__spsm_dtri *from)
 {
     to->empty = from->empty;
     to->ok = from->ok;
@@ -260,7 +260,7 @@ static void move_entry(dtri *to, const dtri *from)
     }
 }
 
-static void shift_window(spsm_state *m, int dx, int dy)
+static void shift_window(om__spsm_state *m, int dx, int dy)
 {
     const int64_t sx = -(int64_t)dx * OM_SUBPIX, sy = -(int64_t)dy * OM_SUBPIX;
     uint32_t have = 0;
@@ -271,7 +271,7 @@ static void shift_window(spsm_state *m, int dx, int dy)
             if (orow < 0 || orow > 2 || ocol < 0 || ocol > 2) continue;
             const int from = orow * 3 + ocol, to = r * 3 + c;
             if (!((m->t_have >> from) & 1u)) continue;
-            dtri *t = &m->t[to];
+            om__spsm_dtri *t = &m->t[to];
             if (to != from) move_entry(t, &m->t[from]);
             t->cx += sx;
             t->cy += sy;
@@ -293,9 +293,9 @@ static void shift_window(spsm_state *m, int dx, int dy)
  * triangle: its setup is then copied from another entry of the 3x3 with the very same
  * vertices. (That entry may be left from an earlier 3x3; the setup is a function of
  * the vertices alone, so a match there is as good.) */
-static const om__tri2 *edges(dtri t[9], int k)
+static const om__tri2 *edges(om__spsm_dtri t[9], int k)
 {
-    dtri *o = &t[k];
+    om__spsm_dtri *o = &t[k];
     if (o->have_e) return &o->e;
     int same = -1;
     for (int j = 0; j < 9 && same < 0; j++)
@@ -310,17 +310,17 @@ static const om__tri2 *edges(dtri t[9], int k)
 
 /* The slack of the pattern's tests (4.2): they only orient the silhouette, so a plane
  * known loosely (a nearly edge-on triangle) is used at its decoded slope. */
-static double pat_tol(const dtri *t, int64_t px, int64_t py)
+static double pat_tol(const om__spsm_dtri *t, int64_t px, int64_t py)
 {
-    const double tol = tol_at(t, px, py);   /* finite: fmin's NaN rule is not needed */
-    return tol < TOL0 + PAT_CAP ? tol : TOL0 + PAT_CAP;
+    const double tol = om__spsm_tol_at(t, px, py);   /* finite: fmin's NaN rule is not needed */
+    return tol < OM__SPSM_TOL0 + PAT_CAP ? tol : OM__SPSM_TOL0 + PAT_CAP;
 }
 
 /* Algorithm 1: the stored triangle covers the point in 2-D and is nearer there (its
  * edges set up: edges). */
-static bool hits(const dtri *t, int64_t px, int64_t py, double pz)
+static bool hits(const om__spsm_dtri *t, int64_t px, int64_t py, double pz)
 {
-    return t->ok && om__tri2_covers(&t->e, px, py) && plane_at(t, px, py) < pz - tol_at(t, px, py);
+    return t->ok && om__tri2_covers(&t->e, px, py) && om__spsm_plane_at(t, px, py) < pz - om__spsm_tol_at(t, px, py);
 }
 
 /* Figure 9: the least depth the triangle reaches inside its texel's square, found where
@@ -328,21 +328,21 @@ static bool hits(const dtri *t, int64_t px, int64_t py, double pz)
  * triangle covers it; otherwise on the triangle's part of the square, whose least depth
  * is at one of its corners, so we clip the triangle to the square. HUGE_VAL when the
  * (quantized) triangle misses the square. Its edges are set up (edges). */
-static double consistent_min(const dtri *t)
+static double consistent_min(const om__spsm_dtri *t)
 {
     const int64_t H = OM_SUBPIX / 2;
     int64_t kx = t->cx + (t->gx > 0 ? -H : H), ky = t->cy + (t->gy > 0 ? -H : H);
-    if (om__tri2_covers(&t->e, kx, ky)) return plane_at(t, kx, ky);
+    if (om__tri2_covers(&t->e, kx, ky)) return om__spsm_plane_at(t, kx, ky);
     /* in the texel's own coordinates, so that the value does not depend on where the
      * 3x3 is centred (shift_window keeps it) */
     const int64_t X[3] = {t->e.x[0] - t->cx, t->e.x[1] - t->cx, t->e.x[2] - t->cx},
                   Y[3] = {t->e.y[0] - t->cy, t->e.y[1] - t->cy, t->e.y[2] - t->cy};
-    const zplane p = {t->z, t->gx, t->gy, 0, 0};
-    return clipped_min(X, Y, -H, -H, OM_SUBPIX, &p);
+    const om__spsm_zplane p = {t->z, t->gx, t->gy, 0, 0};
+    return om__spsm_clipped_min(X, Y, -H, -H, OM_SUBPIX, &p);
 }
 
 /* Light depth (raw) and grid position of a world point, in double throughout. */
-static void project_d(const spsm_state *m, const double w[3], double *gx, double *gy, double *gz)
+static void project_d(const om__spsm_state *m, const double w[3], double *gx, double *gy, double *gz)
 {
     const float *M = m->view.light_vp.m;
     double q[4];
@@ -360,7 +360,7 @@ static void project_d(const spsm_state *m, const double w[3], double *gx, double
  * steps along the surface (from the geometric normal) give the slopes exactly. */
 typedef struct receiver { double z, gx, gy; bool ok; } receiver;
 
-static receiver receiver_plane(const spsm_state *m, const om_sample *smp)
+static receiver receiver_plane(const om__spsm_state *m, const om_sample *smp)
 {
     receiver r;
     double n[3] = {smp->n[0], smp->n[1], smp->n[2]}, a[3] = {0, 0, 0};
@@ -386,12 +386,12 @@ static receiver receiver_plane(const spsm_state *m, const om_sample *smp)
 /* A stored triangle lying wholly on or behind the sample's own plane (seen from the
  * light) cannot block it: the way to the light leaves on the plane's front side. On a
  * curved receiver its neighbouring triangles are such. */
-static bool behind_receiver(dtri *t, const receiver *r, int64_t px, int64_t py)
+static bool behind_receiver(om__spsm_dtri *t, const receiver *r, int64_t px, int64_t py)
 {
     if (!r->ok) return false;
     if (!t->have_vz) {   /* the texel's own part, the same for every sample */
         for (int i = 0; i < 3; i++) {
-            t->vz[i] = plane_at(t, t->rx[i], t->ry[i]);
+            t->vz[i] = om__spsm_plane_at(t, t->rx[i], t->ry[i]);
             t->vtol[i] = pat_tol(t, t->rx[i], t->ry[i]);
         }
         t->have_vz = true;
@@ -406,13 +406,13 @@ static bool behind_receiver(dtri *t, const receiver *r, int64_t px, int64_t py)
 /* The fallback when the pattern holds no silhouette (every texel around is an
  * occluder's): the plain map's answer at the texel centre, with the sample's own plane
  * carried to the centre instead of a slope bias. */
-static bool centre_test(const spsm_state *m, const receiver *r, int64_t tx, int64_t ty, int64_t px,
+static bool centre_test(const om__spsm_state *m, const receiver *r, int64_t tx, int64_t ty, int64_t px,
                         int64_t py)
 {
     uint32_t c = m->cdepth[(size_t)ty * m->size + (size_t)tx];
     if (c == 0xFFFFFFFFu) return false;
     double z = r->ok ? r->z - r->gx * (double)px - r->gy * (double)py : r->z;
-    return (double)c < z - TOL0;
+    return (double)c < z - OM__SPSM_TOL0;
 }
 
 /* The plain map around a point of the pixel at grid offset (qx, qy) from the centre of
@@ -438,14 +438,14 @@ static bool plain_shadow(const uint32_t *buf, int64_t side, int64_t step, const 
             if (c == 0xFFFFFFFFu) return false;
             const double dx = (double)(i * step + h - ox - px), dy = (double)(j * step + h - oy - py);
             const double z = r->ok ? r->z + r->gx * dx + r->gy * dy : r->z;
-            if (!((double)c < z - TOL0)) return false;
+            if (!((double)c < z - OM__SPSM_TOL0)) return false;
         }
     return true;
 }
 
 /* Which of the outline's candidate centres (m->cand) hold something nearer than the
  * sample's own plane carried there: bit c for cand[c]. Sets the receiver plane. */
-static uint16_t centres_nearer(const spsm_state *m, receiver *rp, bool *have_rp, const om_sample *smp,
+static uint16_t centres_nearer(const om__spsm_state *m, receiver *rp, bool *have_rp, const om_sample *smp,
                                int64_t tx, int64_t ty, int64_t px, int64_t py)
 {
     uint16_t use = 0;
@@ -477,7 +477,7 @@ static om_vec3 pixel_step(const om_strip *st, size_t i, int axis)
 /* The occluders the pattern `keep` keeps in the 3x3 of texel (tx, ty) (distinct
  * triangles), their outline, and the texel centres that may extend it. Out of line:
  * it runs once per texel and pattern. */
-static void occluders_of(spsm_state *m, dtri t[9], uint16_t keep, int64_t tx, int64_t ty)
+static void occluders_of(om__spsm_state *m, om__spsm_dtri t[9], uint16_t keep, int64_t tx, int64_t ty)
 {
     m->nocc = 0;
     m->ncand = 0;
@@ -495,7 +495,8 @@ static void occluders_of(spsm_state *m, dtri t[9], uint16_t keep, int64_t tx, in
         if (x < 0 || y < 0 || x >= (int64_t)m->size || y >= (int64_t)m->size) continue;
         const uint32_t c = m->cdepth[(size_t)y * m->size + (size_t)x];
         if (c == 0xFFFFFFFFu || om__tri2_covers(&t[k].e, t[k].cx, t[k].cy)) continue;
-        if (fabs(plane_at(&t[k], t[k].cx, t[k].cy) - (double)c) > tol_at(&t[k], t[k].cx, t[k].cy) + LINK_DZ)
+        if (fabs(om__spsm_plane_at(&t[k], t[k].cx, t[k].cy) - (double)c) >
+            om__spsm_tol_at(&t[k], t[k].cx, t[k].cy) + OM__SPSM_LINK_DZ)
             continue;
         m->cand[m->ncand].x = t[k].cx;
         m->cand[m->ncand].y = t[k].cy;
@@ -513,10 +514,10 @@ static void occluders_of(spsm_state *m, dtri t[9], uint16_t keep, int64_t tx, in
 
 /* Whether (qx, qy) lies inside the outline extended by the candidate centres in `use`
  * (built once per set). */
-static bool inside_extended(spsm_state *m, uint16_t use, int64_t qx, int64_t qy)
+static bool inside_extended(om__spsm_state *m, uint16_t use, int64_t qx, int64_t qy)
 {
     if (use != m->bx_pts) {
-        outline_pt pts[9];
+        om__spsm_outline_pt pts[9];
         int npts = 0;
         for (int c = 0; c < m->ncand; c++)
             if (use >> c & 1u) pts[npts++] = m->cand[c];
@@ -526,11 +527,12 @@ static bool inside_extended(spsm_state *m, uint16_t use, int64_t qx, int64_t qy)
     return om__spsm_outline_inside(&m->bx, qx, qy);
 }
 
-OM_NOINLINE static uint8_t recover(spsm_state *m, const om_strip *st, size_t i, const sample_pt *pp, int64_t tx, int64_t ty);
+OM_NOINLINE static uint8_t recover(om__spsm_state *m, const om_strip *st, size_t i, const sample_pt *pp,
+                                   int64_t tx, int64_t ty);
 
 /* The whole lookup of one sample; returns the term value (255 lit, 0 shadowed, partial
  * with AA). */
-static uint8_t lookup(spsm_state *m, const om_strip *st, size_t i)
+static uint8_t lookup(om__spsm_state *m, const om_strip *st, size_t i)
 {
     const om_sample *smp = &st->samples[i];
     om_vec3 pw = om__v3(smp->p[0], smp->p[1], smp->p[2]);
@@ -547,7 +549,7 @@ static uint8_t lookup(spsm_state *m, const om_strip *st, size_t i)
      * does not cover the sample but lies in its plane (the other half of a floor quad):
      * it too was the nearest thing in the texel. That halves the uncertain samples at
      * no measured cost in accuracy. */
-    dtri *t = m->t;
+    om__spsm_dtri *t = m->t;
     size_t at = (size_t)ty * m->size + (size_t)tx;
     if (at != m->t4_at) {
         const int64_t dx = m->t4_at == (size_t)-1 ? 9 : tx - (int64_t)(m->t4_at % m->size),
@@ -560,10 +562,10 @@ static uint8_t lookup(spsm_state *m, const om_strip *st, size_t i)
     }
     if (t[4].empty) { m->lit++; return 255; }
     if (t[4].ok) {
-        double z = plane_at(&t[4], px, py), tol = tol_at(&t[4], px, py);
+        double z = om__spsm_plane_at(&t[4], px, py), tol = om__spsm_tol_at(&t[4], px, py);
         if (z < p.z - tol) {
             if (om__tri2_covers(edges(t, 4), px, py)) { m->shadowed++; return 0; }
-        } else if (z <= p.z + tol && tol <= TOL0 + LIT_CAP) {
+        } else if (z <= p.z + tol && tol <= OM__SPSM_TOL0 + LIT_CAP) {
             m->lit++;
             return 255;
         }
@@ -581,14 +583,15 @@ static uint8_t lookup(spsm_state *m, const om_strip *st, size_t i)
 /* 4.2 for an uncertain sample: its term. Out of line: few samples come here, and the
  * decisions above stay small enough to sit in the strip's loop. p is the sample's
  * projection, (tx, ty) its texel, whose 3x3 is decoded in m->t. */
-OM_NOINLINE static uint8_t recover(spsm_state *m, const om_strip *st, size_t i, const sample_pt *pp, int64_t tx, int64_t ty)
+OM_NOINLINE static uint8_t recover(om__spsm_state *m, const om_strip *st, size_t i, const sample_pt *pp,
+                                   int64_t tx, int64_t ty)
 {
     const om_sample *smp = &st->samples[i];
     const om_vec3 pw = om__v3(smp->p[0], smp->p[1], smp->p[2]);
     const sample_pt p = *pp;
     const int64_t ox = tx * OM_SUBPIX + OM_SUBPIX / 2, oy = ty * OM_SUBPIX + OM_SUBPIX / 2;
     const int64_t px = p.x - ox, py = p.y - oy;
-    dtri *t = m->t;
+    om__spsm_dtri *t = m->t;
 
     /* 4.2 uncertain: the silhouette from partial geometry. Consistent depth tests give
      * the 3x3 pattern: a texel holds an occluder when its triangle reaches nearer than
@@ -602,7 +605,7 @@ OM_NOINLINE static uint8_t recover(spsm_state *m, const om_strip *st, size_t i, 
     bool have_rp = false;
     for (int k = 0; k < 9; k++) {
         /* cheapest test first; the receiver's plane only when a texel needs it */
-        if (t[k].empty || !(plane_at(&t[k], px, py) < p.z - pat_tol(&t[k], px, py))) continue;
+        if (t[k].empty || !(om__spsm_plane_at(&t[k], px, py) < p.z - pat_tol(&t[k], px, py))) continue;
         if (!have_rp) { rp = receiver_plane(m, smp); have_rp = true; }
         if (t[k].ok && behind_receiver(&t[k], &rp, px, py)) continue;
         if (!t[k].have_cmin) {
@@ -617,9 +620,9 @@ OM_NOINLINE static uint8_t recover(spsm_state *m, const om_strip *st, size_t i, 
      * and `keep`: the next uncertain sample in this texel with the same pattern reuses
      * them. */
     if (!m->bd_have || m->bd_keep != tg->keep) occluders_of(m, t, tg->keep, tx, ty);
-    const dtri *const *occ = m->occ;
+    const om__spsm_dtri *const *occ = m->occ;
     const int nocc = m->nocc;
-    const boundary *bd = &m->bd;
+    const om__spsm_boundary *bd = &m->bd;
 
     /* The decision at one point of the pixel. */
     uint32_t K = m->cfg.spsm_aa > 1 ? m->cfg.spsm_aa : 1, nlit = 0;
@@ -668,7 +671,7 @@ OM_NOINLINE static uint8_t recover(spsm_state *m, const om_strip *st, size_t i, 
 static om_status spsm_resolve(void *state, om_strip *st, om_diag *d)
 {
     (void)d;
-    spsm_state *m = (spsm_state *)state;
+    om__spsm_state *m = (om__spsm_state *)state;
     size_t n = (size_t)st->rows * st->width;
     for (size_t i = 0; i < n; i++) {
         om_term *t = &st->terms[i];
@@ -682,12 +685,12 @@ static om_status spsm_resolve(void *state, om_strip *st, om_diag *d)
 
 static bool spsm_observes(const void *state)
 {
-    return ((const spsm_state *)state)->marks;
+    return ((const om__spsm_state *)state)->marks;
 }
 
 static void spsm_stats(const void *state, om_method_stats *out)
 {
-    const spsm_state *m = (const spsm_state *)state;
+    const om__spsm_state *m = (const om__spsm_state *)state;
     memset(out, 0, sizeof *out);
     out->bytes_used = spsm_need(&m->cfg);
     out->counters[0] = m->samples;

@@ -12,7 +12,7 @@
 /* need = seen grown by one texel each way (the 3x3 the lookup decodes); returns the
  * number of texels in it. Bits past the map's width in a row's last word may be set:
  * no texel reads them. */
-static uint32_t grow_needs(spsm_state *m)
+static uint32_t grow_needs(om__spsm_state *m)
 {
     const uint32_t W = m->words, S = m->size;
     uint32_t count = 0;
@@ -38,7 +38,7 @@ static uint32_t grow_needs(spsm_state *m)
     return count;
 }
 typedef struct build_ctx {
-    spsm_state *m;
+    om__spsm_state *m;
     double zx, zy;               /* the plane whose codes are cached */
     uint8_t qx, qy;
     bool have;
@@ -53,7 +53,7 @@ typedef struct build_ctx {
 /* One texel x of row y touched by t: the depth test and, for the winner, its record. */
 static void texel(build_ctx *b, int32_t x, int32_t y, const om__rtri *t)
 {
-    spsm_state *m = b->m;
+    om__spsm_state *m = b->m;
     const om__tri2 *e = &t->e;
     const double H = OM_SUBPIX / 2;
     double cx = (double)((int64_t)x * OM_SUBPIX) + H - (double)e->x[0];
@@ -71,23 +71,23 @@ static void texel(build_ctx *b, int32_t x, int32_t y, const om__rtri *t)
      * answer (at the map's edge the bounds are clamped, and zmin stays a lower bound) */
     const bool alone = t->minx == t->maxx && t->miny == t->maxy;
     if (!alone && !om__tri2_covers(e, kx + (t->zx > 0 ? 0 : OM_SUBPIX), ky + (t->zy > 0 ? 0 : OM_SUBPIX))) {
-        const zplane p = {t->z0, t->zx, t->zy, e->x[0], e->y[0]};
-        double zc = clipped_min(e->x, e->y, kx, ky, OM_SUBPIX, &p);
+        const om__spsm_zplane p = {t->z0, t->zx, t->zy, e->x[0], e->y[0]};
+        double zc = om__spsm_clipped_min(e->x, e->y, kx, ky, OM_SUBPIX, &p);
         if (zc > z && zc != HUGE_VAL) z = zc;   /* (no overlap: only touching) */
     }
     if (!(z >= t->zmin)) z = t->zmin;
-    uint32_t dz = (uint32_t)z & ~TIES;
+    uint32_t dz = (uint32_t)z & ~OM__SPSM_TIES;
     size_t i = (size_t)y * m->size + (size_t)x;
-    /* Near ties (within TIE_DZ, what recovery takes for one surface) are most often
+    /* Near ties (within OM__SPSM_TIE_DZ, what recovery takes for one surface) are most often
      * the halves of one flat quad, the faces of one thin part (a fence bar, a pole)
      * or the small triangles of a fine mesh. The k-th triangle to tie for a texel (k
      * = nt) takes it where (x + (k - 1) y) mod k = k - 1: the second on a checkerboard,
      * the third on one texel of each row and column of a 3x3, and so on, so that the
      * neighbourhood recovery reads holds as many of them as it can (keeping the first
      * everywhere loses the rest of the outline). The depth keeps the nearer. */
-    uint32_t o = m->depth[i], od = o & ~TIES, nt = o & TIES;
-    if (o != 0xFFFFFFFFu && (dz >= od ? dz - od : od - dz) <= (uint32_t)TIE_DZ) {
-        if (nt < TIES - 1) nt++;
+    uint32_t o = m->depth[i], od = o & ~OM__SPSM_TIES, nt = o & OM__SPSM_TIES;
+    if (o != 0xFFFFFFFFu && (dz >= od ? dz - od : od - dz) <= (uint32_t)OM__SPSM_TIE_DZ) {
+        if (nt < OM__SPSM_TIES - 1) nt++;
         m->depth[i] = (dz < od ? dz : od) | nt;
         if (((uint32_t)x + (nt - 1) * (uint32_t)y) % nt != nt - 1) return;
     } else {
@@ -96,7 +96,7 @@ static void texel(build_ctx *b, int32_t x, int32_t y, const om__rtri *t)
     }
     if (!b->have || t->zx != b->zx || t->zy != b->zy) {
         /* derivatives in depth steps per texel, scaled (spsm.h) */
-        const double k = (double)OM_SUBPIX / STEP / OM_SPSM_DSCALE;
+        const double k = (double)OM_SUBPIX / OM__SPSM_STEP / OM_SPSM_DSCALE;
         b->qx = om__spsm_q_encode(t->zx * k);
         b->qy = om__spsm_q_encode(t->zy * k);
         b->zx = t->zx;
@@ -113,7 +113,7 @@ static void texel(build_ctx *b, int32_t x, int32_t y, const om__rtri *t)
 }
 
 /* Sets a buffer to the far plane (empty) at the needed texels, a word of them at a time. */
-static void clear_needed(const spsm_state *m, uint32_t *buf)
+static void clear_needed(const om__spsm_state *m, uint32_t *buf)
 {
     if (!m->marks) {   /* every texel is needed: one pass over the buffer */
         const size_t n = (size_t)m->size * m->size;
@@ -130,7 +130,7 @@ static void clear_needed(const spsm_state *m, uint32_t *buf)
 
 /* fneed = need at twice the resolution (a texel's bit becomes its four points'), and
  * those points of the fine map cleared. */
-static void grow_fine_needs(spsm_state *m)
+static void grow_fine_needs(om__spsm_state *m)
 {
     const uint32_t S = m->size, W = m->words, FW = m->fwords;
     for (uint32_t y = 0; y < S; y++) {
@@ -160,7 +160,7 @@ static void no_span(void *user, int32_t y, int32_t x0, int32_t x1, const om__rtr
 
 /* Every triangle of the scene through r, from the light, back faces of closed shapes
  * culled. */
-static void raster_scene(const spsm_state *m, om_raster *r)
+static void raster_scene(const om__spsm_state *m, om_raster *r)
 {
     const om_scene *s = m->scene;
     om__cull cl;
@@ -185,7 +185,7 @@ static void span(void *user, int32_t y, int32_t x0, int32_t x1, const om__rtri *
 om_status om__spsm_build(void *state, om_diag *d)
 {
     (void)d;
-    spsm_state *m = (spsm_state *)state;
+    om__spsm_state *m = (om__spsm_state *)state;
     m->t4_at = (size_t)-1;   /* no texel index: the map is about to change */
     m->bd_have = false;
     m->needed = grow_needs(m);

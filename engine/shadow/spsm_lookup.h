@@ -7,14 +7,16 @@
 
 #include "spsm.h"
 
-#define STEP 65536.0             /* one 16-bit depth step in raw units */
-#define TOL0 (1.5 * STEP)        /* what a record's depth cannot resolve at its centre */
-#define LINK_DZ (32.0 * STEP)    /* planes of one smooth surface agree this well */
-#define MAXV 36                  /* outline points: 9 triangles x 3, and 9 texel centres */
+#define OM__SPSM_STEP 65536.0                     /* one 16-bit depth step in raw units */
+#define OM__SPSM_TOL0 (1.5 * OM__SPSM_STEP)       /* what a record's depth cannot resolve at
+                                                     its centre */
+#define OM__SPSM_LINK_DZ (32.0 * OM__SPSM_STEP)   /* planes of one smooth surface agree this well */
+#define OM__SPSM_MAXV 36                          /* outline points: 9 triangles x 3, and 9
+                                                     texel centres */
 
 /* A texel's record decoded around the sample's texel: grid coordinates relative to
  * the centre of the sample's texel, plane in raw depth per grid unit. */
-typedef struct dtri {
+typedef struct om__spsm_dtri {
     bool empty, ok;              /* ok: a 2-D triangle with area */
     bool have_e;                 /* e is set up (edges(): most samples need only the plane) */
     om__tri2 e;
@@ -25,43 +27,44 @@ typedef struct dtri {
     bool have_cmin;
     double vz[3], vtol[3];       /* plane and pat_tol at the vertices rx, ry (have_vz) */
     bool have_vz;
-} dtri;   /* a new field is moved in spsm.c's move_entry too */
+} om__spsm_dtri;   /* a new field is moved in spsm.c's move_entry too */
 
 /* The recovered silhouette of an uncertain sample (4.2; spsm_outline.c). */
-typedef struct boundary {
+typedef struct om__spsm_boundary {
     int nv;
-    int64_t x[MAXV], y[MAXV];
-    uint8_t piece[MAXV];
+    int64_t x[OM__SPSM_MAXV], y[OM__SPSM_MAXV];
+    uint8_t piece[OM__SPSM_MAXV];
     uint8_t first[9];            /* a vertex of each occluder (its piece's) */
     /* the pieces' hulls, counter-clockwise without collinear points, one after another:
      * hull h has the vertices [hoff[h], hoff[h + 1]) of hx, hy; pieces with no area
      * (a point, a segment) have none */
     int nh;
-    uint8_t hoff[MAXV + 1];
-    int64_t hx[MAXV], hy[MAXV];
-} boundary;
+    uint8_t hoff[OM__SPSM_MAXV + 1];
+    int64_t hx[OM__SPSM_MAXV], hy[OM__SPSM_MAXV];
+} om__spsm_boundary;
 
 /* Equation 1: the stored plane at grid point (px, py), and what it cannot resolve. */
-static inline double plane_at(const dtri *t, int64_t px, int64_t py)
+static inline double om__spsm_plane_at(const om__spsm_dtri *t, int64_t px, int64_t py)
 {
     return t->z + t->gx * (double)(px - t->cx) + t->gy * (double)(py - t->cy);
 }
 
-static inline double tol_at(const dtri *t, int64_t px, int64_t py)
+static inline double om__spsm_tol_at(const om__spsm_dtri *t, int64_t px, int64_t py)
 {
-    return TOL0 + t->ex * fabs((double)(px - t->cx)) + t->ey * fabs((double)(py - t->cy));
+    return OM__SPSM_TOL0 + t->ex * fabs((double)(px - t->cx)) + t->ey * fabs((double)(py - t->cy));
 }
 
 /* Builds the outline of the occluders occ[0..nocc) (distinct triangles, their edges
  * set up): their vertices, linked into pieces, and each piece's convex hull. */
-void om__spsm_outline_build(boundary *b, const dtri *const occ[9], int nocc);
+void om__spsm_outline_build(om__spsm_boundary *b, const om__spsm_dtri *const occ[9], int nocc);
 /* A point known to lie under the surface of occluder `owner` (an index into the
  * occluders the outline was built from): a texel centre that the plain map saw there. */
-typedef struct outline_pt { int64_t x, y; int owner; } outline_pt;
+typedef struct om__spsm_outline_pt { int64_t x, y; int owner; } om__spsm_outline_pt;
 
 /* The outline `base` with the points pts[0..npts) joined to their owners' pieces. */
-void om__spsm_outline_extend(boundary *out, const boundary *base, const outline_pt *pts, int npts);
+void om__spsm_outline_extend(om__spsm_boundary *out, const om__spsm_boundary *base,
+                             const om__spsm_outline_pt *pts, int npts);
 /* Whether (px, py) lies strictly inside one of the outline's hulls. */
-bool om__spsm_outline_inside(const boundary *b, int64_t px, int64_t py);
+bool om__spsm_outline_inside(const om__spsm_boundary *b, int64_t px, int64_t py);
 
 #endif

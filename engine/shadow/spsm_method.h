@@ -7,8 +7,9 @@
 #include "shadow.h"
 #include "spsm_lookup.h"
 
-#define TIE_DZ (LINK_DZ / 2)     /* the build's near tie: one surface to recovery */
-#define TIES 0xFFu               /* the depth buffer's low bits: ties counted (texel) */
+#define OM__SPSM_TIE_DZ (OM__SPSM_LINK_DZ / 2)   /* the build's near tie: one surface to recovery */
+#define OM__SPSM_TIES 0xFFu                      /* the depth buffer's low bits: ties counted
+                                                    (texel) */
 
 /* What spsm's settings (spsm.c) set. */
 typedef struct om__spsm_cfg {
@@ -24,7 +25,7 @@ typedef struct om__spsm_cfg {
                               samples along fine rims), 0: at texel centres */
 } om__spsm_cfg;
 
-typedef struct spsm_state {
+typedef struct om__spsm_state {
     const om_scene *scene;
     om__spsm_cfg cfg;
     uint32_t size;
@@ -52,27 +53,27 @@ typedef struct spsm_state {
      * index, so it is kept from one sample to the next while `t4_at` names the texel
      * (and what it shares with the next texel's 3x3 is kept too: shift_window): bit k
      * of `t_have` says t[k] is decoded. The build forgets it. */
-    dtri t[9];
+    om__spsm_dtri t[9];
     size_t t4_at;
     uint32_t t_have;
     /* The recovery's occluders (pointers into t) and outline for the pattern `bd_keep`
      * of the texel t4_at, while bd_have. */
-    const dtri *occ[9];
+    const om__spsm_dtri *occ[9];
     int nocc;
     /* and the texel centres that may join the outline (cand_k: their texels): those
      * nearer than the sample, which varies, do. bd is the outline without them, bx
      * with those in bx_pts (a superset of bd's hulls: points only join pieces). */
-    outline_pt cand[9];
+    om__spsm_outline_pt cand[9];
     uint8_t cand_k[9];
     int ncand;
     uint16_t bx_pts;
-    boundary bd, bx;
+    om__spsm_boundary bd, bx;
     uint16_t bd_keep;
     bool bd_have;
-} spsm_state;
+} om__spsm_state;
 
 /* A depth plane: z at grid point (ox, oy), slopes gx, gy per grid unit. */
-typedef struct zplane { double z, gx, gy; int64_t ox, oy; } zplane;
+typedef struct om__spsm_zplane { double z, gx, gy; int64_t ox, oy; } om__spsm_zplane;
 
 /* The least depth of plane p over the triangle (X, Y) clipped to the square
  * [x0, x0 + side] x [y0, y0 + side], for a square whose corner the slopes point to
@@ -80,8 +81,8 @@ typedef struct zplane { double z, gx, gy; int64_t ox, oy; } zplane;
  * value over the two's overlap is then on the triangle's boundary, at an end of one
  * of its edges clipped to the square (Liang-Barsky), whichever the slope along the
  * edge points to. HUGE_VAL when no edge crosses the square. */
-static inline double clipped_min(const int64_t X[3], const int64_t Y[3], int64_t x0, int64_t y0, int64_t side,
-                                 const zplane *p)
+static inline double om__spsm_clipped_min(const int64_t X[3], const int64_t Y[3], int64_t x0, int64_t y0, int64_t side,
+                                 const om__spsm_zplane *p)
 {
     const double lo[2] = {(double)x0, (double)y0}, hi[2] = {(double)(x0 + side), (double)(y0 + side)};
     double best = HUGE_VAL;

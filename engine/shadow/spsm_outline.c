@@ -14,14 +14,14 @@ static int64_t turn(int64_t ox, int64_t oy, int64_t ax, int64_t ay, int64_t bx, 
 
 /* Each piece's convex hull (Andrew's monotone chain on its points sorted by x, then
  * y), built once per boundary so that every test point costs one pass over it. */
-static void hulls_build(boundary *b)
+static void hulls_build(om__spsm_boundary *b)
 {
     b->nh = 0;
     b->hoff[0] = 0;
     int used = 0;
     for (int pc = 0; pc < b->nv; pc++) {
         if (b->piece[pc] != pc) continue;   /* a piece is labelled by its first vertex */
-        int64_t px[MAXV], py[MAXV];
+        int64_t px[OM__SPSM_MAXV], py[OM__SPSM_MAXV];
         int n = 0;
         for (int i = 0; i < b->nv; i++) {
             if (b->piece[i] != pc) continue;
@@ -35,7 +35,7 @@ static void hulls_build(boundary *b)
         }
         if (n < 3) continue;
         int64_t *hx = b->hx + used, *hy = b->hy + used;
-        int64_t cx[2 * MAXV], cy[2 * MAXV];   /* the chain; its last point repeats the first */
+        int64_t cx[2 * OM__SPSM_MAXV], cy[2 * OM__SPSM_MAXV];   /* the chain; its last point repeats the first */
         int k = 0;
         for (int i = 0; i < n; i++) {         /* lower chain */
             while (k >= 2 && turn(cx[k - 2], cy[k - 2], cx[k - 1], cy[k - 1], px[i], py[i]) <= 0) k--;
@@ -57,7 +57,7 @@ static void hulls_build(boundary *b)
  * that AA sub-samples reuse it (section 5). Its points are the vertices of the
  * occluders the pattern keeps. Two are linked when they belong to one stored triangle,
  * or lie within OM_SPSM_LINK of each other on one smooth surface (the plane of one's
- * triangle, carried to the other, meets the other's within LINK_DZ): a gap that narrow
+ * triangle, carried to the other, meets the other's within OM__SPSM_LINK_DZ): a gap that narrow
  * is taken for geometry the map could not keep, as a dense mesh keeps one small
  * triangle per texel (Figure 10a), while a cloud of separate small triangles does not
  * line up and stays apart. Links join the points into pieces; a piece's outline is the
@@ -83,9 +83,9 @@ static int unite(uint8_t up[9], int a, int c)
     return 1;
 }
 
-void om__spsm_outline_build(boundary *b, const dtri *const occ[9], int nocc)
+void om__spsm_outline_build(om__spsm_boundary *b, const om__spsm_dtri *const occ[9], int nocc)
 {
-    uint8_t owner[MAXV];         /* the first occluder with this vertex */
+    uint8_t owner[OM__SPSM_MAXV];         /* the first occluder with this vertex */
     uint8_t up[9];
     int sets = nocc;
     b->nv = 0;
@@ -108,9 +108,9 @@ void om__spsm_outline_build(boundary *b, const dtri *const occ[9], int nocc)
             /* one surface: i's triangle's plane, carried to j, meets j's triangle there
              * (a smooth mesh bends little over a texel; a cloud of separate triangles
              * does not line up) */
-            const dtri *a = occ[owner[i]], *c = occ[owner[j]];
-            double za = plane_at(a, b->x[j], b->y[j]), zc = plane_at(c, b->x[j], b->y[j]);
-            if (fabs(za - zc) > tol_at(a, b->x[j], b->y[j]) + LINK_DZ) continue;
+            const om__spsm_dtri *a = occ[owner[i]], *c = occ[owner[j]];
+            double za = om__spsm_plane_at(a, b->x[j], b->y[j]), zc = om__spsm_plane_at(c, b->x[j], b->y[j]);
+            if (fabs(za - zc) > om__spsm_tol_at(a, b->x[j], b->y[j]) + OM__SPSM_LINK_DZ) continue;
             sets -= unite(up, owner[i], owner[j]);
         }
     /* A piece is labelled by its first vertex. */
@@ -128,7 +128,8 @@ void om__spsm_outline_build(boundary *b, const dtri *const occ[9], int nocc)
  * tessellated rim the record keeps the nearest, innermost triangle of each texel, and
  * the surface reaches on towards the silhouette; its piece reaches as far as the
  * plain map saw it (spsm.c chooses the points). */
-void om__spsm_outline_extend(boundary *out, const boundary *base, const outline_pt *pts, int npts)
+void om__spsm_outline_extend(om__spsm_boundary *out, const om__spsm_boundary *base,
+                             const om__spsm_outline_pt *pts, int npts)
 {
     out->nv = base->nv;
     for (int i = 0; i < base->nv; i++) {
@@ -136,7 +137,7 @@ void om__spsm_outline_extend(boundary *out, const boundary *base, const outline_
         out->y[i] = base->y[i];
         out->piece[i] = base->piece[i];
     }
-    for (int p = 0; p < npts && out->nv < MAXV; p++) {
+    for (int p = 0; p < npts && out->nv < OM__SPSM_MAXV; p++) {
         out->x[out->nv] = pts[p].x;
         out->y[out->nv] = pts[p].y;
         out->piece[out->nv] = base->piece[base->first[pts[p].owner]];
@@ -146,7 +147,7 @@ void om__spsm_outline_extend(boundary *out, const boundary *base, const outline_
 }
 
 /* Strictly inside the hull of one piece: strictly left of each of its edges. */
-bool om__spsm_outline_inside(const boundary *b, int64_t px, int64_t py)
+bool om__spsm_outline_inside(const om__spsm_boundary *b, int64_t px, int64_t py)
 {
     for (int h = 0; h < b->nh; h++) {
         int a = b->hoff[h], e = b->hoff[h + 1];
