@@ -294,8 +294,8 @@ struct om_method;
 
 /* One method's settings, by value: plain memory the host keeps where it likes (the
  * stack, a static) and copies freely. Made by om_method_cfg_default for a method,
- * changed by om_method_cfg_set, read by that method's bytes and init, which refuse
- * a configuration made for another method. */
+ * changed by om_method_cfg_set, read by that method's bytes and init (a method with
+ * settings refuses a configuration made for another one: OM_E_INVALID). */
 typedef struct om_method_cfg {
     const struct om_method *method;   /* whose settings these are; NULL: none */
     union {                /* private: the method's configuration struct */
