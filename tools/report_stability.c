@@ -129,16 +129,18 @@ static om_status path(const om_scene *s, const om_method *m, const om_method_cfg
     return st;
 }
 
-/* The case's "# ombra-set NAME=VALUE ..." lines, as make stability applies them. */
-static void case_settings(const char *text, om_method_cfg *c)
+/* The case's "# ombra-set NAME=VALUE ..." lines, as make stability applies them: each
+ * to the methods that take it. */
+static void case_settings(const char *text, cli_settings *c)
 {
+    c->n = 0;
     for (const char *p = strstr(text, "# ombra-set "); p; p = strstr(p + 1, "# ombra-set ")) {
         const char *q = p + 12;
         while (*q && *q != '\n') {
             size_t n = strcspn(q, " \n");
             char item[96];
             snprintf(item, sizeof item, "%.*s", (int)(n < 95 ? n : 95), q);
-            if (n) cli_set(c, item);
+            if (n) cli_settings_add(c, item);
             q += n;
             while (*q == ' ') q++;
         }
@@ -161,10 +163,14 @@ static void flicker_crops(FILE *f, const char *name, const char *method, int fra
         fprintf(f, "<p>(no crops: %s is not here)</p>\n", path_s);
         return;
     }
-    om_method_cfg cfg;
-    om_method_cfg_default(&cfg);
-    case_settings(text, &cfg);
+    static cli_settings set;   /* 4 KB: off the stack */
+    case_settings(text, &set);
     free(text);
+    om_method_cfg cfg, rcfg;
+    if (!cli_cfg(m, &set, &cfg, NULL) || !cli_cfg(ref, &set, &rcfg, NULL)) {
+        fprintf(f, "<p>(no crops: %s has a setting out of range)</p>\n", path_s);
+        return;
+    }
     size_t n = (size_t)SW * SH;
     uint8_t *buf = malloc(n * 4 + n * 3 * 2);
     if (!buf || cli_scene_load(&cs, path_s, 0, &d) != OM_OK) {
@@ -173,7 +179,7 @@ static void flicker_crops(FILE *f, const char *name, const char *method, int fra
         return;
     }
     uint8_t *rp = buf, *rc = rp + n, *mp = rc + n, *mc = mp + n, *rgb = mc + n, *img = rgb + n * 3;
-    om_status st = path(&cs.scene, ref, &cfg, frames, flick, rp, rc, rgb, &d);
+    om_status st = path(&cs.scene, ref, &rcfg, frames, flick, rp, rc, rgb, &d);
     if (st == OM_OK) st = path(&cs.scene, m, &cfg, frames, flick, mp, mc, NULL, &d);
     if (st != OM_OK) {
         fprintf(f, "<p>(no crops: ");

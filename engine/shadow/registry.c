@@ -101,7 +101,7 @@ om_status om_method_cfg_set(om_method_cfg *c, const char *name, double value, om
     char tmp[8];
     if (!f) {
         om__str s = om__diag_begin(d, OM_E_NOTFOUND, tmp, sizeof tmp);
-        om__str_s(&s, c->method ? c->method->name : "no method");
+        om__str_s(&s, c->method ? c->method->name : "the configuration of no method");
         om__str_s(&s, " has no setting '");
         om__str_s(&s, name ? name : "");
         om__str_s(&s, "'");
