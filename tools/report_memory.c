@@ -49,9 +49,9 @@ static int words(const char *s, char out[][16], int max)
     return n;
 }
 
-static bool configure(const char *setting, om_method_cfg *cfg)
+static bool configure(const om_method *m, const char *setting, om_method_cfg *cfg)
 {
-    om_method_cfg_default(cfg);
+    om_method_cfg_default(cfg, m);
     char item[64];
     for (const char *p = setting; *p;) {
         size_t l = strcspn(p, " ");
@@ -72,7 +72,7 @@ static bool fit(const om_method *m, const char *setting, const cli_scene *cs, ui
     om_method_cfg cfg;
     size_t mn, full;
     *need = SIZE_MAX;
-    if (!configure(setting, &cfg) || m->bytes(&cfg, &cs->scene, W, H, &mn, &full) != OM_OK) return false;
+    if (!configure(m, setting, &cfg) || m->bytes(&cfg, &cs->scene, W, H, &mn, &full) != OM_OK) return false;
     uint32_t lo = W <= 160 ? 1 : H < MIN_ROWS ? H : MIN_ROWS;
     size_t base = cs->bytes + full;
     *need = base + om_frame_bytes(W, lo);
@@ -133,7 +133,7 @@ static void best(const knobs *k, const cli_scene *cs, const om_view *v, size_t b
         cli_point p;
         om_diag d;
         memset(&p, 0, sizeof p);
-        if (!configure(c[i].setting, &cfg) ||
+        if (!configure(m, c[i].setting, &cfg) ||
             cli_measure_strips(m, &cfg, cs, v, runs, c[i].rows < H ? c[i].rows : 0, c[i].fbytes, mask, NULL, &p,
                                &d) != OM_OK)
             continue;
@@ -182,7 +182,7 @@ int report_memory(FILE *f, int runs)
         uint8_t *ref = malloc(n), *mask = malloc(n);
         cli_point p;
         om_method_cfg cfg;
-        om_method_cfg_default(&cfg);
+        om_method_cfg_default(&cfg, om_method_find("ref"));
         if (!ref || !mask) st = cli_oom(&d);
         else st = cli_measure(om_method_find("ref"), &cfg, cs, &v, 1, ref, NULL, &p, &d);
         fprintf(stderr, "report:   equal memory: every method in %zu KiB\n", budgets[b] >> 10);
