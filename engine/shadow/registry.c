@@ -30,7 +30,8 @@
 #define OM_WITH_HYBRID 1
 #endif
 
-/* One line a method: X(name, switch), in the order tools list them. */
+/* One line a method, in the order tools list them: X(name, 1) builds it in always,
+ * X(name, OM_WITH_NAME) lets a firmware leave it out (with its default above). */
 #define METHODS(X)           \
     X(none, OM_WITH_NONE)    \
     X(ref, OM_WITH_REF)      \
