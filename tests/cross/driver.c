@@ -197,7 +197,7 @@ static void count_scene(const char *tag, const char *text, int *bad)
     for (size_t k = 0; k < om_method_count(); k++) {
         const om_method *m = om_method_at(k);
         om_method_cfg cfg;
-        method_cfg(&cfg, &sz, 0);
+        method_cfg(&cfg, m, &sz, 0);
         size_t mn, full;
         om_arena ma, fa;
         void *state;
