@@ -22,6 +22,9 @@ CC_KIND := $(if $(shell $(CC) --version 2>/dev/null | grep -i clang),clang,$(she
 DETERM  = -ffp-contract=off $(if $(findstring clang,$(CC_KIND)),,$(if $(filter s390%,$(CC_KIND)),-fexcess-precision=fast,-fexcess-precision=standard))
 CFLAGS_ALL = $(WARN) $(DETERM) $(OPT) -g -Iinclude $(EXTRA)
 LDLIBS  = -lm
+# The host programs' parallel-for (platform/jobs.c) runs on POSIX threads; the engine
+# library needs none (the embedding examples link without it).
+PTHREAD = -pthread
 
 ENGINE_SRC   = $(sort $(wildcard engine/*/*.c))
 PLATFORM_SRC = $(sort $(wildcard platform/*.c))
@@ -49,13 +52,13 @@ $(O)/libombra.a: $(ENGINE_OBJ)
 	$(Q)ar rcs $@ $^
 
 $(O)/ombra: $(TOOL_OBJ) $(PLATFORM_OBJ) $(O)/libombra.a
-	$(Q)$(CC) $(CFLAGS_ALL) -o $@ $^ $(LDLIBS)
+	$(Q)$(CC) $(CFLAGS_ALL) -o $@ $^ $(LDLIBS) $(PTHREAD)
 
 $(O)/run-tests: $(TEST_OBJ) $(PLATFORM_OBJ) $(O)/libombra.a
-	$(Q)$(CC) $(CFLAGS_ALL) -o $@ $^ $(LDLIBS)
+	$(Q)$(CC) $(CFLAGS_ALL) -o $@ $^ $(LDLIBS) $(PTHREAD)
 
 $(O)/bench: $(BENCH_SRC) $(PLATFORM_OBJ) $(O)/libombra.a $(wildcard tests/bench/*.h)
-	$(Q)$(CC) $(CFLAGS_ALL) -o $@ $(filter %.c %.o %.a,$^) $(LDLIBS)
+	$(Q)$(CC) $(CFLAGS_ALL) -o $@ $(filter %.c %.o %.a,$^) $(LDLIBS) $(PTHREAD)
 
 run: $(O)/ombra
 	@mkdir -p out
@@ -131,7 +134,7 @@ cross-test:
 
 # Every method under every budget from 0 to one pass, with guard bytes.
 $(O)/stress: tests/stress/stress.c tests/bench/bench_main.c $(PLATFORM_OBJ) $(O)/libombra.a
-	$(Q)$(CC) $(CFLAGS_ALL) -DOM_BENCH_NO_MAIN -o $@ $(filter %.c %.o %.a,$^) $(LDLIBS)
+	$(Q)$(CC) $(CFLAGS_ALL) -DOM_BENCH_NO_MAIN -o $@ $(filter %.c %.o %.a,$^) $(LDLIBS) $(PTHREAD)
 
 stress:
 	$(MAKE) --no-print-directory $(O)/stress OPT=-O2
@@ -139,7 +142,7 @@ stress:
 
 # Every method along the failure cases' paths (tests/stability/*.scene).
 $(O)/stability: tests/stability/stability.c tests/bench/bench_main.c $(PLATFORM_OBJ) $(O)/libombra.a
-	$(Q)$(CC) $(CFLAGS_ALL) -DOM_BENCH_NO_MAIN -o $@ $(filter %.c %.o %.a,$^) $(LDLIBS)
+	$(Q)$(CC) $(CFLAGS_ALL) -DOM_BENCH_NO_MAIN -o $@ $(filter %.c %.o %.a,$^) $(LDLIBS) $(PTHREAD)
 
 stability:
 	$(MAKE) --no-print-directory $(O)/stability OPT=-O2

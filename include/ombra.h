@@ -387,10 +387,22 @@ typedef struct om_frame_stats {
     uint64_t ns_eye, ns_observe, ns_build, ns_resolve, ns_shade;  /* 0 without a clock */
     uint32_t strips, eye_passes;
     size_t frame_peak;
+    uint32_t jobs;         /* jobs run at once: 1 inline, up to om_frame_desc.threads */
 } om_frame_stats;
 
 /* A monotonic clock the host may provide for per-stage timings; NULL for none. */
 typedef uint64_t (*om_clock_fn)(void *user);
+
+/* Parallel work. The engine starts no threads; the host may hand in a parallel-for:
+ * run(host, fn, job_user, n) calls fn(job_user, i) once for every i in [0, n), in any
+ * order, on any of its threads (the calling one included), and returns when all n calls
+ * have returned. The engine calls it only from inside om_render_frame, never nested.
+ * The jobs write disjoint memory the engine carved from its arenas and take no locks:
+ * the host needs no allocation and no locks beyond its own (to hand out and join the
+ * jobs). Frames, masks and method counters are bit-identical whatever the thread count
+ * and whatever order the jobs run in. NULL runs every job inline, in order. */
+typedef void (*om_job_fn)(void *job_user, uint32_t i);
+typedef void (*om_parallel_for_fn)(void *host, om_job_fn fn, void *job_user, uint32_t n);
 
 typedef struct om_frame_desc {
     const om_scene *scene;
@@ -404,6 +416,11 @@ typedef struct om_frame_desc {
     void *user;
     om_clock_fn clock;     /* may be NULL */
     void *clock_user;
+    om_parallel_for_fn parallel_for;  /* may be NULL: one thread, inline */
+    void *parallel_user;   /* the parallel-for's `host` */
+    uint32_t threads;      /* jobs at once (0 or 1: inline); each needs its share of the
+                              frame arena (om_frame_bytes_jobs), and a frame arena with
+                              room for fewer runs that many */
 } om_frame_desc;
 
 /* Bytes the frame arena needs for width x strip_rows (samples, terms and the eye
@@ -414,6 +431,14 @@ size_t om_frame_bytes(uint32_t width, uint32_t strip_rows);
  * projected once per frame, instead of clipping and setting up all of them. A frame
  * arena of om_frame_bytes gives the same pixels, more slowly. */
 size_t om_frame_bytes_scene(const om_scene *s, uint32_t width, uint32_t strip_rows);
+/* What the frame arena needs beyond om_frame_bytes(_scene) to run `threads` jobs at
+ * once with method m (0 for threads <= 1): each job's scratch for the method's resolve.
+ * With threads > 1 the frame splits each strip into bands of rows: the eye pass and
+ * shading run on bands at once, and so does the resolve of the built-in methods whose
+ * resolve allows it (DESIGN.md lists them); the others resolve a strip at a
+ * time. A whole-frame render (one strip) also uses the bins when they fit after the
+ * jobs' scratch. */
+size_t om_frame_bytes_jobs(const struct om_method *m, uint32_t threads);
 /* Renders one frame. The frame arena is rewound on return; the method's arena keeps
  * what the method keeps. */
 om_status om_render_frame(const om_frame_desc *fd, om_arena *frame_arena,

@@ -44,6 +44,18 @@ om_status om_file_loader_init(om_file_loader *fl, const char *scene_path);
 om_loader om_file_loader_get(om_file_loader *fl);
 void om_file_loader_free(om_file_loader *fl);
 
+/* A parallel-for on a pool of threads (jobs.c): om_jobs_for is an om_parallel_for_fn
+ * whose `host` is the pool. om_jobs_start starts threads - 1 workers (the caller is
+ * the last thread); threads <= 1 starts none and runs every job inline. */
+typedef struct om_jobs om_jobs;
+om_status om_jobs_start(om_jobs **out, uint32_t threads, om_diag *d);
+void om_jobs_for(void *host, om_job_fn fn, void *user, uint32_t n);
+/* The threads a pool runs jobs on (1 for NULL), the caller's included. */
+uint32_t om_jobs_threads(const om_jobs *j);
+void om_jobs_stop(om_jobs *j);
+/* The CPUs online (at least 1). */
+uint32_t om_cpus_online(void);
+
 /* Nanoseconds from a monotonic clock (an om_clock_fn; user is unused). */
 uint64_t om_clock_ns(void *user);
 

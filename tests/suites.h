@@ -20,6 +20,7 @@
     X(suite_oracle) \
     X(suite_hybrid) \
     X(suite_settings) \
+    X(suite_threads) \
     /* end of list */
 #endif
 #define X(suite) void suite(void);

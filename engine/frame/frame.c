@@ -4,8 +4,29 @@
  * A method that observes (needs every visible sample before it builds) and a
  * directional light (fitted to the visible samples) need a first pass over the image.
  * When the frame is one strip the samples are kept and the eye pass runs once; with
- * smaller strips it runs again for each pass, so memory stays at one strip. */
+ * smaller strips it runs again for each pass, so memory stays at one strip.
+ *
+ * With the host's parallel-for and more than one thread, each strip is cut into bands
+ * of rows, and the eye pass, the exposure marks, shading and (for methods with
+ * om__bands) the resolve run on the bands at once, one job per thread. A band's pixels
+ * are those of the strip (every stage is strip-invariant), so the frame is the same
+ * whatever the number of jobs; the stages that fold the whole strip into one answer
+ * (the light's fit, observe, a serial resolve) stay on the calling thread. */
 #include "frame.h"
+
+/* One running job: its method counts and resolve scratch (from the frame arena). */
+typedef struct job_slot {
+    uint32_t counts[8];
+    void *scratch;
+} job_slot;
+
+size_t om_frame_bytes_jobs(const om_method *m, uint32_t threads)
+{
+    if (threads <= 1) return 0;
+    const om__bands *b = m ? om__method_bands(m) : NULL;
+    return (size_t)threads * (om_arena_need(sizeof(job_slot), 8) +
+                              (b ? om_arena_need(b->scratch ? b->scratch : 1, 16) : 0));
+}
 
 size_t om_frame_bytes(uint32_t width, uint32_t strip_rows)
 {
@@ -52,6 +73,117 @@ static void grow_light_box(const om_view *v, const om_strip *st, om_vec3 *lo, om
     }
 }
 
+/* The bands of the strip and the jobs that run them: band b goes to job b % jobs, so a
+ * job owns its slot and the rows it writes. */
+typedef enum { STAGE_PREPARE, STAGE_RESOLVE, STAGE_SHADE } stage;
+
+typedef struct frame_ctx {
+    const om_frame_desc *fd;
+    const om_view *view;
+    const om__bins *bins;      /* NULL: every strip walks every triangle */
+    const om__bands *bands;    /* NULL: the method resolves a strip at a time */
+    om_target tg;              /* the strip's */
+    om_strip strip;
+    uint32_t jobs, band_rows, nbands;
+    job_slot *slots;           /* jobs of them */
+    stage stage;
+    bool eye, mark;            /* STAGE_PREPARE: run the eye pass, mark exposure */
+} frame_ctx;
+
+static void band_job(void *user, uint32_t j)
+{
+    const frame_ctx *c = (const frame_ctx *)user;
+    const om_frame_desc *fd = c->fd;
+    for (uint32_t b = j; b < c->nbands; b += c->jobs) {
+        uint32_t r0 = b * c->band_rows;
+        size_t off = (size_t)r0 * c->strip.width;
+        om_strip st = c->strip;
+        st.y0 += r0;
+        st.rows = c->strip.rows - r0 < c->band_rows ? c->strip.rows - r0 : c->band_rows;
+        st.samples += off;
+        st.terms += off;
+        if (c->stage == STAGE_PREPARE) {
+            if (c->eye) {
+                om_target tg = c->tg;
+                tg.y0 = st.y0;
+                tg.rows = st.rows;
+                tg.depth += off;
+                tg.id += off;
+                om__eye_pass(fd->scene, c->view, &tg, &st, c->bins);
+            }
+            if (c->mark) mark_exposed(c->view, &st);
+        } else if (c->stage == STAGE_RESOLVE) {
+            c->bands->resolve(fd->method_state, &st, c->slots[j].scratch, c->slots[j].counts);
+        } else {
+            om_framebuffer fb = *fd->fb;
+            fb.pixels += (size_t)r0 * fb.stride;
+            fb.rows = st.rows;
+            om__shade_strip(fd->scene, c->view, fd->shade, &st, &fb);
+        }
+    }
+}
+
+/* Runs one stage over the current strip's bands on the host's threads. */
+static void run_bands(frame_ctx *c, stage sg)
+{
+    c->stage = sg;
+    c->nbands = (c->strip.rows + c->band_rows - 1) / c->band_rows;
+    uint32_t n = c->nbands < c->jobs ? c->nbands : c->jobs;
+    c->fd->parallel_for(c->fd->parallel_user, band_job, c, n);
+}
+
+/* The eye pass and the exposure marks of the current strip (rows at strip.y0). */
+static void prepare(frame_ctx *c, bool eye, bool mark, om_frame_stats *fs)
+{
+    uint64_t t0 = now(c->fd);
+    if (c->jobs > 1) {
+        c->eye = eye;
+        c->mark = mark;
+        run_bands(c, STAGE_PREPARE);
+    } else {
+        if (eye) om__eye_pass(c->fd->scene, c->view, &c->tg, &c->strip, c->bins);
+        if (mark) mark_exposed(c->view, &c->strip);
+    }
+    if (eye) {
+        fs->ns_eye += now(c->fd) - t0;
+        fs->eye_passes++;
+    }
+}
+
+/* Moves the strip (and its target) to rows [y, y + rows). */
+static void strip_at(frame_ctx *c, uint32_t y, uint32_t rows)
+{
+    uint32_t H = c->strip.height;
+    c->strip.y0 = c->tg.y0 = y;
+    c->strip.rows = c->tg.rows = y + rows > H ? H - y : rows;
+}
+
+/* Carves the jobs' slots: as many as the host asks for and the arena holds beyond
+ * `keep` bytes (at least two, or none and the frame runs inline). */
+static void carve_jobs(frame_ctx *c, om_arena *fa, size_t keep)
+{
+    const om_frame_desc *fd = c->fd;
+    c->jobs = 1;
+    if (!fd->parallel_for || fd->threads <= 1) return;
+    const om__bands *b = om__method_bands(fd->method);
+    size_t per = om_frame_bytes_jobs(fd->method, 2) / 2;
+    size_t left = om_arena_left(fa), fit = left > keep ? (left - keep) / per : 0;
+    uint32_t jobs = fit < fd->threads ? (uint32_t)fit : fd->threads;
+    void *p;
+    if (jobs < 2 || om_arena_alloc(fa, jobs * sizeof(job_slot), 8, &p, NULL)) return;
+    c->slots = (job_slot *)p;
+    for (uint32_t j = 0; b && j < jobs; j++)
+        if (om_arena_alloc(fa, b->scratch ? b->scratch : 1, 16, &c->slots[j].scratch, NULL))
+            return;   /* cannot happen: `per` counted it */
+    c->bands = b;
+    c->jobs = jobs;
+    /* Bands of whole 16-row blocks (methods tile strips by 16 from their top row, so a
+     * band resolves the same blocks the strip would), about four a job to even out the
+     * work of the rows. */
+    uint32_t rows = c->tg.rows, want = (rows + 4 * jobs - 1) / (4 * jobs);
+    c->band_rows = (want + 15) / 16 * 16;
+}
+
 om_status om_render_frame(const om_frame_desc *fd, om_arena *fa, om_frame_stats *stats,
                           om_diag *d)
 {
@@ -79,23 +211,33 @@ om_status om_render_frame(const om_frame_desc *fd, om_arena *fa, om_frame_stats 
         om_arena_rewind(fa, mark);
         return st;
     }
-    om_target tg;
-    tg.width = W; tg.height = H; tg.y0 = 0; tg.rows = rows;
-    tg.depth = (uint32_t *)pd;
-    tg.id = (uint32_t *)pi;
-    om_strip strip;
-    strip.width = W; strip.height = H; strip.y0 = 0; strip.rows = rows;
-    strip.samples = (om_sample *)ps;
-    strip.terms = (om_term *)pt;
-
     om_view view = *fd->view;
+    frame_ctx c;
+    memset(&c, 0, sizeof c);
+    c.fd = fd;
+    c.view = &view;
+    c.tg.width = W; c.tg.height = H; c.tg.y0 = 0; c.tg.rows = rows;
+    c.tg.depth = (uint32_t *)pd;
+    c.tg.id = (uint32_t *)pi;
+    c.strip.width = W; c.strip.height = H; c.strip.y0 = 0; c.strip.rows = rows;
+    c.strip.samples = (om_sample *)ps;
+    c.strip.terms = (om_term *)pt;
+
     const bool single = rows == H;
-    /* Bins when the frame has strips and the arena has room (om__bins): each strip
-     * then sets up only its own triangles, from vertices projected once (the same
+    /* Bins when the frame has strips (or bands) and the arena has room (om__bins): each
+     * strip then sets up only its own triangles, from vertices projected once (the same
      * pixels; without room, every strip walks every triangle). The camera's matrix
-     * does not change within the frame. */
+     * does not change within the frame. With strips the bins come before the jobs'
+     * slots, as they did before there were jobs; one strip needs them only for bands. */
     om__bins bins = {NULL, NULL};
-    if (!single && s->ntris && om_arena_left(fa) >= om__bins_rows_bytes(s)) {
+    for (int pass = 0; pass < 2; pass++) {
+        /* one strip: the bins' bytes are kept if two jobs fit beside them */
+        size_t keep = om__bins_rows_bytes(s) + om__bins_verts_bytes(s);
+        if (pass == 1)
+            carve_jobs(&c, fa, single && om_arena_left(fa) >= keep + om_frame_bytes_jobs(m, 2) ? keep : 0);
+        if ((pass == 0) == single || (single && c.jobs < 2) || !s->ntris ||
+            om_arena_left(fa) < om__bins_rows_bytes(s))
+            continue;
         void *pb, *pv;
         if (om_arena_alloc(fa, (size_t)s->ntris * sizeof(uint32_t), 8, &pb, NULL) == OM_OK) {
             bins.rows = (uint32_t *)pb;
@@ -105,30 +247,23 @@ om_status om_render_frame(const om_frame_desc *fd, om_arena *fa, om_frame_stats 
             uint64_t tb = now(fd);
             om__bins_make(s, &view.cam_vp, W, H, &bins);
             fs->ns_eye += now(fd) - tb;
+            c.bins = &bins;
         }
     }
+    fs->jobs = c.jobs;
     const bool observes = (m->flags & OM_METHOD_OBSERVES) && (!m->observes || m->observes(fd->method_state));
     const bool fit = view.light.kind == OM_LIGHT_DIRECTIONAL;
     bool have_samples = false;   /* strip.samples hold the whole frame already */
     bool have_terms = false;     /* and strip.terms their exposure (mark_exposed) */
     uint64_t t0;
 
-#define EYE(y)                                                                   \
-    do {                                                                         \
-        strip.y0 = tg.y0 = (y);                                                  \
-        strip.rows = tg.rows = (y) + rows > H ? H - (y) : rows;                  \
-        t0 = now(fd);                                                            \
-        om__eye_pass(s, &view, &tg, &strip, bins.rows ? &bins : NULL);           \
-        fs->ns_eye += now(fd) - t0;                                              \
-        fs->eye_passes++;                                                        \
-    } while (0)
-
     if (fit) {
         om_vec3 lo = om__v3(0, 0, 0), hi = om__v3(0, 0, 0);
         bool any = false;
         for (uint32_t y = 0; y < H; y += rows) {
-            EYE(y);
-            grow_light_box(&view, &strip, &lo, &hi, &any);
+            strip_at(&c, y, rows);
+            prepare(&c, true, false, fs);
+            grow_light_box(&view, &c.strip, &lo, &hi, &any);
         }
         if (any) om_view_fit_light(&view, s, lo, hi);
         have_samples = single;
@@ -136,10 +271,10 @@ om_status om_render_frame(const om_frame_desc *fd, om_arena *fa, om_frame_stats 
     if ((st = m->begin(fd->method_state, &view, d)) != OM_OK) goto done;
     if (observes) {
         for (uint32_t y = 0; y < H; y += rows) {
-            if (!have_samples) EYE(y);
-            mark_exposed(&view, &strip);
+            strip_at(&c, y, rows);
+            prepare(&c, !have_samples, true, fs);
             t0 = now(fd);
-            st = m->observe(fd->method_state, &strip, d);
+            st = m->observe(fd->method_state, &c.strip, d);
             fs->ns_observe += now(fd) - t0;
             if (st != OM_OK) goto done;
         }
@@ -151,19 +286,28 @@ om_status om_render_frame(const om_frame_desc *fd, om_arena *fa, om_frame_stats 
     fs->ns_build += now(fd) - t0;
     if (st != OM_OK) goto done;
     for (uint32_t y = 0; y < H; y += rows) {
-        if (!have_samples) EYE(y);
-        if (!have_terms) mark_exposed(&view, &strip);
+        strip_at(&c, y, rows);
+        prepare(&c, !have_samples, !have_terms, fs);
         t0 = now(fd);
-        st = m->resolve(fd->method_state, &strip, d);
+        if (c.bands) {
+            for (uint32_t j = 0; j < c.jobs; j++) memset(c.slots[j].counts, 0, sizeof c.slots[j].counts);
+            run_bands(&c, STAGE_RESOLVE);
+            uint32_t sum[8] = {0};
+            for (uint32_t j = 0; j < c.jobs; j++)
+                for (int k = 0; k < 8; k++) sum[k] += c.slots[j].counts[k];
+            c.bands->merge(fd->method_state, sum);
+        } else {
+            st = m->resolve(fd->method_state, &c.strip, d);
+        }
         fs->ns_resolve += now(fd) - t0;
         if (st != OM_OK) goto done;
         t0 = now(fd);
-        om__shade_strip(s, &view, fd->shade, &strip, fd->fb);
+        if (c.jobs > 1) run_bands(&c, STAGE_SHADE);
+        else om__shade_strip(s, &view, fd->shade, &c.strip, fd->fb);
         fs->ns_shade += now(fd) - t0;
         fs->strips++;
-        if (fd->on_strip && (st = fd->on_strip(fd->user, &strip, fd->fb)) != OM_OK) goto done;
+        if (fd->on_strip && (st = fd->on_strip(fd->user, &c.strip, fd->fb)) != OM_OK) goto done;
     }
-#undef EYE
 done:
     fs->frame_peak = fa->peak;
     om_arena_rewind(fa, mark);

@@ -85,6 +85,22 @@ bool om__exposed(const om_view *v, const om_sample *smp);
 /* Direction from a point towards the light (unit). */
 om_vec3 om__to_light(const om_view *v, om_vec3 p);
 
+/* A method's resolve by bands (frame.c runs them at once on the host's threads): the
+ * built-in methods whose resolve only reads the state after build. resolve writes the
+ * band's terms (the same as the method's own resolve) and touches nothing else but
+ * its job's `scratch` (`scratch` bytes, from the frame arena, aligned to 16) and
+ * `counts`, which the frame adds up over the jobs and hands to merge once per strip:
+ * integer sums, so the same whatever the number of jobs and their order. */
+typedef struct om__bands {
+    void (*resolve)(const void *state, om_strip *band, void *scratch, uint32_t counts[8]);
+    void (*merge)(void *state, const uint32_t counts[8]);
+    size_t scratch;
+} om__bands;
+
+/* Method m's bands; NULL where its resolve must run a strip at a time (registry.c,
+ * which alone names methods, so a firmware without one links none of its code). */
+const om__bands *om__method_bands(const om_method *m);
+
 /* Shades a strip into fb rows 0..st->rows-1. */
 void om__shade_strip(const om_scene *s, const om_view *v, const om_shade_cfg *c,
                      const om_strip *st, om_framebuffer *fb);

@@ -48,6 +48,21 @@ static om_status none_resolve(void *state, om_strip *st, om_diag *d)
     return OM_OK;
 }
 
+/* Bands: the same terms; no counts, no scratch. */
+static void none_band(const void *state, om_strip *st, void *scratch, uint32_t counts[8])
+{
+    (void)scratch; (void)counts;
+    (void)state;
+    none_resolve(NULL, st, NULL);
+}
+
+static void none_merge(void *state, const uint32_t counts[8])
+{
+    (void)state; (void)counts;
+}
+
+const om__bands om__bands_none = {none_band, none_merge, 0};
+
 static void none_stats(const void *state, om_method_stats *out)
 {
     memset(out, 0, sizeof *out);

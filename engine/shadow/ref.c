@@ -131,8 +131,17 @@ static om_status ref_build(void *state, om_diag *d)
     return OM_OK;
 }
 
+/* What one resolve changes: its counts and (one pass) its packet. The state is only
+ * read while the frame resolves, so jobs on several bands share it (om__bands). */
+typedef struct ref_job {
+    const ref_state *r;
+    packet *pk;
+    uint32_t samples, candidates, blocked;
+} ref_job;
+
 typedef struct walk_ctx {
-    ref_state *r;
+    const ref_state *r;
+    ref_job *j;
     om__lpoint p;
     om__odepth od;
 } walk_ctx;
@@ -141,7 +150,7 @@ static bool visit(void *user, uint32_t tri)
 {
     walk_ctx *w = (walk_ctx *)user;
     om__ltri lt;
-    w->r->candidates++;
+    w->j->candidates++;
     if (tri == w->p.tri || !om__lspace_maybe(&w->r->ls, tri, &w->p) ||
         !om__lspace_tri(&w->r->ls, tri, &lt) || !om__blocks(&lt, &w->p))
         return false;
@@ -149,18 +158,20 @@ static bool visit(void *user, uint32_t tri)
     return om__odepth_opaque(&w->od);
 }
 
-static void finish(ref_state *r, const walk_ctx *w, om_term *t)
+static void finish(const walk_ctx *w, om_term *t)
 {
     om__odepth_term(&w->od, t);
-    if (t->r != 255 || t->g != 255 || t->b != 255) r->blocked++;
+    if (t->r != 255 || t->g != 255 || t->b != 255) w->j->blocked++;
 }
 
 /* The shadow term of one sample against every triangle (the walk is a filter): the
  * least memory's way, along the segment in 3-D. */
-static void shade_sample(ref_state *r, const om_sample *smp, om_term *t)
+static void shade_sample(ref_job *j, const om_sample *smp, om_term *t)
 {
+    const ref_state *r = j->r;
     walk_ctx w;
     w.r = r;
+    w.j = j;
     memset(&w.od, 0, sizeof w.od);
     if (!om__lspace_point(&r->ls, smp, &w.p)) return;
     om_vec3 p = om__v3(smp->p[0], smp->p[1], smp->p[2]), dir;
@@ -174,16 +185,17 @@ static void shade_sample(ref_state *r, const om_sample *smp, om_term *t)
         tmax = 2.0f * (fabsf(ext.x) + fabsf(ext.y) + fabsf(ext.z)) + 1.0f;
     }
     om__bvh_walk(&r->bvh, p, dir, tmax, r->margin, visit, &w);
-    finish(r, &w, t);
+    finish(&w, t);
 }
 
 /* One pass: the samples of the block of side `size` at (bx, by) in the tile at (x0, y0),
  * with the nodes its enclosing block listed (ref_light.h). It recurses at most LEVELS
  * deep. */
-static void shade_block(ref_state *r, om_strip *st, uint32_t x0, uint32_t y0, uint32_t bx,
+static void shade_block(ref_job *j, om_strip *st, uint32_t x0, uint32_t y0, uint32_t bx,
                         uint32_t by, uint32_t size, const uint32_t *in, uint32_t nin, int level)
 {
-    packet *pk = r->pk;
+    const ref_state *r = j->r;
+    packet *pk = j->pk;
     om__lrect q = {INT64_MAX, INT64_MAX, INT64_MIN, INT64_MIN, 0.0};
     bool any = false;
     for (uint32_t y = by; y < by + size; y++)
@@ -203,10 +215,10 @@ static void shade_block(ref_state *r, om_strip *st, uint32_t x0, uint32_t y0, ui
     uint32_t n = om__lbvh_narrow(&r->lb, in, nin, &q, list, LIST, &open);
     if (open && size > 1) {
         uint32_t h = size / 2;
-        shade_block(r, st, x0, y0, bx, by, h, list, n, level + 1);
-        shade_block(r, st, x0, y0, bx + h, by, h, list, n, level + 1);
-        shade_block(r, st, x0, y0, bx, by + h, h, list, n, level + 1);
-        shade_block(r, st, x0, y0, bx + h, by + h, h, list, n, level + 1);
+        shade_block(j, st, x0, y0, bx, by, h, list, n, level + 1);
+        shade_block(j, st, x0, y0, bx + h, by, h, list, n, level + 1);
+        shade_block(j, st, x0, y0, bx, by + h, h, list, n, level + 1);
+        shade_block(j, st, x0, y0, bx + h, by + h, h, list, n, level + 1);
         return;
     }
     for (uint32_t y = by; y < by + size; y++)
@@ -214,17 +226,19 @@ static void shade_block(ref_state *r, om_strip *st, uint32_t x0, uint32_t y0, ui
             if (!pk->on[y * TILE + x]) continue;
             walk_ctx w;
             w.r = r;
+            w.j = j;
             w.p = pk->p[y * TILE + x];
             memset(&w.od, 0, sizeof w.od);
             om__lbvh_walk_list(&r->lb, &r->bvh, list, n, &w.p, visit, &w);
-            finish(r, &w, &st->terms[(size_t)(y0 + y) * st->width + x0 + x]);
+            finish(&w, &st->terms[(size_t)(y0 + y) * st->width + x0 + x]);
         }
 }
 
 /* Projects the tile's exposed samples, then shades it as one block. */
-static void shade_tile(ref_state *r, om_strip *st, uint32_t x0, uint32_t y0)
+static void shade_tile(ref_job *j, om_strip *st, uint32_t x0, uint32_t y0)
 {
-    packet *pk = r->pk;
+    const ref_state *r = j->r;
+    packet *pk = j->pk;
     for (uint32_t y = 0; y < TILE; y++)
         for (uint32_t x = 0; x < TILE; x++) {
             pk->on[y * TILE + x] = 0;
@@ -233,32 +247,61 @@ static void shade_tile(ref_state *r, om_strip *st, uint32_t x0, uint32_t y0)
             om_term *t = &st->terms[i];
             t->r = t->g = t->b = 255;
             if (!(t->flags & OM_TERM_EXPOSED)) continue;
-            r->samples++;
+            j->samples++;
             pk->on[y * TILE + x] = om__lspace_point(&r->ls, &st->samples[i], &pk->p[y * TILE + x]);
         }
     const uint32_t root = 0;
-    shade_block(r, st, x0, y0, 0, 0, TILE, &root, r->bvh.nnodes ? 1 : 0, 0);
+    shade_block(j, st, x0, y0, 0, 0, TILE, &root, r->bvh.nnodes ? 1 : 0, 0);
 }
 
-static om_status ref_resolve(void *state, om_strip *st, om_diag *d)
+static void resolve_job(ref_job *j, om_strip *st)
 {
-    (void)d;
-    ref_state *r = (ref_state *)state;
-    if (r->pk) {
+    if (j->pk) {
         for (uint32_t y = 0; y < st->rows; y += TILE)
-            for (uint32_t x = 0; x < st->width; x += TILE) shade_tile(r, st, x, y);
-        return OM_OK;
+            for (uint32_t x = 0; x < st->width; x += TILE) shade_tile(j, st, x, y);
+        return;
     }
     size_t n = (size_t)st->rows * st->width;
     for (size_t i = 0; i < n; i++) {
         om_term *t = &st->terms[i];
         t->r = t->g = t->b = 255;
         if (!(t->flags & OM_TERM_EXPOSED)) continue;
-        r->samples++;
-        shade_sample(r, &st->samples[i], t);
+        j->samples++;
+        shade_sample(j, &st->samples[i], t);
     }
+}
+
+static void ref_merge(void *state, const uint32_t counts[8])
+{
+    ref_state *r = (ref_state *)state;
+    r->samples += counts[0];
+    r->candidates += counts[1];
+    r->blocked += counts[2];
+}
+
+static om_status ref_resolve(void *state, om_strip *st, om_diag *d)
+{
+    (void)d;
+    ref_state *r = (ref_state *)state;
+    ref_job j = {r, r->pk, 0, 0, 0};
+    resolve_job(&j, st);
+    const uint32_t counts[8] = {j.samples, j.candidates, j.blocked, 0, 0, 0, 0, 0};
+    ref_merge(r, counts);
     return OM_OK;
 }
+
+/* Bands: each job walks with its own packet (the frame's scratch) and counts. */
+static void ref_band(const void *state, om_strip *st, void *scratch, uint32_t counts[8])
+{
+    const ref_state *r = (const ref_state *)state;
+    ref_job j = {r, r->pk ? (packet *)scratch : NULL, 0, 0, 0};
+    resolve_job(&j, st);
+    counts[0] += j.samples;
+    counts[1] += j.candidates;
+    counts[2] += j.blocked;
+}
+
+const om__bands om__bands_ref = {ref_band, ref_merge, sizeof(packet)};
 
 static void ref_stats(const void *state, om_method_stats *out)
 {

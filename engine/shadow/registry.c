@@ -54,6 +54,30 @@ METHODS(DECLARE)
 
 static const om_method *const methods[] = {METHODS(ENTRY) NULL};
 
+/* The methods whose resolve runs by bands on the host's threads (frame.h, om__bands):
+ * those whose resolve only reads the state once it is built. asm (its resolve moves a
+ * cache and the tree's use marks), spsm (counts inside its lookup), izb and hybrid
+ * (per-strip lists in the state) resolve a strip at a time. */
+#define BANDED(X)            \
+    X(none, OM_WITH_NONE)    \
+    X(ref, OM_WITH_REF)      \
+    X(sm, OM_WITH_SM)        \
+    X(rtw, OM_WITH_RTW)
+
+#define DECLARE_BANDS(m, on) extern const om__bands om__bands_##m;
+BANDED(DECLARE_BANDS)
+
+#define BANDS_1(m) if (m_ == &om__method_##m) return &om__bands_##m;
+#define BANDS_0(m)
+#define BANDS(m, on) CAT(BANDS_, on)(m)
+
+const om__bands *om__method_bands(const om_method *m_)
+{
+    BANDED(BANDS)
+    (void)m_;
+    return NULL;
+}
+
 size_t om_method_count(void) { return sizeof methods / sizeof methods[0] - 1; }
 
 const om_method *om_method_at(size_t i)

@@ -468,6 +468,22 @@ static om_status rtw_resolve(void *state, om_strip *st, om_diag *d)
     return OM_OK;
 }
 
+/* Bands: as sm's; the warp tables are read only. */
+static void rtw_band(const void *state, om_strip *st, void *scratch, uint32_t counts[8])
+{
+    (void)scratch;
+    om__smlook_strip(&((const om__rtw *)state)->look, st, &counts[0], &counts[1]);
+}
+
+static void rtw_merge(void *state, const uint32_t counts[8])
+{
+    om__rtw *m = (om__rtw *)state;
+    m->samples += counts[0];
+    m->shadowed += counts[1];
+}
+
+const om__bands om__bands_rtw = {rtw_band, rtw_merge, 0};
+
 static uint32_t sat_u32(double v)
 {
     return !(v > 0.0) ? 0u : v >= 4294967295.0 ? 0xFFFFFFFFu : (uint32_t)(v + 0.5);

@@ -112,6 +112,22 @@ static om_status sm_resolve(void *state, om_strip *st, om_diag *d)
     return OM_OK;
 }
 
+/* Bands: the lookup reads the map and the state; its counts go to the job's. */
+static void sm_band(const void *state, om_strip *st, void *scratch, uint32_t counts[8])
+{
+    (void)scratch;
+    om__smlook_strip(&((const sm_state *)state)->look, st, &counts[0], &counts[1]);
+}
+
+static void sm_merge(void *state, const uint32_t counts[8])
+{
+    sm_state *m = (sm_state *)state;
+    m->samples += counts[0];
+    m->shadowed += counts[1];
+}
+
+const om__bands om__bands_sm = {sm_band, sm_merge, 0};
+
 static void sm_stats(const void *state, om_method_stats *out)
 {
     const sm_state *m = (const sm_state *)state;

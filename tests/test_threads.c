@@ -1,0 +1,149 @@
+/* test_threads.c — many cores, same bits: every method's frame (pixels, terms, mask)
+ * and counters with 1, 2, 3, 4, 7 and 16 threads through the platform's pool, and with
+ * a parallel-for that runs its jobs backwards, against the inline frame; whole frames
+ * and strips, a spot and a directional light. And the frame arena: room for N jobs
+ * but not N + 1 runs N. */
+#include "test.h"
+#include "harness.h"
+#include "../platform/platform.h"
+
+#include <stdlib.h>
+
+/* Jobs in reverse order on the calling thread: no job may depend on another's order. */
+static void backwards(void *host, om_job_fn fn, void *user, uint32_t n)
+{
+    (void)host;
+    for (uint32_t i = n; i-- > 0;) fn(user, i);
+}
+
+typedef struct frame_out {
+    uint64_t hash;             /* pixels, terms and samples, strip by strip */
+    om_method_stats ms;
+    uint32_t jobs;
+    om_status st;
+} frame_out;
+
+static om_status on_strip(void *user, const om_strip *st, const om_framebuffer *fb)
+{
+    uint64_t *h = (uint64_t *)user;
+    size_t n = (size_t)st->rows * st->width;
+    *h = om_hash(*h, fb->pixels, fb->stride * st->rows);
+    *h = om_hash(*h, st->terms, n * sizeof *st->terms);
+    *h = om_hash(*h, st->samples, n * sizeof *st->samples);
+    return OM_OK;
+}
+
+/* One frame of method m with a fresh state; frame arena of om_frame_bytes_scene (or
+ * without bins, om_frame_bytes) plus `jobs_room` jobs' share. */
+static frame_out render(const om_scene *s, const om_method *m, uint32_t W, uint32_t H, uint32_t rows,
+                        om_parallel_for_fn pf, void *host, uint32_t threads, uint32_t jobs_room,
+                        bool bins)
+{
+    frame_out o;
+    memset(&o, 0, sizeof o);
+    om_camera cam;
+    om_light light;
+    om_view v;
+    om_diag d;
+    om_scene_at(s, 0.0f, &cam, &light);
+    cam.width = W;
+    cam.height = H;
+    if ((o.st = om_view_init(&v, &cam, &light, s, &d))) return o;
+    om_method_cfg c = h_cfg(m->name, "map=512");
+    size_t mn, full;
+    if ((o.st = m->bytes(&c, s, W, H, &mn, &full))) return o;
+    uint32_t r = rows ? rows : H;
+    size_t fbytes = (bins ? om_frame_bytes_scene(s, W, r) : om_frame_bytes(W, r)) +
+                    om_frame_bytes_jobs(m, jobs_room);
+    void *mm = malloc(full), *fm = malloc(fbytes), *px = malloc((size_t)W * r * 3);
+    om_arena ma, fa;
+    om_arena_init(&ma, mm, full, "method");
+    om_arena_init(&fa, fm, fbytes, "frame");
+    void *state;
+    if ((o.st = m->init(&state, &ma, &c, s, W, H, &d)) == OM_OK) {
+        om_framebuffer fb = {OM_RGB888, W, r, (size_t)W * 3, (uint8_t *)px};
+        om_shade_cfg shade;
+        om_shade_cfg_default(&shade);
+        om_frame_desc fd;
+        memset(&fd, 0, sizeof fd);
+        fd.scene = s; fd.view = &v; fd.method = m; fd.method_state = state; fd.shade = &shade;
+        fd.strip_rows = rows; fd.fb = &fb; fd.on_strip = on_strip; fd.user = &o.hash;
+        fd.parallel_for = pf; fd.parallel_user = host; fd.threads = threads;
+        o.hash = OM_HASH_INIT;
+        om_frame_stats fs;
+        o.st = om_render_frame(&fd, &fa, &fs, &d);
+        o.jobs = fs.jobs;
+        m->stats(state, &o.ms);
+    }
+    free(mm);
+    free(fm);
+    free(px);
+    return o;
+}
+
+/* The default scene (a spot light) and one under a directional light, which the frame
+ * fits to the visible samples in a pass of its own. */
+static const char directional[] =
+    "camera eye 2 6 9 target 0 0.5 0 fov 50\n"
+    "light directional dir -0.4 -1 -0.3\n"
+    "plane size 20 20 divisions 5\n"
+    "sphere radius 1 segments 32 rings 16 translate 0 1.5 0 opacity 0.5\n"
+    "box size 1 2 1 translate 2 1 -1 rotate 0 30 0\n"
+    "triangles count 300 seed 5 area 10 in -3 2 -3 3 4 3\n";
+
+static void same_bits(void)
+{
+    static const uint32_t threads[] = {1, 2, 3, 4, 7, 16};
+    om_jobs *pools[6];
+    for (int k = 0; k < 6; k++) CHECK_OK(om_jobs_start(&pools[k], threads[k], NULL));
+    for (int li = 0; li < 2; li++) {
+        const char *text = li ? directional : om_scene_default_text();
+        h_scene hs;
+        if (!h_scene_parse(&hs, text)) continue;
+        for (size_t mi = 0; mi < om_method_count(); mi++) {
+            const om_method *m = om_method_at(mi);
+            for (uint32_t rows = 0; rows <= 40; rows += 40) {
+                frame_out one = render(&hs.s, m, 120, 90, rows, NULL, NULL, 1, 0, true);
+                CHECK_MSG(one.st == OM_OK && one.jobs == 1, "%s: inline frame", m->name);
+                for (int k = 0; k < 7; k++) {
+                    uint32_t n = k < 6 ? threads[k] : 5;
+                    frame_out o = k < 6 ? render(&hs.s, m, 120, 90, rows, om_jobs_for, pools[k], n, n, true)
+                                        : render(&hs.s, m, 120, 90, rows, backwards, NULL, n, n, true);
+                    CHECK_MSG(o.st == OM_OK && o.jobs == n, "%s: %u jobs ran %u", m->name, n, o.jobs);
+                    CHECK_MSG(o.hash == one.hash, "%s light %d strips %u: %u threads%s change the frame",
+                              m->name, li, rows, n, k < 6 ? "" : " backwards");
+                    CHECK_MSG(!memcmp(o.ms.counters, one.ms.counters, sizeof o.ms.counters),
+                              "%s: %u threads change the counters", m->name, n);
+                }
+            }
+        }
+        h_scene_free(&hs);
+    }
+    for (int k = 0; k < 6; k++) om_jobs_stop(pools[k]);
+}
+
+/* A frame arena with room for 3 jobs runs 3 when 8 are asked for (the bins of a whole
+ * frame kept beside them), and one (inline) with room for fewer than 2. */
+static void fewer_jobs(void)
+{
+    h_scene hs;
+    if (!h_scene_parse(&hs, om_scene_default_text())) return;
+    const om_method *m = om_method_find("ref");
+    frame_out one = render(&hs.s, m, 64, 48, 0, NULL, NULL, 1, 0, true);
+    frame_out three = render(&hs.s, m, 64, 48, 0, backwards, NULL, 8, 3, true);
+    frame_out three_nobins = render(&hs.s, m, 64, 48, 0, backwards, NULL, 8, 3, false);
+    frame_out none = render(&hs.s, m, 64, 48, 0, backwards, NULL, 8, 1, false);
+    CHECK_EQ_U(three.jobs, 3);
+    CHECK_EQ_U(three_nobins.jobs, 3);
+    CHECK_EQ_U(none.jobs, 1);
+    CHECK(three.hash == one.hash && three_nobins.hash == one.hash && none.hash == one.hash);
+    CHECK_EQ_U(om_frame_bytes_jobs(m, 1), 0);
+    CHECK(om_frame_bytes_jobs(m, 4) == 2 * om_frame_bytes_jobs(m, 2));
+    h_scene_free(&hs);
+}
+
+void suite_threads(void)
+{
+    RUN(same_bits);
+    RUN(fewer_jobs);
+}
