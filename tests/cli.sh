@@ -326,6 +326,7 @@ expect 1 "bench on a malformed scene" -- "$OMBRA" bench --scenes "$dir/ok.scene,
 cmp -s "$dir/bench/bench.csv" "$dir/bench-old.csv" && ok || bad "a failed bench replaced the CSV"
 has "$dir/bench/bench.csv" "^scene,method,setting,width,height,time_ms,init_ms," "bench.csv has an init column"
 has "$dir/bench/bench.csv" ",stats$" "bench.csv ends with the methods' counters"
+has "$dir/bench/bench.csv" ",threads,stats$" "bench.csv records the threads"
 has "$dir/bench/bench.csv" "bsp nodes=" "bench.csv carries izb's counters"
 if awk -F, 'NR > 1 && ($4 != 64 || $5 != 48) {exit 1}' "$dir/bench/bench.csv"; then ok; else bad "bench ignored the scene's 64x48"; fi
 if [ -s "$dir/bench/ok.scene-first.svg" ]; then ok; else bad "no first-frame (init + frame) chart"; fi
@@ -343,7 +344,17 @@ hashes=$(dirname "$OMBRA")/frame-hashes.txt
 for m in $("$OMBRA" methods | awk 'NF == 0 {exit} {print $1}'); do
     expect 0 "render --method $m" -- "$OMBRA" render --size 160x120 --method "$m" --map 512 --out "$dir/m.ppm"
     echo "$m $(grep '^hash:' "$dir/out")" >>"$hashes"
+    # the same frame on 1 and 3 threads, whole and through strips (engine/frame/frame.c)
+    want=$(grep '^hash:' "$dir/out")
+    for args in "--threads 1" "--threads 3" "--threads 3 --strip 50"; do
+        expect 0 "render --method $m $args" -- "$OMBRA" render --size 160x120 --method "$m" --map 512 $args --out "$dir/m.ppm"
+        [ "$(grep '^hash:' "$dir/out")" = "$want" ] && ok || bad "$m: $args changes the frame"
+    done
 done
+expect 2 "render --threads 0" -- "$OMBRA" render --threads 0 --out "$dir/z.ppm"
+has "$dir/err" "threads takes a thread count" "--threads 0 is a usage error"
+expect 0 "render --threads 2" -- "$OMBRA" render --size 64x48 --threads 2 --out "$dir/z.ppm"
+has "$dir/out" ", 2 thread(s)$" "render says how many threads the frame ran on"
 
 echo "cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]

@@ -32,6 +32,8 @@ static const char bench_help[] =
     "  --methods LIST    comma-separated method names (default: every swept method)\n"
     "  --size WxH        image size (default: each scene's own camera size)\n"
     "  --runs N          frames per point; times are their median (default 3)\n"
+    "  --threads N       threads each frame runs on (default: the CPUs online); the\n"
+    "                    CSV's threads column says how many jobs ran at once\n"
     "  --tri-sweep       also time the exact methods on 1K..1M random triangles\n"
     "  --out DIR         where bench.csv and the charts go (default out/bench)\n";
 
@@ -125,6 +127,11 @@ om_status cli_measure_strips(const om_method *m, const om_method_cfg *cfg, const
     size_t mn, full;
     om_status st = m->bytes(cfg, &cs->scene, W, H, &mn, &full);
     if (st) return st;
+    /* threads: each job's scratch, and the bins the bands of a whole frame use */
+    if (cli_threads() > 1) {
+        fbytes += om_frame_bytes_jobs(m, cli_threads());
+        if (!rows || rows >= H) fbytes += om_frame_bytes_scene(&cs->scene, W, H) - om_frame_bytes(W, H);
+    }
     void *mem = malloc(full ? full : 1), *fmem = malloc(fbytes), *px = malloc((size_t)W * H * 3);
     if (!mem || !fmem || !px) {
         free(mem); free(fmem); free(px);
@@ -152,8 +159,10 @@ om_status cli_measure_strips(const om_method *m, const om_method_cfg *cfg, const
         fd.scene = &cs->scene; fd.view = v; fd.method = m; fd.method_state = state;
         fd.shade = &shade; fd.fb = &fb; fd.on_strip = grab; fd.user = &mo; fd.clock = om_clock_ns;
         fd.strip_rows = rows;
+        cli_frame_jobs(&fd);
         om_frame_stats fs;
         st = om_render_frame(&fd, &fa, &fs, d);
+        p->threads = fs.jobs;
         t[0][r] = (double)fs.ns_eye / 1e6;
         t[1][r] = (double)fs.ns_observe / 1e6;
         t[2][r] = (double)fs.ns_build / 1e6;
@@ -414,18 +423,18 @@ static int write_outputs(const char *dir, char **names, size_t nn, const cli_poi
         FILE *f = outs[k].f;
         fprintf(f, "scene,method,setting,width,height,time_ms,init_ms,eye_ms,observe_ms,build_ms,"
                    "resolve_ms,shade_ms,bytes,samples,false_lit,false_shadowed,mismatch_share,"
-                   "edge_samples,edge_mismatch_share,time_min_ms,time_max_ms,stats\n");
+                   "edge_samples,edge_mismatch_share,time_min_ms,time_max_ms,threads,stats\n");
         for (int i = 0; i < np; i++) {
             const cli_point *p = &pts[i];
             double share = 1.0 - om_metrics_match(&p->m);
             double edge = p->m.edge_samples ? (double)(p->m.edge_false_lit + p->m.edge_false_shadowed) /
                                                   (double)p->m.edge_samples : 0.0;
-            fprintf(f, "%s,%s,%s,%u,%u,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%zu,%llu,%llu,%llu,%.6f,%llu,%.6f,%.3f,%.3f,%s\n",
+            fprintf(f, "%s,%s,%s,%u,%u,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%zu,%llu,%llu,%llu,%.6f,%llu,%.6f,%.3f,%.3f,%u,%s\n",
                     p->scene, p->method, p->setting, p->w, p->h, p->total, p->init, p->eye,
                     p->observe, p->build, p->resolve, p->shade, p->bytes,
                     (unsigned long long)p->m.samples, (unsigned long long)p->m.false_lit,
                     (unsigned long long)p->m.false_shadowed, share,
-                    (unsigned long long)p->m.edge_samples, edge, p->tmin, p->tmax, p->stats);
+                    (unsigned long long)p->m.edge_samples, edge, p->tmin, p->tmax, p->threads, p->stats);
         }
         k++;
     }
@@ -481,6 +490,7 @@ int cmd_bench(int argc, char **argv)
     const char *scenes = "default,random-10K", *methods = NULL, *dir = "out/bench";
     uint32_t w = 0, h = 0, runs = 3;
     bool tri_sweep = false;
+    const char *threads = NULL;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) { fputs(bench_help, stdout); return 0; }
@@ -489,11 +499,13 @@ int cmd_bench(int argc, char **argv)
         if (!strcmp(a, "--scenes")) scenes = v;
         else if (!strcmp(a, "--methods")) methods = v;
         else if (!strcmp(a, "--out")) dir = v;
+        else if (!strcmp(a, "--threads")) threads = v;
         else if (!strcmp(a, "--size")) { if (!cli_parse_size(v, &w, &h)) return cli_usage_error(argv[0], "--size takes WxH, not '%s'", v); }
         else if (!strcmp(a, "--runs")) { if (!cli_parse_u32(v, 1, 16, &runs)) return cli_usage_error(argv[0], "--runs takes 1..16, not '%s'", v); }
         else return cli_usage_error(argv[0], "unknown option '%s'", a);
         i++;
     }
+    if (!cli_threads_start(argv[0], threads)) return 2;
     size_t cap = 1;
     for (const char *p = scenes; *p; p++) cap += *p == ',';
     char *list = malloc(strlen(scenes) + 1), **names = calloc(cap, sizeof *names);

@@ -294,3 +294,41 @@ bool cli_cfg(const om_method *m, const cli_settings *s, om_method_cfg *c, const 
     }
     return true;
 }
+
+/* The pool every frame of this command runs on (NULL: inline). */
+static om_jobs *pool;
+
+bool cli_threads_start(const char *cmd, const char *arg)
+{
+    uint32_t n = om_cpus_online();
+    if (arg && !cli_parse_u32(arg, 1, 1024, &n)) {
+        cli_usage_error(cmd, "--threads takes a thread count 1..1024, not '%s'", arg);
+        return false;
+    }
+    cli_threads_stop();
+    om_diag d;
+    om_status st = om_jobs_start(&pool, n, &d);
+    if (st != OM_OK) {
+        cli_error(cmd, &d, st);
+        return false;
+    }
+    return true;
+}
+
+void cli_threads_stop(void)
+{
+    om_jobs_stop(pool);
+    pool = NULL;
+}
+
+uint32_t cli_threads(void)
+{
+    return om_jobs_threads(pool);
+}
+
+void cli_frame_jobs(om_frame_desc *fd)
+{
+    fd->parallel_for = pool ? om_jobs_for : NULL;
+    fd->parallel_user = pool;
+    fd->threads = om_jobs_threads(pool);
+}

@@ -59,6 +59,16 @@ bool cli_cfg(const om_method *m, const cli_settings *s, om_method_cfg *c, const 
  * whose product is swept; NULL = the defaults only, "" = left out of sweeps. */
 const char *cli_sweep(const om_method *m);
 
+/* The frames' threads (--threads N, platform/jobs.c): a pool the command starts once
+ * (before that, and for commands without --threads, frames run on one thread).
+ * cli_threads_start takes N as given ("0" or anything but 1..1024 is a usage error,
+ * printed) or, for NULL, the CPUs online; cli_threads_stop ends the pool. */
+bool cli_threads_start(const char *cmd, const char *arg);
+void cli_threads_stop(void);
+uint32_t cli_threads(void);
+/* Hands the pool to a frame: its parallel-for and thread count. */
+void cli_frame_jobs(om_frame_desc *fd);
+
 int cmd_render(int argc, char **argv);
 int cmd_info(int argc, char **argv);
 int cmd_compare(int argc, char **argv);
@@ -75,6 +85,7 @@ typedef struct cli_point {
     size_t bytes;
     om_metrics m;
     char stats[256];       /* the method's counters of the last frame: "name=value; ..." */
+    uint32_t threads;      /* the jobs its frames ran at once (om_frame_stats.jobs) */
     int ok;
 } cli_point;
 

@@ -116,10 +116,13 @@ int main(int argc, char **argv)
         printf("ombra %s\n", OMBRA_VERSION_STRING);
         return 0;
     }
-    if (!strcmp(argv[1], "render")) return cmd_render(argc - 1, argv + 1);
+    if (!strcmp(argv[1], "render") || !strcmp(argv[1], "bench")) {
+        int rc = !strcmp(argv[1], "render") ? cmd_render(argc - 1, argv + 1) : cmd_bench(argc - 1, argv + 1);
+        cli_threads_stop();
+        return rc;
+    }
     if (!strcmp(argv[1], "info")) return cmd_info(argc - 1, argv + 1);
     if (!strcmp(argv[1], "compare")) return cmd_compare(argc - 1, argv + 1);
-    if (!strcmp(argv[1], "bench")) return cmd_bench(argc - 1, argv + 1);
     if (!strcmp(argv[1], "report")) return cmd_report(argc - 1, argv + 1);
     if (!strcmp(argv[1], "scene")) return print_scene(argc, argv);
     if (!strcmp(argv[1], "methods")) return no_options(argc, argv, methods_help, list_methods);

@@ -23,6 +23,8 @@ static const char render_help[] =
     "  --time T          time along the scene's camera and light paths (default 0)\n"
     "  --format F        framebuffer format: rgb888 (default), rgb565, l8\n"
     "  --strip ROWS      render through strips of ROWS rows (default: whole frame)\n"
+    "  --threads N       threads a frame runs on (default: the CPUs online); the\n"
+    "                    frame is the same bits with any N\n"
     "  --budget BYTES    total memory for scene, frame and method (K, M, G suffixes),\n"
     "                    or 'none' (the default); the strip height shrinks to fit, down\n"
     "                    to one row\n"
@@ -78,11 +80,18 @@ static om_status on_strip(void *user, const om_strip *st, const om_framebuffer *
 /* The frame arena: the strips, and their row bins when `bins` (then each strip sets
  * up only its own triangles; the same pixels either way). */
 static om_status run_frame(run *r, const cli_scene *cs, const om_view *v, uint32_t rows, bool bins,
-                           om_format fmt, strip_out *out, om_frame_stats *fs, size_t *frame_bytes,
+                           bool jobs, om_format fmt, strip_out *out, om_frame_stats *fs, size_t *frame_bytes,
                            om_diag *d)
 {
     uint32_t W = v->cam.width;
     *frame_bytes = bins ? om_frame_bytes_scene(&cs->scene, W, rows) : om_frame_bytes(W, rows);
+    /* Threads: each job's scratch, and bins for the bands of a whole frame (under a
+     * --budget there is no room kept for them: the frame runs with what fits). */
+    if (jobs) {
+        *frame_bytes += om_frame_bytes_jobs(r->m, cli_threads());
+        if (rows == v->cam.height) *frame_bytes = om_frame_bytes_scene(&cs->scene, W, rows) +
+                                                 om_frame_bytes_jobs(r->m, cli_threads());
+    }
     void *frame_mem = malloc(*frame_bytes);
     om_framebuffer fb;
     fb.format = fmt;
@@ -110,6 +119,7 @@ static om_status run_frame(run *r, const cli_scene *cs, const om_view *v, uint32
         fd.on_strip = on_strip;
         fd.user = out;
         fd.clock = om_clock_ns;
+        cli_frame_jobs(&fd);
         st = om_render_frame(&fd, &fa, fs, d);
     }
     free(frame_mem);
@@ -157,7 +167,7 @@ static int same_files(const char *const *paths, const char *const *names, size_t
 int cmd_render(int argc, char **argv)
 {
     const char *scene_path = NULL, *out = NULL, *mask = NULL, *mname = "sm";
-    const char *against = NULL, *diff = NULL;
+    const char *against = NULL, *diff = NULL, *threads = NULL;
     uint32_t w = 0, h = 0, strip = 0;
     size_t budget = 0;     /* 0: no --budget (or --budget none) */
     float t = 0.0f;
@@ -175,7 +185,7 @@ int cmd_render(int argc, char **argv)
         if (!strcmp(a, "--quiet") || !strcmp(a, "-q")) { quiet = true; continue; }
         static const char *const valued[] = {"--method", "--against", "--out", "--mask", "--diff",
             "--size", "--strip", "--budget", "--time", "--format", "--set", "--map", "--pcf",
-            "--bias", "--slope", "--offset"};
+            "--bias", "--slope", "--offset", "--threads"};
         bool known = false;
         for (size_t k = 0; k < sizeof valued / sizeof valued[0]; k++) known |= !strcmp(a, valued[k]);
         if (a[0] == '-' && !known) return cli_usage_error("render", "unknown option '%s'", a);
@@ -187,6 +197,7 @@ int cmd_render(int argc, char **argv)
         else if (!strcmp(a, "--diff")) diff = v;
         else if (!strcmp(a, "--size")) { if (!cli_parse_size(v, &w, &h)) return cli_usage_error("render", "--size takes WxH with each side 1..8192, not '%s'", v); }
         else if (!strcmp(a, "--strip")) { if (!cli_parse_u32(v, 1, OM_MAX_DIM, &strip)) return cli_usage_error("render", "--strip takes a row count 1..8192, not '%s'", v); }
+        else if (!strcmp(a, "--threads")) threads = v;
         else if (!strcmp(a, "--budget")) { if (!cli_parse_budget("render", v, &budget)) return 2; }
         else if (!strcmp(a, "--time")) { if (!cli_parse_float(v, &t)) return cli_usage_error("render", "--time takes a number, not '%s'", v); }
         else if (!strcmp(a, "--format")) { if (!parse_format(v, &fmt)) return cli_usage_error("render", "--format is rgb888, rgb565 or l8, not '%s'", v); }
@@ -206,6 +217,7 @@ int cmd_render(int argc, char **argv)
     }
     /* A grey frame is written as a PGM; the default name says so. */
     if (!out) out = fmt == OM_L8 ? "ombra.pgm" : "ombra.ppm";
+    if (!cli_threads_start("render", threads)) return 2;
     if (diff && !against) return cli_usage_error("render", "%s needs --against", "--diff");
     main_run.m = om_method_find(mname);
     if (!main_run.m) return cli_unknown_method("render", "--method", mname);
@@ -301,7 +313,7 @@ int cmd_render(int argc, char **argv)
         strip_out ro = {NULL, mask_ref};
         om_frame_stats rfs;
         size_t rfb;
-        if ((st = run_frame(&ref_run, &cs, &view, rows, bins, fmt, &ro, &rfs, &rfb, &d)) != OM_OK) {
+        if ((st = run_frame(&ref_run, &cs, &view, rows, bins, !budget, fmt, &ro, &rfs, &rfb, &d)) != OM_OK) {
             rc = cli_error(against, &d, st);
             goto out;
         }
@@ -310,7 +322,7 @@ int cmd_render(int argc, char **argv)
     om_frame_stats fs;
     size_t frame_bytes;
     uint64_t t0 = om_clock_ns(NULL);
-    st = run_frame(&main_run, &cs, &view, rows, bins, fmt, &so, &fs, &frame_bytes, &d);
+    st = run_frame(&main_run, &cs, &view, rows, bins, !budget, fmt, &so, &fs, &frame_bytes, &d);
     uint64_t t1 = om_clock_ns(NULL);
     if (st != OM_OK) {
         /* A write that failed stopped the frame: name the file, not the method. */
@@ -337,8 +349,8 @@ int cmd_render(int argc, char **argv)
     if (!quiet) {
         om_method_stats ms;
         main_run.m->stats(main_run.state, &ms);
-        fprintf(info, "%s: %ux%u, %u triangles, method %s, %u strip(s) of %u rows\n", where, W, H,
-                cs.scene.ntris, mname, fs.strips, rows);
+        fprintf(info, "%s: %ux%u, %u triangles, method %s, %u strip(s) of %u rows, %u thread(s)\n",
+                where, W, H, cs.scene.ntris, mname, fs.strips, rows, fs.jobs);
         fprintf(info, "time: total %.2f ms (init %.2f, eye %.2f x%u, observe %.2f, build %.2f, "
                 "resolve %.2f, shade %.2f)\n",
                 (double)(main_run.ns_init + (t1 - t0)) / 1e6, (double)main_run.ns_init / 1e6,
