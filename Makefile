@@ -122,6 +122,20 @@ test-sanitize:
 	$(MAKE) --no-print-directory check CC=clang OPT=-O1 O=build/san \
 	  EXTRA="-fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer"
 
+# The threaded tests and a threaded render of every method under clang's
+# ThreadSanitizer: the frame's jobs must share nothing they write.
+TSAN = build/tsan
+test-tsan:
+	$(MAKE) --no-print-directory $(TSAN)/run-tests $(TSAN)/ombra CC=clang OPT=-O1 O=$(TSAN) \
+	  EXTRA="-fsanitize=thread -fno-omit-frame-pointer"
+	TSAN_OPTIONS=halt_on_error=1 $(TSAN)/run-tests same_bits
+	TSAN_OPTIONS=halt_on_error=1 $(TSAN)/run-tests fewer_jobs
+	@for m in $$($(TSAN)/ombra methods | awk 'NF == 0 {exit} {print $$1}'); do \
+	  for s in 0 40; do \
+	    TSAN_OPTIONS=halt_on_error=1 $(TSAN)/ombra render --quiet --size 200x150 --method $$m --map 512 \
+	      --threads 4 $$([ $$s -gt 0 ] && echo --strip $$s) --out $(TSAN)/tsan.ppm || exit 1; \
+	  done; done; echo "tsan: every method, 4 threads, whole frame and strips: clean"
+
 bench:
 	$(MAKE) --no-print-directory $(O)/bench $(O)/ombra OPT="-O2 -DNDEBUG"
 	$(O)/bench
@@ -184,5 +198,5 @@ install-check: $(O)/embed-render-once
 clean:
 	rm -rf build out
 
-.PHONY: all run test check test-sanitize bench cross-test fuzz fuzz-regress test-valgrind stress stability clean \
+.PHONY: all run test check test-sanitize test-tsan bench cross-test fuzz fuzz-regress test-valgrind stress stability clean \
         install uninstall install-check
