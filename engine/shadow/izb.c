@@ -2,9 +2,10 @@
  *
  * Section 3: every exposed visible sample is transformed to the light's image plane
  * without discretising it (the light grid of occlude.h, 2^21 steps across).
- * Section 5.1: the samples are organised in an axis-aligned 2-D BSP with alternating
- * x/y splits at the median (quickselect), leaves of at most izb.leaf samples; each
- * node keeps the bounds of its samples and their largest light depth.
+ * Section 5.1: the samples are organised in an axis-aligned 2-D BSP (here split along
+ * their Z order rather than at medians), leaves of at most izb.leaf samples; each
+ * node keeps the bounds of its samples and their largest light depth. A grid of
+ * cells, each one node of the tree, lets small triangles skip the descent.
  * Sections 3-5: every triangle is rasterized through the BSP: a node is entered only
  * when the triangle's footprint can touch its bounds (bounding boxes, then the exact
  * integer edge functions at the box's corners), when it still holds a sample not yet
@@ -33,10 +34,31 @@ typedef struct izb_state {
 /* Least samples a split leaves in a leaf: a node splits only above `leaf` samples. */
 static uint32_t min_leaf(uint32_t leaf) { return (leaf + 1) / 2 ? (leaf + 1) / 2 : 1; }
 
+/* The Z order of the BSP's keys has ZBITS bits an axis (see zcode): 4M cells over a
+ * tile, far finer than its leaves (keys of one code are split in the middle), and a
+ * sort of two passes. */
+#define ZBITS 11
+
+/* The grid in front of the BSP (see om__izb_build): at most a cell per CELL_FILL
+ * samples, a power of 4 (2^k x 2^k cells), k at most ZBITS. Finer cells let a small
+ * triangle reach its samples without descending the tree; coarser ones cost a large
+ * triangle fewer cell checks. */
+#define CELL_FILL 4u
+#define DIRECT 16   /* most cells a triangle's bounds may cover to be sent to them directly */
+
+static uint32_t cells_bound(uint32_t samples)
+{
+    uint32_t c = 1, want = samples / CELL_FILL;
+    while (c < (1u << 2 * ZBITS) && c * 4 <= want) c *= 4;
+    return c;
+}
+
+/* The tree's top (down to the grid's cells) has at most 2 nodes a cell; below, a node
+ * splits only while it has room. */
 static uint32_t node_bound(uint32_t samples, uint32_t leaf)
 {
     uint32_t leaves = samples / min_leaf(leaf);
-    return 2 * (leaves ? leaves : 1) + 1;
+    return 2 * (leaves ? leaves : 1) + 1 + 2 * cells_bound(samples);
 }
 
 /* The per-frame vertex projection is kept only when the arena has room for one pass
@@ -51,7 +73,8 @@ size_t om__izb_pool_bytes(uint32_t samples, uint32_t leaf)
 {
     return om_arena_need((size_t)samples * sizeof(om__izb_sample), 16) +
            2 * om_arena_need((size_t)samples * sizeof(om__izb_key), 16) +
-           om_arena_need((size_t)node_bound(samples, leaf) * sizeof(om__izb_node), 16);
+           om_arena_need((size_t)node_bound(samples, leaf) * sizeof(om__izb_node), 16) +
+           om_arena_need((size_t)cells_bound(samples) * sizeof(uint32_t), 16);
 }
 
 static size_t fixed_bytes(const om_scene *s, bool cache)
@@ -113,6 +136,9 @@ om_status om__izb_setup(om__izb *z, om_arena *a, const om__izb_cfg *c, const om_
     z->sorted = (om__izb_key *)p;
     if ((st = om_arena_alloc(a, (size_t)z->node_cap * sizeof(om__izb_node), 16, &p, d))) return st;
     z->nodes = (om__izb_node *)p;
+    z->cells_cap = cells_bound(cap);
+    if ((st = om_arena_alloc(a, (size_t)z->cells_cap * sizeof(uint32_t), 16, &p, d))) return st;
+    z->cells = (uint32_t *)p;
     return OM_OK;
 }
 
@@ -194,7 +220,7 @@ uint32_t om__izb_transform(om__izb *z, const om_strip *st, size_t *next, size_t 
 /* ---- stage 2: the 2-D BSP */
 
 /* The Z-order (Morton) code of a key: x and y relative to the tile's corner, shifted
- * to 16 bits each, bits interleaved. */
+ * to ZBITS bits each, bits interleaved. */
 static uint32_t spread(uint32_t v)
 {
     v &= 0xFFFFu;
@@ -209,60 +235,57 @@ static uint32_t zcode(const om__izb_key *k, int32_t x0, int32_t y0, int shift)
     return spread((uint32_t)(k->x - x0) >> shift) | spread((uint32_t)(k->y - y0) >> shift) << 1;
 }
 
-/* Sorts z->keys into Z order (a stable least-significant-digit radix sort through
- * z->sorted, three passes of 11 bits; keys of equal code keep the screen's order), so
+/* Gives every key its code, then sorts z->keys into Z order (a stable
+ * least-significant-digit radix sort through z->sorted, two passes of 11 bits; keys
+ * of equal code keep the screen's order), so
  * that halving the array again and again gives nodes that are compact in the light's
- * image. Integer keys only: the same order in any floating-point mode. */
-typedef struct zframe { int32_t x0, y0; int shift; } zframe;
-
-static zframe zsort(om__izb *z)
+ * image. Integer keys only: the same order in any floating-point mode. Returns the
+ * shift that fits the tile's span into the codes' 16 bits an axis. */
+static int zsort(om__izb *z)
 {
     uint32_t n = z->n;
     int32_t x0 = z->kx0, y0 = z->ky0, x1 = z->kx1, y1 = z->ky1;
     uint32_t span = (uint32_t)(x1 - x0) > (uint32_t)(y1 - y0) ? (uint32_t)(x1 - x0) : (uint32_t)(y1 - y0);
     int shift = 0;
-    while ((span >> shift) > 0xFFFFu) shift++;
-    /* three digits of 11 bits; their histograms in one pass over the keys */
-    static const int at[3] = {0, 11, 22};
-    uint32_t count[3][2049];
+    while ((span >> shift) >> ZBITS) shift++;
+    /* two digits of 11 bits; their histograms in one pass over the keys */
+    uint32_t count[2][2049];
     memset(count, 0, sizeof count);
     for (uint32_t i = 0; i < n; i++) {
-        uint32_t c = zcode(&z->keys[i], x0, y0, shift);
+        uint32_t c = z->keys[i].code = zcode(&z->keys[i], x0, y0, shift);
         count[0][(c & 2047u) + 1]++;
-        count[1][(c >> 11 & 2047u) + 1]++;
-        count[2][(c >> 22) + 1]++;
+        count[1][(c >> 11) + 1]++;
     }
     om__izb_key *src = z->keys, *dst = z->sorted;
-    for (int pass = 0; pass < 3; pass++) {
+    for (int pass = 0; pass < 2; pass++) {
         uint32_t *cnt = count[pass];
-        int d = at[pass];
-        if (cnt[((zcode(&src[0], x0, y0, shift) >> d) & 2047u) + 1] == n) continue;   /* one digit */
+        int d = 11 * pass;
+        if (cnt[((src[0].code >> d) & 2047u) + 1] == n) continue;   /* one digit */
         for (int b = 0; b < 2048; b++) cnt[b + 1] += cnt[b];
-        for (uint32_t i = 0; i < n; i++) dst[cnt[(zcode(&src[i], x0, y0, shift) >> d) & 2047u]++] = src[i];
+        for (uint32_t i = 0; i < n; i++) dst[cnt[(src[i].code >> d) & 2047u]++] = src[i];
         om__izb_key *t = src;
         src = dst;
         dst = t;
     }
     z->keys = src;   /* the two buffers trade places rather than copy */
     z->sorted = dst;
-    zframe f = {x0, y0, shift};
-    return f;
+    return shift;
 }
 
 /* Where the sorted keys [first, first + count) split: at the highest bit in which their
  * codes differ (the node's quadtree-like cell is cut in two halves of space), or in
  * the middle when they all share one code. */
-static uint32_t zsplit(const om__izb *z, const zframe *f, uint32_t first, uint32_t count)
+static uint32_t zsplit(const om__izb *z, uint32_t first, uint32_t count)
 {
     const om__izb_key *k = &z->keys[first];
-    uint32_t a = zcode(&k[0], f->x0, f->y0, f->shift), b = zcode(&k[count - 1], f->x0, f->y0, f->shift);
+    uint32_t a = k[0].code, b = k[count - 1].code;
     if (a == b) return count / 2;
-    uint32_t bit = 0x80000000u;
+    uint32_t bit = 1u << (2 * ZBITS - 1);
     while (!((a ^ b) & bit)) bit >>= 1;
     uint32_t lo = 0, hi = count - 1;   /* the first key with the bit set: in (lo, hi] */
     while (hi - lo > 1) {
         uint32_t mid = lo + (hi - lo) / 2;
-        if (zcode(&k[mid], f->x0, f->y0, f->shift) & bit) hi = mid;
+        if (k[mid].code & bit) hi = mid;
         else lo = mid;
     }
     return hi;
@@ -297,33 +320,75 @@ static void bound_node(om__izb *z, om__izb_node *nd)
     nd->open = nd->count;
 }
 
+/* A new node over keys [first, first + count) under `parent`. */
+static uint32_t new_node(om__izb *z, uint32_t first, uint32_t count, uint32_t parent)
+{
+    om__izb_node *nd = &z->nodes[z->nnodes];
+    nd->first = first;
+    nd->count = count;
+    nd->child = 0;
+    nd->parent = parent;
+    return z->nnodes++;
+}
+
+static void split_node(om__izb *z, uint32_t ni, uint32_t half)
+{
+    om__izb_node *nd = &z->nodes[ni];
+    uint32_t c = new_node(z, nd->first, half, ni);
+    new_node(z, nd->first + half, nd->count - half, ni);
+    nd->child = c;
+}
+
+/* The tree is built in two phases. The top splits every node whose keys fall in more
+ * than one cell of the grid (2^gk x 2^gk cells, the top 2 gk bits of the Z order): a
+ * split at the highest differing bit of the codes then parts whole cells, so every
+ * non-empty cell ends as one node holding exactly its keys, and the grid records it.
+ * Then each cell's node is split as before, down to leaves of at most `leaf` keys (or
+ * while nodes remain). The top never runs out: it has fewer than 2 nodes a cell. */
 void om__izb_build(om__izb *z)
 {
     z->nnodes = 0;
     if (z->n == 0) return;
-    zframe f = zsort(z);
+    int shift = zsort(z);
+    int k = 0;
+    uint32_t ncells = 1, want = z->n / CELL_FILL;
+    while (ncells < z->cells_cap && ncells * 4 <= want) {
+        ncells *= 4;
+        k++;
+    }
+    z->gk = k;
+    z->gshift = shift + ZBITS - k;
+    z->zshift = shift;
+    for (uint32_t i = 0; i < ncells; i++) z->cells[i] = OM_IZB_NONE;
     uint32_t stack[64];
     int sp = 0;
-    om__izb_node *root = &z->nodes[z->nnodes++];
-    root->first = 0;
-    root->count = z->n;
-    root->child = 0;
-    stack[sp++] = 0;
+    stack[sp++] = new_node(z, 0, z->n, OM_IZB_NONE);
+    const int cut = 2 * (ZBITS - k);   /* a code's cell: its top 2k bits */
     while (sp > 0) {
-        om__izb_node *nd = &z->nodes[stack[--sp]];
-        if (nd->count <= z->leaf || z->nnodes + 2 > z->node_cap || sp + 2 > 64) continue;
-        uint32_t half = zsplit(z, &f, nd->first, nd->count);
-        uint32_t c = z->nnodes;
-        z->nnodes += 2;
-        om__izb_node *l = &z->nodes[c], *r = &z->nodes[c + 1];
-        l->first = nd->first;
-        l->count = half;
-        r->first = nd->first + half;
-        r->count = nd->count - half;
-        l->child = r->child = 0;
-        nd->child = c;
-        stack[sp++] = c;
-        stack[sp++] = c + 1;
+        uint32_t ni = stack[--sp];
+        const om__izb_node *nd = &z->nodes[ni];
+        uint32_t a = z->keys[nd->first].code, b = z->keys[nd->first + nd->count - 1].code;
+        if (a >> cut == b >> cut) {
+            z->cells[a >> cut] = ni;
+            continue;
+        }
+        split_node(z, ni, zsplit(z, nd->first, nd->count));
+        stack[sp++] = z->nodes[ni].child;
+        stack[sp++] = z->nodes[ni].child + 1;
+    }
+    uint32_t top = z->nnodes;
+    for (uint32_t r = 0; r < top; r++) {
+        if (z->nodes[r].child) continue;   /* a cell's node: the rest of the tree below it */
+        sp = 0;
+        stack[sp++] = r;
+        while (sp > 0) {
+            uint32_t ni = stack[--sp];
+            const om__izb_node *nd = &z->nodes[ni];
+            if (nd->count <= z->leaf || z->nnodes + 2 > z->node_cap || sp + 2 > 64) continue;
+            split_node(z, ni, zsplit(z, nd->first, nd->count));
+            stack[sp++] = z->nodes[ni].child;
+            stack[sp++] = z->nodes[ni].child + 1;
+        }
     }
     for (uint32_t i = z->nnodes; i-- > 0;) bound_node(z, &z->nodes[i]);
     z->st.nodes += z->nnodes;
@@ -349,19 +414,35 @@ static bool box_touches(const om__ltri *lt, const om__izb_node *nd)
     return false;
 }
 
+/* One triangle on its way through the tree: its setup, its optical depth, and the
+ * range of Z-order codes of its bounds (clamped to the tile's): a key inside the
+ * bounds has a code in [clo, chi], as the code grows with x and with y. */
+typedef struct tjob {
+    const om__ltri *lt;
+    const om__odepth *od;
+    uint32_t clo, chi;
+} tjob;
+
 /* Returns how many samples of the subtree became opaque-shadowed. */
-static uint32_t visit(om__izb *z, uint32_t ni, const om__ltri *lt, const om__odepth *od)
+static uint32_t visit(om__izb *z, uint32_t ni, const tjob *j)
 {
     om__izb_node *nd = &z->nodes[ni];
+    const om__ltri *lt = j->lt;
     z->st.visited++;
     if (nd->open == 0) { z->st.culled_shadowed++; return 0; }
     if (lt->zmin >= nd->zmax) { z->st.culled_depth++; return 0; }
-    if (!box_touches(lt, nd)) return 0;
+    uint32_t first = nd->first, end = first + nd->count;
+    if (z->keys[first].code > j->chi || z->keys[end - 1].code < j->clo || !box_touches(lt, nd)) return 0;
     uint32_t closed = 0;
     if (nd->child) {
-        closed = visit(z, nd->child, lt, od) + visit(z, nd->child + 1, lt, od);
+        closed = visit(z, nd->child, j) + visit(z, nd->child + 1, j);
     } else {
-        for (uint32_t i = nd->first; i < nd->first + nd->count; i++) {
+        while (end - first > 1) {   /* the first key whose code can be in the bounds */
+            uint32_t mid = first + (end - first) / 2;
+            if (z->keys[mid - 1].code < j->clo) first = mid;
+            else end = mid;
+        }
+        for (uint32_t i = first; i < nd->first + nd->count && z->keys[i].code <= j->chi; i++) {
             om__izb_key *k = &z->keys[i];
             if ((k->s & OM_IZB_DONE) || k->x < lt->lox || k->x > lt->hix || k->y < lt->loy ||
                 k->y > lt->hiy)
@@ -370,7 +451,7 @@ static uint32_t visit(om__izb *z, uint32_t ni, const om__ltri *lt, const om__ode
             z->st.tested++;
             if (!om__blocks(lt, &s->p)) continue;
             z->st.blocked++;
-            om__odepth_add(&s->od, od);
+            om__odepth_add(&s->od, j->od);
             if (om__odepth_opaque(&s->od)) {
                 k->s |= OM_IZB_DONE;
                 closed++;
@@ -381,28 +462,118 @@ static uint32_t visit(om__izb *z, uint32_t ni, const om__ltri *lt, const om__ode
     return closed;
 }
 
+/* Visits a cell's node and takes the samples it closed off the counts above it. */
+static void visit_cell(om__izb *z, uint32_t ni, const tjob *j)
+{
+    uint32_t closed = visit(z, ni, j);
+    if (closed)
+        for (uint32_t p = z->nodes[ni].parent; p != OM_IZB_NONE; p = z->nodes[p].parent)
+            z->nodes[p].open -= closed;
+}
+
+/* The grid cells that the grid bounds [lox, hix] x [loy, hiy] can reach; false when
+ * they miss the tile's keys. */
+typedef struct crange { uint32_t x0, y0, x1, y1; } crange;
+
+static bool cell_range(const om__izb *z, int64_t lox, int64_t loy, int64_t hix, int64_t hiy, crange *c)
+{
+    if (hix < z->kx0 || lox > z->kx1 || hiy < z->ky0 || loy > z->ky1) return false;
+    if (lox < z->kx0) lox = z->kx0;
+    if (loy < z->ky0) loy = z->ky0;
+    if (hix > z->kx1) hix = z->kx1;
+    if (hiy > z->ky1) hiy = z->ky1;
+    c->x0 = (uint32_t)((lox - z->kx0) >> z->gshift);
+    c->x1 = (uint32_t)((hix - z->kx0) >> z->gshift);
+    c->y0 = (uint32_t)((loy - z->ky0) >> z->gshift);
+    c->y1 = (uint32_t)((hiy - z->ky0) >> z->gshift);
+    return true;
+}
+
+/* The codes of a triangle's bounds; false when the bounds miss the tile's keys. */
+static bool codes_of(const om__izb *z, const om__ltri *lt, tjob *j)
+{
+    if (lt->hix < z->kx0 || lt->lox > z->kx1 || lt->hiy < z->ky0 || lt->loy > z->ky1) return false;
+    om__izb_key lo, hi;
+    lo.x = (int32_t)(lt->lox > z->kx0 ? lt->lox : z->kx0);
+    lo.y = (int32_t)(lt->loy > z->ky0 ? lt->loy : z->ky0);
+    hi.x = (int32_t)(lt->hix < z->kx1 ? lt->hix : z->kx1);
+    hi.y = (int32_t)(lt->hiy < z->ky1 ? lt->hiy : z->ky1);
+    j->clo = zcode(&lo, z->kx0, z->ky0, z->zshift);
+    j->chi = zcode(&hi, z->kx0, z->ky0, z->zshift);
+    return true;
+}
+
+static uint32_t cell_at(const om__izb *z, uint32_t cx, uint32_t cy)
+{
+    return z->cells[spread(cx) | spread(cy) << 1];
+}
+
+/* A triangle whose bounds cover at most DIRECT cells goes straight to their nodes;
+ * with its projected vertices at hand (no clipping), the nodes are first checked
+ * against the vertices' bounds and nearest depth, so that a triangle over no open,
+ * farther sample costs no setup. Any other triangle descends the tree from its root.
+ * Both reach every sample inside the triangle's bounds once: the cells part the
+ * tile's keys. */
 void om__izb_raster(om__izb *z)
 {
     if (z->nnodes == 0) return;
     const om_scene *sc = z->scene;
     const om__izb_node *root = &z->nodes[0];
-    for (uint32_t t = 0; t < sc->ntris && z->nodes[0].open; t++) {
-        /* Cheap rejection by the projected vertices before any setup: the tile's
-         * light-space bounds and its farthest sample. */
+    for (uint32_t t = 0; t < sc->ntris && root->open; t++) {
         const uint32_t *ix = sc->idx + (size_t)t * 3;
         const om__lvert *a = z->ls.verts ? &z->ls.verts[ix[0]] : NULL;
         const om__lvert *b = a ? &z->ls.verts[ix[1]] : NULL, *c = a ? &z->ls.verts[ix[2]] : NULL;
+        const om__odepth *od = &z->mat_od[sc->tri_mat[t]];
+        crange cr;
+        uint32_t hit[DIRECT];
+        int nhit = -1;   /* -1: not sorted out before setup */
         if (a && a->x != INT32_MIN && b->x != INT32_MIN && c->x != INT32_MIN) {
-            if ((a->x < root->x0 && b->x < root->x0 && c->x < root->x0) ||
-                (a->x > root->x1 && b->x > root->x1 && c->x > root->x1) ||
-                (a->y < root->y0 && b->y < root->y0 && c->y < root->y0) ||
-                (a->y > root->y1 && b->y > root->y1 && c->y > root->y1) ||
-                (a->z >= root->zmax && b->z >= root->zmax && c->z >= root->zmax))
-                continue;
+            /* The plane's depth lies within its vertices', and the triangle's bounds are
+             * its vertices': the same culls visit() makes, before any setup. */
+            int32_t lox = a->x, hix = a->x, loy = a->y, hiy = a->y;
+            uint32_t zlo = a->z;
+            if (b->x < lox) lox = b->x;
+            if (b->x > hix) hix = b->x;
+            if (c->x < lox) lox = c->x;
+            if (c->x > hix) hix = c->x;
+            if (b->y < loy) loy = b->y;
+            if (b->y > hiy) hiy = b->y;
+            if (c->y < loy) loy = c->y;
+            if (c->y > hiy) hiy = c->y;
+            if (b->z < zlo) zlo = b->z;
+            if (c->z < zlo) zlo = c->z;
+            if ((double)zlo >= root->zmax || !cell_range(z, lox, loy, hix, hiy, &cr)) continue;
+            if ((uint64_t)(cr.x1 - cr.x0 + 1) * (cr.y1 - cr.y0 + 1) <= DIRECT) {
+                nhit = 0;
+                for (uint32_t cy = cr.y0; cy <= cr.y1; cy++)
+                    for (uint32_t cx = cr.x0; cx <= cr.x1; cx++) {
+                        uint32_t ni = cell_at(z, cx, cy);
+                        if (ni == OM_IZB_NONE) continue;
+                        const om__izb_node *nd = &z->nodes[ni];
+                        if (nd->open && (double)zlo < nd->zmax && lox <= nd->x1 && hix >= nd->x0 &&
+                            loy <= nd->y1 && hiy >= nd->y0)
+                            hit[nhit++] = ni;
+                    }
+                if (nhit == 0) continue;
+            }
         }
         om__ltri lt;
-        if (!om__lspace_tri(&z->ls, t, &lt)) continue;
-        visit(z, 0, &lt, &z->mat_od[sc->tri_mat[t]]);
+        tjob j = {&lt, od, 0, 0};
+        if (!om__lspace_tri(&z->ls, t, &lt) || !codes_of(z, &lt, &j)) continue;
+        if (nhit < 0 && cell_range(z, lt.lox, lt.loy, lt.hix, lt.hiy, &cr) &&
+            (uint64_t)(cr.x1 - cr.x0 + 1) * (cr.y1 - cr.y0 + 1) <= DIRECT) {
+            nhit = 0;
+            for (uint32_t cy = cr.y0; cy <= cr.y1; cy++)
+                for (uint32_t cx = cr.x0; cx <= cr.x1; cx++) {
+                    uint32_t ni = cell_at(z, cx, cy);
+                    if (ni != OM_IZB_NONE) hit[nhit++] = ni;
+                }
+        }
+        if (nhit < 0) {
+            visit(z, 0, &j);
+        } else {
+            for (int i = 0; i < nhit; i++) visit_cell(z, hit[i], &j);
+        }
     }
 }
 

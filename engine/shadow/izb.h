@@ -19,19 +19,22 @@ typedef struct om__izb_sample {
 
 /* What the BSP orders and the leaves scan: a sample's grid position, its light depth
  * rounded up to float (enough to cull conservatively) and where the sample is, with
- * OM_IZB_DONE set once it is opaquely shadowed. The 48-byte samples never move: the
- * leaves touch one only when it lies inside a triangle's bounds. */
-typedef struct om__izb_key { int32_t x, y; uint32_t s; float z; } om__izb_key;
+ * OM_IZB_DONE set once it is opaquely shadowed; and its Z-order code in the tile
+ * (made once by the build, which sorts and splits by it). The 48-byte samples never
+ * move: the leaves touch one only when it lies inside a triangle's bounds. */
+typedef struct om__izb_key { int32_t x, y; uint32_t s; float z; uint32_t code; } om__izb_key;
 #define OM_IZB_DONE 0x80000000u
 
 /* A BSP node: the bounds of its samples on the light grid, their largest light depth,
  * and how many of them are not yet fully (opaquely) shadowed. Leaves have count > 0
- * and no children; inner nodes have children at `child` and `child + 1`. */
+ * and no children; inner nodes have children at `child` and `child + 1`; `parent` is
+ * OM_IZB_NONE at the root. */
 typedef struct om__izb_node {
-    int64_t x0, y0, x1, y1;
-    double zmax;
-    uint32_t first, count, child, open;
+    int32_t x0, y0, x1, y1;   /* keys' coordinates: the light grid fits in 27 bits */
+    float zmax;
+    uint32_t first, count, child, open, parent;
 } om__izb_node;
+#define OM_IZB_NONE 0xFFFFFFFFu
 
 typedef struct om__izb_stats {
     uint32_t nodes, visited, culled_shadowed, culled_depth, tested, blocked, tiles;
@@ -45,6 +48,13 @@ typedef struct om__izb {
     om__izb_key *keys;
     om__izb_key *sorted;   /* the radix sort's second buffer */
     om__izb_node *nodes;
+    /* The grid in front of the BSP: 2^gk x 2^gk cells over the tile's keys (the cells
+     * of the Z order's top 2 gk bits), each the node that holds exactly its samples
+     * (OM_IZB_NONE when empty), indexed by the cell's Z-order code. */
+    uint32_t *cells;
+    uint32_t cells_cap;    /* cells the grid holds: a power of 4 */
+    int gk, gshift;        /* grid level; grid units -> cell: >> gshift */
+    int zshift;            /* grid units -> a code's ZBITS-bit coordinates: >> zshift */
     uint32_t cap;          /* samples the pool holds */
     uint32_t node_cap;
     uint32_t leaf;
