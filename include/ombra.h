@@ -432,13 +432,16 @@ size_t om_frame_bytes(uint32_t width, uint32_t strip_rows);
  * arena of om_frame_bytes gives the same pixels, more slowly. */
 size_t om_frame_bytes_scene(const om_scene *s, uint32_t width, uint32_t strip_rows);
 /* What the frame arena needs beyond om_frame_bytes(_scene) to run `threads` jobs at
- * once with method m (0 for threads <= 1): each job's scratch for the method's resolve.
+ * once with method m on scene s (0 for threads <= 1): each job's scratch for the
+ * method's resolve, and the bins of the light's map for a method whose depth pass runs
+ * by bands of the map (sm; s may be NULL: without them, each band walks every
+ * triangle).
  * With threads > 1 the frame splits each strip into bands of rows: the eye pass and
  * shading run on bands at once, and so does the resolve of the built-in methods whose
  * resolve allows it (DESIGN.md lists them); the others resolve a strip at a
  * time. A whole-frame render (one strip) also uses the bins when they fit after the
  * jobs' scratch. */
-size_t om_frame_bytes_jobs(const struct om_method *m, uint32_t threads);
+size_t om_frame_bytes_jobs(const struct om_method *m, const om_scene *s, uint32_t threads);
 /* Renders one frame. The frame arena is rewound on return; the method's arena keeps
  * what the method keeps. */
 om_status om_render_frame(const om_frame_desc *fd, om_arena *frame_arena,

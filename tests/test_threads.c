@@ -34,9 +34,9 @@ static om_status on_strip(void *user, const om_strip *st, const om_framebuffer *
 }
 
 /* One frame of method m with a fresh state; frame arena of om_frame_bytes_scene (or
- * without bins, om_frame_bytes) plus `jobs_room` jobs' share. */
+ * without bins, om_frame_bytes) plus job_bytes for the jobs. */
 static frame_out render(const om_scene *s, const om_method *m, uint32_t W, uint32_t H, uint32_t rows,
-                        om_parallel_for_fn pf, void *host, uint32_t threads, uint32_t jobs_room,
+                        om_parallel_for_fn pf, void *host, uint32_t threads, size_t job_bytes,
                         bool bins)
 {
     frame_out o;
@@ -53,8 +53,7 @@ static frame_out render(const om_scene *s, const om_method *m, uint32_t W, uint3
     size_t mn, full;
     if ((o.st = m->bytes(&c, s, W, H, &mn, &full))) return o;
     uint32_t r = rows ? rows : H;
-    size_t fbytes = (bins ? om_frame_bytes_scene(s, W, r) : om_frame_bytes(W, r)) +
-                    om_frame_bytes_jobs(m, jobs_room);
+    size_t fbytes = (bins ? om_frame_bytes_scene(s, W, r) : om_frame_bytes(W, r)) + job_bytes;
     void *mm = malloc(full), *fm = malloc(fbytes), *px = malloc((size_t)W * r * 3);
     om_arena ma, fa;
     om_arena_init(&ma, mm, full, "method");
@@ -107,8 +106,8 @@ static void same_bits(void)
                 CHECK_MSG(one.st == OM_OK && one.jobs == 1, "%s: inline frame", m->name);
                 for (int k = 0; k < 7; k++) {
                     uint32_t n = k < 6 ? threads[k] : 5;
-                    frame_out o = k < 6 ? render(&hs.s, m, 120, 90, rows, om_jobs_for, pools[k], n, n, true)
-                                        : render(&hs.s, m, 120, 90, rows, backwards, NULL, n, n, true);
+                    frame_out o = k < 6 ? render(&hs.s, m, 120, 90, rows, om_jobs_for, pools[k], n, om_frame_bytes_jobs(m, &hs.s, n), true)
+                                        : render(&hs.s, m, 120, 90, rows, backwards, NULL, n, om_frame_bytes_jobs(m, &hs.s, n), true);
                     CHECK_MSG(o.st == OM_OK && o.jobs == n, "%s: %u jobs ran %u", m->name, n, o.jobs);
                     CHECK_MSG(o.hash == one.hash, "%s light %d strips %u: %u threads%s change the frame",
                               m->name, li, rows, n, k < 6 ? "" : " backwards");
@@ -130,15 +129,22 @@ static void fewer_jobs(void)
     if (!h_scene_parse(&hs, om_scene_default_text())) return;
     const om_method *m = om_method_find("ref");
     frame_out one = render(&hs.s, m, 64, 48, 0, NULL, NULL, 1, 0, true);
-    frame_out three = render(&hs.s, m, 64, 48, 0, backwards, NULL, 8, 3, true);
-    frame_out three_nobins = render(&hs.s, m, 64, 48, 0, backwards, NULL, 8, 3, false);
-    frame_out none = render(&hs.s, m, 64, 48, 0, backwards, NULL, 8, 1, false);
+    frame_out three = render(&hs.s, m, 64, 48, 0, backwards, NULL, 8, om_frame_bytes_jobs(m, &hs.s, 3), true);
+    frame_out three_nobins = render(&hs.s, m, 64, 48, 0, backwards, NULL, 8, om_frame_bytes_jobs(m, &hs.s, 3), false);
+    frame_out none = render(&hs.s, m, 64, 48, 0, backwards, NULL, 8, om_frame_bytes_jobs(m, &hs.s, 1), false);
     CHECK_EQ_U(three.jobs, 3);
     CHECK_EQ_U(three_nobins.jobs, 3);
     CHECK_EQ_U(none.jobs, 1);
     CHECK(three.hash == one.hash && three_nobins.hash == one.hash && none.hash == one.hash);
-    CHECK_EQ_U(om_frame_bytes_jobs(m, 1), 0);
-    CHECK(om_frame_bytes_jobs(m, 4) == 2 * om_frame_bytes_jobs(m, 2));
+    CHECK_EQ_U(om_frame_bytes_jobs(m, &hs.s, 1), 0);
+    CHECK(om_frame_bytes_jobs(m, &hs.s, 4) == 2 * om_frame_bytes_jobs(m, &hs.s, 2));
+    /* sm's map by bands, with the light's bins and without (one band a job) */
+    const om_method *sm = om_method_find("sm");
+    frame_out sm1 = render(&hs.s, sm, 64, 48, 0, NULL, NULL, 1, 0, true);
+    frame_out sm3 = render(&hs.s, sm, 64, 48, 0, backwards, NULL, 3, om_frame_bytes_jobs(sm, &hs.s, 3), false);
+    frame_out sm3_lean = render(&hs.s, sm, 64, 48, 0, backwards, NULL, 3, om_frame_bytes_jobs(sm, NULL, 3), false);
+    CHECK(sm3.jobs == 3 && sm3_lean.jobs == 3);
+    CHECK(sm3.hash == sm1.hash && sm3_lean.hash == sm1.hash);
     h_scene_free(&hs);
 }
 

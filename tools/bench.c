@@ -129,7 +129,7 @@ om_status cli_measure_strips(const om_method *m, const om_method_cfg *cfg, const
     if (st) return st;
     /* threads: each job's scratch, and the bins the bands of a whole frame use */
     if (cli_threads() > 1) {
-        fbytes += om_frame_bytes_jobs(m, cli_threads());
+        fbytes += om_frame_bytes_jobs(m, &cs->scene, cli_threads());
         if (!rows || rows >= H) fbytes += om_frame_bytes_scene(&cs->scene, W, H) - om_frame_bytes(W, H);
     }
     void *mem = malloc(full ? full : 1), *fmem = malloc(fbytes), *px = malloc((size_t)W * H * 3);

@@ -88,9 +88,9 @@ static om_status run_frame(run *r, const cli_scene *cs, const om_view *v, uint32
     /* Threads: each job's scratch, and bins for the bands of a whole frame (under a
      * --budget there is no room kept for them: the frame runs with what fits). */
     if (jobs) {
-        *frame_bytes += om_frame_bytes_jobs(r->m, cli_threads());
+        *frame_bytes += om_frame_bytes_jobs(r->m, &cs->scene, cli_threads());
         if (rows == v->cam.height) *frame_bytes = om_frame_bytes_scene(&cs->scene, W, rows) +
-                                                 om_frame_bytes_jobs(r->m, cli_threads());
+                                                 om_frame_bytes_jobs(r->m, &cs->scene, cli_threads());
     }
     void *frame_mem = malloc(*frame_bytes);
     om_framebuffer fb;

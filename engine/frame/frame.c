@@ -20,12 +20,24 @@ typedef struct job_slot {
     void *scratch;
 } job_slot;
 
-size_t om_frame_bytes_jobs(const om_method *m, uint32_t threads)
+static size_t bins_bytes(const om_scene *s)
+{
+    return om__bins_rows_bytes(s) + om__bins_verts_bytes(s);
+}
+
+/* A method whose light depth pass runs by bands of the map also wants bins for it. */
+static size_t map_bins_bytes(const om__bands *b, const om_scene *s)
+{
+    return b && b->build_rows && s ? bins_bytes(s) : 0;
+}
+
+size_t om_frame_bytes_jobs(const om_method *m, const om_scene *s, uint32_t threads)
 {
     if (threads <= 1) return 0;
     const om__bands *b = m ? om__method_bands(m) : NULL;
     return (size_t)threads * (om_arena_need(sizeof(job_slot), 8) +
-                              (b ? om_arena_need(b->scratch ? b->scratch : 1, 16) : 0));
+                              (b ? om_arena_need(b->scratch ? b->scratch : 1, 16) : 0)) +
+           map_bins_bytes(b, s);
 }
 
 size_t om_frame_bytes(uint32_t width, uint32_t strip_rows)
@@ -75,7 +87,7 @@ static void grow_light_box(const om_view *v, const om_strip *st, om_vec3 *lo, om
 
 /* The bands of the strip and the jobs that run them: band b goes to job b % jobs, so a
  * job owns its slot and the rows it writes. */
-typedef enum { STAGE_PREPARE, STAGE_RESOLVE, STAGE_SHADE } stage;
+typedef enum { STAGE_PREPARE, STAGE_RESOLVE, STAGE_SHADE, STAGE_BUILD } stage;
 
 typedef struct frame_ctx {
     const om_frame_desc *fd;
@@ -88,12 +100,22 @@ typedef struct frame_ctx {
     job_slot *slots;           /* jobs of them */
     stage stage;
     bool eye, mark;            /* STAGE_PREPARE: run the eye pass, mark exposure */
+    om__bins map_bins;         /* the light map's (rows NULL: none) */
+    uint32_t map_size, map_band;   /* STAGE_BUILD: the map's side, rows per band */
 } frame_ctx;
 
 static void band_job(void *user, uint32_t j)
 {
     const frame_ctx *c = (const frame_ctx *)user;
     const om_frame_desc *fd = c->fd;
+    if (c->stage == STAGE_BUILD) {
+        for (uint32_t b = j; b < c->nbands; b += c->jobs) {
+            uint32_t y0 = b * c->map_band, rows = c->map_size - y0;
+            c->bands->build_rows(fd->method_state, c->map_bins.rows ? &c->map_bins : NULL, y0,
+                                 rows < c->map_band ? rows : c->map_band);
+        }
+        return;
+    }
     for (uint32_t b = j; b < c->nbands; b += c->jobs) {
         uint32_t r0 = b * c->band_rows;
         size_t off = (size_t)r0 * c->strip.width;
@@ -123,13 +145,47 @@ static void band_job(void *user, uint32_t j)
     }
 }
 
-/* Runs one stage over the current strip's bands on the host's threads. */
-static void run_bands(frame_ctx *c, stage sg)
+/* Runs one stage over `nbands` bands on the host's threads. */
+static void run_stage(frame_ctx *c, stage sg, uint32_t nbands)
 {
     c->stage = sg;
-    c->nbands = (c->strip.rows + c->band_rows - 1) / c->band_rows;
-    uint32_t n = c->nbands < c->jobs ? c->nbands : c->jobs;
-    c->fd->parallel_for(c->fd->parallel_user, band_job, c, n);
+    c->nbands = nbands;
+    c->fd->parallel_for(c->fd->parallel_user, band_job, c, nbands < c->jobs ? nbands : c->jobs);
+}
+
+/* The same over the current strip's bands. */
+static void run_bands(frame_ctx *c, stage sg)
+{
+    run_stage(c, sg, (c->strip.rows + c->band_rows - 1) / c->band_rows);
+}
+
+/* The light depth pass by bands of the map (om__bands.build_rows): with bins, about
+ * four bands a job, each setting up only its own triangles; without, one band a job,
+ * since each band then walks every triangle. */
+static void build_map(frame_ctx *c)
+{
+    const om_mat4 *vp;
+    c->map_size = c->bands->map_of(c->fd->method_state, &vp);
+    if (c->map_bins.rows) om__bins_make(c->fd->scene, vp, c->map_size, c->map_size, &c->map_bins);
+    uint32_t n = c->map_bins.rows ? 4 * c->jobs : c->jobs;
+    c->map_band = ((c->map_size + n - 1) / n + 15) / 16 * 16;
+    run_stage(c, STAGE_BUILD, (c->map_size + c->map_band - 1) / c->map_band);
+}
+
+/* Bins' memory: the rows, and the vertices when they fit too. False: no room. */
+static bool carve_bins(om_arena *fa, const om_scene *s, om__bins *b)
+{
+    void *pb, *pv;
+    b->rows = NULL;
+    b->verts = NULL;
+    if (!s->ntris || om_arena_left(fa) < om__bins_rows_bytes(s) ||
+        om_arena_alloc(fa, (size_t)s->ntris * sizeof(uint32_t), 8, &pb, NULL) != OM_OK)
+        return false;
+    b->rows = (uint32_t *)pb;
+    if (om_arena_left(fa) >= om__bins_verts_bytes(s) &&
+        om_arena_alloc(fa, (size_t)s->nverts * sizeof(om__vsnap), 8, &pv, NULL) == OM_OK)
+        b->verts = (om__vsnap *)pv;
+    return true;
 }
 
 /* The eye pass and the exposure marks of the current strip (rows at strip.y0). */
@@ -166,7 +222,7 @@ static void carve_jobs(frame_ctx *c, om_arena *fa, size_t keep)
     c->jobs = 1;
     if (!fd->parallel_for || fd->threads <= 1) return;
     const om__bands *b = om__method_bands(fd->method);
-    size_t per = om_frame_bytes_jobs(fd->method, 2) / 2;
+    size_t per = om_frame_bytes_jobs(fd->method, NULL, 2) / 2;
     size_t left = om_arena_left(fa), fit = left > keep ? (left - keep) / per : 0;
     uint32_t jobs = fit < fd->threads ? (uint32_t)fit : fd->threads;
     void *p;
@@ -230,26 +286,22 @@ om_status om_render_frame(const om_frame_desc *fd, om_arena *fa, om_frame_stats 
      * does not change within the frame. With strips the bins come before the jobs'
      * slots, as they did before there were jobs; one strip needs them only for bands. */
     om__bins bins = {NULL, NULL};
-    for (int pass = 0; pass < 2; pass++) {
-        /* one strip: the bins' bytes are kept if two jobs fit beside them */
-        size_t keep = om__bins_rows_bytes(s) + om__bins_verts_bytes(s);
-        if (pass == 1)
-            carve_jobs(&c, fa, single && om_arena_left(fa) >= keep + om_frame_bytes_jobs(m, 2) ? keep : 0);
-        if ((pass == 0) == single || (single && c.jobs < 2) || !s->ntris ||
-            om_arena_left(fa) < om__bins_rows_bytes(s))
-            continue;
-        void *pb, *pv;
-        if (om_arena_alloc(fa, (size_t)s->ntris * sizeof(uint32_t), 8, &pb, NULL) == OM_OK) {
-            bins.rows = (uint32_t *)pb;
-            if (om_arena_left(fa) >= om__bins_verts_bytes(s) &&
-                om_arena_alloc(fa, (size_t)s->nverts * sizeof(om__vsnap), 8, &pv, NULL) == OM_OK)
-                bins.verts = (om__vsnap *)pv;
-            uint64_t tb = now(fd);
-            om__bins_make(s, &view.cam_vp, W, H, &bins);
-            fs->ns_eye += now(fd) - tb;
-            c.bins = &bins;
-        }
+    bool eye_bins = !single && carve_bins(fa, s, &bins);
+    /* The jobs, keeping beside them the bins they use when two jobs fit as well: one
+     * strip's bands want the camera's, a map built by bands the light's. */
+    {
+        const om__bands *b = om__method_bands(m);
+        size_t keep = (single ? bins_bytes(s) : 0) + map_bins_bytes(b, s);
+        carve_jobs(&c, fa, om_arena_left(fa) >= keep + om_frame_bytes_jobs(m, NULL, 2) ? keep : 0);
     }
+    if (single && c.jobs > 1) eye_bins = carve_bins(fa, s, &bins);
+    if (eye_bins) {
+        uint64_t tb = now(fd);
+        om__bins_make(s, &view.cam_vp, W, H, &bins);
+        fs->ns_eye += now(fd) - tb;
+        c.bins = &bins;
+    }
+    if (c.jobs > 1 && c.bands && c.bands->build_rows) carve_bins(fa, s, &c.map_bins);
     fs->jobs = c.jobs;
     const bool observes = (m->flags & OM_METHOD_OBSERVES) && (!m->observes || m->observes(fd->method_state));
     const bool fit = view.light.kind == OM_LIGHT_DIRECTIONAL;
@@ -282,7 +334,8 @@ om_status om_render_frame(const om_frame_desc *fd, om_arena *fa, om_frame_stats 
         have_terms = single;   /* observe leaves the strip as marked */
     }
     t0 = now(fd);
-    st = m->build(fd->method_state, d);
+    if (c.jobs > 1 && c.bands && c.bands->build_rows) build_map(&c);
+    else st = m->build(fd->method_state, d);
     fs->ns_build += now(fd) - t0;
     if (st != OM_OK) goto done;
     for (uint32_t y = 0; y < H; y += rows) {

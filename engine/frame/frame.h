@@ -95,6 +95,12 @@ typedef struct om__bands {
     void (*resolve)(const void *state, om_strip *band, void *scratch, uint32_t counts[8]);
     void (*merge)(void *state, const uint32_t counts[8]);
     size_t scratch;
+    /* May be NULL. The light depth pass by bands of the map's rows, in place of build:
+     * map_of gives this frame's map side and light matrix (after begin); build_rows
+     * rasterizes rows [y0, y0 + rows) of the map, with bins made for that matrix and
+     * side (om__bins_make) or NULL. The same map whatever the bands. */
+    uint32_t (*map_of)(const void *state, const om_mat4 **vp);
+    void (*build_rows)(const void *state, const om__bins *bins, uint32_t y0, uint32_t rows);
 } om__bands;
 
 /* Method m's bands; NULL where its resolve must run a strip at a time (registry.c,

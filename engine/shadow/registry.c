@@ -56,8 +56,8 @@ static const om_method *const methods[] = {METHODS(ENTRY) NULL};
 
 /* The methods whose resolve runs by bands on the host's threads (frame.h, om__bands):
  * those whose resolve only reads the state once it is built. asm (its resolve moves a
- * cache and the tree's use marks), spsm (counts inside its lookup), izb and hybrid
- * (per-strip lists in the state) resolve a strip at a time. */
+ * cache and the tree's use marks), spsm (its lookup moves a window of decoded texels),
+ * izb and hybrid (per-strip lists in the state) resolve a strip at a time. */
 #define BANDED(X)            \
     X(none, OM_WITH_NONE)    \
     X(ref, OM_WITH_REF)      \

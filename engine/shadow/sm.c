@@ -95,12 +95,12 @@ static om_status sm_observe(void *state, const om_strip *st, om_diag *d)
     return OM_OK;
 }
 
+static void sm_build_rows(const void *state, const om__bins *bins, uint32_t y0, uint32_t rows);
+
 static om_status sm_build(void *state, om_diag *d)
 {
     (void)d;
-    sm_state *m = (sm_state *)state;
-    om_target tg = {m->size, m->size, 0, m->size, m->depth, NULL};
-    om__scene_raster(m->scene, &m->view.light_vp, &tg, OM_RASTER_DEPTH, true, NULL);
+    sm_build_rows(state, NULL, 0, ((sm_state *)state)->size);
     return OM_OK;
 }
 
@@ -126,7 +126,22 @@ static void sm_merge(void *state, const uint32_t counts[8])
     m->shadowed += counts[1];
 }
 
-const om__bands om__bands_sm = {sm_band, sm_merge, 0};
+/* The depth pass by rows of the map: each band a target of its own rows. */
+static uint32_t sm_map_of(const void *state, const om_mat4 **vp)
+{
+    const sm_state *m = (const sm_state *)state;
+    *vp = &m->view.light_vp;
+    return m->size;
+}
+
+static void sm_build_rows(const void *state, const om__bins *bins, uint32_t y0, uint32_t rows)
+{
+    const sm_state *m = (const sm_state *)state;
+    om_target tg = {m->size, m->size, y0, rows, m->depth + (size_t)y0 * m->size, NULL};
+    om__scene_raster(m->scene, &m->view.light_vp, &tg, OM_RASTER_DEPTH, true, bins);
+}
+
+const om__bands om__bands_sm = {sm_band, sm_merge, 0, sm_map_of, sm_build_rows};
 
 static void sm_stats(const void *state, om_method_stats *out)
 {
