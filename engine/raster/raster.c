@@ -6,10 +6,19 @@
 
 #include <math.h>
 
-static int64_t floordiv(int64_t a, int64_t b)   /* b > 0 */
+/* floor(a / 256), a grid position's pixel, by shifts of non-negative values (a
+ * shift of a negative one is the implementation's to define, a 64-bit division a
+ * library routine on a 32-bit CPU). */
+static int64_t pixel_floor(int64_t a)
 {
-    int64_t q = a / b;
-    return (a % b != 0 && a < 0) ? q - 1 : q;
+    return a >= 0 ? a >> OM_SUBPIX_BITS : -((OM_SUBPIX - 1 - a) >> OM_SUBPIX_BITS);
+}
+
+/* n / d for n >= 0, d > 0: in 32 bits when both fit (a single instruction where a
+ * 64-bit division is a library routine), the same quotient either way. */
+static inline int64_t div_nonneg(int64_t n, int64_t d)
+{
+    return ((uint64_t)n | (uint64_t)d) >> 32 ? n / d : (int64_t)((uint32_t)n / (uint32_t)d);
 }
 
 /* The top-left rule for the edge with coefficients a (of x) and b (of y), area2 > 0 in
@@ -219,12 +228,12 @@ static bool bounds(om__rtri *t, const om_target *tg, bool conservative)
     tri_box(e, &minX, &maxX, &minY, &maxY);
     int64_t x0, x1, y0, y1;
     if (conservative) {       /* pixels whose closed square meets the bounding box */
-        x0 = floordiv(minX - 1, OM_SUBPIX); x1 = floordiv(maxX, OM_SUBPIX);
-        y0 = floordiv(minY - 1, OM_SUBPIX); y1 = floordiv(maxY, OM_SUBPIX);
+        x0 = pixel_floor(minX - 1); x1 = pixel_floor(maxX);
+        y0 = pixel_floor(minY - 1); y1 = pixel_floor(maxY);
     } else {                  /* pixels whose centre lies in the bounding box */
         const int64_t h = OM_SUBPIX / 2;
-        x0 = floordiv(minX - h + OM_SUBPIX - 1, OM_SUBPIX); x1 = floordiv(maxX - h, OM_SUBPIX);
-        y0 = floordiv(minY - h + OM_SUBPIX - 1, OM_SUBPIX); y1 = floordiv(maxY - h, OM_SUBPIX);
+        x0 = pixel_floor(minX - h + OM_SUBPIX - 1); x1 = pixel_floor(maxX - h);
+        y0 = pixel_floor(minY - h + OM_SUBPIX - 1); y1 = pixel_floor(maxY - h);
     }
     if (x0 < 0) x0 = 0;
     if (y0 < (int64_t)tg->y0) y0 = tg->y0;
@@ -247,13 +256,13 @@ static bool row_span(const int64_t E[3], const int64_t step[3], int64_t w, int64
     for (int i = 0; i < 3; i++) {
         if (step[i] > 0) {
             if (E[i] < 0) {
-                int64_t k = (-E[i] + step[i] - 1) / step[i];   /* first texel with E >= 0 */
+                int64_t k = div_nonneg(-E[i] + step[i] - 1, step[i]);   /* first texel with E >= 0 */
                 if (k > l) l = k;
             }
         } else if (E[i] < 0) {
             return false;                                   /* never rises to 0 */
         } else if (step[i] < 0) {
-            int64_t k = E[i] / -step[i];                     /* last texel with E >= 0 */
+            int64_t k = div_nonneg(E[i], -step[i]);                  /* last texel with E >= 0 */
             if (k < h) h = k;
         }
     }
