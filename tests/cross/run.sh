@@ -12,14 +12,15 @@
 set -u
 cd "$(dirname "$0")/../.."
 out=build/cross
-rm -rf "$out"
-mkdir -p "$out"
 t_start=$(date +%s)
 skip_missing=${CROSS_SKIP_MISSING:-0}
-
-# The stability case's scene as a C string for the driver (a board has no files).
-sed -e 's/\\/\\\\/g' -e 's/"/\\"/g' -e 's/^/"/' -e 's/$/\\n"/' tests/stability/fast-camera.scene \
-    >"$out/stab_scene.h"
+if [ "${1:-}" != --one ]; then   # (--one: one build, run by this script in parallel)
+    rm -rf "$out"
+    mkdir -p "$out"
+    # The stability case's scene as a C string for the driver (a board has no files).
+    sed -e 's/\\/\\\\/g' -e 's/"/\\"/g' -e 's/^/"/' -e 's/$/\\n"/' tests/stability/fast-camera.scene \
+        >"$out/stab_scene.h"
+fi
 
 ENGINE=$(ls engine/*/*.c | tr '\n' ' ')
 WARN="-std=c99 -Wall -Wextra -Wpedantic -Werror -Iinclude -I$out"
@@ -103,40 +104,19 @@ case_names() {
     done
 }
 
-pass=0
-fail=0
-skip=0
-loose=0
-ref=""
-summary=""
-note() { summary="$summary$(printf '    %-40s %s' "$1" "$2")
-"; }
-
-if command -v clang >/dev/null 2>&1 && command -v qemu-s390x >/dev/null 2>&1 &&
-   clang --target=s390x-linux-gnu $WARN -O2 tests/cross/mdebr_probe.c -o "$out/mdebr-probe" \
-       >"$out/mdebr-probe.txt" 2>&1; then
-    if qemu-s390x -L /usr/s390x-linux-gnu "$out/mdebr-probe" >"$out/mdebr-probe.txt" 2>&1; then
-        configs="$configs
-s390x-clang-O2|same|clang|-O2 --target=s390x-linux-gnu|qemu-s390x -L /usr/s390x-linux-gnu|$BIG"
-    else
-        echo "cross: s390x-clang-O2 not run: this QEMU's mdebr is wrong ($(cat "$out/mdebr-probe.txt"))"
-        note s390x-clang-O2 "not run: the emulator's mdebr is wrong (tests/cross/mdebr_probe.c)"
-    fi
-fi
-
-IFS='
-'
-for c in $configs; do
+# One build: compiles the driver, runs it, compares its lines with the reference's
+# ($ref, empty while the reference itself runs). Prints what it found and writes
+# "$out/NAME.result": the outcome (ref, pass, loose, fail or skip) and the summary's
+# note. Builds run in parallel (CROSS_JOBS at a time, default the CPUs online), each
+# in its own files; the summary then lists them in the order above.
+result() { printf '%s\t%s\n' "$1" "$2" >"$out/$name.result"; }
+run_one() {
+    c=$1
     IFS='|'
     set -- $c
     name=$1 kind=$2 cc=$3 flags=$4 runner=$5 only=$6
     IFS=' 	
 '
-    if [ -n "${CROSS_ONLY:-}" ] && [ -n "$ref" ] && ! echo "$name" | grep -Eq -- "$CROSS_ONLY"; then
-        IFS='
-'
-        continue
-    fi
     t0=$(date +%s)
     [ "$runner" = - ] && runner=""
     needs="$cc ${runner%% *}"
@@ -146,16 +126,12 @@ for c in $configs; do
     if [ -n "$missing" ]; then
         if [ "$skip_missing" = 1 ]; then
             echo "cross: skip $name (not installed:$missing; CROSS_SKIP_MISSING=1)"
-            skip=$((skip + 1))
-            note "$name" "skipped: not installed:$missing"
+            result skip "skipped: not installed:$missing"
         else
             echo "cross: FAIL $name: not installed:$missing (CROSS_SKIP_MISSING=1 skips it)"
-            fail=$((fail + 1))
-            note "$name" "FAIL: not installed:$missing"
+            result fail "FAIL: not installed:$missing"
         fi
-        IFS='
-'
-        continue
+        return
     fi
     if [ "$kind" = board ] && [ "$cc" = clang ]; then
         # clang compiles for its bare-metal target with newlib's headers and enum size
@@ -187,11 +163,8 @@ for c in $configs; do
     fi
     if [ $? -ne 0 ]; then
         echo "cross: FAIL $name does not build: $(head -c 600 "$out/$name.err")"
-        fail=$((fail + 1))
-        note "$name" "FAIL: does not build"
-        IFS='
-'
-        continue
+        result fail "FAIL: does not build"
+        return
     fi
     ok=true
     if [ "$kind" = board ]; then
@@ -215,21 +188,14 @@ for c in $configs; do
     grep -v '^bytes' "$out/$name.txt" >"$out/$name.hashes"
     if ! $ok; then
         echo "cross: FAIL $name exits non-zero (or ran past its time): $(tail -c 600 "$out/$name.txt")"
-        fail=$((fail + 1))
-        note "$name" "FAIL: exits non-zero or ran past its time (${secs} s)"
-        IFS='
-'
-        continue
+        result fail "FAIL: exits non-zero or ran past its time (${secs} s)"
+        return
     fi
     if [ -z "$ref" ]; then
-        ref=$name
-        pass=$((pass + 1))
         n=$(grep -c . "$out/$name.hashes")
         echo "cross: $name is the reference: $n frames (${secs} s)"
-        note "$name" "reference, $n frames (${secs} s)"
-        IFS='
-'
-        continue
+        result ref "reference, $n frames (${secs} s)"
+        return
     fi
     # What the reference printed for this build's cases.
     awk 'NR == FNR { want[$1] = 1; next } ($1 in want)' "$out/$name.cases" "$out/$ref.hashes" >"$out/$name.want"
@@ -238,32 +204,93 @@ for c in $configs; do
         if [ "$(cut -d' ' -f1,2 "$out/$name.want")" != "$(cut -d' ' -f1,2 "$out/$name.hashes")" ]; then
             echo "cross: FAIL $name did not render every case:"
             diff "$out/$name.want" "$out/$name.hashes" | sed 's/^/    /' | head -20
-            fail=$((fail + 1))
-            note "$name" "FAIL: missing cases"
+            result fail "FAIL: missing cases"
         else
             d=$(diff "$out/$name.want" "$out/$name.hashes" | grep -c '^>')
-            loose=$((loose + 1))
             echo "cross: $name (outside the promise) renders every case; $d of $n frames differ (${secs} s)"
-            note "$name" "out of the promise: ends, $d of $n frames differ (${secs} s)"
+            result loose "out of the promise: ends, $d of $n frames differ (${secs} s)"
         fi
     elif cmp -s "$out/$name.want" "$out/$name.hashes"; then
-        pass=$((pass + 1))
         extra=""
         [ "$kind" = board ] && extra=", $(arm-none-eabi-size "$out/$name" | awk 'NR == 2 {print $1}') bytes of code"
         echo "cross: $name matches: $n frames (${secs} s$extra)"
-        note "$name" "matches, $n frames (${secs} s)"
+        result pass "matches, $n frames (${secs} s)"
         if [ "$kind" = board ] && [ "${name#*-gcc-O2}" != "$name" ]; then
             grep '^bytes' "$out/$name.txt" | awk '{printf "    %-6s peak %8d, minimum %8d: %s\n", $2, $3, $5, $5 <= 262144 ? "fits 256 KiB" : "over 256 KiB"}'
         fi
     else
-        fail=$((fail + 1))
         d=$(diff "$out/$name.want" "$out/$name.hashes" | grep -c '^>')
         echo "cross: FAIL $name differs from $ref in $d of $n frames:"
         diff "$out/$name.want" "$out/$name.hashes" | sed 's/^/    /' | head -40
-        note "$name" "FAIL: $d of $n frames differ (${secs} s)"
+        result fail "FAIL: $d of $n frames differ (${secs} s)"
     fi
-    IFS='
+}
+
+if [ "${1:-}" = --one ]; then
+    name=${2%%|*}
+    run_one "$2" >"$out/$name.log" 2>&1
+    cat "$out/$name.log"
+    exit 0
+fi
+
+pass=0
+fail=0
+skip=0
+loose=0
+summary=""
+note() { summary="$summary$(printf '    %-40s %s' "$1" "$2")
+"; }
+
+if command -v clang >/dev/null 2>&1 && command -v qemu-s390x >/dev/null 2>&1 &&
+   clang --target=s390x-linux-gnu $WARN -O2 tests/cross/mdebr_probe.c -o "$out/mdebr-probe" \
+       >"$out/mdebr-probe.txt" 2>&1; then
+    if qemu-s390x -L /usr/s390x-linux-gnu "$out/mdebr-probe" >"$out/mdebr-probe.txt" 2>&1; then
+        configs="$configs
+s390x-clang-O2|same|clang|-O2 --target=s390x-linux-gnu|qemu-s390x -L /usr/s390x-linux-gnu|$BIG"
+    else
+        echo "cross: s390x-clang-O2 not run: this QEMU's mdebr is wrong ($(cat "$out/mdebr-probe.txt"))"
+        note s390x-clang-O2 "not run: the emulator's mdebr is wrong (tests/cross/mdebr_probe.c)"
+    fi
+fi
+
+# The reference first, alone; then every other build (or those CROSS_ONLY names),
+# CROSS_JOBS at a time.
+ref=""
+todo=""
+IFS='
 '
+for c in $configs; do
+    name=${c%%|*}
+    if [ -z "$ref" ]; then
+        run_one "$c"
+        [ "$(cut -f1 "$out/$name.result" 2>/dev/null)" = ref ] || { printf 'cross: FAIL the reference %s did not run\n' "$name"; exit 1; }
+        ref=$name
+        continue
+    fi
+    if [ -n "${CROSS_ONLY:-}" ] && ! echo "$name" | grep -Eq -- "$CROSS_ONLY"; then continue; fi
+    todo="$todo$c
+"
+done
+IFS=' 	
+'
+jobs=${CROSS_JOBS:-$(getconf _NPROCESSORS_ONLN 2>/dev/null || echo 2)}
+export ref CROSS_SKIP_MISSING
+printf '%s' "$todo" | tr '\n' '\0' | xargs -0 -r -n 1 -P "$jobs" sh tests/cross/run.sh --one
+all="$ref
+$todo"
+IFS='
+'
+for c in $all; do
+    name=${c%%|*}
+    [ -n "$name" ] || continue
+    IFS='	' read -r what why <"$out/$name.result" || { what=fail why="FAIL: no result"; }
+    case $what in
+        ref|pass) pass=$((pass + 1)) ;;
+        loose) loose=$((loose + 1)) ;;
+        skip) skip=$((skip + 1)) ;;
+        *) fail=$((fail + 1)) ;;
+    esac
+    note "$name" "$why"
 done
 IFS=' 	
 '
