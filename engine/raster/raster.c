@@ -208,24 +208,26 @@ void om__rtri_zplane(om__rtri *t, const uint32_t z[3])
     }
 }
 
-/* The snapped triangle's bounding box on the grid. */
-static void tri_box(const om__tri2 *e, int64_t *minX, int64_t *maxX, int64_t *minY, int64_t *maxY)
+/* The bounding box of three grid points (a triangle's, in any vertex order). */
+static void tri_box(const int64_t x[3], const int64_t y[3], int64_t *minX, int64_t *maxX, int64_t *minY,
+                    int64_t *maxY)
 {
-    *minX = *maxX = e->x[0];
-    *minY = *maxY = e->y[0];
+    *minX = *maxX = x[0];
+    *minY = *maxY = y[0];
     for (int i = 1; i < 3; i++) {
-        if (e->x[i] < *minX) *minX = e->x[i];
-        if (e->x[i] > *maxX) *maxX = e->x[i];
-        if (e->y[i] < *minY) *minY = e->y[i];
-        if (e->y[i] > *maxY) *maxY = e->y[i];
+        if (x[i] < *minX) *minX = x[i];
+        if (x[i] > *maxX) *maxX = x[i];
+        if (y[i] < *minY) *minY = y[i];
+        if (y[i] > *maxY) *maxY = y[i];
     }
 }
 
-static bool bounds(om__rtri *t, const om_target *tg, bool conservative)
+/* The pixels of the target whose centre (or, conservative, whose closed square) meets
+ * the bounding box of the triangle with vertices x, y (within om__tri2's range). */
+static bool bounds(om__rtri *t, const int64_t x[3], const int64_t y[3], const om_target *tg, bool conservative)
 {
-    const om__tri2 *e = &t->e;
     int64_t minX, maxX, minY, maxY;
-    tri_box(e, &minX, &maxX, &minY, &maxY);
+    tri_box(x, y, &minX, &maxX, &minY, &maxY);
     int64_t x0, x1, y0, y1;
     if (conservative) {       /* pixels whose closed square meets the bounding box */
         x0 = pixel_floor(minX - 1); x1 = pixel_floor(maxX);
@@ -290,7 +292,9 @@ static void depth_row(const om__rtri *t, const om_target *tg, int32_t y, int32_t
     }
 }
 
-static void fill(const om_raster *r, const om__rtri *t, uint32_t id)
+/* The plain fill. The depth plane (two divisions) is set up at the first row with a
+ * covered pixel: most triangles of a detailed scene cover no pixel centre at all. */
+static void fill(const om_raster *r, om__rtri *t, const uint32_t z[3], uint32_t id)
 {
     const om_target *tg = r->target;
     const om__tri2 *e = &t->e;
@@ -302,6 +306,10 @@ static void fill(const om_raster *r, const om__rtri *t, uint32_t id)
         const int64_t E[3] = {om__tri2_edge(e, 0, px0, py), om__tri2_edge(e, 1, px0, py),
                               om__tri2_edge(e, 2, px0, py)};
         if (!row_span(E, step, t->maxx - t->minx, &lo, &hi)) continue;
+        if (z) {
+            om__rtri_zplane(t, z);
+            z = NULL;
+        }
         uint32_t *id_row = with_id ? tg->id + (size_t)(y - (int32_t)tg->y0) * tg->width : NULL;
         depth_row(t, tg, y, t->minx + (int32_t)lo, t->minx + (int32_t)hi, id_row, id);
     }
@@ -411,7 +419,7 @@ static bool bounds_grid(om__rtri *t, const om_raster *r)
     const om_target *tg = r->target;
     const om__tri2 *e = &t->e;
     int64_t minX, maxX, minY, maxY;
-    tri_box(e, &minX, &maxX, &minY, &maxY);
+    tri_box(e->x, e->y, &minX, &maxX, &minY, &maxY);
     const int32_t xe = (int32_t)tg->width - 1, ye = (int32_t)(tg->y0 + tg->rows) - 1;
     const uint32_t s = r->grid_shift, nb = r->grid_buckets;
     /* the first grid point at or past each side */
@@ -477,20 +485,26 @@ bool om__raster_snapped(const om_raster *r, const int64_t x[3], const int64_t y[
     if (r->cull_back && (x[1] - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[1] - y[0]) > 0)
         return false;
     om__rtri t;
-    if (!om__tri2_setup(&t.e, x, y, !cons)) return false;
     if (r->grid_x) {
-        if (!bounds_grid(&t, r)) return false;
+        if (!om__tri2_setup(&t.e, x, y, !cons) || !bounds_grid(&t, r)) return false;
         om__rtri_zplane(&t, z);
         fill_grid(r, &t);
         return true;
     }
-    if (!bounds(&t, r->target, cons)) return false;
-    om__rtri_zplane(&t, z);
+    /* the bounds first: they need no edges, and most triangles of a detailed scene
+     * hold no pixel centre of a small target (the setup's range test comes first, as
+     * om__tri2_setup would refuse the same triangles) */
+    for (int i = 0; i < 3; i++)
+        if (x[i] > OM_TRI2_MAX_COORD || x[i] < -OM_TRI2_MAX_COORD || y[i] > OM_TRI2_MAX_COORD ||
+            y[i] < -OM_TRI2_MAX_COORD)
+            return false;
+    if (!bounds(&t, x, y, r->target, cons) || !om__tri2_setup(&t.e, x, y, !cons)) return false;
     if (cons) {
+        om__rtri_zplane(&t, z);
         om__rtri_plane(&t, z);   /* the spans' callers test the plane beyond the triangle */
         fill_conservative(r, &t);
     } else {
-        fill(r, &t, id);
+        fill(r, &t, z, id);
     }
     return true;
 }
