@@ -144,7 +144,7 @@ void om__bins_make(const om_scene *s, const om_mat4 *vp, uint32_t width, uint32_
         const om_vec4 c = om__mat_apply(vp, s->verts[v]);
         if (!snap_alone(&c, width, height, &vs[v])) vs[v].x = INT32_MIN;
     }
-    for (uint32_t t = 0; t < s->ntris; t++) {
+    for (uint32_t t = 0; b->rows && t < s->ntris; t++) {
         const uint32_t *ix = s->idx + (size_t)t * 3;
         if (vs && vs[ix[0]].x != INT32_MIN && vs[ix[1]].x != INT32_MIN && vs[ix[2]].x != INT32_MIN) {
             int64_t lo = vs[ix[0]].y, hi = lo;

@@ -45,7 +45,9 @@ typedef struct om__bins {
 
 size_t om__bins_rows_bytes(const om_scene *s);
 size_t om__bins_verts_bytes(const om_scene *s);
-/* Fills b->verts (when not NULL) and then b->rows for the camera matrix vp. */
+/* Fills b->verts and b->rows (each when not NULL) for the matrix vp onto a width x
+ * height image: the camera's for the eye pass, the light's for a light pass
+ * (vertices only: om__scene_raster walks every triangle without rows). */
 void om__bins_make(const om_scene *s, const om_mat4 *vp, uint32_t width, uint32_t height, const om__bins *b);
 
 /* Clears `tg` and rasterizes every triangle of the scene through `vp` into it: the

@@ -23,6 +23,7 @@ typedef struct sm_state {
     sm_cfg cfg;
     uint32_t size;
     uint32_t *depth;
+    om__vsnap *verts;      /* each vertex on the map's grid, once a frame; NULL: no room */
     om_view view;
     om__smlook look;       /* the biased depth test, shared with rtw (smlookup.c) */
     uint32_t samples, shadowed;
@@ -42,7 +43,8 @@ static om_status sm_bytes(const om_method_cfg *mc, const om_scene *s, uint32_t w
     const sm_cfg *c = &cv;
     if (om__method_cfg_of(mc, &om__method_sm, &cv, NULL)) return OM_E_INVALID;
     if (c->map_size < 1 || c->map_size > OM_MAX_DIM) return OM_E_INVALID;
-    *min = *full = sm_need(c);
+    *min = sm_need(c);
+    *full = *min + om__bins_verts_bytes(s);   /* the light pass projects each vertex once */
     return OM_OK;
 }
 
@@ -66,6 +68,10 @@ static om_status sm_init(void **state, om_arena *a, const om_method_cfg *mc, con
     m->size = c->map_size;
     if ((st = om_arena_alloc(a, (size_t)m->size * m->size * sizeof(uint32_t), 16, &p, d))) return st;
     m->depth = (uint32_t *)p;
+    m->verts = NULL;
+    if (s->nverts && om_arena_left(a) >= om__bins_verts_bytes(s) &&
+        om_arena_alloc(a, (size_t)s->nverts * sizeof(om__vsnap), 8, &p, NULL) == OM_OK)
+        m->verts = (om__vsnap *)p;
     m->look.depth = m->depth;
     m->look.size = m->size;
     m->look.bias_const = c->bias_const;
@@ -100,7 +106,10 @@ static void sm_build_rows(const void *state, const om__bins *bins, uint32_t y0, 
 static om_status sm_build(void *state, om_diag *d)
 {
     (void)d;
-    sm_build_rows(state, NULL, 0, ((sm_state *)state)->size);
+    sm_state *m = (sm_state *)state;
+    const om__bins b = {NULL, m->verts};
+    if (m->verts) om__bins_make(m->scene, &m->view.light_vp, m->size, m->size, &b);
+    sm_build_rows(state, m->verts ? &b : NULL, 0, m->size);
     return OM_OK;
 }
 
@@ -147,7 +156,7 @@ static void sm_stats(const void *state, om_method_stats *out)
 {
     const sm_state *m = (const sm_state *)state;
     memset(out, 0, sizeof *out);
-    out->bytes_used = sm_need(&m->cfg);
+    out->bytes_used = sm_need(&m->cfg) + (m->verts ? om__bins_verts_bytes(m->scene) : 0);
     out->counters[0] = m->samples;
     out->counter_names[0] = "samples";
     out->counters[1] = m->shadowed;
