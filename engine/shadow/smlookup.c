@@ -41,16 +41,23 @@ static inline void warp(const om__smlook *L, double *u, double *v, double *densi
 
 /* floor(f) for a texel coordinate, limited to 16 texels beyond either side of the
  * map: every PCF tap (k <= 9) of a texel further out clamps to the same edge texel. */
-static inline int64_t texel_floor(float f, uint32_t size)
+static inline int32_t texel_floor(float f, uint32_t size)
 {
     const float hi = (float)size + 16.0f;
-    return f > -16.0f ? (f < hi ? om__floorf_i32(f) : (int64_t)size + 16) : -16;
+    return f > -16.0f ? (f < hi ? om__floorf_i32(f) : (int32_t)size + 16) : -16;
+}
+
+/* The same for a warped coordinate (in texels, double). */
+static inline int32_t texel_floor_d(double f, uint32_t size)
+{
+    const double hi = (double)size + 16.0;
+    return f > -16.0 ? (f < hi ? (int32_t)floor(f) : (int32_t)size + 16) : -16;
 }
 
 /* Where one sample's test looks: its biased depth and the texel under it (before the
  * clamp to the map); for a warped map also where it lies before the warp (normalized
  * coordinates), from which unwarped PCF taps are placed. */
-typedef struct tap { uint64_t zlit; int64_t cx, cy; double u, v; } tap;
+typedef struct tap { uint64_t zlit; int32_t cx, cy; double u, v; } tap;
 
 /* The least stored depth a biased sample depth z is not behind: z <= D for a stored
  * integer D exactly when ceil(z) <= D (a NaN never is: 2^32 + 1). Integer compares per
@@ -120,8 +127,8 @@ static bool locate(const om__smlook *L, const om_sample *smp, tap *out)
             out->v = v0;
             warp(L, &u0, &v0, &dens);
         }
-        out->cx = (int64_t)floor(u0 * L->size);
-        out->cy = (int64_t)floor(v0 * L->size);
+        out->cx = texel_floor_d(u0 * L->size, L->size);
+        out->cy = texel_floor_d(v0 * L->size, L->size);
     } else {
         out->u = out->v = 0.0;   /* no warp: taps are the map's texels */
         const float uf = (q.x * iw + 1.0f) * (0.5f * (float)L->size);
@@ -151,9 +158,17 @@ static int64_t unwarped_tap(const int32_t *P, uint32_t n, uint32_t size, double 
 
 /* The map loads: k x k taps around the texel (or, for unwarped PCF, around the
  * sample's unwarped position), each clamped to the map. */
+static inline int32_t clamp_texel(int64_t x, uint32_t size)
+{
+    return x < 0 ? 0 : x >= (int64_t)size ? (int32_t)size - 1 : (int32_t)x;
+}
+
 static uint8_t test(const om__smlook *L, const tap *tp)
 {
     const uint64_t z = tp->zlit;
+    if (L->pcf == 1)   /* one tap: the common case, without the loops */
+        return z <= L->depth[(size_t)clamp_texel(tp->cy, L->size) * L->size + (size_t)clamp_texel(tp->cx, L->size)]
+                   ? 255 : 0;
     int k = (int)L->pcf, half = k / 2, lit = 0;
     int64_t tx[9], ty[9];   /* pcf <= 9 */
     for (int d = -half; d < k - half; d++) {
@@ -162,14 +177,8 @@ static uint8_t test(const om__smlook *L, const tap *tp)
         ty[d + half] = spread ? unwarped_tap(L->warp_y, L->warp_n, L->size, tp->v, d) : tp->cy + d;
     }
     for (int j = 0; j < k; j++)
-        for (int i = 0; i < k; i++) {
-            int64_t x = tx[i], y = ty[j];
-            if (x < 0) x = 0;
-            if (y < 0) y = 0;
-            if (x >= L->size) x = L->size - 1;
-            if (y >= L->size) y = L->size - 1;
-            lit += z <= L->depth[(size_t)y * L->size + (size_t)x];
-        }
+        for (int i = 0; i < k; i++)
+            lit += z <= L->depth[(size_t)clamp_texel(ty[j], L->size) * L->size + (size_t)clamp_texel(tx[i], L->size)];
     uint8_t val = (uint8_t)((255 * lit + k * k / 2) / (k * k));
     if (lit < k * k && val == 255) val = 254;   /* partly shadowed is never "lit" */
     return val;
@@ -197,10 +206,8 @@ void om__smlook_strip(const om__smlook *L, om_strip *st, uint32_t *samples, uint
             ++*samples;
             if (locate(L, &st->samples[i], &taps[got])) {
 #if defined(__GNUC__) || defined(__clang__)
-                int64_t x = taps[got].cx, y = taps[got].cy;
-                x = x < 0 ? 0 : x >= L->size ? L->size - 1 : x;
-                y = y < 0 ? 0 : y >= L->size ? L->size - 1 : y;
-                __builtin_prefetch(&L->depth[(size_t)y * L->size + (size_t)x]);
+                __builtin_prefetch(&L->depth[(size_t)clamp_texel(taps[got].cy, L->size) * L->size +
+                                             (size_t)clamp_texel(taps[got].cx, L->size)]);
 #endif
                 at[got++] = (uint32_t)i;
             }
