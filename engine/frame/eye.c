@@ -231,8 +231,9 @@ void om__eye_pass(const om_scene *s, const om_view *v, const om_target *tg, om_s
             size_t i = (size_t)y * st->width + x;
             uint32_t t = tg->id[i];
             om_sample *smp = &st->samples[i];
-            if (t == OM_NO_TRI) {
-                memset(smp, 0, sizeof *smp);
+            if (t == OM_NO_TRI) {   /* field by field: a freestanding build calls memset */
+                smp->p[0] = smp->p[1] = smp->p[2] = 0.0f;
+                smp->n[0] = smp->n[1] = smp->n[2] = 0.0f;
                 smp->tri = OM_NO_TRI;
                 continue;
             }
