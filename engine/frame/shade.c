@@ -39,9 +39,10 @@ static uint8_t to8(float v)
     return v <= 0.0f ? 0 : v >= 255.0f ? 255 : (uint8_t)v;
 }
 
-static void put(om_framebuffer *fb, uint8_t *px, uint8_t r, uint8_t g, uint8_t b)
+/* In line with a constant format (shade_row's callers): the switch then goes. */
+static inline void put(om_format f, uint8_t *px, uint8_t r, uint8_t g, uint8_t b)
 {
-    switch (fb->format) {
+    switch (f) {
     case OM_RGB888: px[0] = r; px[1] = g; px[2] = b; break;
     case OM_RGB565: {   /* little-endian 16-bit word: r in the top 5 bits */
         uint16_t w = (uint16_t)(((r >> 3) << 11) | ((g >> 2) << 5) | (b >> 3));
@@ -53,30 +54,40 @@ static void put(om_framebuffer *fb, uint8_t *px, uint8_t r, uint8_t g, uint8_t b
     }
 }
 
+/* One row of the strip into the framebuffer row `px`, `bpp` bytes a pixel. A blocked
+ * term adds k * 0 = 0 to the ambient light (k is finite: unit vectors), so the light's
+ * direction is not computed for it. */
+static inline void shade_row(const om_scene *s, const om_view *v, const om_shade_cfg *c, const om_sample *smp,
+                             const om_term *t, uint32_t width, om_format f, uint32_t bpp, uint8_t *px)
+{
+    for (uint32_t x = 0; x < width; x++, smp++, t++, px += bpp) {
+        if (smp->tri == OM_NO_TRI) { put(f, px, c->bg_r, c->bg_g, c->bg_b); continue; }
+        const om_material *m = &s->mats[s->tri_mat[smp->tri]];
+        float lr = c->ambient, lg = c->ambient, lb = c->ambient;
+        if ((t->flags & OM_TERM_EXPOSED) && (t->r | t->g | t->b)) {
+            om_vec3 p = om__v3(smp->p[0], smp->p[1], smp->p[2]);
+            om_vec3 n = om__v3(smp->n[0], smp->n[1], smp->n[2]);
+            if (om__dot(n, om__sub(v->cam.eye, p)) < 0.0f) n = om__scale(n, -1.0f);
+            float k = om__dot(n, om__to_light(v, p)) * (1.0f - c->ambient) * (1.0f / 255.0f);
+            lr += k * (float)t->r;
+            lg += k * (float)t->g;
+            lb += k * (float)t->b;
+        }
+        put(f, px, to8(m->r * lr), to8(m->g * lg), to8(m->b * lb));
+    }
+}
+
 void om__shade_strip(const om_scene *s, const om_view *v, const om_shade_cfg *c,
                      const om_strip *st, om_framebuffer *fb)
 {
-    uint32_t bpp = om_format_bpp(fb->format);
+    const uint32_t bpp = om_format_bpp(fb->format);
     for (uint32_t y = 0; y < st->rows; y++) {
+        const size_t i = (size_t)y * st->width;
         uint8_t *row = fb->pixels + (size_t)y * fb->stride;
-        for (uint32_t x = 0; x < st->width; x++) {
-            size_t i = (size_t)y * st->width + x;
-            const om_sample *smp = &st->samples[i];
-            uint8_t *px = row + (size_t)x * bpp;
-            if (smp->tri == OM_NO_TRI) { put(fb, px, c->bg_r, c->bg_g, c->bg_b); continue; }
-            const om_material *m = &s->mats[s->tri_mat[smp->tri]];
-            const om_term *t = &st->terms[i];
-            float lr = c->ambient, lg = c->ambient, lb = c->ambient;
-            if (t->flags & OM_TERM_EXPOSED) {
-                om_vec3 p = om__v3(smp->p[0], smp->p[1], smp->p[2]);
-                om_vec3 n = om__v3(smp->n[0], smp->n[1], smp->n[2]);
-                if (om__dot(n, om__sub(v->cam.eye, p)) < 0.0f) n = om__scale(n, -1.0f);
-                float k = om__dot(n, om__to_light(v, p)) * (1.0f - c->ambient) * (1.0f / 255.0f);
-                lr += k * (float)t->r;
-                lg += k * (float)t->g;
-                lb += k * (float)t->b;
-            }
-            put(fb, px, to8(m->r * lr), to8(m->g * lg), to8(m->b * lb));
+        switch (fb->format) {
+        case OM_RGB888: shade_row(s, v, c, st->samples + i, st->terms + i, st->width, OM_RGB888, 3, row); break;
+        case OM_RGB565: shade_row(s, v, c, st->samples + i, st->terms + i, st->width, OM_RGB565, 2, row); break;
+        default: shade_row(s, v, c, st->samples + i, st->terms + i, st->width, fb->format, bpp, row); break;
         }
     }
 }
