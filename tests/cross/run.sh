@@ -344,8 +344,33 @@ if [ -z "${CROSS_ONLY:-}" ] || echo "m4-count" | grep -Eq -- "$CROSS_ONLY"; then
     fi
 fi
 
-# Code size: .text of each part of the engine for Cortex-M3 at -Os.
+# Code size: .text of each part of the engine for Cortex-M3 at -Os, and of the README's
+# embedding example as Cortex-M4 firmware (gcc -O2) with every method and with `sm`
+# alone (OM_WITH_*=0 for the others); also in out/cross/code-size.csv.
 if command -v arm-none-eabi-gcc >/dev/null 2>&1; then
+    mkdir -p out/cross
+    sizes="$out/code-size.csv"
+    echo "part,text" >"$sizes"
+    printf 'int render_once(void);\nint om_cross_main(void);\nint om_cross_main(void) { return render_once(); }\n' \
+        >"$out/example_main.c"
+    for methods in all sm; do
+        only=""
+        [ "$methods" = sm ] && only="-DOM_WITH_NONE=0 -DOM_WITH_REF=0 -DOM_WITH_ASM=0 -DOM_WITH_RTW=0 -DOM_WITH_SPSM=0 -DOM_WITH_IZB=0 -DOM_WITH_HYBRID=0"
+        # shellcheck disable=SC2086
+        if arm-none-eabi-gcc $BFLAGS -O2 $M4 $only -Dmain=host_main $ENGINE tests/embed/render_once.c \
+               "$out/example_main.c" platform/cortex-m/startup.c platform/cortex-m/semihost.c \
+               -T platform/cortex-m/mps2.ld -nostartfiles -Wl,--gc-sections -lm -lc -lgcc \
+               -o "$out/example-$methods" 2>"$out/example-$methods.err"; then
+            t=$(arm-none-eabi-size "$out/example-$methods" | awk 'NR == 2 {print $1}')
+            [ "$methods" = sm ] && with="sm alone" || with="every method"
+            echo "cross: the README's example as Cortex-M4 firmware (gcc -O2) with $with: $t bytes of code"
+            echo "example-m4-$methods,$t" >>"$sizes"
+        else
+            echo "cross: FAIL the README's example does not build as firmware ($methods): $(head -c 400 "$out/example-$methods.err")"
+            fail=$((fail + 1))
+            note "example-$methods" "FAIL: does not build"
+        fi
+    done
     echo "cross: .text bytes for Cortex-M3 at -Os:"
     for part in core raster scene frame measure shadow/occlude shadow/bvh shadow/smlookup shadow/registry \
                 $(ls engine/shadow/*.c | sed -n 's|engine/shadow/\([a-z]*\)\.c|\1|p' | \
@@ -363,7 +388,9 @@ if command -v arm-none-eabi-gcc >/dev/null 2>&1; then
             total=$((total + t))
         done
         printf '    %-16s %7d\n' "$part" "$total"
+        echo "$part,$total" >>"$sizes"
     done
+    cp "$sizes" out/cross/code-size.csv
 fi
 
 echo "cross: summary ($(($(date +%s) - t_start)) s in all):"
