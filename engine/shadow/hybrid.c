@@ -9,13 +9,12 @@
  * touches a texel when its edge functions admit a point of the texel's square (tested
  * against the square's extreme corner per edge: never missed, sometimes extra). Per
  * texel the build keeps
- *   lo, id  the least over touching triangles of (their plane's least depth over the
- *           square, clamped as the predicate clamps, + their snapping bound), and
- *           which triangle gave it;
- *   lo2     the same least over every triangle but `id`;
- *   hi, cid over unclipped opaque triangles whose edges admit all four corners of the
- *           square (so every point of it: the admitted set is convex): the least of
- *           (their plane's greatest depth over the square + their bound), and which.
+ *   lo      a plane below every touching triangle's depth over the square (clamped as
+ *           the predicate clamps) plus its snapping bound;
+ *   hi, cid over opaque triangles of one sub-triangle whose edges admit all four
+ *           corners of the square (so every point of it: the admitted set is convex):
+ *           the least of (their depth at the square's corner where their plane is
+ *           greatest, + their bound), and which triangle gave it.
  * Depths are rounded outwards by a depth unit (far above the double evaluation's
  * error), then to float outwards.
  *
@@ -23,15 +22,14 @@
  * texel e (om__blocks: a triangle t blocks p when t != p's own triangle, g is inside
  * t's first sub-triangle that admits it, and that sub-triangle's depth at g plus its
  * bound is below p.z):
- *   certainly lit when L >= p.z, L = (id == own ? lo2 : lo). A blocker t != own admits
- *     g, so it touches e and its entry is at most its depth at g plus its bound, which
- *     is below p.z; if t == id then id != own and L = lo <= that; else L <= lo2 <=
- *     that (lo2 is over every triangle but id, and lo <= lo2). Either way L < p.z.
- *   certainly shadowed when hi < p.z and cid != own. cid is one sub-triangle (unclipped)
- *     admitting every point of e, g among them, with depth at g at most its greatest
- *     over the square, so its depth + bound < p.z: it blocks p; it is opaque, so the
+ *   certainly lit when lo at g >= p.z. A blocker t admits g, so it touches e, and lo at
+ *     g is at most its depth at g plus its bound, which is below p.z: lo < p.z.
+ *   certainly shadowed when hi < p.z and cid != own. cid is one sub-triangle admitting
+ *     every point of e, g among them (so it is the first that admits g), with depth
+ *     at g at most its depth at the corner where its plane is greatest (the clamp
+ *     keeps the order), so its depth + bound < p.z: it blocks p; it is opaque, so the
  *     optical depth saturates whatever else blocks, and the term is 0 in every
- *     channel, as the reference's.
+ *     channel, as the reference's. No predicate is run: the lookup is the answer.
  * A semi-transparent caster never makes a sample certain but lit (then nothing blocks
  * and the term is exactly 255); the sample's own triangle is excluded by its id; a
  * sample on a texel's border belongs to the one texel its grid point falls in, and
@@ -42,11 +40,10 @@
 #include <float.h>
 
 /* A texel: a plane P(x, y) = z + gx (x - xc) + gy (y - yc) about the texel's centre,
- * below every touching triangle's depth plus bound over the texel; and the nearest
- * opaque triangle touching it, with its least depth there. */
-typedef struct htexel { float z, gx, gy, near; uint32_t cid; } htexel;
-
-#define MRU 4
+ * below every touching triangle's depth plus bound over the texel (lo); and the
+ * opaque triangle covering all of it whose greatest depth plus bound is least (hi,
+ * cid). */
+typedef struct htexel { float z, gx, gy, hi; uint32_t cid; } htexel;
 
 /* hybrid's configuration: the sample pool's settings and its map's side. */
 typedef struct hybrid_cfg {
@@ -63,8 +60,8 @@ typedef struct hybrid_state {
     htexel *map;
     uint32_t side;         /* texels per side */
     int64_t T;             /* grid units per texel side */
+    int tshift;            /* log2(T) when T is a power of two (the default sides), else -1 */
     uint32_t lit, shadowed, uncertain;
-    om__ltri mru[MRU];     /* opaque triangles that blocked recent samples, newest first */
 } hybrid_state;
 
 #define GRID_SIDE ((int64_t)OM_LIGHT_GRID * OM_SUBPIX)   /* 2^21 grid units */
@@ -126,6 +123,9 @@ static om_status hybrid_init(void **state, om_arena *a, const om_method_cfg *mc,
     m->cfg = *c;
     m->side = map_side(c, w, h);
     m->T = (GRID_SIDE + m->side - 1) / m->side;
+    m->tshift = -1;
+    for (int b = 0; b < 62; b++)
+        if (((int64_t)1 << b) == m->T) m->tshift = b;
     size_t tex = (size_t)m->side * m->side;
     if ((st = om_arena_alloc(a, tex * sizeof(htexel), 16, &p, d))) return st;
     m->map = (htexel *)p;
@@ -158,6 +158,24 @@ static float f_down(double v)
     return (double)f > v ? (float)(v - fabs(v) * 1e-6 - 1.0) : f;
 }
 
+/* A double depth to float, never below it (as f_down, the other way). */
+static float f_up(double v)
+{
+    float f = (float)v;
+    return (double)f < v ? (float)(v + fabs(v) * 1e-6 + 1.0) : f;
+}
+
+/* Does every point of the square pass every edge of e? Each edge is tested at the
+ * corner where it is least. */
+static bool square_inside(const om__tri2 *e, int64_t x0, int64_t y0, int64_t x1, int64_t y1)
+{
+    for (int i = 0; i < 3; i++)
+        if ((e->a[i] > 0 ? e->a[i] * x0 : e->a[i] * x1) + (e->b[i] > 0 ? e->b[i] * y0 : e->b[i] * y1) +
+                e->c[i] < 0)
+            return false;
+    return true;
+}
+
 /* Does any point of the square [x0, x1] x [y0, y1] pass every edge of e? Each edge is
  * tested at the corner where it is largest: a square outside one edge is out. */
 static bool square_touches(const om__tri2 *e, int64_t x0, int64_t y0, int64_t x1, int64_t y1)
@@ -178,7 +196,9 @@ static double least_diff(double a0, double ax, double ay, double b0, double bx, 
     return a0 - b0 + (dx < 0.0 ? dx * (double)w : 0.0) + (dy < 0.0 ? dy * (double)h : 0.0);
 }
 
-static void add_sub(hybrid_state *m, const om__rtri *r, double bound, uint32_t t, bool opaque)
+/* Adds sub-triangle r (with its bound) of triangle t to the texels it touches; `cover`:
+ * r is an opaque triangle's only sub-triangle, a candidate for hi. */
+static void add_sub(hybrid_state *m, const om__rtri *r, double bound, uint32_t t, bool cover)
 {
     const om__tri2 *e = &r->e;
     int64_t lox = e->x[0], hix = e->x[0], loy = e->y[0], hiy = e->y[0];
@@ -221,10 +241,11 @@ static void add_sub(hybrid_state *m, const om__rtri *r, double bound, uint32_t t
             double b = least_diff(r->zmax, 0.0, 0.0, p0, gx, gy, x1 - x0, y1 - y0);
             float z = f_down((a < b ? a : b) + bound - 1.0);
             if (z < h->z) h->z = z;
-            if (opaque) {
-                float lo = f_down(om__rtri_depth(r, xlo ? x0 : x1, ylo ? y0 : y1) + bound);
-                if (lo < h->near) {
-                    h->near = lo;
+            if (cover && lox <= x0 && hix >= x1 && loy <= y0 && hiy >= y1 &&
+                square_inside(e, x0, y0, x1, y1)) {
+                float hi = f_up(om__rtri_depth(r, xlo ? x1 : x0, ylo ? y1 : y0) + bound + 1.0);
+                if (hi < h->hi) {
+                    h->hi = hi;
                     h->cid = t;
                 }
             }
@@ -239,7 +260,7 @@ static om_status hybrid_build(void *state, om_diag *d)
     size_t n = (size_t)m->side * m->side;
     for (size_t i = 0; i < n; i++) {
         htexel *h = &m->map[i];
-        h->z = h->near = FLT_MAX;
+        h->z = h->hi = FLT_MAX;
         h->gx = h->gy = NAN;
         h->cid = OM_NO_TRI;
     }
@@ -247,19 +268,23 @@ static om_status hybrid_build(void *state, om_diag *d)
     for (uint32_t t = 0; t < s->ntris; t++) {
         om__ltri lt;
         if (!om__lspace_tri(&m->z.ls, t, &lt)) continue;
-        bool opaque = om__odepth_opaque(&m->z.mat_od[s->tri_mat[t]]);
-        for (int k = 0; k < lt.n; k++) add_sub(m, &lt.sub[k], lt.bound[k], t, opaque);
+        bool cover = lt.n == 1 && om__odepth_opaque(&m->z.mat_od[s->tri_mat[t]]);
+        for (int k = 0; k < lt.n; k++) add_sub(m, &lt.sub[k], lt.bound[k], t, cover);
     }
-    for (int k = 0; k < MRU; k++) m->mru[k].tri = OM_NO_TRI;
     return OM_OK;
 }
 
-int om__hybrid_decide(void *state, const om__lpoint *p, om_term *t)
+/* The texel of a grid point: a shift rather than a division where it can be (this
+ * runs once a sample); points off the grid take the border texels. */
+static inline int64_t texel_of(const hybrid_state *m, int64_t v)
 {
-    hybrid_state *m = (hybrid_state *)state;
-    int64_t last = (int64_t)m->side - 1, tx = p->x / m->T, ty = p->y / m->T;
-    if (p->x < 0) tx = 0;
-    if (p->y < 0) ty = 0;
+    if (v < 0) return 0;
+    return m->tshift >= 0 ? v >> m->tshift : v / m->T;
+}
+
+static inline int classify(hybrid_state *m, const om__lpoint *p, om_term *t)
+{
+    int64_t last = (int64_t)m->side - 1, tx = texel_of(m, p->x), ty = texel_of(m, p->y);
     if (tx > last) tx = last;
     if (ty > last) ty = last;
     const htexel *h = &m->map[ty * (int64_t)m->side + tx];
@@ -269,37 +294,24 @@ int om__hybrid_decide(void *state, const om__lpoint *p, om_term *t)
         m->lit++;
         return 1;   /* the term is already 255 */
     }
-    /* An opaque triangle that blocks p decides it: the predicate itself says so. The
-     * candidates: triangles that blocked recent samples (neighbours in the image are
-     * mostly neighbours in the light's), then the texel's nearest opaque one. */
-    if ((double)h->near < p->z) {
-        int hit = -1;
-        bool known = false;   /* the texel's candidate is among the recent ones */
-        for (int k = 0; k < MRU && hit < 0; k++) {
-            const om__ltri *lt = &m->mru[k];
-            known |= lt->tri == h->cid;
-            if (lt->tri != OM_NO_TRI && om__blocks(lt, p)) hit = k;
-        }
-        /* the texel's candidate replaces the oldest recent one */
-        if (hit < 0 && !known && h->cid != p->tri && om__lspace_tri(&m->z.ls, h->cid, &m->mru[MRU - 1]) &&
-            om__blocks(&m->mru[MRU - 1], p))
-            hit = MRU - 1;
-        if (hit >= 0) {
-            if (hit > 0) {   /* to the front */
-                om__ltri lt = m->mru[hit];
-                memmove(&m->mru[1], &m->mru[0], (size_t)hit * sizeof lt);
-                m->mru[0] = lt;
-            }
-            t->r = t->g = t->b = 0;
-            m->shadowed++;
-            return 2;
-        }
+    if ((double)h->hi < p->z && h->cid != p->tri) {
+        t->r = t->g = t->b = 0;
+        m->shadowed++;
+        return 2;
     }
     m->uncertain++;
     return 0;
 }
 
-static bool decide(void *user, const om__lpoint *p, om_term *t) { return om__hybrid_decide(user, p, t) != 0; }
+int om__hybrid_decide(void *state, const om__lpoint *p, om_term *t)
+{
+    return classify((hybrid_state *)state, p, t);
+}
+
+static bool decide(void *user, const om__lpoint *p, om_term *t)
+{
+    return classify((hybrid_state *)user, p, t) != 0;
+}
 
 static om_status hybrid_resolve(void *state, om_strip *st, om_diag *d)
 {
