@@ -220,19 +220,21 @@ uint32_t om__izb_transform(om__izb *z, const om_strip *st, size_t *next, size_t 
 /* ---- stage 2: the 2-D BSP */
 
 /* The Z-order (Morton) code of a key: x and y relative to the tile's corner, shifted
- * to ZBITS bits each, bits interleaved. */
-static uint32_t spread(uint32_t v)
+ * to ZBITS bits each, bits interleaved. Both are spread at once, one in each half of
+ * a 64-bit word. */
+static uint32_t zcode_xy(uint32_t x, uint32_t y)
 {
-    v &= 0xFFFFu;
-    v = (v | (v << 8)) & 0x00FF00FFu;
-    v = (v | (v << 4)) & 0x0F0F0F0Fu;
-    v = (v | (v << 2)) & 0x33333333u;
-    return (v | (v << 1)) & 0x55555555u;
+    uint64_t v = (uint64_t)x | (uint64_t)y << 32;
+    v = (v | (v << 8)) & 0x00FF00FF00FF00FFull;
+    v = (v | (v << 4)) & 0x0F0F0F0F0F0F0F0Full;
+    v = (v | (v << 2)) & 0x3333333333333333ull;
+    v = (v | (v << 1)) & 0x5555555555555555ull;
+    return (uint32_t)v | (uint32_t)(v >> 32) << 1;
 }
 
 static uint32_t zcode(const om__izb_key *k, int32_t x0, int32_t y0, int shift)
 {
-    return spread((uint32_t)(k->x - x0) >> shift) | spread((uint32_t)(k->y - y0) >> shift) << 1;
+    return zcode_xy((uint32_t)(k->x - x0) >> shift, (uint32_t)(k->y - y0) >> shift);
 }
 
 /* Gives every key its code, then sorts z->keys into Z order (a stable
@@ -505,7 +507,7 @@ static bool codes_of(const om__izb *z, const om__ltri *lt, tjob *j)
 
 static uint32_t cell_at(const om__izb *z, uint32_t cx, uint32_t cy)
 {
-    return z->cells[spread(cx) | spread(cy) << 1];
+    return z->cells[zcode_xy(cx, cy)];
 }
 
 /* A triangle whose bounds cover at most DIRECT cells goes straight to their nodes;
