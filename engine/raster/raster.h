@@ -47,6 +47,11 @@
 #include <math.h>
 #include <string.h>
 
+/* The depth scale: z/w in [0, 1] is stored as z/w * 2^32 (the rule below), in double
+ * and in float. */
+#define OM_DEPTH_ONE 4294967296.0
+#define OM_DEPTH_ONE_F 4294967296.0f
+
 #define OM_SUBPIX_BITS 8
 #define OM_SUBPIX (1 << OM_SUBPIX_BITS)
 #define OM_GUARD_PX 8192

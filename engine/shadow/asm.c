@@ -530,7 +530,7 @@ static bool setup_uv(const asm_state *m, const om_sample *smp, asm_pt *o)
     const double R = m->tree.lay.tile, iw = 1.0 / q.w;
     o->u = (q.x * iw + 1.0) * 0.5 * R;
     o->v = (1.0 - q.y * iw) * 0.5 * R;
-    o->z = q.z * iw * 4294967296.0;
+    o->z = q.z * iw * OM_DEPTH_ONE;
     o->tri = smp->tri;
     return o->u > -1e9 && o->u < 1e9 && o->v > -1e9 && o->v < 1e9 && o->z > -1e30 && o->z < 1e30;
 }
@@ -552,10 +552,10 @@ static void setup_bias(const asm_state *m, const om_sample *smp, asm_pt *o, bool
         float dist = om__dot(om__sub(p, v->light.pos), v->light_axis);
         double f = v->light.zfar, nn = v->light.znear, ee = dist > nn * 0.5f ? dist : nn * 0.5;
         texel = (double)dist * m->span_per_dist / R;
-        dz = f * nn / ((f - nn) * ee * ee) * 4294967296.0;
+        dz = f * nn / ((f - nn) * ee * ee) * OM_DEPTH_ONE;
     } else {
         texel = 2.0 / fabs((double)v->light_proj.m[0]) / R;
-        dz = 4294967296.0 * fabs((double)v->light_proj.m[10]);
+        dz = OM_DEPTH_ONE * fabs((double)v->light_proj.m[10]);
     }
     float cosl = om__dot(n, l);
     double tanl = cosl > 0.0995f ? sqrt(1.0 - (double)cosl * cosl) / cosl : 10.0;

@@ -46,12 +46,12 @@ static void bound_begin(om__lspace *ls, const om_view *v)
     /* x/w, y/w reach 3 at the guard band's edge; z/w is clamped to [0, 1]. The grid has
      * 2^20 units per unit of x/w, depth 2^32 per unit of z/w. */
     ls->lat = u10 * ((sx > sy ? sx : sy) + 3.0 * sw) * 1048576.0;
-    ls->dep = u10 * (sz + sw) * 4294967296.0;
+    ls->dep = u10 * (sz + sw) * OM_DEPTH_ONE;
     if (v->light.kind == OM_LIGHT_SPOT) {
         /* z/w = -p10 + p11 / w for the perspective projection, so 1/w is affine in depth */
         double p10 = v->light_proj.m[10], p11 = v->light_proj.m[11];
         ls->iw0 = p10 / p11;
-        ls->iw1 = 1.0 / (p11 * 4294967296.0);
+        ls->iw1 = 1.0 / (p11 * OM_DEPTH_ONE);
     } else {
         ls->iw0 = 1.0;
         ls->iw1 = 0.0;
@@ -124,7 +124,7 @@ bool om__lspace_tri(const om__lspace *ls, uint32_t t, om__ltri *lt)
     lt->tri = t;
     lt->lox = lt->loy = INT64_MAX;
     lt->hix = lt->hiy = INT64_MIN;
-    lt->zmin = 4294967296.0;
+    lt->zmin = OM_DEPTH_ONE;
     const om__lvert *a = ls->verts ? &ls->verts[ix[0]] : NULL;
     const om__lvert *b = ls->verts ? &ls->verts[ix[1]] : NULL, *c = ls->verts ? &ls->verts[ix[2]] : NULL;
     if (a && a->x != INT32_MIN && b->x != INT32_MIN && c->x != INT32_MIN) {

@@ -31,7 +31,7 @@ static void box_none(om__lbox *x)
 {
     x->lox = x->loy = INT32_MAX;
     x->hix = x->hiy = INT32_MIN;
-    x->zmin = 4294967296.0;   /* beyond every depth */
+    x->zmin = OM_DEPTH_ONE;   /* beyond every depth */
 }
 
 static void box_union(om__lbox *x, const om__lbox *a)

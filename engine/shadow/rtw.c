@@ -265,7 +265,7 @@ static void emit(tess_ctx *x, const tvert *a, const tvert *b, const tvert *c)
     int64_t gx[3], gy[3];
     uint32_t gz[3];
     for (int k = 0; k < 3; k++)
-        if (!om__snap(t[k]->u * s, t[k]->v * s, (double)t[k]->c.z * (1.0 / (double)t[k]->c.w) * 4294967296.0,
+        if (!om__snap(t[k]->u * s, t[k]->v * s, (double)t[k]->c.z * (1.0 / (double)t[k]->c.w) * OM_DEPTH_ONE,
                       &gx[k], &gy[k], &gz[k]))
             return;
     om__raster_snapped(&x->r, gx, gy, gz, x->tri);

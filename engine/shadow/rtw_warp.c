@@ -226,10 +226,10 @@ static double bias_depth(const om__rtw *m, double d)
 {
     const om_view *v = &m->view;
     double b = (double)m->cfg.bias_const;
-    if (v->light.kind != OM_LIGHT_SPOT) return b * 4294967296.0 * fabs((double)v->light_proj.m[10]) + 1.0;
-    double f = v->light.zfar, nn = v->light.znear, zn = d / 4294967296.0;
+    if (v->light.kind != OM_LIGHT_SPOT) return b * OM_DEPTH_ONE * fabs((double)v->light_proj.m[10]) + 1.0;
+    double f = v->light.zfar, nn = v->light.znear, zn = d / OM_DEPTH_ONE;
     double dist = f * nn / (f - zn * (f - nn));
-    return b * f * nn / ((f - nn) * dist * dist) * 4294967296.0 + 1.0;
+    return b * f * nn / ((f - nn) * dist * dist) * OM_DEPTH_ONE + 1.0;
 }
 
 /* Section 5.3: a texel is on a shadow edge when its depth breaks against one of its

@@ -67,7 +67,7 @@ static inline uint64_t depth_threshold(float z)
 {
     if (z != z) return (1ull << 32) + 1;
     if (!(z > 0.0f)) return 0;
-    if (!(z < 4294967296.0f)) return 1ull << 32;
+    if (!(z < OM_DEPTH_ONE_F)) return 1ull << 32;
     const uint32_t t = (uint32_t)z;
     return (uint64_t)t + ((float)t < z);
 }
@@ -136,14 +136,14 @@ static bool locate(const om__smlook *L, const om_sample *smp, tap *out)
         out->cx = texel_floor(uf, L->size);
         out->cy = texel_floor(wf, L->size);
     }
-    float z = q.z * iw * 4294967296.0f;
+    float z = q.z * iw * OM_DEPTH_ONE_F;
     /* bias from world units to depth units: d(z/w)/d(distance) at this sample */
     float dz;
     if (v->light.kind == OM_LIGHT_SPOT) {
         float f = v->light.zfar, nn = v->light.znear, e = dist > nn * 0.5f ? dist : nn * 0.5f;
-        dz = f * nn / ((f - nn) * e * e) * 4294967296.0f;
+        dz = f * nn / ((f - nn) * e * e) * OM_DEPTH_ONE_F;
     } else {
-        dz = 4294967296.0f * om__fabsf(v->light_proj.m[10]);
+        dz = OM_DEPTH_ONE_F * om__fabsf(v->light_proj.m[10]);
     }
     out->zlit = depth_threshold(z - bias * dz);
     return true;

@@ -352,7 +352,7 @@ static void project_d(const om__spsm_state *m, const double w[3], double *gx, do
     double iw = 1.0 / q[3], half = (double)m->size * (OM_SUBPIX / 2);
     *gx = (q[0] * iw + 1.0) * half;
     *gy = (1.0 - q[1] * iw) * half;
-    *gz = q[2] * iw * 4294967296.0;
+    *gz = q[2] * iw * OM_DEPTH_ONE;
 }
 
 /* The sample's own surface as a plane in light space: depth (raw) at grid offset
