@@ -50,7 +50,7 @@ static void equals_ref(const char *text, const char *what, int min_blocked)
     h_scene_free(&hs);
 }
 
-static void default_scene(void) { equals_ref(om_scene_default_text(), "default scene", 500); }
+static void izb_default_scene(void) { equals_ref(om_scene_default_text(), "default scene", 500); }
 
 static void random_scenes(void)
 {
@@ -155,7 +155,7 @@ static void budgets(void)
 
 void suite_izb(void)
 {
-    RUN(default_scene);
+    RUN(izb_default_scene);
     RUN(random_scenes);
     RUN(hot_spot);
     RUN(directional);
