@@ -8,13 +8,20 @@
  *
  * With the host's parallel-for and more than one thread, each strip is cut into bands
  * of rows, and the eye pass, the exposure marks, shading and (for methods with
- * om__bands) the resolve run on the bands at once, one job per thread. A band's pixels
- * are those of the strip (every stage is strip-invariant), so the frame is the same
+ * om__bands) the resolve run on the bands at once, each band a job of the host's
+ * parallel-for (up to BANDS_PER_JOB a thread, so the host can even out the work and a
+ * stalled thread holds up one small band). A band's pixels are those of the strip (every stage is strip-invariant), so the frame is the same
  * whatever the number of jobs; the stages that fold the whole strip into one answer
  * (the light's fit, observe, a serial resolve) stay on the calling thread. */
 #include "frame.h"
 
-/* One running job: its method counts and resolve scratch (from the frame arena). */
+/* Bands per thread: a strip (or a map) is cut into at most this many bands a thread,
+ * and the host's parallel-for hands them out, so a thread that the system stalls holds
+ * up one small band, not a thread's share. */
+#define BANDS_PER_JOB 4
+
+/* One band's method counts and resolve scratch (from the frame arena): a band is one
+ * job of the host's parallel-for, so it owns its slot whichever thread runs it. */
 typedef struct job_slot {
     uint32_t counts[8];
     void *scratch;
@@ -35,8 +42,8 @@ size_t om_frame_bytes_jobs(const om_method *m, const om_scene *s, uint32_t threa
 {
     if (threads <= 1) return 0;
     const om__bands *b = m ? om__method_bands(m) : NULL;
-    return (size_t)threads * (om_arena_need(sizeof(job_slot), 8) +
-                              (b ? om_arena_need(b->scratch ? b->scratch : 1, 16) : 0)) +
+    return (size_t)threads * BANDS_PER_JOB *
+               (om_arena_need(sizeof(job_slot), 8) + (b ? om_arena_need(b->scratch ? b->scratch : 1, 16) : 0)) +
            map_bins_bytes(b, s);
 }
 
@@ -85,8 +92,8 @@ static void grow_light_box(const om_view *v, const om_strip *st, om_vec3 *lo, om
     }
 }
 
-/* The bands of the strip and the jobs that run them: band b goes to job b % jobs, so a
- * job owns its slot and the rows it writes. */
+/* The bands of the strip: band b is job b of the host's parallel-for, with slot b and
+ * rows of its own. */
 typedef enum { STAGE_PREPARE, STAGE_RESOLVE, STAGE_SHADE, STAGE_BUILD } stage;
 
 typedef struct frame_ctx {
@@ -96,52 +103,48 @@ typedef struct frame_ctx {
     const om__bands *bands;    /* NULL: the method resolves a strip at a time */
     om_target tg;              /* the strip's */
     om_strip strip;
-    uint32_t jobs, band_rows, nbands;
-    job_slot *slots;           /* jobs of them */
+    uint32_t jobs, band_rows;
+    job_slot *slots;           /* BANDS_PER_JOB * jobs of them */
     stage stage;
     bool eye, mark;            /* STAGE_PREPARE: run the eye pass, mark exposure */
     om__bins map_bins;         /* the light map's (rows NULL: none) */
     uint32_t map_size, map_band;   /* STAGE_BUILD: the map's side, rows per band */
 } frame_ctx;
 
-static void band_job(void *user, uint32_t j)
+static void band_job(void *user, uint32_t b)
 {
     const frame_ctx *c = (const frame_ctx *)user;
     const om_frame_desc *fd = c->fd;
     if (c->stage == STAGE_BUILD) {
-        for (uint32_t b = j; b < c->nbands; b += c->jobs) {
-            uint32_t y0 = b * c->map_band, rows = c->map_size - y0;
-            c->bands->build_rows(fd->method_state, c->map_bins.rows ? &c->map_bins : NULL, y0,
-                                 rows < c->map_band ? rows : c->map_band);
-        }
+        uint32_t y0 = b * c->map_band, rows = c->map_size - y0;
+        c->bands->build_rows(fd->method_state, c->map_bins.rows ? &c->map_bins : NULL, y0,
+                             rows < c->map_band ? rows : c->map_band);
         return;
     }
-    for (uint32_t b = j; b < c->nbands; b += c->jobs) {
-        uint32_t r0 = b * c->band_rows;
-        size_t off = (size_t)r0 * c->strip.width;
-        om_strip st = c->strip;
-        st.y0 += r0;
-        st.rows = c->strip.rows - r0 < c->band_rows ? c->strip.rows - r0 : c->band_rows;
-        st.samples += off;
-        st.terms += off;
-        if (c->stage == STAGE_PREPARE) {
-            if (c->eye) {
-                om_target tg = c->tg;
-                tg.y0 = st.y0;
-                tg.rows = st.rows;
-                tg.depth += off;
-                tg.id += off;
-                om__eye_pass(fd->scene, c->view, &tg, &st, c->bins);
-            }
-            if (c->mark) mark_exposed(c->view, &st);
-        } else if (c->stage == STAGE_RESOLVE) {
-            c->bands->resolve(fd->method_state, &st, c->slots[j].scratch, c->slots[j].counts);
-        } else {
-            om_framebuffer fb = *fd->fb;
-            fb.pixels += (size_t)r0 * fb.stride;
-            fb.rows = st.rows;
-            om__shade_strip(fd->scene, c->view, fd->shade, &st, &fb);
+    uint32_t r0 = b * c->band_rows;
+    size_t off = (size_t)r0 * c->strip.width;
+    om_strip st = c->strip;
+    st.y0 += r0;
+    st.rows = c->strip.rows - r0 < c->band_rows ? c->strip.rows - r0 : c->band_rows;
+    st.samples += off;
+    st.terms += off;
+    if (c->stage == STAGE_PREPARE) {
+        if (c->eye) {
+            om_target tg = c->tg;
+            tg.y0 = st.y0;
+            tg.rows = st.rows;
+            tg.depth += off;
+            tg.id += off;
+            om__eye_pass(fd->scene, c->view, &tg, &st, c->bins);
         }
+        if (c->mark) mark_exposed(c->view, &st);
+    } else if (c->stage == STAGE_RESOLVE) {
+        c->bands->resolve(fd->method_state, &st, c->slots[b].scratch, c->slots[b].counts);
+    } else {
+        om_framebuffer fb = *fd->fb;
+        fb.pixels += (size_t)r0 * fb.stride;
+        fb.rows = st.rows;
+        om__shade_strip(fd->scene, c->view, fd->shade, &st, &fb);
     }
 }
 
@@ -149,8 +152,7 @@ static void band_job(void *user, uint32_t j)
 static void run_stage(frame_ctx *c, stage sg, uint32_t nbands)
 {
     c->stage = sg;
-    c->nbands = nbands;
-    c->fd->parallel_for(c->fd->parallel_user, band_job, c, nbands < c->jobs ? nbands : c->jobs);
+    c->fd->parallel_for(c->fd->parallel_user, band_job, c, nbands);
 }
 
 /* The same over the current strip's bands. */
@@ -159,15 +161,15 @@ static void run_bands(frame_ctx *c, stage sg)
     run_stage(c, sg, (c->strip.rows + c->band_rows - 1) / c->band_rows);
 }
 
-/* The light depth pass by bands of the map (om__bands.build_rows): with bins, about
- * four bands a job, each setting up only its own triangles; without, one band a job,
- * since each band then walks every triangle. */
+/* The light depth pass by bands of the map (om__bands.build_rows): with bins,
+ * BANDS_PER_JOB bands a job, each setting up only its own triangles; without, one band
+ * a job, since each band then walks every triangle. */
 static void build_map(frame_ctx *c)
 {
     const om_mat4 *vp;
     c->map_size = c->bands->map_of(c->fd->method_state, &vp);
     if (c->map_bins.rows) om__bins_make(c->fd->scene, vp, c->map_size, c->map_size, &c->map_bins);
-    uint32_t n = c->map_bins.rows ? 4 * c->jobs : c->jobs;
+    uint32_t n = c->map_bins.rows ? BANDS_PER_JOB * c->jobs : c->jobs;
     c->map_band = ((c->map_size + n - 1) / n + 15) / 16 * 16;
     run_stage(c, STAGE_BUILD, (c->map_size + c->map_band - 1) / c->map_band);
 }
@@ -226,17 +228,17 @@ static void carve_jobs(frame_ctx *c, om_arena *fa, size_t keep)
     size_t left = om_arena_left(fa), fit = left > keep ? (left - keep) / per : 0;
     uint32_t jobs = fit < fd->threads ? (uint32_t)fit : fd->threads;
     void *p;
-    if (jobs < 2 || om_arena_alloc(fa, jobs * sizeof(job_slot), 8, &p, NULL)) return;
+    const uint32_t nslots = BANDS_PER_JOB * jobs;
+    if (jobs < 2 || om_arena_alloc(fa, nslots * sizeof(job_slot), 8, &p, NULL)) return;
     c->slots = (job_slot *)p;
-    for (uint32_t j = 0; b && j < jobs; j++)
+    for (uint32_t j = 0; b && j < nslots; j++)
         if (om_arena_alloc(fa, b->scratch ? b->scratch : 1, 16, &c->slots[j].scratch, NULL))
             return;   /* cannot happen: `per` counted it */
     c->bands = b;
     c->jobs = jobs;
     /* Bands of whole 16-row blocks (methods tile strips by 16 from their top row, so a
-     * band resolves the same blocks the strip would), about four a job to even out the
-     * work of the rows. */
-    uint32_t rows = c->tg.rows, want = (rows + 4 * jobs - 1) / (4 * jobs);
+     * band resolves the same blocks the strip would), at most one a slot. */
+    uint32_t rows = c->tg.rows, want = (rows + nslots - 1) / nslots;
     c->band_rows = (want + 15) / 16 * 16;
 }
 
@@ -343,10 +345,11 @@ om_status om_render_frame(const om_frame_desc *fd, om_arena *fa, om_frame_stats 
         prepare(&c, !have_samples, !have_terms, fs);
         t0 = now(fd);
         if (c.bands) {
-            for (uint32_t j = 0; j < c.jobs; j++) memset(c.slots[j].counts, 0, sizeof c.slots[j].counts);
+            for (uint32_t j = 0; j < BANDS_PER_JOB * c.jobs; j++)
+                memset(c.slots[j].counts, 0, sizeof c.slots[j].counts);
             run_bands(&c, STAGE_RESOLVE);
             uint32_t sum[8] = {0};
-            for (uint32_t j = 0; j < c.jobs; j++)
+            for (uint32_t j = 0; j < BANDS_PER_JOB * c.jobs; j++)
                 for (int k = 0; k < 8; k++) sum[k] += c.slots[j].counts[k];
             c.bands->merge(fd->method_state, sum);
         } else {
