@@ -1,8 +1,8 @@
 /* report_machines.c — the report's "small machines" section (see report.h): what
  * `make cross-test` measured on the Cortex-M4 firmware under QEMU, read from the CSVs
  * it writes (never typed in): per method and scene the instructions of a frame and
- * the bytes of each arena, and the engine's code size per build. Where the files are
- * not there, the page says which command writes them. */
+ * the bytes of each arena, the engine's code size per build, per method and part.
+ * Where the files are not there, the page says which command writes them. */
 #define _POSIX_C_SOURCE 200809L
 #include "cli.h"
 #include "report.h"
@@ -27,6 +27,11 @@ static const rcol size_cols[] = {
     {"text", "code (.text), bytes", R_INT, NULL},
     {"data", "initialised data (.data), bytes", R_INT, NULL},
     {"bss", "zeroed data (.bss), bytes", R_INT, NULL},
+};
+
+static const rcol code_cols[] = {
+    {"part", "part of the engine, or firmware", R_TEXT, NULL},
+    {"text", "code (.text), bytes", R_INT, NULL},
 };
 
 static void missing(FILE *f, const char *path, const char *what)
@@ -101,6 +106,19 @@ void report_machines(FILE *f, const char *cross)
     } else if (size) {
         missing(f, size, "the code size of each Cortex-M4 build");
     }
+    char *code = cli_path(cross, "code-size.csv");
+    if (code && rcsv_load(&c, code)) {
+        fprintf(f, "<p>Code per method and part of the engine (each part's files compiled "
+                   "alone for Cortex-M3 at <code>-Os</code>), and the README's embedding example "
+                   "as Cortex-M4 firmware with every method and with <code>sm</code> alone "
+                   "(<code>OM_WITH_*=0</code> for the others), as <code>make cross-test</code> "
+                   "prints them:</p>\n");
+        report_table(f, &c, code_cols, sizeof code_cols / sizeof code_cols[0], NULL, NULL);
+        rcsv_free(&c);
+    } else if (code) {
+        missing(f, code, "the code size of each method and part of the engine");
+    }
     free(m4);
     free(size);
+    free(code);
 }
