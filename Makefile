@@ -98,6 +98,11 @@ fuzz-regress: $(FUZZ_TARGETS:%=$(O)/fuzz-replay-%)
 $(O)/embed-render-once: tests/embed/render_once.c $(O)/libombra.a include/ombra.h
 	$(Q)$(CC) $(CFLAGS_ALL) -o $@ $(filter %.c %.a,$^) $(LDLIBS)
 
+# The README's second example: arenas from the bytes queries, a whole 640x480 frame;
+# sized.sh checks it draws what `ombra render` draws.
+$(O)/embed-render-sized: tests/embed/render_sized.c $(O)/libombra.a include/ombra.h
+	$(Q)$(CC) $(CFLAGS_ALL) -o $@ $(filter %.c %.a,$^) $(LDLIBS)
+
 # The same example in a firmware with only `sm`: registry.c (the only file that reads
 # OM_WITH_*) compiled with every other method off and linked ahead of the library;
 # tests/methods.sh checks that no other method's code came along and that the frame
@@ -109,12 +114,13 @@ $(O)/embed-only-sm: tests/embed/render_once.c engine/shadow/registry.c $(O)/libo
 	$(Q)$(CC) $(CFLAGS_ALL) $(ONLY_SM) -o $@ $(filter %.c %.a,$^) $(LDLIBS)
 
 check: $(O)/run-tests $(O)/ombra $(FUZZ_TARGETS:%=$(O)/fuzz-replay-%) $(O)/embed-render-once \
-       $(O)/embed-only-sm
+       $(O)/embed-render-sized $(O)/embed-only-sm
 	@echo "== $(O)"
 	$(O)/run-tests
 	sh tests/cli.sh $(O)/ombra
 	$(Q)$(REPLAY)
 	$(O)/embed-render-once
+	sh tests/embed/sized.sh $(O)
 	sh tests/embed/readme.sh
 	sh tests/methods.sh $(O)
 
