@@ -21,8 +21,6 @@
 #include "shadow.h"
 #include "izb.h"
 
-#include <float.h>
-
 extern const om_method om__method_izb;
 
 typedef struct izb_state {
@@ -71,10 +69,27 @@ size_t om__izb_parts_bytes(const om_scene *s, bool cache)
 
 size_t om__izb_pool_bytes(uint32_t samples, uint32_t leaf)
 {
-    return om_arena_need((size_t)samples * sizeof(om__izb_sample), 16) +
+    return om_arena_need((size_t)samples * sizeof(om__odepth), 16) +
            2 * om_arena_need((size_t)samples * sizeof(om__izb_key), 16) +
            om_arena_need((size_t)node_bound(samples, leaf) * sizeof(om__izb_node), 16) +
            om_arena_need((size_t)cells_bound(samples) * sizeof(uint32_t), 16);
+}
+
+/* The pool by default: tiles of at least TILE_LEAST samples, and at least TILE_PER_TRI
+ * a triangle of the scene, up to the whole image. Every tile walks every triangle, so
+ * with a pool of k triangles' samples the walks cost about one triangle per k samples
+ * whatever the scene, while a small tile keeps its keys, nodes and cells in the
+ * cache and the arena to clear at init small. On random clouds at 1024x768 (see
+ * izb.md) the one pass pays off only from about 400K triangles. */
+#define TILE_LEAST 32768u
+#define TILE_PER_TRI 2u
+
+static uint32_t auto_pool(const om_scene *s, uint32_t w, uint32_t h)
+{
+    uint64_t want = (uint64_t)s->ntris * TILE_PER_TRI, all = (uint64_t)w * h;
+    if (want < TILE_LEAST) want = TILE_LEAST;
+    if (want > all) want = all;
+    return (uint32_t)(want > w ? want : w);
 }
 
 static size_t fixed_bytes(const om_scene *s, bool cache)
@@ -86,7 +101,7 @@ static om_status pool_bytes(const om__izb_cfg *c, const om_scene *s, uint32_t w,
                             size_t *min, size_t *full)
 {
     if (c->izb_leaf < 1) return OM_E_INVALID;
-    uint32_t one_pass = w * h, smallest = w;   /* the smallest tile: one row */
+    uint32_t one_pass = auto_pool(s, w, h), smallest = w;   /* the smallest tile: one row */
     if (c->izb_pool) one_pass = smallest = c->izb_pool;
     *min = fixed_bytes(s, false) + om__izb_pool_bytes(smallest, c->izb_leaf);
     *full = fixed_bytes(s, true) + om__izb_pool_bytes(one_pass, c->izb_leaf);
@@ -128,8 +143,8 @@ om_status om__izb_setup(om__izb *z, om_arena *a, const om__izb_cfg *c, const om_
     }
     z->cap = cap;
     z->node_cap = node_bound(cap, z->leaf);
-    if ((st = om_arena_alloc(a, (size_t)cap * sizeof(om__izb_sample), 16, &p, d))) return st;
-    z->samples = (om__izb_sample *)p;
+    if ((st = om_arena_alloc(a, (size_t)cap * sizeof(om__odepth), 16, &p, d))) return st;
+    z->od = (om__odepth *)p;
     if ((st = om_arena_alloc(a, (size_t)cap * sizeof(om__izb_key), 16, &p, d))) return st;
     z->keys = (om__izb_key *)p;
     if ((st = om_arena_alloc(a, (size_t)cap * sizeof(om__izb_key), 16, &p, d))) return st;
@@ -159,7 +174,7 @@ static om_status izb_init(void **state, om_arena *a, const om_method_cfg *mc, co
     m->cfg = *c;
     m->width = w;
     m->height = h;
-    if ((st = om__izb_setup(&m->z, a, c, s, w * h, w, d))) return st;
+    if ((st = om__izb_setup(&m->z, a, c, s, auto_pool(s, w, h), w, d))) return st;
     *state = m;
     return OM_OK;
 }
@@ -194,18 +209,16 @@ uint32_t om__izb_transform(om__izb *z, const om_strip *st, size_t *next, size_t 
     uint32_t n = 0;
     for (; i < end && n < z->cap; i++) {
         if (!(st->terms[i].flags & OM_TERM_EXPOSED)) continue;
-        om__izb_sample *s = &z->samples[n];
-        if (!om__lspace_point(&z->ls, &st->samples[i], &s->p)) continue;   /* behind the light */
-        if (decide && decide(user, &s->p, &st->terms[i])) continue;
-        s->idx = (uint32_t)i;
-        memset(&s->od, 0, sizeof s->od);
+        om__lpoint p;
+        if (!om__lspace_point(&z->ls, &st->samples[i], &p)) continue;   /* behind the light */
+        if (decide && decide(user, &p, &st->terms[i])) continue;
         /* the sample's key for the BSP, and the tile's bounds, while it is at hand */
         om__izb_key *k = &z->keys[n];
-        float f = (float)s->p.z;
-        k->x = (int32_t)s->p.x;   /* the light grid fits in 27 bits */
-        k->y = (int32_t)s->p.y;
-        k->s = n;
-        k->z = (double)f < s->p.z ? f * (1.0f + FLT_EPSILON) : f;   /* never below */
+        k->x = (int32_t)p.x;   /* the light grid fits in 27 bits */
+        k->y = (int32_t)p.y;
+        k->z = (uint32_t)p.z;  /* a whole number: the projection's depth */
+        k->tri = p.tri;
+        k->s = (uint32_t)i;
         if (n == 0 || k->x < z->kx0) z->kx0 = k->x;
         if (n == 0 || k->x > z->kx1) z->kx1 = k->x;
         if (n == 0 || k->y < z->ky0) z->ky0 = k->y;
@@ -308,7 +321,7 @@ static void bound_node(om__izb *z, om__izb_node *nd)
     } else {
         const om__izb_key *k = &z->keys[nd->first];
         int32_t x0 = k->x, x1 = k->x, y0 = k->y, y1 = k->y;
-        float zm = k->z;
+        uint32_t zm = k->z;
         for (uint32_t i = 1; i < nd->count; i++) {
             if (k[i].x < x0) x0 = k[i].x;
             if (k[i].x > x1) x1 = k[i].x;
@@ -393,6 +406,7 @@ void om__izb_build(om__izb *z)
         }
     }
     for (uint32_t i = z->nnodes; i-- > 0;) bound_node(z, &z->nodes[i]);
+    memset(z->od, 0, (size_t)z->n * sizeof *z->od);   /* by the keys' sorted places */
     z->st.nodes += z->nnodes;
 }
 
@@ -432,7 +446,7 @@ static uint32_t visit(om__izb *z, uint32_t ni, const tjob *j)
     const om__ltri *lt = j->lt;
     z->st.visited++;
     if (nd->open == 0) { z->st.culled_shadowed++; return 0; }
-    if (lt->zmin >= nd->zmax) { z->st.culled_depth++; return 0; }
+    if (lt->zmin >= (double)nd->zmax) { z->st.culled_depth++; return 0; }
     uint32_t first = nd->first, end = first + nd->count;
     if (z->keys[first].code > j->chi || z->keys[end - 1].code < j->clo || !box_touches(lt, nd)) return 0;
     uint32_t closed = 0;
@@ -449,12 +463,12 @@ static uint32_t visit(om__izb *z, uint32_t ni, const tjob *j)
             if ((k->s & OM_IZB_DONE) || k->x < lt->lox || k->x > lt->hix || k->y < lt->loy ||
                 k->y > lt->hiy)
                 continue;
-            om__izb_sample *s = &z->samples[k->s];
+            const om__lpoint p = {k->x, k->y, (double)k->z, k->tri};
             z->st.tested++;
-            if (!om__blocks(lt, &s->p)) continue;
+            if (!om__blocks(lt, &p)) continue;
             z->st.blocked++;
-            om__odepth_add(&s->od, j->od);
-            if (om__odepth_opaque(&s->od)) {
+            om__odepth_add(&z->od[i], j->od);
+            if (om__odepth_opaque(&z->od[i])) {
                 k->s |= OM_IZB_DONE;
                 closed++;
             }
@@ -544,7 +558,7 @@ void om__izb_raster(om__izb *z)
             if (c->y > hiy) hiy = c->y;
             if (b->z < zlo) zlo = b->z;
             if (c->z < zlo) zlo = c->z;
-            if ((double)zlo >= root->zmax || !cell_range(z, lox, loy, hix, hiy, &cr)) continue;
+            if (zlo >= root->zmax || !cell_range(z, lox, loy, hix, hiy, &cr)) continue;
             if ((uint64_t)(cr.x1 - cr.x0 + 1) * (cr.y1 - cr.y0 + 1) <= DIRECT) {
                 nhit = 0;
                 for (uint32_t cy = cr.y0; cy <= cr.y1; cy++)
@@ -552,7 +566,7 @@ void om__izb_raster(om__izb *z)
                         uint32_t ni = cell_at(z, cx, cy);
                         if (ni == OM_IZB_NONE) continue;
                         const om__izb_node *nd = &z->nodes[ni];
-                        if (nd->open && (double)zlo < nd->zmax && lox <= nd->x1 && hix >= nd->x0 &&
+                        if (nd->open && zlo < nd->zmax && lox <= nd->x1 && hix >= nd->x0 &&
                             loy <= nd->y1 && hiy >= nd->y0)
                             hit[nhit++] = ni;
                     }
@@ -581,7 +595,7 @@ void om__izb_raster(om__izb *z)
 
 void om__izb_write(const om__izb *z, om_strip *st)
 {
-    for (uint32_t i = 0; i < z->n; i++) om__odepth_term(&z->samples[i].od, &st->terms[z->samples[i].idx]);
+    for (uint32_t i = 0; i < z->n; i++) om__odepth_term(&z->od[i], &st->terms[z->keys[i].s & ~OM_IZB_DONE]);
 }
 
 void om__izb_resolve(om__izb *z, om_strip *st, om__izb_decide decide, void *user)

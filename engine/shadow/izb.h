@@ -10,19 +10,13 @@
 
 #include "occlude.h"
 
-/* A visible sample on the light's image plane, with its accumulated optical depth. */
-typedef struct om__izb_sample {
-    om__lpoint p;
-    uint32_t idx;          /* index of the sample in its strip */
-    om__odepth od;
-} om__izb_sample;
-
-/* What the BSP orders and the leaves scan: a sample's grid position, its light depth
- * rounded up to float (enough to cull conservatively) and where the sample is, with
- * OM_IZB_DONE set once it is opaquely shadowed; and its Z-order code in the tile
- * (made once by the build, which sorts and splits by it). The 48-byte samples never
- * move: the leaves touch one only when it lies inside a triangle's bounds. */
-typedef struct om__izb_key { int32_t x, y; uint32_t s; float z; uint32_t code; } om__izb_key;
+/* What the BSP orders and the leaves test: a sample's grid position and light depth
+ * (exact: the projection gives integers), its own triangle, where the sample is in its
+ * strip, with OM_IZB_DONE set once it is opaquely shadowed, and its Z-order code in
+ * the tile (made once by the build, which sorts and splits by it). The key is the
+ * whole sample, so the leaves read nothing else; its optical depth sits at the same
+ * index of z->od once the build has sorted the keys. */
+typedef struct om__izb_key { int32_t x, y; uint32_t z, tri, s, code; } om__izb_key;
 #define OM_IZB_DONE 0x80000000u
 
 /* A BSP node: the bounds of its samples on the light grid, their largest light depth,
@@ -31,7 +25,7 @@ typedef struct om__izb_key { int32_t x, y; uint32_t s; float z; uint32_t code; }
  * OM_IZB_NONE at the root. */
 typedef struct om__izb_node {
     int32_t x0, y0, x1, y1;   /* keys' coordinates: the light grid fits in 27 bits */
-    float zmax;
+    uint32_t zmax;
     uint32_t first, count, child, open, parent;
 } om__izb_node;
 #define OM_IZB_NONE 0xFFFFFFFFu
@@ -44,8 +38,8 @@ typedef struct om__izb {
     const om_scene *scene;
     om__lspace ls;
     om__odepth *mat_od;
-    om__izb_sample *samples;
     om__izb_key *keys;
+    om__odepth *od;        /* the optical depth of z->keys[i], once they are sorted */
     om__izb_key *sorted;   /* the radix sort's second buffer */
     om__izb_node *nodes;
     /* The grid in front of the BSP: 2^gk x 2^gk cells over the tile's keys (the cells
@@ -68,7 +62,8 @@ typedef struct om__izb {
 /* The sample pool's settings: izb's whole configuration, and a part of hybrid's. */
 typedef struct om__izb_cfg {
     uint32_t izb_leaf;     /* most samples in a BSP leaf */
-    uint32_t izb_pool;     /* samples the pool holds; 0 = the whole frame in one pass */
+    uint32_t izb_pool;     /* samples the pool holds; 0: izb picks by the scene (izb.c,
+                              auto_pool), hybrid takes the whole frame */
 } om__izb_cfg;
 
 /* Their entries in the settings of a method whose struct T holds them at `f` (a field
@@ -77,7 +72,7 @@ typedef struct om__izb_cfg {
     OM__SETTING(T, f, "izb.leaf", OM_SETTING_U32, 1, 65536, 64, "most samples in a BSP leaf (the paper: 64)")
 #define OM__SET_IZB_POOL(T, f) \
     OM__SETTING(T, f, "izb.pool", OM_SETTING_U32, 0, 1e9, 0, \
-                "samples the pool holds, 0 = the whole frame in one pass")
+                "samples the pool holds, 0 = izb: 2 a triangle, 32768 to the frame; hybrid: the frame")
 
 /* Arena bytes of om__izb_setup's parts: the material depths and, with `cache`, the
  * per-frame vertex projection; and of a pool of `samples` with its BSP nodes. */
@@ -92,7 +87,7 @@ om_status om__izb_setup(om__izb *z, om_arena *a, const om__izb_cfg *c, const om_
 /* Decides a sample without the BSP when it can: writes its term and returns true. */
 typedef bool (*om__izb_decide)(void *user, const om__lpoint *p, om_term *t);
 
-/* Fills the pool (samples and their keys) from strip samples [*next, end) that are
+/* Fills the pool (the samples' keys) from strip samples [*next, end) that are
  * exposed, up to its capacity; advances *next. With `decide`, only the samples it leaves undecided enter the pool.
  * Returns the number taken. */
 uint32_t om__izb_transform(om__izb *z, const om_strip *st, size_t *next, size_t end,
