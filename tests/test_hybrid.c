@@ -44,11 +44,11 @@ static uint32_t certain_agree(const om_scene *s, const om_method_cfg *c, const c
     uint32_t decided = 0, wrong = 0;
     if (m->init(&state, &a, c, s, W, H, &d) == OM_OK && m->begin(state, &v, &d) == OM_OK &&
         m->build(state, &d) == OM_OK) {
-        const om__izb *z = (const om__izb *)state;   /* the state begins with one */
+        const om__lspace *ls = om__hybrid_lspace(state);
         for (int i = 0; i < W * H; i++) {
             if (!(ref_t[i].flags & OM_TERM_EXPOSED)) continue;
             om__lpoint p;
-            if (!om__lspace_point(&z->ls, &smp[i], &p)) continue;
+            if (!om__lspace_point(ls, &smp[i], &p)) continue;
             om_term t = {255, 255, 255, ref_t[i].flags};
             int k = om__hybrid_decide(state, &p, &t);
             if (k == 0) continue;

@@ -1,7 +1,8 @@
 /* hybrid.c — exact shadows at close to a shadow map's cost. A conservative map of the
  * occlusion predicate's light grid (occlude.h) proves most samples lit or shadowed;
- * only the samples it leaves uncertain go through the irregular z-buffer (izb.c),
- * whose answer is the reference's. The result equals `ref` bit for bit.
+ * only the samples it leaves uncertain go through an irregular z-buffer of their own
+ * (below), whose every test is the shared predicate. The result equals `ref` bit for
+ * bit.
  *
  * The map has side x side texels over the light's grid (hybrid.map, or by default
  * about half the image's larger side: map_side), each a square of
@@ -33,21 +34,46 @@
  * A semi-transparent caster never makes a sample certain but lit (then nothing blocks
  * and the term is exactly 255); the sample's own triangle is excluded by its id; a
  * sample on a texel's border belongs to the one texel its grid point falls in, and
- * that texel's square holds the point. Everything else is uncertain. */
+ * that texel's square holds the point. Everything else is uncertain.
+ *
+ * The uncertain samples: an irregular z-buffer of texel lists. Each tile of them
+ * (izb.pool, or as many as the arena holds) is sorted by the texel its grid point
+ * falls in, and each block of BLOCK x BLOCK texels keeps the farthest of their
+ * depths. A triangle then reaches only the blocks its bounds touch that hold samples
+ * farther than its nearest depth (with its projected vertices at hand, no clipping,
+ * that is checked before any setup, so the triangles near no uncertain sample cost a
+ * few comparisons), and in them the texels its edges touch. Every sample it reaches gets the
+ * predicate, om__blocks; semi-transparent casters add their optical depth (integer
+ * sums, the same in any order), and an opaquely shadowed sample is done. */
 #include "shadow.h"
 #include "hybrid.h"
+#include "izb.h"   /* izb.pool, the setting both take */
 
 #include <float.h>
 
 /* A texel: a plane P(x, y) = z + gx (x - xc) + gy (y - yc) about the texel's centre,
- * below every touching triangle's depth plus bound over the texel (lo); and the
- * opaque triangle covering all of it whose greatest depth plus bound is least (hi,
- * cid). */
-typedef struct htexel { float z, gx, gy, hi; uint32_t cid; } htexel;
+ * below every touching triangle's depth plus bound over the texel (lo); the opaque
+ * triangle covering all of it whose greatest depth plus bound is least (hi, cid); and
+ * where the tile's uncertain samples in it end (they begin where the texel before it,
+ * in row order, ends). */
+typedef struct htexel { float z, gx, gy, hi; uint32_t cid, end; } htexel;
 
-/* hybrid's configuration: the sample pool's settings and its map's side. */
+/* An uncertain sample on the light's grid (the grid fits in 27 bits, its depth is a
+ * whole unit: om__lspace_point) and what blocks it so far; idx is its place in the
+ * strip, with DONE set once it is opaquely shadowed. */
+typedef struct hsample {
+    int32_t x, y;
+    uint32_t z, tri, idx;
+    om__odepth od;
+} hsample;
+#define DONE 0x80000000u
+
+/* Texels per side of a block (the coarse level a triangle looks at first). */
+#define BLOCK 4
+
+/* hybrid's configuration: the sample pool's size and its map's side. */
 typedef struct hybrid_cfg {
-    om__izb_cfg izb;
+    uint32_t izb_pool;     /* 0: the whole frame in one pass */
     uint32_t hybrid_map;   /* 0: auto (map_side) */
 } hybrid_cfg;
 OM__CFG_FITS(hybrid_cfg);
@@ -55,13 +81,22 @@ OM__CFG_FITS(hybrid_cfg);
 extern const om_method om__method_hybrid;
 
 typedef struct hybrid_state {
-    om__izb z;             /* first: the irregular z-buffer for the uncertain samples */
+    const om_scene *scene;
+    om__lspace ls;
+    om__odepth *mat_od;    /* each material's optical depth */
     hybrid_cfg cfg;
     htexel *map;
     uint32_t side;         /* texels per side */
     int64_t T;             /* grid units per texel side */
     int tshift;            /* log2(T) when T is a power of two (the default sides), else -1 */
-    uint32_t lit, shadowed, uncertain;
+    uint32_t bside;        /* blocks per side */
+    /* The tile: its samples as they come (raw, with each one's texel) and sorted by
+     * texel (smp; htexel.end); the farthest depth of a block's samples, bzmax (0: none
+     * a triangle could block). */
+    hsample *raw, *smp;
+    uint32_t *rtex, *bzmax;
+    uint32_t cap;          /* samples the pool holds */
+    uint32_t lit, shadowed, uncertain, setups, tested, tiles;
 } hybrid_state;
 
 #define GRID_SIDE ((int64_t)OM_LIGHT_GRID * OM_SUBPIX)   /* 2^21 grid units */
@@ -79,20 +114,35 @@ static uint32_t map_side(const hybrid_cfg *c, uint32_t w, uint32_t h)
     return side;
 }
 
+static uint32_t blocks_of(uint32_t side) { return (side + BLOCK - 1) / BLOCK; }
+
+static size_t mats_bytes(const om_scene *s)
+{
+    return om_arena_need((size_t)(s->nmats ? s->nmats : 1) * sizeof(om__odepth), 4);
+}
+
+/* Everything but the pool; the per-frame vertex projection with `cache`. */
 static size_t fixed_bytes(uint32_t side, const om_scene *s, bool cache)
 {
-    return om_arena_need(sizeof(hybrid_state), 16) + om__izb_parts_bytes(s, cache) +
-           om_arena_need((size_t)side * side * sizeof(htexel), 16);
+    size_t nb = (size_t)blocks_of(side) * blocks_of(side);
+    return om_arena_need(sizeof(hybrid_state), 16) + (cache ? om__lspace_bytes(s) : 0) + mats_bytes(s) +
+           om_arena_need((size_t)side * side * sizeof(htexel), 16) + om_arena_need(nb * sizeof(uint32_t), 16);
+}
+
+/* A pool of n uncertain samples: both orders and each one's texel. */
+static size_t pool_bytes(uint32_t n)
+{
+    return 2 * om_arena_need((size_t)n * sizeof(hsample), 16) + om_arena_need((size_t)n * sizeof(uint32_t), 16);
 }
 
 static om_status need(const hybrid_cfg *c, const om_scene *s, uint32_t w, uint32_t h,
                       size_t *min, size_t *full)
 {
-    if (c->izb.izb_leaf < 1 || c->hybrid_map > OM_LIGHT_GRID) return OM_E_INVALID;
+    if (c->hybrid_map > OM_LIGHT_GRID) return OM_E_INVALID;
     uint32_t one_pass = w * h, smallest = w, side = map_side(c, w, h);
-    if (c->izb.izb_pool) one_pass = smallest = c->izb.izb_pool;
-    *min = fixed_bytes(side, s, false) + om__izb_pool_bytes(smallest, c->izb.izb_leaf);
-    *full = fixed_bytes(side, s, true) + om__izb_pool_bytes(one_pass, c->izb.izb_leaf);
+    if (c->izb_pool) one_pass = smallest = c->izb_pool;
+    *min = fixed_bytes(side, s, false) + pool_bytes(smallest);
+    *full = fixed_bytes(side, s, true) + pool_bytes(one_pass);
     return OM_OK;
 }
 
@@ -104,32 +154,66 @@ static om_status hybrid_bytes(const om_method_cfg *mc, const om_scene *s, uint32
     return need(&c, s, w, h, min, full);
 }
 
+static om_status carve(om_arena *a, size_t n, size_t size, void **p, om_diag *d)
+{
+    return om_arena_alloc(a, n * size, 16, p, d);
+}
+
 static om_status hybrid_init(void **state, om_arena *a, const om_method_cfg *mc, const om_scene *s,
                              uint32_t w, uint32_t h, om_diag *d)
 {
     om_status st;
     void *p;
     size_t mn, full;
-    hybrid_cfg cv;
-    const hybrid_cfg *c = &cv;
-    if ((st = om__method_cfg_of(mc, &om__method_hybrid, &cv, d))) return st;
-    if (c->izb.izb_leaf < 1) return om__fail(d, OM_E_INVALID, "hybrid: izb.leaf must be at least 1");
-    if (c->hybrid_map > OM_LIGHT_GRID)
+    hybrid_cfg c;
+    if ((st = om__method_cfg_of(mc, &om__method_hybrid, &c, d))) return st;
+    if (c.hybrid_map > OM_LIGHT_GRID)
         return om__fail(d, OM_E_INVALID, "hybrid: hybrid.map must be 0 (auto) to 8192");
-    if ((st = need(c, s, w, h, &mn, &full))) return st;
+    if ((st = need(&c, s, w, h, &mn, &full))) return st;
     if ((st = om__need(a, mn, "hybrid", d))) return st;
     if ((st = om_arena_alloc(a, sizeof(hybrid_state), 16, &p, d))) return st;
     hybrid_state *m = (hybrid_state *)p;
-    m->cfg = *c;
-    m->side = map_side(c, w, h);
+    memset(m, 0, sizeof *m);
+    m->scene = s;
+    m->cfg = c;
+    m->side = map_side(&c, w, h);
+    m->bside = blocks_of(m->side);
     m->T = (GRID_SIDE + m->side - 1) / m->side;
     m->tshift = -1;
     for (int b = 0; b < 62; b++)
         if (((int64_t)1 << b) == m->T) m->tshift = b;
-    size_t tex = (size_t)m->side * m->side;
-    if ((st = om_arena_alloc(a, tex * sizeof(htexel), 16, &p, d))) return st;
+    size_t nb = (size_t)m->bside * m->bside;
+    if ((st = carve(a, (size_t)m->side * m->side, sizeof(htexel), &p, d))) return st;
     m->map = (htexel *)p;
-    if ((st = om__izb_setup(&m->z, a, &c->izb, s, w * h, w, d))) return st;
+    if ((st = carve(a, nb, sizeof(uint32_t), &p, d))) return st;
+    m->bzmax = (uint32_t *)p;
+    /* The vertex projection only when a one-pass pool fits beside it (it speeds up
+     * triangle setup, it changes no result); then the pool, as set or as large as
+     * the arena allows, from one row up to the frame. */
+    uint32_t want = c.izb_pool ? c.izb_pool : w * h, least = c.izb_pool ? c.izb_pool : w;
+    if (om_arena_left(a) >= om__lspace_bytes(s) + mats_bytes(s) + pool_bytes(want)) {
+        if ((st = om__lspace_init(&m->ls, a, s, d))) return st;
+    } else {
+        om__lspace_init_lean(&m->ls, s);
+    }
+    if ((st = om_arena_alloc(a, (size_t)(s->nmats ? s->nmats : 1) * sizeof(om__odepth), 4, &p, d)))
+        return st;
+    m->mat_od = (om__odepth *)p;
+    for (uint32_t i = 0; i < s->nmats; i++) m->mat_od[i] = om__material_odepth(&s->mats[i]);
+    size_t left = om_arena_left(a);
+    uint32_t cap = least, hi = want;
+    while (cap < hi) {   /* the largest pool that fits */
+        uint32_t mid = cap + (hi - cap + 1) / 2;
+        if (pool_bytes(mid) <= left) cap = mid;
+        else hi = mid - 1;
+    }
+    m->cap = cap;
+    if ((st = carve(a, cap, sizeof(hsample), &p, d))) return st;
+    m->raw = (hsample *)p;
+    if ((st = carve(a, cap, sizeof(hsample), &p, d))) return st;
+    m->smp = (hsample *)p;
+    if ((st = carve(a, cap, sizeof(uint32_t), &p, d))) return st;
+    m->rtex = (uint32_t *)p;
     *state = m;
     return OM_OK;
 }
@@ -138,9 +222,8 @@ static om_status hybrid_begin(void *state, const om_view *v, om_diag *d)
 {
     (void)d;
     hybrid_state *m = (hybrid_state *)state;
-    om__lspace_begin(&m->z.ls, v);
-    memset(&m->z.st, 0, sizeof m->z.st);
-    m->lit = m->shadowed = m->uncertain = 0;
+    om__lspace_begin(&m->ls, v);
+    m->lit = m->shadowed = m->uncertain = m->setups = m->tested = m->tiles = 0;
     return OM_OK;
 }
 
@@ -253,6 +336,91 @@ static void add_sub(hybrid_state *m, const om__rtri *r, double bound, uint32_t t
     }
 }
 
+/* The texel of a grid coordinate: a shift rather than a division where it can be
+ * (this runs once a sample); points off the grid take the border texels. Monotone, so
+ * the texels of a range of points are those between its ends'. */
+static inline int64_t texel_of(const hybrid_state *m, int64_t v)
+{
+    if (v < 0) return 0;
+    int64_t t = m->tshift >= 0 ? v >> m->tshift : v / m->T;
+    return t < (int64_t)m->side ? t : (int64_t)m->side - 1;
+}
+
+/* The texels a grid box [lox, hix] x [loy, hiy] reaches. */
+typedef struct trange { uint32_t x0, y0, x1, y1; } trange;
+
+static trange texels_in(const hybrid_state *m, int64_t lox, int64_t loy, int64_t hix, int64_t hiy)
+{
+    trange r;
+    r.x0 = (uint32_t)texel_of(m, lox);
+    r.y0 = (uint32_t)texel_of(m, loy);
+    r.x1 = (uint32_t)texel_of(m, hix);
+    r.y1 = (uint32_t)texel_of(m, hiy);
+    return r;
+}
+
+/* A projected triangle's bounds and nearest vertex depth; false when it needs
+ * clipping (or the projection is not kept). */
+typedef struct vbox { int32_t lox, loy, hix, hiy; uint32_t zlo; } vbox;
+
+static bool vbox_of(const hybrid_state *m, uint32_t t, vbox *v)
+{
+    if (!m->ls.verts) return false;
+    const uint32_t *ix = m->scene->idx + (size_t)t * 3;
+    const om__lvert *a = &m->ls.verts[ix[0]], *b = &m->ls.verts[ix[1]], *c = &m->ls.verts[ix[2]];
+    if (a->x == INT32_MIN || b->x == INT32_MIN || c->x == INT32_MIN) return false;
+    v->lox = v->hix = a->x;
+    v->loy = v->hiy = a->y;
+    v->zlo = a->z;
+    if (b->x < v->lox) v->lox = b->x;
+    if (b->x > v->hix) v->hix = b->x;
+    if (c->x < v->lox) v->lox = c->x;
+    if (c->x > v->hix) v->hix = c->x;
+    if (b->y < v->loy) v->loy = b->y;
+    if (b->y > v->hiy) v->hiy = b->y;
+    if (c->y < v->loy) v->loy = c->y;
+    if (c->y > v->hiy) v->hiy = c->y;
+    if (b->z < v->zlo) v->zlo = b->z;
+    if (c->z < v->zlo) v->zlo = c->z;
+    return true;
+}
+
+/* A small triangle (projected without clipping, its bounds within 2 x 2 texels and too
+ * narrow to cover one) lowers the texels its bounds reach (a superset of those its
+ * edges reach) to its nearest vertex's depth, without a setup: the predicate's depth
+ * is clamped to the vertices' range and its bound is positive, so depth plus bound is
+ * above that everywhere. As sharp as the plane where the texel is larger than the
+ * triangle (the plane, continued over the texel, falls below it). False: the
+ * triangle takes the full path. */
+static bool add_small(hybrid_state *m, uint32_t t)
+{
+    vbox v;
+    if (!vbox_of(m, t, &v)) return false;
+    if ((int64_t)v.hix - v.lox >= m->T - 1 && (int64_t)v.hiy - v.loy >= m->T - 1) return false;
+    trange r = texels_in(m, v.lox, v.loy, v.hix, v.hiy);
+    if ((r.x1 - r.x0 + 1) * (r.y1 - r.y0 + 1) > 4) return false;
+    int64_t last = (int64_t)m->side - 1;
+    for (int64_t ty = r.y0; ty <= r.y1; ty++)
+        for (int64_t tx = r.x0; tx <= r.x1; tx++) {
+            htexel *h = &m->map[ty * (int64_t)m->side + tx];
+            int64_t x0 = tx * m->T, y0 = ty * m->T, x1 = x0 + m->T - 1, y1 = y0 + m->T - 1;
+            int64_t xc = x0 + m->T / 2, yc = y0 + m->T / 2;
+            if (tx == 0) x0 = -FAR_OUT;
+            if (ty == 0) y0 = -FAR_OUT;
+            if (tx == last) x1 = FAR_OUT;
+            if (ty == last) y1 = FAR_OUT;
+            if (h->gx != h->gx) {   /* empty: a flat plane */
+                h->gx = h->gy = 0.0f;
+                h->z = FLT_MAX;
+            }
+            double gx = h->gx, gy = h->gy;
+            double p0 = gx * (double)(x0 - xc) + gy * (double)(y0 - yc);
+            float z = f_down(least_diff((double)v.zlo, 0.0, 0.0, p0, gx, gy, x1 - x0, y1 - y0) - 1.0);
+            if (z < h->z) h->z = z;
+        }
+    return true;
+}
+
 static om_status hybrid_build(void *state, om_diag *d)
 {
     (void)d;
@@ -264,72 +432,204 @@ static om_status hybrid_build(void *state, om_diag *d)
         h->gx = h->gy = NAN;
         h->cid = OM_NO_TRI;
     }
-    const om_scene *s = m->z.scene;
+    const om_scene *s = m->scene;
     for (uint32_t t = 0; t < s->ntris; t++) {
         om__ltri lt;
-        if (!om__lspace_tri(&m->z.ls, t, &lt)) continue;
-        bool cover = lt.n == 1 && om__odepth_opaque(&m->z.mat_od[s->tri_mat[t]]);
+        if (add_small(m, t) || !om__lspace_tri(&m->ls, t, &lt)) continue;
+        bool cover = lt.n == 1 && om__odepth_opaque(&m->mat_od[s->tri_mat[t]]);
         for (int k = 0; k < lt.n; k++) add_sub(m, &lt.sub[k], lt.bound[k], t, cover);
     }
     return OM_OK;
 }
 
-/* The texel of a grid point: a shift rather than a division where it can be (this
- * runs once a sample); points off the grid take the border texels. */
-static inline int64_t texel_of(const hybrid_state *m, int64_t v)
+/* The map's answer for a sample: 1 certainly lit, 2 certainly shadowed (t set to 0),
+ * 0 uncertain, with *tex its texel. */
+static inline int classify(const hybrid_state *m, const om__lpoint *p, om_term *t, int64_t *tex)
 {
-    if (v < 0) return 0;
-    return m->tshift >= 0 ? v >> m->tshift : v / m->T;
-}
-
-static inline int classify(hybrid_state *m, const om__lpoint *p, om_term *t)
-{
-    int64_t last = (int64_t)m->side - 1, tx = texel_of(m, p->x), ty = texel_of(m, p->y);
-    if (tx > last) tx = last;
-    if (ty > last) ty = last;
+    int64_t tx = texel_of(m, p->x), ty = texel_of(m, p->y);
     const htexel *h = &m->map[ty * (int64_t)m->side + tx];
+    *tex = ty * (int64_t)m->side + tx;
     int64_t xc = tx * m->T + m->T / 2, yc = ty * m->T + m->T / 2;
-    if ((double)h->z + (double)h->gx * (double)(p->x - xc) + (double)h->gy * (double)(p->y - yc) >= p->z ||
-        h->z == FLT_MAX) {
-        m->lit++;
+    if (h->z == FLT_MAX ||
+        (double)h->z + (double)h->gx * (double)(p->x - xc) + (double)h->gy * (double)(p->y - yc) >= p->z)
         return 1;   /* the term is already 255 */
-    }
     if ((double)h->hi < p->z && h->cid != p->tri) {
         t->r = t->g = t->b = 0;
-        m->shadowed++;
         return 2;
     }
-    m->uncertain++;
     return 0;
 }
 
 int om__hybrid_decide(void *state, const om__lpoint *p, om_term *t)
 {
-    return classify((hybrid_state *)state, p, t);
+    int64_t tex;
+    return classify((const hybrid_state *)state, p, t, &tex);
 }
 
-static bool decide(void *user, const om__lpoint *p, om_term *t)
+const om__lspace *om__hybrid_lspace(const void *state) { return &((const hybrid_state *)state)->ls; }
+
+/* Does a block that r reaches hold a sample farther than depth z? (A triangle whose
+ * every depth plus bound is at z or beyond blocks none there.) */
+static bool any_farther(const hybrid_state *m, const trange *r, double z)
 {
-    return classify((hybrid_state *)user, p, t) != 0;
+    for (uint32_t by = r->y0 / BLOCK; by <= r->y1 / BLOCK; by++)
+        for (uint32_t bx = r->x0 / BLOCK; bx <= r->x1 / BLOCK; bx++)
+            if ((double)m->bzmax[by * m->bside + bx] > z) return true;
+    return false;
 }
 
+/* Is an open sample in the texels of r inside v's bounds and farther than its nearest
+ * vertex? */
+static bool any_within(const hybrid_state *m, const trange *r, const vbox *v)
+{
+    for (uint32_t ty = r->y0; ty <= r->y1; ty++)
+        for (uint32_t tx = r->x0; tx <= r->x1; tx++) {
+            size_t tex = (size_t)ty * m->side + tx;
+            for (uint32_t i = tex ? m->map[tex - 1].end : 0; i < m->map[tex].end; i++) {
+                const hsample *q = &m->smp[i];
+                if (!(q->idx & DONE) && q->x >= v->lox && q->x <= v->hix && q->y >= v->loy && q->y <= v->hiy &&
+                    q->z > v->zlo)
+                    return true;
+            }
+        }
+    return false;
+}
+
+/* Sorts the tile's n samples by texel (a counting sort through htexel.end, stable:
+ * strip order within a texel) and notes each block's farthest depth. */
+static void sort_tile(hybrid_state *m, uint32_t n)
+{
+    size_t nt = (size_t)m->side * m->side;
+    memset(m->bzmax, 0, (size_t)m->bside * m->bside * sizeof *m->bzmax);
+    for (size_t t = 0; t < nt; t++) m->map[t].end = 0;
+    for (uint32_t i = 0; i < n; i++) {
+        uint32_t t = m->rtex[i], b = t / m->side / BLOCK * m->bside + t % m->side / BLOCK;
+        m->map[t].end++;
+        if (m->raw[i].z > m->bzmax[b]) m->bzmax[b] = m->raw[i].z;
+    }
+    uint32_t sum = 0;
+    for (size_t t = 0; t < nt; t++) {   /* counts -> starts */
+        uint32_t c = m->map[t].end;
+        m->map[t].end = sum;
+        sum += c;
+    }
+    for (uint32_t i = 0; i < n; i++) m->smp[m->map[m->rtex[i]].end++] = m->raw[i];   /* starts -> ends */
+}
+
+/* Could a sub-triangle of lt cover a point of texel (tx, ty)? Each edge is tested at
+ * the square's corner where it is largest; the border texels reach off the grid. */
+static bool texel_touches(const hybrid_state *m, const om__ltri *lt, int64_t tx, int64_t ty)
+{
+    int64_t last = (int64_t)m->side - 1, x0 = tx * m->T, y0 = ty * m->T, x1 = x0 + m->T - 1, y1 = y0 + m->T - 1;
+    if (tx == 0) x0 = -FAR_OUT;
+    if (ty == 0) y0 = -FAR_OUT;
+    if (tx == last) x1 = FAR_OUT;
+    if (ty == last) y1 = FAR_OUT;
+    for (int k = 0; k < lt->n; k++)
+        if (square_touches(&lt->sub[k].e, x0, y0, x1, y1)) return true;
+    return false;
+}
+
+/* Triangle t against the tile's samples; returns how many it shadowed opaquely. */
+static uint32_t cast(hybrid_state *m, uint32_t t)
+{
+    const om_scene *s = m->scene;
+    vbox v;
+    if (vbox_of(m, t, &v)) {
+        /* The triangle's bounds are its vertices', its plane's depth lies within
+         * theirs: the culls below, before any setup; and where its bounds reach a few
+         * texels, whether any open sample there lies within them, farther. */
+        trange r = texels_in(m, v.lox, v.loy, v.hix, v.hiy);
+        if (!any_farther(m, &r, (double)v.zlo)) return 0;
+        if ((r.x1 - r.x0 + 1) * (r.y1 - r.y0 + 1) <= 4 && !any_within(m, &r, &v)) return 0;
+    }
+    om__ltri lt;
+    if (!om__lspace_tri(&m->ls, t, &lt)) return 0;
+    m->setups++;
+    const om__odepth *od = &m->mat_od[s->tri_mat[t]];
+    trange r = texels_in(m, lt.lox, lt.loy, lt.hix, lt.hiy);
+    uint32_t closed = 0;
+    for (uint32_t by = r.y0 / BLOCK; by <= r.y1 / BLOCK; by++)
+        for (uint32_t bx = r.x0 / BLOCK; bx <= r.x1 / BLOCK; bx++) {
+            if ((double)m->bzmax[by * m->bside + bx] <= lt.zmin) continue;
+            uint32_t ya = by * BLOCK > r.y0 ? by * BLOCK : r.y0, yb = by * BLOCK + BLOCK - 1 < r.y1 ? by * BLOCK + BLOCK - 1 : r.y1;
+            uint32_t xa = bx * BLOCK > r.x0 ? bx * BLOCK : r.x0, xb = bx * BLOCK + BLOCK - 1 < r.x1 ? bx * BLOCK + BLOCK - 1 : r.x1;
+            for (uint32_t ty = ya; ty <= yb; ty++)
+                for (uint32_t tx = xa; tx <= xb; tx++) {
+                    size_t tex = (size_t)ty * m->side + tx;
+                    uint32_t i = tex ? m->map[tex - 1].end : 0, end = m->map[tex].end;
+                    if (i == end || !texel_touches(m, &lt, tx, ty)) continue;
+                    for (; i < end; i++) {
+                        hsample *q = &m->smp[i];
+                        if ((q->idx & DONE) || q->x < lt.lox || q->x > lt.hix || q->y < lt.loy || q->y > lt.hiy)
+                            continue;
+                        om__lpoint p = {q->x, q->y, (double)q->z, q->tri};
+                        m->tested++;
+                        if (!om__blocks(&lt, &p)) continue;
+                        om__odepth_add(&q->od, od);
+                        if (om__odepth_opaque(&q->od)) {
+                            q->idx |= DONE;
+                            closed++;
+                        }
+                    }
+                }
+        }
+    return closed;
+}
+
+/* One tile of n uncertain samples (in raw): sorted by block, every triangle cast
+ * until all are opaquely shadowed, the terms written. */
+static void run_tile(hybrid_state *m, om_strip *st, uint32_t n)
+{
+    sort_tile(m, n);
+    uint32_t open = n;
+    for (uint32_t t = 0; t < m->scene->ntris && open; t++) open -= cast(m, t);
+    for (uint32_t i = 0; i < n; i++) om__odepth_term(&m->smp[i].od, &st->terms[m->smp[i].idx & ~DONE]);
+    m->tiles++;
+}
+
+/* A strip: every exposed sample projected and looked up; the uncertain ones, a tile at
+ * a time, through the triangle pass. */
 static om_status hybrid_resolve(void *state, om_strip *st, om_diag *d)
 {
     (void)d;
-    om__izb_resolve(&((hybrid_state *)state)->z, st, decide, state);
+    hybrid_state *m = (hybrid_state *)state;
+    size_t n = (size_t)st->rows * st->width, i = 0;
+    while (i < n) {
+        uint32_t k = 0;
+        for (; i < n && k < m->cap; i++) {
+            om_term *t = &st->terms[i];
+            t->r = t->g = t->b = 255;
+            om__lpoint p;
+            if (!(t->flags & OM_TERM_EXPOSED) || !om__lspace_point(&m->ls, &st->samples[i], &p)) continue;
+            int64_t tex;
+            int c = classify(m, &p, t, &tex);
+            if (c == 1) m->lit++;
+            else if (c == 2) m->shadowed++;
+            if (c) continue;
+            m->uncertain++;
+            hsample *q = &m->raw[k];
+            q->x = (int32_t)p.x;
+            q->y = (int32_t)p.y;
+            q->z = (uint32_t)p.z;
+            q->tri = p.tri;
+            q->idx = (uint32_t)i;
+            memset(&q->od, 0, sizeof q->od);
+            m->rtex[k++] = (uint32_t)tex;
+        }
+        if (k) run_tile(m, st, k);
+    }
     return OM_OK;
 }
 
 static void hybrid_stats(const void *state, om_method_stats *out)
 {
     const hybrid_state *m = (const hybrid_state *)state;
-    const om__izb *z = &m->z;
     memset(out, 0, sizeof *out);
-    out->bytes_used = fixed_bytes(m->side, z->scene, z->ls.verts != NULL) +
-                      om__izb_pool_bytes(z->cap, z->leaf);
-    static const char *const names[] = {"certain lit", "certain shadowed", "uncertain", "bsp nodes",
+    out->bytes_used = fixed_bytes(m->side, m->scene, m->ls.verts != NULL) + pool_bytes(m->cap);
+    static const char *const names[] = {"certain lit", "certain shadowed", "uncertain", "triangles set up",
                                         "samples tested", "tiles", "pool samples"};
-    uint32_t v[7] = {m->lit, m->shadowed, m->uncertain, z->st.nodes, z->st.tested, z->st.tiles, z->cap};
+    uint32_t v[7] = {m->lit, m->shadowed, m->uncertain, m->setups, m->tested, m->tiles, m->cap};
     for (int i = 0; i < 7; i++) {
         out->counters[i] = v[i];
         out->counter_names[i] = names[i];
@@ -338,13 +638,13 @@ static void hybrid_stats(const void *state, om_method_stats *out)
 }
 
 static const om_setting settings[] = {
-    OM__SET_IZB_LEAF(hybrid_cfg, izb.izb_leaf), OM__SET_IZB_POOL(hybrid_cfg, izb.izb_pool),
+    OM__SET_IZB_POOL(hybrid_cfg, izb_pool),
     OM__SETTING(hybrid_cfg, hybrid_map, "hybrid.map", OM_SETTING_U32, 0, OM_MAX_DIM, 0,
                 "side of its conservative map (20 bytes a texel), 0 = half the image's side"),
 };
 
 const om_method om__method_hybrid = {
-    "hybrid", "exact: a conservative map decides most samples, the irregular z-buffer the rest",
+    "hybrid", "exact: a conservative map decides most samples, an irregular z-buffer the rest",
     OM_METHOD_EXACT, hybrid_bytes, hybrid_init, hybrid_begin, hybrid_observe, hybrid_build,
     hybrid_resolve, hybrid_stats, NULL, settings, sizeof settings / sizeof settings[0],
     sizeof(hybrid_cfg),
