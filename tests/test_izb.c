@@ -2,7 +2,8 @@
  * default scene, on seeded random scenes with semi-transparent casters, on a hot spot
  * (a floor at a grazing light angle), under a directional light, and at every tiling
  * from one pass down to tiles of a few rows, through strips too. Budgets below the
- * minimum fail naming it; budgets between minimum and one pass tile. */
+ * minimum fail naming it; budgets between minimum and one pass tile; the default pool
+ * takes tiles where the scene has few triangles for the image. */
 #include "test.h"
 #include "harness.h"
 
@@ -153,6 +154,74 @@ static void budgets(void)
     h_scene_free(&hs);
 }
 
+/* The default pool follows the scene: with few triangles on a larger image it takes
+ * tiles of 32768 samples (less memory than one pass), and still equals the reference;
+ * with a pool of the whole image the same frame takes one. */
+static void default_pool(void)
+{
+    enum { W2 = 320, H2 = 240 };
+    h_scene hs;
+    if (!h_scene_parse(&hs, "camera eye 0 5 8 target 0 0.5 0 fov 55\n"
+                            "light spot pos -1 9 2 target 0 0 0 fov 75 near 1 far 40\n"
+                            "plane size 14 14 divisions 3\n"
+                            "triangles count 500 seed 1 area 25 in -3 0.3 -3 3 3 3\n"))
+        return;
+    const om_method *m = om_method_find("izb");
+    om_method_cfg c, one;
+    om_method_cfg_default(&c, m);
+    om_method_cfg_default(&one, m);
+    CHECK_OK(om_method_cfg_set(&one, "izb.pool", W2 * H2, NULL));
+    size_t mn, full, full_one;
+    CHECK_OK(m->bytes(&c, &hs.s, W2, H2, &mn, &full));
+    CHECK_OK(m->bytes(&one, &hs.s, W2, H2, &mn, &full_one));
+    CHECK_MSG(full < full_one / 2, "default pool %zu bytes, one pass %zu", full, full_one);
+    om_term *rt = malloc(sizeof *rt * W2 * H2), *zt = malloc(sizeof *zt * W2 * H2);
+    CHECK_OK(h_render(&hs.s, "ref", NULL, W2, H2, 0, 0, NULL, rt, NULL));
+    uint32_t tiles[2] = {0, 0};
+    for (int k = 0; k < 2; k++) {
+        const om_method_cfg *ck = k ? &one : &c;
+        CHECK_OK(h_render(&hs.s, "izb", ck, W2, H2, 0, 0, NULL, zt, NULL));
+        int diff = 0;
+        for (int i = 0; i < W2 * H2; i++)
+            diff += rt[i].r != zt[i].r || rt[i].g != zt[i].g || rt[i].b != zt[i].b || rt[i].flags != zt[i].flags;
+        CHECK_MSG(diff == 0, "pool %s: %d samples differ", k ? "one pass" : "default", diff);
+        /* the tiles it took, through a frame of its own */
+        size_t bytes = k ? full_one : full;
+        unsigned char *mem = malloc(bytes), *fmem = malloc(om_frame_bytes(W2, H2)), *px = malloc(W2 * H2 * 3);
+        om_arena ma, fa;
+        om_arena_init(&ma, mem, bytes, "method");
+        om_arena_init(&fa, fmem, om_frame_bytes(W2, H2), "frame");
+        om_camera cam;
+        om_light light;
+        om_view v;
+        om_diag d;
+        void *state;
+        om_scene_at(&hs.s, 0, &cam, &light);
+        cam.width = W2;
+        cam.height = H2;
+        CHECK_OK(om_view_init(&v, &cam, &light, &hs.s, NULL));
+        CHECK_OK(m->init(&state, &ma, ck, &hs.s, W2, H2, &d));
+        om_framebuffer fb = {OM_RGB888, W2, H2, W2 * 3, px};
+        om_shade_cfg shade;
+        om_shade_cfg_default(&shade);
+        om_frame_desc fd;
+        memset(&fd, 0, sizeof fd);
+        fd.scene = &hs.s; fd.view = &v; fd.method = m; fd.method_state = state; fd.shade = &shade;
+        fd.fb = &fb;
+        CHECK_OK(om_render_frame(&fd, &fa, NULL, &d));
+        om_method_stats ms;
+        m->stats(state, &ms);
+        tiles[k] = ms.counters[5];
+        free(mem);
+        free(fmem);
+        free(px);
+    }
+    CHECK_MSG(tiles[0] >= 2 && tiles[1] == 1, "default pool %u tiles, one pass %u", tiles[0], tiles[1]);
+    free(rt);
+    free(zt);
+    h_scene_free(&hs);
+}
+
 void suite_izb(void)
 {
     RUN(izb_default_scene);
@@ -160,4 +229,5 @@ void suite_izb(void)
     RUN(hot_spot);
     RUN(directional);
     RUN(budgets);
+    RUN(default_pool);
 }
