@@ -148,8 +148,91 @@ static void fewer_jobs(void)
     h_scene_free(&hs);
 }
 
+/* ---- hybrid: its bands look the map up and mark the samples they leave uncertain;
+ * the irregular pass over those runs after the bands (om__bands.finish). The same
+ * terms, pixels and counters for any number of jobs and their order, whole frames and
+ * strips, one tile of uncertain samples or tiles of a few (izb.pool). */
+static frame_out hybrid_frame(const om_scene *s, uint32_t pool, uint32_t rows, om_parallel_for_fn pf,
+                              void *host, uint32_t threads)
+{
+    frame_out o;
+    memset(&o, 0, sizeof o);
+    const om_method *m = om_method_find("hybrid");
+    om_camera cam;
+    om_light light;
+    om_view v;
+    om_diag d;
+    om_scene_at(s, 0.0f, &cam, &light);
+    cam.width = 160;
+    cam.height = 120;
+    if ((o.st = om_view_init(&v, &cam, &light, s, &d))) return o;
+    om_method_cfg c;
+    om_method_cfg_default(&c, m);
+    if ((o.st = om_method_cfg_set(&c, "izb.pool", pool, &d))) return o;
+    size_t mn, full;
+    if ((o.st = m->bytes(&c, s, 160, 120, &mn, &full))) return o;
+    uint32_t r = rows ? rows : 120;
+    size_t fbytes = om_frame_bytes_scene(s, 160, r) + om_frame_bytes_jobs(m, s, threads);
+    void *mm = malloc(full), *fm = malloc(fbytes), *px = malloc((size_t)160 * r * 3);
+    om_arena ma, fa;
+    om_arena_init(&ma, mm, full, "method");
+    om_arena_init(&fa, fm, fbytes, "frame");
+    void *state;
+    if ((o.st = m->init(&state, &ma, &c, s, 160, 120, &d)) == OM_OK) {
+        om_framebuffer fb = {OM_RGB888, 160, r, 160 * 3, (uint8_t *)px};
+        om_shade_cfg shade;
+        om_shade_cfg_default(&shade);
+        om_frame_desc fd;
+        memset(&fd, 0, sizeof fd);
+        fd.scene = s; fd.view = &v; fd.method = m; fd.method_state = state; fd.shade = &shade;
+        fd.strip_rows = rows; fd.fb = &fb; fd.on_strip = on_strip; fd.user = &o.hash;
+        fd.parallel_for = pf; fd.parallel_user = host; fd.threads = threads;
+        o.hash = OM_HASH_INIT;
+        om_frame_stats fs;
+        o.st = om_render_frame(&fd, &fa, &fs, &d);
+        o.jobs = fs.jobs;
+        m->stats(state, &o.ms);
+    }
+    free(mm);
+    free(fm);
+    free(px);
+    return o;
+}
+
+static void hybrid_bands(void)
+{
+    static const uint32_t threads[] = {2, 3, 7};
+    om_jobs *pools[3];
+    for (int k = 0; k < 3; k++) CHECK_OK(om_jobs_start(&pools[k], threads[k], NULL));
+    for (int li = 0; li < 2; li++) {
+        h_scene hs;
+        if (!h_scene_parse(&hs, li ? directional : om_scene_default_text())) continue;
+        for (int pi = 0; pi < 2; pi++)
+            for (uint32_t rows = 0; rows <= 24; rows += 24) {
+                uint32_t pool = pi ? 97 : 0;
+                frame_out one = hybrid_frame(&hs.s, pool, rows, NULL, NULL, 1);
+                CHECK_MSG(one.st == OM_OK && one.jobs == 1, "hybrid: inline frame");
+                /* a pool of 97 leaves several tiles a strip; the counters say how many */
+                CHECK_MSG(one.ms.counters[2] > 0 && (pool == 0 || one.ms.counters[5] > one.ms.counters[2] / 97),
+                          "hybrid: %u uncertain in %u tiles", one.ms.counters[2], one.ms.counters[5]);
+                for (int k = 0; k < 4; k++) {
+                    uint32_t n = k < 3 ? threads[k] : 5;
+                    frame_out o = k < 3 ? hybrid_frame(&hs.s, pool, rows, om_jobs_for, pools[k], n)
+                                        : hybrid_frame(&hs.s, pool, rows, backwards, NULL, n);
+                    CHECK_MSG(o.st == OM_OK && o.jobs == n, "hybrid: %u jobs ran %u", n, o.jobs);
+                    CHECK_MSG(o.hash == one.hash && !memcmp(o.ms.counters, one.ms.counters, sizeof o.ms.counters),
+                              "hybrid light %d pool %u strips %u: %u threads%s change the frame", li, pool, rows,
+                              n, k < 3 ? "" : " backwards");
+                }
+            }
+        h_scene_free(&hs);
+    }
+    for (int k = 0; k < 3; k++) om_jobs_stop(pools[k]);
+}
+
 void suite_threads(void)
 {
     RUN(same_bits);
     RUN(fewer_jobs);
+    RUN(hybrid_bands);
 }

@@ -352,6 +352,7 @@ om_status om_render_frame(const om_frame_desc *fd, om_arena *fa, om_frame_stats 
             for (uint32_t j = 0; j < BANDS_PER_JOB * c.jobs; j++)
                 for (int k = 0; k < 8; k++) sum[k] += c.slots[j].counts[k];
             c.bands->merge(fd->method_state, sum);
+            if (c.bands->finish) c.bands->finish(fd->method_state, &c.strip);
         } else {
             st = m->resolve(fd->method_state, &c.strip, d);
         }

@@ -55,6 +55,10 @@ typedef struct om__bands {
      * side (om__bins_make) or NULL. The same map whatever the bands. */
     uint32_t (*map_of)(const void *state, const om_mat4 **vp);
     void (*build_rows)(const void *state, const om__bins *bins, uint32_t y0, uint32_t rows);
+    /* May be NULL. Runs on the calling thread after merge, over the whole strip: what
+     * the bands left to the method (hybrid's irregular pass over the samples its
+     * bands found uncertain). */
+    void (*finish)(void *state, om_strip *strip);
 } om__bands;
 
 /* Method m's bands; NULL where its resolve must run a strip at a time (registry.c,

@@ -588,26 +588,37 @@ static void run_tile(hybrid_state *m, om_strip *st, uint32_t n)
     m->tiles++;
 }
 
-/* A strip: every exposed sample projected and looked up; the uncertain ones, a tile at
- * a time, through the triangle pass. */
-static om_status hybrid_resolve(void *state, om_strip *st, om_diag *d)
+/* The term a band leaves on a sample its map could not decide (no certain answer is
+ * ever anything but 0 or 255 in every channel); the pass after the bands overwrites
+ * every one. */
+static bool marked(const om_term *t) { return t->r == 0 && t->g == 0 && t->b == 1; }
+
+/* The irregular pass over a strip's uncertain samples, a tile at a time. With `banded`
+ * the bands have classified and counted every sample already (hybrid_band) and the
+ * marked ones are projected again; otherwise each exposed sample is projected, looked
+ * up and counted here. The same samples, in the same order, either way. */
+static void uncertain_pass(hybrid_state *m, om_strip *st, bool banded)
 {
-    (void)d;
-    hybrid_state *m = (hybrid_state *)state;
     size_t n = (size_t)st->rows * st->width, i = 0;
     while (i < n) {
         uint32_t k = 0;
         for (; i < n && k < m->cap; i++) {
             om_term *t = &st->terms[i];
-            t->r = t->g = t->b = 255;
             om__lpoint p;
-            if (!(t->flags & OM_TERM_EXPOSED) || !om__lspace_point(&m->ls, &st->samples[i], &p)) continue;
             int64_t tex;
-            int c = classify(m, &p, t, &tex);
-            if (c == 1) m->lit++;
-            else if (c == 2) m->shadowed++;
-            if (c) continue;
-            m->uncertain++;
+            if (banded) {
+                if (!(t->flags & OM_TERM_EXPOSED) || !marked(t) || !om__lspace_point(&m->ls, &st->samples[i], &p))
+                    continue;
+                tex = texel_of(m, p.y) * (int64_t)m->side + texel_of(m, p.x);
+            } else {
+                t->r = t->g = t->b = 255;
+                if (!(t->flags & OM_TERM_EXPOSED) || !om__lspace_point(&m->ls, &st->samples[i], &p)) continue;
+                int c = classify(m, &p, t, &tex);
+                if (c == 1) m->lit++;
+                else if (c == 2) m->shadowed++;
+                if (c) continue;
+                m->uncertain++;
+            }
             hsample *q = &m->raw[k];
             q->x = (int32_t)p.x;
             q->y = (int32_t)p.y;
@@ -619,8 +630,49 @@ static om_status hybrid_resolve(void *state, om_strip *st, om_diag *d)
         }
         if (k) run_tile(m, st, k);
     }
+}
+
+static om_status hybrid_resolve(void *state, om_strip *st, om_diag *d)
+{
+    (void)d;
+    uncertain_pass((hybrid_state *)state, st, false);
     return OM_OK;
 }
+
+/* By bands on the host's threads (om__bands): each band projects and looks up its own
+ * samples, reading the map only, and marks the uncertain ones; merge adds up the
+ * counts, and the irregular pass runs over the whole strip after the bands. */
+static void hybrid_band(const void *state, om_strip *st, void *scratch, uint32_t counts[8])
+{
+    (void)scratch;
+    const hybrid_state *m = (const hybrid_state *)state;
+    size_t n = (size_t)st->rows * st->width;
+    for (size_t i = 0; i < n; i++) {
+        om_term *t = &st->terms[i];
+        om__lpoint p;
+        int64_t tex;
+        t->r = t->g = t->b = 255;
+        if (!(t->flags & OM_TERM_EXPOSED) || !om__lspace_point(&m->ls, &st->samples[i], &p)) continue;
+        int c = classify(m, &p, t, &tex);
+        counts[c == 1 ? 0 : c == 2 ? 1 : 2]++;
+        if (c == 0) {
+            t->r = t->g = 0;
+            t->b = 1;
+        }
+    }
+}
+
+static void hybrid_merge(void *state, const uint32_t counts[8])
+{
+    hybrid_state *m = (hybrid_state *)state;
+    m->lit += counts[0];
+    m->shadowed += counts[1];
+    m->uncertain += counts[2];
+}
+
+static void hybrid_finish(void *state, om_strip *st) { uncertain_pass((hybrid_state *)state, st, true); }
+
+const om__bands om__bands_hybrid = {hybrid_band, hybrid_merge, 0, NULL, NULL, hybrid_finish};
 
 static void hybrid_stats(const void *state, om_method_stats *out)
 {

@@ -61,7 +61,7 @@ static void none_merge(void *state, const uint32_t counts[8])
     (void)state; (void)counts;
 }
 
-const om__bands om__bands_none = {none_band, none_merge, 0, NULL, NULL};
+const om__bands om__bands_none = {none_band, none_merge, 0, NULL, NULL, NULL};
 
 static void none_stats(const void *state, om_method_stats *out)
 {

@@ -301,7 +301,7 @@ static void ref_band(const void *state, om_strip *st, void *scratch, uint32_t co
     counts[2] += j.blocked;
 }
 
-const om__bands om__bands_ref = {ref_band, ref_merge, sizeof(packet), NULL, NULL};
+const om__bands om__bands_ref = {ref_band, ref_merge, sizeof(packet), NULL, NULL, NULL};
 
 static void ref_stats(const void *state, om_method_stats *out)
 {

@@ -482,7 +482,7 @@ static void rtw_merge(void *state, const uint32_t counts[8])
     m->shadowed += counts[1];
 }
 
-const om__bands om__bands_rtw = {rtw_band, rtw_merge, 0, NULL, NULL};
+const om__bands om__bands_rtw = {rtw_band, rtw_merge, 0, NULL, NULL, NULL};
 
 static uint32_t sat_u32(double v)
 {

@@ -150,7 +150,7 @@ static void sm_build_rows(const void *state, const om__bins *bins, uint32_t y0, 
     om__scene_raster(m->scene, &m->view.light_vp, &tg, OM_RASTER_DEPTH, true, bins);
 }
 
-const om__bands om__bands_sm = {sm_band, sm_merge, 0, sm_map_of, sm_build_rows};
+const om__bands om__bands_sm = {sm_band, sm_merge, 0, sm_map_of, sm_build_rows, NULL};
 
 static void sm_stats(const void *state, om_method_stats *out)
 {
