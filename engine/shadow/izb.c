@@ -61,13 +61,15 @@ static uint32_t node_bound(uint32_t samples, uint32_t leaf)
 
 /* The per-frame vertex projection is kept only when the arena has room for one pass
  * (it speeds up triangle setup, it changes no result). */
-size_t om__izb_parts_bytes(const om_scene *s, bool cache)
+/* Arena bytes of setup's parts: the material depths and, with `cache`, the per-frame
+ * vertex projection; and of a pool of `samples` with its BSP nodes. */
+static size_t parts_bytes(const om_scene *s, bool cache)
 {
     return (cache ? om__lspace_bytes(s) : 0) +
            om_arena_need((size_t)(s->nmats ? s->nmats : 1) * sizeof(om__odepth), 4);
 }
 
-size_t om__izb_pool_bytes(uint32_t samples, uint32_t leaf)
+static size_t pool_bytes_of(uint32_t samples, uint32_t leaf)
 {
     return om_arena_need((size_t)samples * sizeof(om__odepth), 16) +
            2 * om_arena_need((size_t)samples * sizeof(om__izb_key), 16) +
@@ -94,7 +96,7 @@ static uint32_t auto_pool(const om_scene *s, uint32_t w, uint32_t h)
 
 static size_t fixed_bytes(const om_scene *s, bool cache)
 {
-    return om_arena_need(sizeof(izb_state), 16) + om__izb_parts_bytes(s, cache);
+    return om_arena_need(sizeof(izb_state), 16) + parts_bytes(s, cache);
 }
 
 static om_status pool_bytes(const om__izb_cfg *c, const om_scene *s, uint32_t w, uint32_t h,
@@ -103,8 +105,8 @@ static om_status pool_bytes(const om__izb_cfg *c, const om_scene *s, uint32_t w,
     if (c->izb_leaf < 1) return OM_E_INVALID;
     uint32_t one_pass = auto_pool(s, w, h), smallest = w;   /* the smallest tile: one row */
     if (c->izb_pool) one_pass = smallest = c->izb_pool;
-    *min = fixed_bytes(s, false) + om__izb_pool_bytes(smallest, c->izb_leaf);
-    *full = fixed_bytes(s, true) + om__izb_pool_bytes(one_pass, c->izb_leaf);
+    *min = fixed_bytes(s, false) + pool_bytes_of(smallest, c->izb_leaf);
+    *full = fixed_bytes(s, true) + pool_bytes_of(one_pass, c->izb_leaf);
     return OM_OK;
 }
 
@@ -116,15 +118,18 @@ static om_status izb_bytes(const om_method_cfg *mc, const om_scene *s, uint32_t 
     return pool_bytes(&c, s, w, h, min, full);
 }
 
-om_status om__izb_setup(om__izb *z, om_arena *a, const om__izb_cfg *c, const om_scene *s,
-                        uint32_t want, uint32_t least, om_diag *d)
+/* Carves z's parts from `a`: the vertex projection when the arena also holds a pool of
+ * `want` samples beside it, then the pool: c->izb_pool samples when set, else the
+ * largest from `least` up to `want` that fits. The caller has checked the minimum. */
+static om_status setup(om__izb *z, om_arena *a, const om__izb_cfg *c, const om_scene *s,
+                       uint32_t want, uint32_t least, om_diag *d)
 {
     om_status st;
     void *p;
     z->scene = s;
     z->leaf = c->izb_leaf;
     if (c->izb_pool) want = least = c->izb_pool;
-    if (om_arena_left(a) >= om__izb_parts_bytes(s, true) + om__izb_pool_bytes(want, z->leaf)) {
+    if (om_arena_left(a) >= parts_bytes(s, true) + pool_bytes_of(want, z->leaf)) {
         if ((st = om__lspace_init(&z->ls, a, s, d))) return st;
     } else {
         om__lspace_init_lean(&z->ls, s);
@@ -138,7 +143,7 @@ om_status om__izb_setup(om__izb *z, om_arena *a, const om__izb_cfg *c, const om_
     size_t left = om_arena_left(a);
     while (cap < hi) {   /* largest pool that fits */
         uint32_t mid = cap + (hi - cap + 1) / 2;
-        if (om__izb_pool_bytes(mid, z->leaf) <= left) cap = mid;
+        if (pool_bytes_of(mid, z->leaf) <= left) cap = mid;
         else hi = mid - 1;
     }
     z->cap = cap;
@@ -174,7 +179,7 @@ static om_status izb_init(void **state, om_arena *a, const om_method_cfg *mc, co
     m->cfg = *c;
     m->width = w;
     m->height = h;
-    if ((st = om__izb_setup(&m->z, a, c, s, auto_pool(s, w, h), w, d))) return st;
+    if ((st = setup(&m->z, a, c, s, auto_pool(s, w, h), w, d))) return st;
     *state = m;
     return OM_OK;
 }
@@ -202,8 +207,7 @@ static om_status izb_build(void *state, om_diag *d)
 
 /* ---- stage 1: transform */
 
-uint32_t om__izb_transform(om__izb *z, const om_strip *st, size_t *next, size_t end,
-                           om__izb_decide decide, void *user)
+uint32_t om__izb_transform(om__izb *z, const om_strip *st, size_t *next, size_t end)
 {
     size_t i = *next;
     uint32_t n = 0;
@@ -211,7 +215,6 @@ uint32_t om__izb_transform(om__izb *z, const om_strip *st, size_t *next, size_t 
         if (!(st->terms[i].flags & OM_TERM_EXPOSED)) continue;
         om__lpoint p;
         if (!om__lspace_point(&z->ls, &st->samples[i], &p)) continue;   /* behind the light */
-        if (decide && decide(user, &p, &st->terms[i])) continue;
         /* the sample's key for the BSP, and the tile's bounds, while it is at hand */
         om__izb_key *k = &z->keys[n];
         k->x = (int32_t)p.x;   /* the light grid fits in 27 bits */
@@ -598,12 +601,12 @@ void om__izb_write(const om__izb *z, om_strip *st)
     for (uint32_t i = 0; i < z->n; i++) om__odepth_term(&z->od[i], &st->terms[z->keys[i].s & ~OM_IZB_DONE]);
 }
 
-void om__izb_resolve(om__izb *z, om_strip *st, om__izb_decide decide, void *user)
+void om__izb_resolve(om__izb *z, om_strip *st)
 {
     size_t n = (size_t)st->rows * st->width, next = 0;
     for (size_t i = 0; i < n; i++) st->terms[i].r = st->terms[i].g = st->terms[i].b = 255;
     while (next < n) {
-        if (om__izb_transform(z, st, &next, n, decide, user) == 0) break;
+        if (om__izb_transform(z, st, &next, n) == 0) break;
         om__izb_build(z);
         om__izb_raster(z);
         om__izb_write(z, st);
@@ -614,7 +617,7 @@ void om__izb_resolve(om__izb *z, om_strip *st, om__izb_decide decide, void *user
 static om_status izb_resolve(void *state, om_strip *st, om_diag *d)
 {
     (void)d;
-    om__izb_resolve(&((izb_state *)state)->z, st, NULL, NULL);
+    om__izb_resolve(&((izb_state *)state)->z, st);
     return OM_OK;
 }
 
@@ -623,7 +626,7 @@ static void izb_stats(const void *state, om_method_stats *out)
     const izb_state *m = (const izb_state *)state;
     const om__izb *z = &m->z;
     memset(out, 0, sizeof *out);
-    out->bytes_used = fixed_bytes(z->scene, z->ls.verts != NULL) + om__izb_pool_bytes(z->cap, z->leaf);
+    out->bytes_used = fixed_bytes(z->scene, z->ls.verts != NULL) + pool_bytes_of(z->cap, z->leaf);
     static const char *const names[] = {"bsp nodes", "nodes visited", "nodes culled (shadowed)",
                                         "nodes culled (depth)", "samples tested", "tiles",
                                         "pool samples"};

@@ -59,7 +59,7 @@ typedef struct om__izb {
 
 /* The izb method's state begins with an om__izb, so a state pointer converts to one. */
 
-/* The sample pool's settings: izb's whole configuration, and a part of hybrid's. */
+/* izb's configuration (hybrid takes izb.pool too, into a struct of its own). */
 typedef struct om__izb_cfg {
     uint32_t izb_leaf;     /* most samples in a BSP leaf */
     uint32_t izb_pool;     /* samples the pool holds; 0: izb picks by the scene (izb.c,
@@ -74,31 +74,17 @@ typedef struct om__izb_cfg {
     OM__SETTING(T, f, "izb.pool", OM_SETTING_U32, 0, 1e9, 0, \
                 "samples the pool holds, 0 = izb: 2 a triangle, 32768 to the frame; hybrid: the frame")
 
-/* Arena bytes of om__izb_setup's parts: the material depths and, with `cache`, the
- * per-frame vertex projection; and of a pool of `samples` with its BSP nodes. */
-size_t om__izb_parts_bytes(const om_scene *s, bool cache);
-size_t om__izb_pool_bytes(uint32_t samples, uint32_t leaf);
-/* Carves z's parts from `a`: the vertex projection when the arena also holds a pool of
- * `want` samples beside it, then the pool: c->izb_pool samples when set, else the
- * largest from `least` up to `want` that fits. The caller has checked the minimum. */
-om_status om__izb_setup(om__izb *z, om_arena *a, const om__izb_cfg *c, const om_scene *s,
-                        uint32_t want, uint32_t least, om_diag *d);
-
-/* Decides a sample without the BSP when it can: writes its term and returns true. */
-typedef bool (*om__izb_decide)(void *user, const om__lpoint *p, om_term *t);
-
-/* Fills the pool (the samples' keys) from strip samples [*next, end) that are
- * exposed, up to its capacity; advances *next. With `decide`, only the samples it leaves undecided enter the pool.
- * Returns the number taken. */
-uint32_t om__izb_transform(om__izb *z, const om_strip *st, size_t *next, size_t end,
-                           om__izb_decide decide, void *user);
+/* The stages, one tile at a time (the benchmark times each):
+ * transform fills the pool (the samples' keys) from strip samples [*next, end) that
+ * are exposed, up to its capacity, advances *next and returns the number taken. */
+uint32_t om__izb_transform(om__izb *z, const om_strip *st, size_t *next, size_t end);
 void om__izb_build(om__izb *z);
 /* Rasterizes every triangle of the scene through the BSP. */
 void om__izb_raster(om__izb *z);
 /* Writes the tile's terms into the strip. */
 void om__izb_write(const om__izb *z, om_strip *st);
-/* A strip's terms: 255 everywhere, then tile after tile of the exposed samples (those
- * `decide` leaves undecided, when given) through transform, build, raster, write. */
-void om__izb_resolve(om__izb *z, om_strip *st, om__izb_decide decide, void *user);
+/* A strip's terms: 255 everywhere, then tile after tile of the exposed samples through
+ * transform, build, raster, write. */
+void om__izb_resolve(om__izb *z, om_strip *st);
 
 #endif

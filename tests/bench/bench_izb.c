@@ -44,7 +44,7 @@ static void table_row(const bscene *b, uint32_t W, uint32_t H)
         uint64_t ns[3] = {0, 0, 0};
         for (;;) {   /* tile after tile, as the method's default pool has them */
             uint64_t t0 = om_clock_ns(NULL);
-            uint32_t got = om__izb_transform(z, &st, &next, n, NULL, NULL);
+            uint32_t got = om__izb_transform(z, &st, &next, n);
             uint64_t t1 = om_clock_ns(NULL);
             ns[0] += t1 - t0;
             if (got == 0) break;
