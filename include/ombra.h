@@ -337,7 +337,9 @@ typedef struct om_method {
     const char *summary;
     unsigned flags;
     /* Bytes the method's arena needs for this configuration, scene and image size:
-     * the least it can work with and what it needs to work in one pass. */
+     * the least it can work with, and the size it is meant to run at (`full`): one
+     * pass for every method but izb, whose full is its default pool (it tiles where
+     * the scene has few triangles for its samples, which is faster there). */
     om_status (*bytes)(const om_method_cfg *c, const om_scene *s, uint32_t width,
                        uint32_t height, size_t *min, size_t *full);
     /* Creates the state in `a`; the method keeps `a` for per-frame scratch. */

@@ -430,7 +430,7 @@ int cmd_info(int argc, char **argv)
         om_method_cfg cfg;
         if (!cli_cfg(m, &settings, &cfg, NULL)) { cli_scene_free(&cs); return 2; }
         st = m->bytes(&cfg, s, W, H, &mn, &full);
-        if (st == OM_OK) printf("  %-6s min %zu, one pass %zu\n", m->name, mn, full);
+        if (st == OM_OK) printf("  %-6s min %zu, full %zu\n", m->name, mn, full);
         else printf("  %-6s %s\n", m->name, om_status_str(st));
     }
     cli_scene_free(&cs);

@@ -90,7 +90,7 @@ static void stress_method(ctx *c, const om_method *m)
     om_diag d;
     bool guards;
     if (run(c, m, &cfg, full, c->full, &guards, &d) != OM_OK || !guards) {
-        fail(c->b->name, m->name, full, "the one-pass budget does not render");
+        fail(c->b->name, m->name, full, "the full budget does not render");
         return;
     }
     bool exact = !strcmp(m->name, "ref") || !strcmp(m->name, "izb");
@@ -135,7 +135,7 @@ static void stress_method(ctx *c, const om_method *m)
         }
     }
     free(mask);
-    printf("stress: %-12s %-5s minimum %9zu, one pass %9zu: %d budgets, %d refused\n", c->b->name,
+    printf("stress: %-12s %-5s minimum %9zu, full %9zu: %d budgets, %d refused\n", c->b->name,
            m->name, mn, full, runs, refused);
 }
 
