@@ -221,11 +221,15 @@ void om_view_fit_light(om_view *v, const om_scene *s, om_vec3 lo, om_vec3 hi);
 
 /* One visible sample per pixel: the exact point of the nearest triangle under the
  * pixel centre, its geometric normal (unit, as wound; not turned to the camera) and
- * the triangle. tri == OM_NO_TRI is background. */
+ * the triangle. tri == OM_NO_TRI is background. `nl` is the cosine between the normal
+ * turned to the camera and the direction to the light, which the frame sets with the
+ * exposure marks for an exposed sample (OM_TERM_EXPOSED; 0 for any other), so that
+ * the methods and shading do not work it out again. */
 typedef struct om_sample {
     float p[3];
     float n[3];
     uint32_t tri;
+    float nl;
 } om_sample;
 
 /* The shadow term of a sample: RGB transmittance from the sample to the light,

@@ -66,7 +66,7 @@ static void failure_injection(void)
     om_light light;
     om_scene_at(&hs.s, 0, &cam, &light);
     CHECK_OK(om_view_init(&f.v, &cam, &light, &hs.s, NULL));
-    static unsigned char fmem[W * 9 * 48];
+    static unsigned char fmem[W * 9 * 52];   /* 44 bytes a pixel, and room for the bins */
     for (size_t k = 0; k < om_method_count(); k++) {
         f.m = om_method_at(k);
         f.cfg = h_cfg(f.m->name, SMALL);

@@ -54,6 +54,7 @@ static void resolve_pixel(const om__persp_tri *c, float sx, float sy, om_sample 
     out->n[1] = c->n.y;
     out->n[2] = c->n.z;
     out->tri = c->tri;
+    out->nl = 0.0f;   /* set with the exposure marks */
 }
 
 void om__eye_pass(const om_scene *s, const om_view *v, const om_target *tg, om_strip *st,
@@ -75,6 +76,7 @@ void om__eye_pass(const om_scene *s, const om_view *v, const om_target *tg, om_s
                 smp->p[0] = smp->p[1] = smp->p[2] = 0.0f;
                 smp->n[0] = smp->n[1] = smp->n[2] = 0.0f;
                 smp->tri = OM_NO_TRI;
+                smp->nl = 0.0f;
                 continue;
             }
             if (cache.tri != t) om__persp_setup(s, &v->cam_vp, t, &cache);

@@ -33,8 +33,8 @@ om_vec3 om__persp_point(const om__persp_tri *c, float sx, float sy);
 
 /* The parts of the lit rule that no occluder decides, the same for every method:
  * the normal turned towards the camera faces the light, and the point lies inside
- * the light's frustum. */
-bool om__exposed(const om_view *v, const om_sample *smp);
+ * the light's frustum. Sets smp->nl: that cosine where the sample is exposed, else 0. */
+bool om__exposed(const om_view *v, om_sample *smp);
 
 /* Direction from a point towards the light (unit). */
 om_vec3 om__to_light(const om_view *v, om_vec3 p);

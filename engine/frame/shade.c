@@ -9,15 +9,20 @@ om_vec3 om__to_light(const om_view *v, om_vec3 p)
     return om__normalize(om__sub(v->light.pos, p));
 }
 
-bool om__exposed(const om_view *v, const om_sample *smp)
+bool om__exposed(const om_view *v, om_sample *smp)
 {
     om_vec3 p = om__v3(smp->p[0], smp->p[1], smp->p[2]);
     om_vec3 n = om__v3(smp->n[0], smp->n[1], smp->n[2]);
+    smp->nl = 0.0f;
     if (om__dot(n, om__sub(v->cam.eye, p)) < 0.0f) n = om__scale(n, -1.0f);
-    if (!(om__dot(n, om__to_light(v, p)) > 0.0f)) return false;
+    const float nl = om__dot(n, om__to_light(v, p));
+    if (!(nl > 0.0f)) return false;
     om_vec4 q = om__mat_apply(&v->light_vp, p);
-    return q.w > 0.0f && q.x >= -q.w && q.x <= q.w && q.y >= -q.w && q.y <= q.w &&
-           q.z >= 0.0f && q.z <= q.w;
+    if (!(q.w > 0.0f && q.x >= -q.w && q.x <= q.w && q.y >= -q.w && q.y <= q.w &&
+          q.z >= 0.0f && q.z <= q.w))
+        return false;
+    smp->nl = nl;   /* the lookups and shading read it rather than work it out again */
+    return true;
 }
 
 void om_shade_cfg_default(om_shade_cfg *c)
@@ -54,10 +59,11 @@ static inline void put(om_format f, uint8_t *px, uint8_t r, uint8_t g, uint8_t b
     }
 }
 
-/* One row of the strip into the framebuffer row `px`, `bpp` bytes a pixel. A blocked
- * term adds k * 0 = 0 to the ambient light (k is finite: unit vectors), so the light's
- * direction is not computed for it. */
-static inline void shade_row(const om_scene *s, const om_view *v, const om_shade_cfg *c, const om_sample *smp,
+/* One row of the strip into the framebuffer row `px`, `bpp` bytes a pixel. The cosine
+ * is the one the exposure marks kept in the sample (om__exposed), the same bits as
+ * working it out here. A blocked term adds k * 0 = 0 to the ambient light (k is
+ * finite), so it is skipped. */
+static inline void shade_row(const om_scene *s, const om_shade_cfg *c, const om_sample *smp,
                              const om_term *t, uint32_t width, om_format f, uint32_t bpp, uint8_t *px)
 {
     for (uint32_t x = 0; x < width; x++, smp++, t++, px += bpp) {
@@ -65,10 +71,7 @@ static inline void shade_row(const om_scene *s, const om_view *v, const om_shade
         const om_material *m = &s->mats[s->tri_mat[smp->tri]];
         float lr = c->ambient, lg = c->ambient, lb = c->ambient;
         if ((t->flags & OM_TERM_EXPOSED) && (t->r | t->g | t->b)) {
-            om_vec3 p = om__v3(smp->p[0], smp->p[1], smp->p[2]);
-            om_vec3 n = om__v3(smp->n[0], smp->n[1], smp->n[2]);
-            if (om__dot(n, om__sub(v->cam.eye, p)) < 0.0f) n = om__scale(n, -1.0f);
-            float k = om__dot(n, om__to_light(v, p)) * (1.0f - c->ambient) * (1.0f / 255.0f);
+            float k = smp->nl * (1.0f - c->ambient) * (1.0f / 255.0f);
             lr += k * (float)t->r;
             lg += k * (float)t->g;
             lb += k * (float)t->b;
@@ -80,14 +83,15 @@ static inline void shade_row(const om_scene *s, const om_view *v, const om_shade
 void om__shade_strip(const om_scene *s, const om_view *v, const om_shade_cfg *c,
                      const om_strip *st, om_framebuffer *fb)
 {
+    (void)v;   /* the light's direction is in the samples (nl) */
     const uint32_t bpp = om_format_bpp(fb->format);
     for (uint32_t y = 0; y < st->rows; y++) {
         const size_t i = (size_t)y * st->width;
         uint8_t *row = fb->pixels + (size_t)y * fb->stride;
         switch (fb->format) {
-        case OM_RGB888: shade_row(s, v, c, st->samples + i, st->terms + i, st->width, OM_RGB888, 3, row); break;
-        case OM_RGB565: shade_row(s, v, c, st->samples + i, st->terms + i, st->width, OM_RGB565, 2, row); break;
-        default: shade_row(s, v, c, st->samples + i, st->terms + i, st->width, fb->format, bpp, row); break;
+        case OM_RGB888: shade_row(s, c, st->samples + i, st->terms + i, st->width, OM_RGB888, 3, row); break;
+        case OM_RGB565: shade_row(s, c, st->samples + i, st->terms + i, st->width, OM_RGB565, 2, row); break;
+        default: shade_row(s, c, st->samples + i, st->terms + i, st->width, fb->format, bpp, row); break;
         }
     }
 }

@@ -14,6 +14,9 @@ void om__smlook_begin(om__smlook *L, const om_view *v)
 {
     L->view = v;
     L->span_per_dist = 2.0f * (float)om__tan((double)v->light.fov_deg * OM_PI / 360.0);
+    L->dz_num = v->light.zfar * v->light.znear;   /* the same roundings as per sample */
+    L->dz_den = v->light.zfar - v->light.znear;
+    L->half_near = v->light.znear * 0.5f;
 }
 
 /* World size of one (unwarped) texel at distance `dist` along the light's axis. */
@@ -54,10 +57,25 @@ static inline int32_t texel_floor_d(double f, uint32_t size)
     return f > -16.0 ? (f < hi ? (int32_t)floor(f) : (int32_t)size + 16) : -16;
 }
 
-/* Where one sample's test looks: its biased depth and the texel under it (before the
- * clamp to the map); for a warped map also where it lies before the warp (normalized
- * coordinates), from which unwarped PCF taps are placed. */
-typedef struct tap { uint64_t zlit; int32_t cx, cy; double u, v; } tap;
+/* Where one sample's test looks: its biased depth, the texel under it clamped to the
+ * map (`at`, its index: the one tap without PCF) and, for PCF, before the clamp; for a
+ * warped map also where it lies before the warp (normalized coordinates), from which
+ * unwarped PCF taps are placed. */
+typedef struct tap { uint64_t zlit; uint32_t at; int32_t cx, cy; double u, v; } tap;
+
+/* A texel coordinate clamped to the map, in 32 bits: texel_floor's are within 16
+ * texels of it. */
+static inline uint32_t clamp32(int32_t x, uint32_t size)
+{
+    return x < 0 ? 0u : (uint32_t)x >= size ? size - 1 : (uint32_t)x;
+}
+
+/* clamp32(texel_floor(f, size), size) in one step: below 0 (or NaN) the first texel,
+ * from `size` on the last, between them the truncation, which is the floor there. */
+static inline uint32_t texel_clamped(float f, uint32_t size)
+{
+    return f >= 0.0f ? (f < (float)size ? (uint32_t)f : size - 1) : 0u;
+}
 
 /* The least stored depth a biased sample depth z is not behind: z <= D for a stored
  * integer D exactly when ceil(z) <= D (a NaN never is: 2^32 + 1). Integer compares per
@@ -77,9 +95,6 @@ static bool locate(const om__smlook *L, const om_sample *smp, tap *out)
 {
     const om_view *v = L->view;
     om_vec3 p = om__v3(smp->p[0], smp->p[1], smp->p[2]);
-    om_vec3 n = om__v3(smp->n[0], smp->n[1], smp->n[2]);
-    if (om__dot(n, om__sub(v->cam.eye, p)) < 0.0f) n = om__scale(n, -1.0f);
-    om_vec3 l = om__to_light(v, p);
     float dist = v->light.kind == OM_LIGHT_SPOT ? om__dot(om__sub(p, v->light.pos), v->light_axis) : 1.0f;
     float texel = texel_world(L, dist);
     double u0 = 0.0, v0 = 0.0;
@@ -101,14 +116,20 @@ static bool locate(const om__smlook *L, const om_sample *smp, tap *out)
         if (!(L->unwarped_pcf && L->pcf > 1) || dens < 1.0)
             texel = (float)((double)texel / dens);
     }
-    float cosang = om__dot(n, l);
+    float cosang = smp->nl;   /* n . l, kept by the exposure marks (om__exposed) */
     float tanang = cosang > 0.0995f ? om__sqrtf(1.0f - cosang * cosang) / cosang : 10.0f;
     float bias = L->bias_const + L->bias_slope * texel * tanang;
     om_vec4 q;
     if (L->warp_x && L->normal_offset == 0.0f) {
         q = q0;   /* the point did not move: its projection and warp are done */
     } else {
-        p = om__add(p, om__scale(n, L->normal_offset * texel));
+        /* Without an offset p + n * 0 is p (up to the sign of a zero coordinate,
+         * which no comparison or rounding below sees), so the normal is left alone. */
+        if (L->normal_offset != 0.0f) {
+            om_vec3 n = om__v3(smp->n[0], smp->n[1], smp->n[2]);
+            if (om__dot(n, om__sub(v->cam.eye, p)) < 0.0f) n = om__scale(n, -1.0f);
+            p = om__add(p, om__scale(n, L->normal_offset * texel));
+        }
         q = om__mat_apply(&v->light_vp, p);
         if (!(q.w > 0.0f)) return false;
     }
@@ -129,19 +150,25 @@ static bool locate(const om__smlook *L, const om_sample *smp, tap *out)
         }
         out->cx = texel_floor_d(u0 * L->size, L->size);
         out->cy = texel_floor_d(v0 * L->size, L->size);
+        out->at = clamp32(out->cy, L->size) * L->size + clamp32(out->cx, L->size);
     } else {
         out->u = out->v = 0.0;   /* no warp: taps are the map's texels */
         const float uf = (q.x * iw + 1.0f) * (0.5f * (float)L->size);
         const float wf = (1.0f - q.y * iw) * (0.5f * (float)L->size);
-        out->cx = texel_floor(uf, L->size);
-        out->cy = texel_floor(wf, L->size);
+        out->at = texel_clamped(wf, L->size) * L->size + texel_clamped(uf, L->size);
+        if (L->pcf > 1) {
+            out->cx = texel_floor(uf, L->size);
+            out->cy = texel_floor(wf, L->size);
+        } else {
+            out->cx = out->cy = 0;   /* one tap: `at` is all the test reads */
+        }
     }
     float z = q.z * iw * OM_DEPTH_ONE_F;
     /* bias from world units to depth units: d(z/w)/d(distance) at this sample */
     float dz;
     if (v->light.kind == OM_LIGHT_SPOT) {
-        float f = v->light.zfar, nn = v->light.znear, e = dist > nn * 0.5f ? dist : nn * 0.5f;
-        dz = f * nn / ((f - nn) * e * e) * OM_DEPTH_ONE_F;
+        const float e = dist > L->half_near ? dist : L->half_near;
+        dz = L->dz_num / (L->dz_den * e * e) * OM_DEPTH_ONE_F;   /* f n / ((f - n) e e) */
     } else {
         dz = OM_DEPTH_ONE_F * om__fabsf(v->light_proj.m[10]);
     }
@@ -166,9 +193,7 @@ static inline int32_t clamp_texel(int64_t x, uint32_t size)
 static uint8_t test(const om__smlook *L, const tap *tp)
 {
     const uint64_t z = tp->zlit;
-    if (L->pcf == 1)   /* one tap: the common case, without the loops */
-        return z <= L->depth[(size_t)clamp_texel(tp->cy, L->size) * L->size + (size_t)clamp_texel(tp->cx, L->size)]
-                   ? 255 : 0;
+    if (L->pcf == 1) return z <= L->depth[tp->at] ? 255 : 0;   /* one tap, without the loops */
     int k = (int)L->pcf, half = k / 2, lit = 0;
     int64_t tx[9], ty[9];   /* pcf <= 9 */
     for (int d = -half; d < k - half; d++) {
@@ -197,17 +222,17 @@ void om__smlook_strip(const om__smlook *L, om_strip *st, uint32_t *samples, uint
     const size_t n = (size_t)st->rows * st->width;
     tap taps[SMLOOK_BLOCK];
     uint32_t at[SMLOOK_BLOCK];   /* strip index of each located sample */
+    uint32_t nsamples = 0, nshadowed = 0;   /* counted here: *samples may alias the terms */
     for (size_t i = 0; i < n;) {
         int got = 0;
         for (; i < n && got < SMLOOK_BLOCK; i++) {
             om_term *t = &st->terms[i];
             t->r = t->g = t->b = 255;
             if (!(t->flags & OM_TERM_EXPOSED)) continue;
-            ++*samples;
+            nsamples++;
             if (locate(L, &st->samples[i], &taps[got])) {
 #if defined(__GNUC__) || defined(__clang__)
-                __builtin_prefetch(&L->depth[(size_t)clamp_texel(taps[got].cy, L->size) * L->size +
-                                             (size_t)clamp_texel(taps[got].cx, L->size)]);
+                __builtin_prefetch(&L->depth[taps[got].at]);
 #endif
                 at[got++] = (uint32_t)i;
             }
@@ -216,7 +241,9 @@ void om__smlook_strip(const om__smlook *L, om_strip *st, uint32_t *samples, uint
             uint8_t val = test(L, &taps[j]);
             om_term *t = &st->terms[at[j]];
             t->r = t->g = t->b = val;
-            *shadowed += val != 255;
+            nshadowed += val != 255;
         }
     }
+    *samples += nsamples;
+    *shadowed += nshadowed;
 }

@@ -40,6 +40,7 @@ typedef struct om__smlook {
     float bias_const, bias_slope, normal_offset;
     uint32_t pcf;              /* k for k x k, 1 = a single tap */
     float span_per_dist;       /* spot: frustum width per unit of distance */
+    float dz_num, dz_den, half_near;   /* spot: far * near, far - near, near / 2 */
     /* A warped map's tables (n + 1 entries each), NULL for the conventional map: u
      * and v are warped by them, and "a texel" in the bias rules is a warped one. */
     const int32_t *warp_x, *warp_y;
