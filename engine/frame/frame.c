@@ -135,9 +135,11 @@ static void band_job(void *user, uint32_t b)
             tg.rows = st.rows;
             tg.depth += off;
             tg.id += off;
-            om__eye_pass(fd->scene, c->view, &tg, &st, c->bins);
+            if (c->mark) om__eye_pass_mark(fd->scene, c->view, &tg, &st, c->bins);
+            else om__eye_pass(fd->scene, c->view, &tg, &st, c->bins);
+        } else if (c->mark) {
+            mark_exposed(c->view, &st);
         }
-        if (c->mark) mark_exposed(c->view, &st);
     } else if (c->stage == STAGE_RESOLVE) {
         c->bands->resolve(fd->method_state, &st, c->slots[b].scratch, c->slots[b].counts);
     } else {
@@ -199,8 +201,9 @@ static void prepare(frame_ctx *c, bool eye, bool mark, om_frame_stats *fs)
         c->mark = mark;
         run_bands(c, STAGE_PREPARE);
     } else {
-        if (eye) om__eye_pass(c->fd->scene, c->view, &c->tg, &c->strip, c->bins);
-        if (mark) mark_exposed(c->view, &c->strip);
+        if (eye && mark) om__eye_pass_mark(c->fd->scene, c->view, &c->tg, &c->strip, c->bins);
+        else if (eye) om__eye_pass(c->fd->scene, c->view, &c->tg, &c->strip, c->bins);
+        else if (mark) mark_exposed(c->view, &c->strip);
     }
     if (eye) {
         fs->ns_eye += now(c->fd) - t0;

@@ -31,13 +31,46 @@ typedef struct om__persp_tri {
 void om__persp_setup(const om_scene *s, const om_mat4 *vp, uint32_t t, om__persp_tri *c);
 om_vec3 om__persp_point(const om__persp_tri *c, float sx, float sy);
 
-/* The parts of the lit rule that no occluder decides, the same for every method:
- * the normal turned towards the camera faces the light, and the point lies inside
- * the light's frustum. Sets smp->nl: that cosine where the sample is exposed, else 0. */
-bool om__exposed(const om_view *v, om_sample *smp);
+/* The same for om__eye_pass_mark: the eye pass with the exposure marks of each
+ * covered pixel (st->terms, as om__exposed sets them) in the same loop, while the
+ * pixel's point and its triangle's normal are at hand. */
+void om__eye_pass_mark(const om_scene *s, const om_view *v, const om_target *tg, om_strip *st,
+                       const om__bins *bins);
 
 /* Direction from a point towards the light (unit). */
 om_vec3 om__to_light(const om_view *v, om_vec3 p);
+
+/* om__to_light in line (the exposure marks run it for every covered pixel): the
+ * operations of om__normalize, in its order, so the same bits. */
+static inline om_vec3 om__to_light_in(const om_view *v, om_vec3 p)
+{
+    if (v->light.kind == OM_LIGHT_DIRECTIONAL) return om__scale(v->light_axis, -1.0f);
+    const om_vec3 a = om__sub(v->light.pos, p);
+    const float l2 = om__dot(a, a);
+    if (!(l2 > 0.0f)) return om__v3(0, 0, 0);
+    return om__scale(a, 1.0f / om__sqrtf(l2));
+}
+
+/* The parts of the lit rule that no occluder decides, the same for every method:
+ * the normal turned towards the camera faces the light, and the point p (with the
+ * normal n, as wound) lies inside the light's frustum. *nl: the cosine between them
+ * where exposed, else 0. */
+static inline bool om__exposed_at(const om_view *v, om_vec3 p, om_vec3 n, float *nl)
+{
+    *nl = 0.0f;
+    if (om__dot(n, om__sub(v->cam.eye, p)) < 0.0f) n = om__scale(n, -1.0f);
+    const float c = om__dot(n, om__to_light_in(v, p));
+    if (!(c > 0.0f)) return false;
+    const om_vec4 q = om__mat_apply(&v->light_vp, p);
+    if (!(q.w > 0.0f && q.x >= -q.w && q.x <= q.w && q.y >= -q.w && q.y <= q.w &&
+          q.z >= 0.0f && q.z <= q.w))
+        return false;
+    *nl = c;   /* the lookups and shading read it rather than work it out again */
+    return true;
+}
+
+/* om__exposed_at for a sample; sets smp->nl. */
+bool om__exposed(const om_view *v, om_sample *smp);
 
 /* A method's resolve by bands (frame.c runs them at once on the host's threads): the
  * built-in methods whose resolve only reads the state after build. resolve writes the

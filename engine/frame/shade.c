@@ -5,24 +5,13 @@
 
 om_vec3 om__to_light(const om_view *v, om_vec3 p)
 {
-    if (v->light.kind == OM_LIGHT_DIRECTIONAL) return om__scale(v->light_axis, -1.0f);
-    return om__normalize(om__sub(v->light.pos, p));
+    return om__to_light_in(v, p);
 }
 
 bool om__exposed(const om_view *v, om_sample *smp)
 {
-    om_vec3 p = om__v3(smp->p[0], smp->p[1], smp->p[2]);
-    om_vec3 n = om__v3(smp->n[0], smp->n[1], smp->n[2]);
-    smp->nl = 0.0f;
-    if (om__dot(n, om__sub(v->cam.eye, p)) < 0.0f) n = om__scale(n, -1.0f);
-    const float nl = om__dot(n, om__to_light(v, p));
-    if (!(nl > 0.0f)) return false;
-    om_vec4 q = om__mat_apply(&v->light_vp, p);
-    if (!(q.w > 0.0f && q.x >= -q.w && q.x <= q.w && q.y >= -q.w && q.y <= q.w &&
-          q.z >= 0.0f && q.z <= q.w))
-        return false;
-    smp->nl = nl;   /* the lookups and shading read it rather than work it out again */
-    return true;
+    return om__exposed_at(v, om__v3(smp->p[0], smp->p[1], smp->p[2]),
+                          om__v3(smp->n[0], smp->n[1], smp->n[2]), &smp->nl);
 }
 
 void om_shade_cfg_default(om_shade_cfg *c)
