@@ -8,6 +8,7 @@
     X(suite_obj) \
     X(suite_scene_fuzz) \
     X(suite_raster) \
+    X(suite_hiz) \
     X(suite_frame) \
     X(suite_platform) \
     X(suite_shadow) \

@@ -194,7 +194,7 @@ static om_status run_rtw(const om_scene *s, const om_method_cfg *c, uint32_t w, 
         fd.strip_rows = strip; fd.fb = &fb; fd.on_strip = on_strip; fd.user = terms;
         st = om_render_frame(&fd, &fa, NULL, &d);
         if (st == OM_OK && fn) fn((const om__rtw *)state, user);
-        CHECK(ma.peak <= mn);
+        CHECK(ma.peak <= full);   /* with the coarse depth, beyond the minimum */
     }
     if (st) fprintf(stderr, "  (run_rtw: %s)\n", d.msg);
     free(mm);
@@ -469,7 +469,7 @@ static void budget_and_determinism(void)
         CHECK_OK(om_method_cfg_set(&c, "rtw.analysis", analysis, NULL));
         size_t mn, full;
         CHECK_OK(m->bytes(&c, &hs.s, w, h, &mn, &full));
-        CHECK(mn == full && mn >= 256 * 256 * 4);
+        CHECK(mn < full && mn >= 256 * 256 * 4);
         unsigned char *buf = malloc(mn + 64);
         memset(buf, 0xC3, mn + 64);
         om_arena a;

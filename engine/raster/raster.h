@@ -205,6 +205,26 @@ int om__raster_tri_on(const om_raster *r, const om_vec4 clip[3], uint32_t id, ui
 bool om__raster_snapped(const om_raster *r, const int64_t x[3], const int64_t y[3], const uint32_t z[3],
                         uint32_t id);
 
+/* The coarse depth of a depth-only target (om__hiz): an upper bound of the stored
+ * depths over tiles of 8 x 8 texels and over tiles of 16 rows x 256 columns, for the
+ * whole image, after the first level's (om__hiz_words(width, height) words). Depths
+ * only ever go down, so a bound stays true whatever is drawn; large triangles tighten
+ * the tiles they write and skip, without touching a texel, the tiles where their
+ * depth is nowhere below the bound, so a map under thousands of huge overlapping
+ * triangles costs about texels + triangles instead of their product. The same texels
+ * with it or without (raster.c gives the proof). A target uses it when its rows start
+ * on a multiple of 16 and end on one or at the image's last row (the bands of a map
+ * built by bands do), so that no tile is shared by two targets. */
+size_t om__hiz_words(uint32_t width, uint32_t height);
+/* Sets the bounds of the target's rows to 2^32 - 1: with om__target_clear. */
+void om__hiz_clear(uint32_t *hiz, const om_target *tg);
+/* om__raster_snapped and om__raster_tri_on with a coarse depth for r's target (NULL:
+ * none); OM_RASTER_DEPTH only, the same texels. */
+bool om__raster_snapped_hiz(const om_raster *r, uint32_t *hiz, const int64_t x[3], const int64_t y[3],
+                            const uint32_t z[3], uint32_t id);
+int om__raster_tri_on_hiz(const om_raster *r, uint32_t *hiz, const om_vec4 clip[3], uint32_t id,
+                          uint32_t width, uint32_t height);
+
 /* Which of the six clip planes (near, far, four guard-band sides) a vertex is outside
  * of, as a bit mask; 0 means it needs no clipping. */
 unsigned om__outcode(const om_vec4 *v, uint32_t width, uint32_t height);

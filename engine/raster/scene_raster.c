@@ -122,6 +122,12 @@ void om__bins_make(const om_scene *s, const om_mat4 *vp, uint32_t width, uint32_
 void om__scene_raster(const om_scene *s, const om_mat4 *vp, const om_target *tg,
                       om_raster_mode mode, bool cull, const om__bins *bins)
 {
+    om__scene_raster_hiz(s, vp, tg, mode, cull, bins, NULL);
+}
+
+void om__scene_raster_hiz(const om_scene *s, const om_mat4 *vp, const om_target *tg,
+                          om_raster_mode mode, bool cull, const om__bins *bins, uint32_t *hiz)
+{
     om_raster r;
     r.target = tg;
     r.mode = mode;
@@ -137,6 +143,7 @@ void om__scene_raster(const om_scene *s, const om_mat4 *vp, const om_target *tg,
     om__cull cl;
     om__cull_begin(&cl, s, vp);
     om__target_clear(tg);
+    om__hiz_clear(hiz, tg);
     const uint32_t y0 = tg->y0, y1 = tg->y0 + tg->rows - 1;
     const uint32_t *rows = bins ? bins->rows : NULL;
     const om__vsnap *vs = bins ? bins->verts : NULL;
@@ -148,11 +155,11 @@ void om__scene_raster(const om_scene *s, const om_mat4 *vp, const om_target *tg,
             const int64_t x[3] = {vs[ix[0]].x, vs[ix[1]].x, vs[ix[2]].x};
             const int64_t y[3] = {vs[ix[0]].y, vs[ix[1]].y, vs[ix[2]].y};
             const uint32_t z[3] = {vs[ix[0]].z, vs[ix[1]].z, vs[ix[2]].z};
-            om__raster_snapped(&r, x, y, z, t);
+            om__raster_snapped_hiz(&r, hiz, x, y, z, t);
             continue;
         }
         om_vec4 c[3];
         om__clip_tri(s, vp, t, c);
-        om__raster_tri(&r, c, t);
+        om__raster_tri_on_hiz(&r, hiz, c, t, tg->width, tg->height);
     }
 }

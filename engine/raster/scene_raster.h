@@ -63,5 +63,9 @@ void om__bins_make(const om_scene *s, const om_mat4 *vp, uint32_t width, uint32_
  * setup; NULL walks every triangle. The same pixels either way. */
 void om__scene_raster(const om_scene *s, const om_mat4 *vp, const om_target *tg,
                       om_raster_mode mode, bool cull, const om__bins *bins);
+/* The same with a coarse depth of tg's image (om__hiz_words; NULL: none), cleared
+ * with the target: for the depth-only light passes, the same texels. */
+void om__scene_raster_hiz(const om_scene *s, const om_mat4 *vp, const om_target *tg,
+                          om_raster_mode mode, bool cull, const om__bins *bins, uint32_t *hiz);
 
 #endif

@@ -79,13 +79,19 @@ static const char *check_cfg(const om__rtw_cfg *c)
     return NULL;
 }
 
+static size_t hiz_bytes(const om__rtw_cfg *c)
+{
+    return om_arena_need(om__hiz_words(c->map_size, c->map_size) * sizeof(uint32_t), 16);
+}
+
 static om_status rtw_bytes(const om_method_cfg *mc, const om_scene *s, uint32_t w, uint32_t h,
                            size_t *min, size_t *full)
 {
     (void)s; (void)w; (void)h;
     om__rtw_cfg c;
     if (om__method_cfg_of(mc, &om__method_rtw, &c, NULL) || check_cfg(&c)) return OM_E_INVALID;
-    *min = *full = rtw_need(&c);
+    *min = rtw_need(&c);
+    *full = *min + hiz_bytes(&c);   /* the coarse depth bounds the cost of huge triangles */
     return OM_OK;
 }
 
@@ -166,6 +172,9 @@ static om_status rtw_init(void **state, om_arena *a, const om_method_cfg *mc, co
     m->look.warp_n = m->n;
     m->look.unwarped_pcf = c->rtw_footprint == 1;
     for (uint32_t k = 0; k <= m->n; k++) m->px[k] = m->py[k] = (int32_t)(((int64_t)k * OM_RTW_ONE + m->n / 2) / m->n);
+    m->hiz = NULL;
+    if (om_arena_left(a) >= hiz_bytes(c) && carve(a, om__hiz_words(m->size, m->size) * sizeof(uint32_t), &p, NULL) == OM_OK)
+        m->hiz = (uint32_t *)p;
     *state = m;
     return OM_OK;
 }
@@ -268,7 +277,7 @@ static void emit(tess_ctx *x, const tvert *a, const tvert *b, const tvert *c)
         if (!om__snap(t[k]->u * s, t[k]->v * s, (double)t[k]->c.z * (1.0 / (double)t[k]->c.w) * OM_DEPTH_ONE,
                       &gx[k], &gy[k], &gz[k]))
             return;
-    om__raster_snapped(&x->r, gx, gy, gz, x->tri);
+    om__raster_snapped_hiz(&x->r, x->m->hiz, gx, gy, gz, x->tri);
     x->drawn++;
 }
 
@@ -395,7 +404,7 @@ static void render_exact(om__rtw *m, om_raster *r, om__cull *cl)
         om_vec4 c[3];
         for (int k = 0; k < 3; k++) c[k] = om__mat_apply(&m->view.light_vp, s->verts[ix[k]]);
         r->cull_back = om__cull_next(cl, t);
-        drawn += (uint32_t)om__raster_tri_on(r, c, t, OM_LIGHT_GRID, OM_LIGHT_GRID);
+        drawn += (uint32_t)om__raster_tri_on_hiz(r, m->hiz, c, t, OM_LIGHT_GRID, OM_LIGHT_GRID);
     }
     m->tris_drawn = drawn;
 }
@@ -405,6 +414,7 @@ void om__rtw_render_map(om__rtw *m)
     const om_scene *s = m->scene;
     om_target tg = {m->size, m->size, 0, m->size, m->depth, NULL};
     om__target_clear(&tg);
+    om__hiz_clear(m->hiz, &tg);
     tess_ctx x;
     x.m = m;
     x.r.target = &tg;
@@ -493,7 +503,7 @@ static void rtw_stats(const void *state, om_method_stats *out)
 {
     const om__rtw *m = (const om__rtw *)state;
     memset(out, 0, sizeof *out);
-    out->bytes_used = rtw_need(&m->cfg);
+    out->bytes_used = rtw_need(&m->cfg) + (m->hiz ? hiz_bytes(&m->cfg) : 0);
     out->counters[0] = m->shadowed;
     out->counters[1] = m->tris_drawn;
     /* maximum effective resolution: the conventional map as dense as the densest

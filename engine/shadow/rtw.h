@@ -97,6 +97,7 @@ typedef struct om__rtw {
     double *cols, *rows, *scratch, *kernel;
     int32_t *px, *py;          /* warp tables, n + 1 each */
     uint32_t *depth;           /* size * size warped shadow map */
+    uint32_t *hiz;             /* its coarse depth (om__hiz_words); NULL: no room */
     int64_t *gridx, *gridy;    /* rtw_exact: each texel's sample point on the light grid */
     int32_t *gridxs, *gridys;  /* and their indexes (om__grid_index), grid_buckets + 1 */
     uint32_t grid_shift, grid_buckets;

@@ -24,6 +24,7 @@ typedef struct sm_state {
     uint32_t size;
     uint32_t *depth;
     om__vsnap *verts;      /* each vertex on the map's grid, once a frame; NULL: no room */
+    uint32_t *hiz;         /* the map's coarse depth (om__hiz_words); NULL: no room */
     om_view view;
     om__smlook look;       /* the biased depth test, shared with rtw (smlookup.c) */
     uint32_t samples, shadowed;
@@ -35,6 +36,11 @@ static size_t sm_need(const sm_cfg *c)
            om_arena_need((size_t)c->map_size * c->map_size * sizeof(uint32_t), 16);
 }
 
+static size_t sm_hiz_bytes(const sm_cfg *c)
+{
+    return om_arena_need(om__hiz_words(c->map_size, c->map_size) * sizeof(uint32_t), 16);
+}
+
 static om_status sm_bytes(const om_method_cfg *mc, const om_scene *s, uint32_t w, uint32_t h,
                           size_t *min, size_t *full)
 {
@@ -44,7 +50,9 @@ static om_status sm_bytes(const om_method_cfg *mc, const om_scene *s, uint32_t w
     if (om__method_cfg_of(mc, &om__method_sm, &cv, NULL)) return OM_E_INVALID;
     if (c->map_size < 1 || c->map_size > OM_MAX_DIM) return OM_E_INVALID;
     *min = sm_need(c);
-    *full = *min + om__bins_verts_bytes(s);   /* the light pass projects each vertex once */
+    /* the coarse depth bounds the cost of huge triangles; the light pass projects each
+     * vertex once */
+    *full = *min + sm_hiz_bytes(c) + om__bins_verts_bytes(s);
     return OM_OK;
 }
 
@@ -68,6 +76,10 @@ static om_status sm_init(void **state, om_arena *a, const om_method_cfg *mc, con
     m->size = c->map_size;
     if ((st = om_arena_alloc(a, (size_t)m->size * m->size * sizeof(uint32_t), 16, &p, d))) return st;
     m->depth = (uint32_t *)p;
+    m->hiz = NULL;
+    if (om_arena_left(a) >= sm_hiz_bytes(c) &&
+        om_arena_alloc(a, om__hiz_words(m->size, m->size) * sizeof(uint32_t), 16, &p, NULL) == OM_OK)
+        m->hiz = (uint32_t *)p;
     m->verts = NULL;
     if (s->nverts && om_arena_left(a) >= om__bins_verts_bytes(s) &&
         om_arena_alloc(a, (size_t)s->nverts * sizeof(om__vsnap), 8, &p, NULL) == OM_OK)
@@ -147,7 +159,7 @@ static void sm_build_rows(const void *state, const om__bins *bins, uint32_t y0, 
 {
     const sm_state *m = (const sm_state *)state;
     om_target tg = {m->size, m->size, y0, rows, m->depth + (size_t)y0 * m->size, NULL};
-    om__scene_raster(m->scene, &m->view.light_vp, &tg, OM_RASTER_DEPTH, true, bins);
+    om__scene_raster_hiz(m->scene, &m->view.light_vp, &tg, OM_RASTER_DEPTH, true, bins, m->hiz);
 }
 
 const om__bands om__bands_sm = {sm_band, sm_merge, 0, sm_map_of, sm_build_rows, NULL};
@@ -156,7 +168,8 @@ static void sm_stats(const void *state, om_method_stats *out)
 {
     const sm_state *m = (const sm_state *)state;
     memset(out, 0, sizeof *out);
-    out->bytes_used = sm_need(&m->cfg) + (m->verts ? om__bins_verts_bytes(m->scene) : 0);
+    out->bytes_used = sm_need(&m->cfg) + (m->hiz ? sm_hiz_bytes(&m->cfg) : 0) +
+                      (m->verts ? om__bins_verts_bytes(m->scene) : 0);
     out->counters[0] = m->samples;
     out->counter_names[0] = "samples";
     out->counters[1] = m->shadowed;

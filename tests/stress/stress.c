@@ -151,8 +151,13 @@ int main(void)
                 "plane size 12 12 divisions 3\ncylinder radius 0.3 height 2 segments 12\n"
                 "box size 2 0.1 2 translate 1 1.5 1\n"},
         {"default", NULL},
+        /* issue 24: huge triangles over the whole light map, each budget with and
+         * without room for the maps' coarse depth */
+        {"huge", "camera eye 0 2 5 target 0 0 0\n"
+                 "light spot pos 2 7 1 target 0 0 0 fov 70 near 1 far 40\n"
+                 "plane size 8 8\ntriangles count 300 area 1e12 in 0 0 0 0 0 0\n"},
     };
-    for (int k = 0; k < 3; k++) {
+    for (size_t k = 0; k < sizeof texts / sizeof texts[0]; k++) {
         bscene b;
         if (bench_load(&b, texts[k][0], texts[k][1] ? texts[k][1] : om_scene_default_text())) return 1;
         ctx *c = calloc(1, sizeof *c);
