@@ -61,9 +61,9 @@ static inline bool om__exposed_at(const om_view *v, om_vec3 p, om_vec3 n, float 
     if (om__dot(n, om__sub(v->cam.eye, p)) < 0.0f) n = om__scale(n, -1.0f);
     const float c = om__dot(n, om__to_light_in(v, p));
     if (!(c > 0.0f)) return false;
+    /* inside the frustum: -w <= x <= w is |x| <= w (both false for a NaN) */
     const om_vec4 q = om__mat_apply(&v->light_vp, p);
-    if (!(q.w > 0.0f && q.x >= -q.w && q.x <= q.w && q.y >= -q.w && q.y <= q.w &&
-          q.z >= 0.0f && q.z <= q.w))
+    if (!(q.w > 0.0f && om__fabsf(q.x) <= q.w && om__fabsf(q.y) <= q.w && q.z >= 0.0f && q.z <= q.w))
         return false;
     *nl = c;   /* the lookups and shading read it rather than work it out again */
     return true;

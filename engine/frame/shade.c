@@ -27,10 +27,15 @@ uint32_t om_format_bpp(om_format f)
     return f == OM_RGB888 ? 3u : f == OM_RGB565 ? 2u : 1u;
 }
 
+/* The clamps compare the float's bits as an integer, which orders non-negative
+ * floats as their values (and puts every negative one, -0 too, at or below 0): the
+ * same answers as float comparisons for the finite values shading makes, without a
+ * transfer of the float unit's flags per comparison. */
 static uint8_t to8(float v)
 {
-    v = v * 255.0f + 0.5f;
-    return v <= 0.0f ? 0 : v >= 255.0f ? 255 : (uint8_t)v;
+    union { float f; int32_t i; } b;
+    b.f = v * 255.0f + 0.5f;
+    return b.i <= 0 ? 0 : b.i >= 0x437F0000 /* 255.0f */ ? 255 : (uint8_t)b.f;
 }
 
 /* In line with a constant format (shade_row's callers): the switch then goes. */

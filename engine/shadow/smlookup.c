@@ -217,8 +217,14 @@ static uint8_t test(const om__smlook *L, const tap *tp)
  * scene took about 1.5x sm's without the hint and 1.2x with it. The hint changes no
  * term: they are the same as testing sample by sample. */
 #define SMLOOK_BLOCK 32
-void om__smlook_strip(const om__smlook *L, om_strip *st, uint32_t *samples, uint32_t *shadowed)
+void om__smlook_strip(const om__smlook *Lin, om_strip *st, uint32_t *samples, uint32_t *shadowed)
 {
+    /* Copies on the stack, once a strip: the terms' byte stores may alias any memory
+     * the caller's pointers reach, so every field would be loaded again per sample. */
+    const om_view view = *Lin->view;
+    om__smlook look = *Lin;
+    look.view = &view;
+    const om__smlook *L = &look;
     const size_t n = (size_t)st->rows * st->width;
     tap taps[SMLOOK_BLOCK];
     uint32_t at[SMLOOK_BLOCK];   /* strip index of each located sample */
