@@ -52,11 +52,10 @@
 #include <float.h>
 
 /* A texel: a plane P(x, y) = z + gx (x - xc) + gy (y - yc) about the texel's centre,
- * below every touching triangle's depth plus bound over the texel (lo); the opaque
- * triangle covering all of it whose greatest depth plus bound is least (hi, cid); and
- * where the tile's uncertain samples in it end (they begin where the texel before it,
- * in row order, ends). */
-typedef struct htexel { float z, gx, gy, hi; uint32_t cid, end; } htexel;
+ * below every touching triangle's depth plus bound over the texel (lo); and the
+ * opaque triangle covering all of it whose greatest depth plus bound is least (hi,
+ * cid). */
+typedef struct htexel { float z, gx, gy, hi; uint32_t cid; } htexel;
 
 /* An uncertain sample on the light's grid (the grid fits in 27 bits, its depth is a
  * whole unit: om__lspace_point) and what blocks it so far; idx is its place in the
@@ -91,10 +90,11 @@ typedef struct hybrid_state {
     int tshift;            /* log2(T) when T is a power of two (the default sides), else -1 */
     uint32_t bside;        /* blocks per side */
     /* The tile: its samples as they come (raw, with each one's texel) and sorted by
-     * texel (smp; htexel.end); the farthest depth of a block's samples, bzmax (0: none
-     * a triangle could block). */
+     * texel (smp): texel t's are smp[t ? tend[t - 1] : 0 .. tend[t]), in an array of
+     * their own, so the sort sweeps 4 bytes a texel, not the map; the farthest depth
+     * of a block's samples, bzmax (0: none a triangle could block). */
     hsample *raw, *smp;
-    uint32_t *rtex, *bzmax;
+    uint32_t *rtex, *tend, *bzmax;
     uint32_t cap;          /* samples the pool holds */
     uint32_t lit, shadowed, uncertain, setups, tested, tiles;
 } hybrid_state;
@@ -126,7 +126,8 @@ static size_t fixed_bytes(uint32_t side, const om_scene *s, bool cache)
 {
     size_t nb = (size_t)blocks_of(side) * blocks_of(side);
     return om_arena_need(sizeof(hybrid_state), 16) + (cache ? om__lspace_bytes(s) : 0) + mats_bytes(s) +
-           om_arena_need((size_t)side * side * sizeof(htexel), 16) + om_arena_need(nb * sizeof(uint32_t), 16);
+           om_arena_need((size_t)side * side * sizeof(htexel), 16) +
+           om_arena_need((size_t)side * side * sizeof(uint32_t), 16) + om_arena_need(nb * sizeof(uint32_t), 16);
 }
 
 /* A pool of n uncertain samples: both orders and each one's texel. */
@@ -185,6 +186,8 @@ static om_status hybrid_init(void **state, om_arena *a, const om_method_cfg *mc,
     size_t nb = (size_t)m->bside * m->bside;
     if ((st = carve(a, (size_t)m->side * m->side, sizeof(htexel), &p, d))) return st;
     m->map = (htexel *)p;
+    if ((st = carve(a, (size_t)m->side * m->side, sizeof(uint32_t), &p, d))) return st;
+    m->tend = (uint32_t *)p;
     if ((st = carve(a, nb, sizeof(uint32_t), &p, d))) return st;
     m->bzmax = (uint32_t *)p;
     /* The vertex projection only when a one-pass pool fits beside it (it speeds up
@@ -485,7 +488,7 @@ static bool any_within(const hybrid_state *m, const trange *r, const vbox *v)
     for (uint32_t ty = r->y0; ty <= r->y1; ty++)
         for (uint32_t tx = r->x0; tx <= r->x1; tx++) {
             size_t tex = (size_t)ty * m->side + tx;
-            for (uint32_t i = tex ? m->map[tex - 1].end : 0; i < m->map[tex].end; i++) {
+            for (uint32_t i = tex ? m->tend[tex - 1] : 0; i < m->tend[tex]; i++) {
                 const hsample *q = &m->smp[i];
                 if (!(q->idx & DONE) && q->x >= v->lox && q->x <= v->hix && q->y >= v->loy && q->y <= v->hiy &&
                     q->z > v->zlo)
@@ -495,25 +498,25 @@ static bool any_within(const hybrid_state *m, const trange *r, const vbox *v)
     return false;
 }
 
-/* Sorts the tile's n samples by texel (a counting sort through htexel.end, stable:
+/* Sorts the tile's n samples by texel (a counting sort through tend, stable:
  * strip order within a texel) and notes each block's farthest depth. */
 static void sort_tile(hybrid_state *m, uint32_t n)
 {
     size_t nt = (size_t)m->side * m->side;
     memset(m->bzmax, 0, (size_t)m->bside * m->bside * sizeof *m->bzmax);
-    for (size_t t = 0; t < nt; t++) m->map[t].end = 0;
+    memset(m->tend, 0, nt * sizeof *m->tend);
     for (uint32_t i = 0; i < n; i++) {
         uint32_t t = m->rtex[i], b = t / m->side / BLOCK * m->bside + t % m->side / BLOCK;
-        m->map[t].end++;
+        m->tend[t]++;
         if (m->raw[i].z > m->bzmax[b]) m->bzmax[b] = m->raw[i].z;
     }
     uint32_t sum = 0;
     for (size_t t = 0; t < nt; t++) {   /* counts -> starts */
-        uint32_t c = m->map[t].end;
-        m->map[t].end = sum;
+        uint32_t c = m->tend[t];
+        m->tend[t] = sum;
         sum += c;
     }
-    for (uint32_t i = 0; i < n; i++) m->smp[m->map[m->rtex[i]].end++] = m->raw[i];   /* starts -> ends */
+    for (uint32_t i = 0; i < n; i++) m->smp[m->tend[m->rtex[i]]++] = m->raw[i];   /* starts -> ends */
 }
 
 /* Could a sub-triangle of lt cover a point of texel (tx, ty)? Each edge is tested at
@@ -557,7 +560,7 @@ static uint32_t cast(hybrid_state *m, uint32_t t)
             for (uint32_t ty = ya; ty <= yb; ty++)
                 for (uint32_t tx = xa; tx <= xb; tx++) {
                     size_t tex = (size_t)ty * m->side + tx;
-                    uint32_t i = tex ? m->map[tex - 1].end : 0, end = m->map[tex].end;
+                    uint32_t i = tex ? m->tend[tex - 1] : 0, end = m->tend[tex];
                     if (i == end || !texel_touches(m, &lt, tx, ty)) continue;
                     for (; i < end; i++) {
                         hsample *q = &m->smp[i];
@@ -692,7 +695,7 @@ static void hybrid_stats(const void *state, om_method_stats *out)
 static const om_setting settings[] = {
     OM__SET_IZB_POOL(hybrid_cfg, izb_pool),
     OM__SETTING(hybrid_cfg, hybrid_map, "hybrid.map", OM_SETTING_U32, 0, OM_MAX_DIM, 0,
-                "side of its conservative map (20 bytes a texel), 0 = half the image's side"),
+                "side of its conservative map (24 bytes a texel), 0 = half the image's side"),
 };
 
 const om_method om__method_hybrid = {
