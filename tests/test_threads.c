@@ -35,9 +35,9 @@ static om_status on_strip(void *user, const om_strip *st, const om_framebuffer *
 
 /* One frame of method m with a fresh state; frame arena of om_frame_bytes_scene (or
  * without bins, om_frame_bytes) plus job_bytes for the jobs. */
-static frame_out render(const om_scene *s, const om_method *m, uint32_t W, uint32_t H, uint32_t rows,
-                        om_parallel_for_fn pf, void *host, uint32_t threads, size_t job_bytes,
-                        bool bins)
+static frame_out render_set(const om_scene *s, const om_method *m, const char *set, uint32_t W,
+                            uint32_t H, uint32_t rows, om_parallel_for_fn pf, void *host,
+                            uint32_t threads, size_t job_bytes, bool bins)
 {
     frame_out o;
     memset(&o, 0, sizeof o);
@@ -49,7 +49,7 @@ static frame_out render(const om_scene *s, const om_method *m, uint32_t W, uint3
     cam.width = W;
     cam.height = H;
     if ((o.st = om_view_init(&v, &cam, &light, s, &d))) return o;
-    om_method_cfg c = h_cfg(m->name, "map=512");
+    om_method_cfg c = h_cfg(m->name, set);
     size_t mn, full;
     if ((o.st = m->bytes(&c, s, W, H, &mn, &full))) return o;
     uint32_t r = rows ? rows : H;
@@ -78,6 +78,14 @@ static frame_out render(const om_scene *s, const om_method *m, uint32_t W, uint3
     free(fm);
     free(px);
     return o;
+}
+
+/* The same with the settings "map=512". */
+static frame_out render(const om_scene *s, const om_method *m, uint32_t W, uint32_t H, uint32_t rows,
+                        om_parallel_for_fn pf, void *host, uint32_t threads, size_t job_bytes,
+                        bool bins)
+{
+    return render_set(s, m, "map=512", W, H, rows, pf, host, threads, job_bytes, bins);
 }
 
 /* The default scene (a spot light) and one under a directional light, which the frame
@@ -230,9 +238,38 @@ static void hybrid_bands(void)
     for (int k = 0; k < 3; k++) om_jobs_stop(pools[k]);
 }
 
+/* rtw's warped map by bands: the exact map (with the light's bins, which pass over the
+ * triangles that miss a band's grid rows, and without) and the warped vertices' map
+ * (every band splits every triangle alike), with forward analysis too: the same frame
+ * and counters (triangles drawn among them) as inline. */
+static void rtw_map_bands(void)
+{
+    h_scene hs;
+    if (!h_scene_parse(&hs, om_scene_default_text())) return;
+    const om_method *m = om_method_find("rtw");
+    static const char *const sets[] = {"map=512", "map=300 rtw.exact=0", "map=256 rtw.analysis=2 rtw.sigma=0"};
+    for (int i = 0; i < 3; i++) {
+        frame_out one = render_set(&hs.s, m, sets[i], 96, 72, 0, NULL, NULL, 1, 0, true);
+        CHECK_MSG(one.st == OM_OK && one.ms.counters[1] > 0, "rtw %s: inline frame", sets[i]);
+        for (uint32_t n = 2; n <= 5; n += 3)
+            for (int lean = 0; lean < 2; lean++) {
+                frame_out o = render_set(&hs.s, m, sets[i], 96, 72, 0, backwards, NULL, n,
+                                         om_frame_bytes_jobs(m, lean ? NULL : &hs.s, n), !lean);
+                CHECK_MSG(o.st == OM_OK && o.jobs == n, "rtw %s: %u jobs ran %u", sets[i], n, o.jobs);
+                CHECK_MSG(o.hash == one.hash, "rtw %s: %u bands%s change the frame", sets[i], n,
+                          lean ? " without bins" : "");
+                CHECK_MSG(!memcmp(o.ms.counters, one.ms.counters, sizeof o.ms.counters),
+                          "rtw %s: %u bands change the counters (drawn %u, inline %u)", sets[i], n,
+                          (unsigned)o.ms.counters[1], (unsigned)one.ms.counters[1]);
+            }
+    }
+    h_scene_free(&hs);
+}
+
 void suite_threads(void)
 {
     RUN(same_bits);
     RUN(fewer_jobs);
     RUN(hybrid_bands);
+    RUN(rtw_map_bands);
 }

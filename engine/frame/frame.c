@@ -118,7 +118,7 @@ static void band_job(void *user, uint32_t b)
     if (c->stage == STAGE_BUILD) {
         uint32_t y0 = b * c->map_band, rows = c->map_size - y0;
         c->bands->build_rows(fd->method_state, c->map_bins.rows ? &c->map_bins : NULL, y0,
-                             rows < c->map_band ? rows : c->map_band);
+                             rows < c->map_band ? rows : c->map_band, c->slots[b].counts);
         return;
     }
     uint32_t r0 = b * c->band_rows;
@@ -165,7 +165,8 @@ static void run_bands(frame_ctx *c, stage sg)
 
 /* The light depth pass by bands of the map (om__bands.build_rows): with bins,
  * BANDS_PER_JOB bands a job, each setting up only its own triangles; without, one band
- * a job, since each band then walks every triangle. */
+ * a job, since each band then walks every triangle. The bands' counts are added up
+ * after the map, as the resolve's after a strip. */
 static void build_map(frame_ctx *c)
 {
     const om_mat4 *vp;
@@ -173,7 +174,13 @@ static void build_map(frame_ctx *c)
     if (c->map_bins.rows) om__bins_make(c->fd->scene, vp, c->map_size, c->map_size, &c->map_bins);
     uint32_t n = c->map_bins.rows ? BANDS_PER_JOB * c->jobs : c->jobs;
     c->map_band = ((c->map_size + n - 1) / n + 15) / 16 * 16;
-    run_stage(c, STAGE_BUILD, (c->map_size + c->map_band - 1) / c->map_band);
+    const uint32_t nb = (c->map_size + c->map_band - 1) / c->map_band;
+    for (uint32_t j = 0; j < nb; j++) memset(c->slots[j].counts, 0, sizeof c->slots[j].counts);
+    run_stage(c, STAGE_BUILD, nb);
+    uint32_t sum[8] = {0};
+    for (uint32_t j = 0; j < nb; j++)
+        for (int k = 0; k < 8; k++) sum[k] += c->slots[j].counts[k];
+    c->bands->merge(c->fd->method_state, sum);
 }
 
 /* Bins' memory: the rows, and the vertices when they fit too. False: no room. */

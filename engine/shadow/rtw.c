@@ -383,56 +383,71 @@ static int clip_tri(const om_vec4 in[3], float g, om_vec4 *out)
  * stay straight where they are straight, in the unwarped image, and no triangle needs
  * splitting. The map is what a conventional map as fine as the warp would hold at
  * those points, and the lookup reads the texel whose centre is nearest in warped
- * coordinates, as before. */
-static void render_exact(om__rtw *m, om_raster *r, om__cull *cl)
+ * coordinates, as before.
+ *
+ * By rows of the map (the frame's bands, om__bands.build_rows): each band clears and
+ * fills its own rows. With bins (made through the light's matrix for a map_size image,
+ * conservative by a row), a triangle whose unwarped rows miss the band's grid rows is
+ * passed over; the map is the same. A sub-triangle counts as drawn in the band that
+ * holds its first grid row, so the count is the same whatever the bands. */
+static uint32_t render_exact(const om__rtw *m, om_raster *r, const om__bins *bins)
 {
     const om_scene *s = m->scene;
-    const double steps = (double)OM_LIGHT_GRID * OM_SUBPIX;
-    om__rtw_unwarp_grid(m->px, m->n, m->size, steps, m->gridx);
-    om__rtw_unwarp_grid(m->py, m->n, m->size, steps, m->gridy);
-    om__grid_index(m->gridx, (int32_t)m->size, m->grid_shift, m->grid_buckets, m->gridxs);
-    om__grid_index(m->gridy, (int32_t)m->size, m->grid_shift, m->grid_buckets, m->gridys);
+    const om_target *tg = r->target;
     r->grid_x = m->gridx;
     r->grid_y = m->gridy;
     r->grid_xs = m->gridxs;
     r->grid_ys = m->gridys;
     r->grid_shift = m->grid_shift;
     r->grid_buckets = m->grid_buckets;
-    uint32_t drawn = 0;
-    for (uint32_t t = 0; t < s->ntris; t++) {
-        const uint32_t *ix = s->idx + (size_t)t * 3;
-        om_vec4 c[3];
-        for (int k = 0; k < 3; k++) c[k] = om__mat_apply(&m->view.light_vp, s->verts[ix[k]]);
-        r->cull_back = om__cull_next(cl, t);
-        drawn += (uint32_t)om__raster_tri_on_hiz(r, m->hiz, c, t, OM_LIGHT_GRID, OM_LIGHT_GRID);
-    }
-    m->tris_drawn = drawn;
-}
-
-void om__rtw_render_map(om__rtw *m)
-{
-    const om_scene *s = m->scene;
-    om_target tg = {m->size, m->size, 0, m->size, m->depth, NULL};
-    om__target_clear(&tg);
-    om__hiz_clear(m->hiz, &tg);
-    tess_ctx x;
-    x.m = m;
-    x.r.target = &tg;
-    x.r.mode = OM_RASTER_DEPTH;
-    x.r.span = NULL;
-    x.r.user = NULL;
-    x.r.centres = NULL;
-    x.r.centre_mask = NULL;
-    x.r.mask_words = 0;
-    x.r.grid_x = x.r.grid_y = NULL;
-    x.r.grid_xs = x.r.grid_ys = NULL;
-    x.r.grid_shift = x.r.grid_buckets = 0;
+    /* the band's grid rows, and the last grid row above it (a sub-triangle whose top
+     * lies past that starts in this band) */
+    const int64_t g0 = m->gridy[tg->y0], g1 = m->gridy[tg->y0 + tg->rows - 1];
+    const int64_t above = tg->y0 ? m->gridy[tg->y0 - 1] : INT64_MIN;
+    /* a bin row of the map_size image is unit_num / unit_den grid units high */
+    const int64_t unit_num = (int64_t)OM_LIGHT_GRID * OM_SUBPIX, unit_den = m->size;
+    const uint32_t *rows = bins ? bins->rows : NULL;
     om__cull cl;
     om__cull_begin(&cl, s, &m->view.light_vp);
-    if (m->cfg.rtw_exact) {
-        render_exact(m, &x.r, &cl);
-        return;
+    uint32_t drawn = 0;
+    for (uint32_t t = 0; t < s->ntris; t++) {
+        if (rows) {
+            const uint32_t r0 = rows[t] & 0xFFFFu, r1 = rows[t] >> 16;
+            if (r0 > r1) continue;   /* covers nothing */
+            /* rows at the image's edges were clamped there: open-ended */
+            if (r0 > 0 && (int64_t)r0 * unit_num / unit_den > g1) continue;
+            if (r1 + 1 < m->size && ((int64_t)r1 + 1) * unit_num / unit_den + 1 < g0) continue;
+        }
+        om_vec4 c[3];
+        om__clip_tri(s, &m->view.light_vp, t, c);
+        r->cull_back = om__cull_next(&cl, t);
+        bool ok = true;
+        for (int k = 0; k < 3; k++)
+            ok = ok && om__finite(c[k].x) && om__finite(c[k].y) && om__finite(c[k].z) && om__finite(c[k].w);
+        if (!ok) continue;
+        int64_t gx[9], gy[9];
+        uint32_t gz[9];
+        const int n = om__clip_project(c, OM_LIGHT_GRID, OM_LIGHT_GRID, gx, gy, gz);
+        for (int k = 1; k + 1 < n; k++) {
+            const int64_t tx[3] = {gx[0], gx[k], gx[k + 1]}, ty[3] = {gy[0], gy[k], gy[k + 1]};
+            const uint32_t tz[3] = {gz[0], gz[k], gz[k + 1]};
+            int64_t top = ty[0] < ty[1] ? ty[0] : ty[1];
+            if (ty[2] < top) top = ty[2];
+            if (om__raster_snapped_hiz(r, m->hiz, tx, ty, tz, t) && top > above) drawn++;
+        }
     }
+    return drawn;
+}
+
+/* The warped map with warped vertices (rtw_exact 0): every band walks and splits every
+ * triangle (the cap on splitting counts them all, so each band splits alike) and fills
+ * its own rows; the count is the same in every band. */
+static uint32_t render_tess(const om__rtw *m, om_raster *r)
+{
+    const om_scene *s = m->scene;
+    tess_ctx x;
+    x.m = m;
+    x.r = *r;
     x.limit2 = m->limit * m->limit;
     x.bend2 = (RTW_BEND / (double)m->size) * (RTW_BEND / (double)m->size);
     x.drawn = 0;
@@ -442,6 +457,8 @@ void om__rtw_render_map(om__rtw *m)
         if (m->limit > 0.0) cap += 64.0 / (m->limit * m->limit);
         x.cap = cap < 4294967295.0 ? (uint32_t)cap : UINT32_MAX;
     }
+    om__cull cl;
+    om__cull_begin(&cl, s, &m->view.light_vp);
     const float g = 1.0f + 4.0f / (float)m->size;
     for (uint32_t t = 0; t < s->ntris; t++) {
         const uint32_t *ix = s->idx + (size_t)t * 3;
@@ -465,7 +482,60 @@ void om__rtw_render_map(om__rtw *m)
         x.tri = t;
         for (int k = 1; k + 1 < n; k++) tess(&x, &v[0], &v[k], &v[k + 1], 0);
     }
-    m->tris_drawn = x.drawn;
+    return x.drawn;
+}
+
+/* Rows [y0, y0 + rows) of the map (om__bands.build_rows); counts[2] += triangles
+ * drawn, counted so that the bands add up to the whole map's count. */
+static void rtw_build_rows(const void *state, const om__bins *bins, uint32_t y0, uint32_t rows,
+                           uint32_t counts[8])
+{
+    const om__rtw *m = (const om__rtw *)state;
+    om_target tg = {m->size, m->size, y0, rows, m->depth + (size_t)y0 * m->size, NULL};
+    om__target_clear(&tg);
+    om__hiz_clear(m->hiz, &tg);   /* bands start on multiples of 16 rows: no tile shared */
+    om_raster r;
+    memset(&r, 0, sizeof r);
+    r.target = &tg;
+    r.mode = OM_RASTER_DEPTH;
+    if (m->cfg.rtw_exact) {
+        counts[2] += render_exact(m, &r, bins);
+    } else {
+        const uint32_t drawn = render_tess(m, &r);
+        if (y0 == 0) counts[2] += drawn;
+    }
+}
+
+/* The exact map's inverse-warped grid and its indexes, which every row reads. */
+static void map_grids(om__rtw *m)
+{
+    if (!m->cfg.rtw_exact) return;
+    const double steps = (double)OM_LIGHT_GRID * OM_SUBPIX;
+    om__rtw_unwarp_grid(m->px, m->n, m->size, steps, m->gridx);
+    om__rtw_unwarp_grid(m->py, m->n, m->size, steps, m->gridy);
+    om__grid_index(m->gridx, (int32_t)m->size, m->grid_shift, m->grid_buckets, m->gridxs);
+    om__grid_index(m->gridy, (int32_t)m->size, m->grid_shift, m->grid_buckets, m->gridys);
+}
+
+/* What the map's rows share, on the calling thread: the analysis's tables and the
+ * grids. */
+static uint32_t rtw_map_of(void *state, const om_mat4 **vp)
+{
+    om__rtw *m = (om__rtw *)state;
+    om__rtw_importance_finish(m);
+    om__rtw_build_tables(m);
+    map_grids(m);
+    m->tris_drawn = 0;
+    *vp = &m->view.light_vp;
+    return m->size;
+}
+
+void om__rtw_render_map(om__rtw *m)
+{
+    map_grids(m);
+    uint32_t counts[8] = {0};
+    rtw_build_rows(m, NULL, 0, m->size, counts);
+    m->tris_drawn = counts[2];
 }
 
 /* ---------------------------------------------------------------- lookup */
@@ -485,14 +555,16 @@ static void rtw_band(const void *state, om_strip *st, void *scratch, uint32_t co
     om__smlook_strip(&((const om__rtw *)state)->look, st, &counts[0], &counts[1]);
 }
 
+/* The resolve's counts after each strip, the map's (counts[2]) after the build. */
 static void rtw_merge(void *state, const uint32_t counts[8])
 {
     om__rtw *m = (om__rtw *)state;
     m->samples += counts[0];
     m->shadowed += counts[1];
+    m->tris_drawn += counts[2];
 }
 
-const om__bands om__bands_rtw = {rtw_band, rtw_merge, 0, NULL, NULL, NULL};
+const om__bands om__bands_rtw = {rtw_band, rtw_merge, 0, rtw_map_of, rtw_build_rows, NULL};
 
 static uint32_t sat_u32(double v)
 {

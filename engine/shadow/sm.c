@@ -113,7 +113,8 @@ static om_status sm_observe(void *state, const om_strip *st, om_diag *d)
     return OM_OK;
 }
 
-static void sm_build_rows(const void *state, const om__bins *bins, uint32_t y0, uint32_t rows);
+static void sm_build_rows(const void *state, const om__bins *bins, uint32_t y0, uint32_t rows,
+                          uint32_t counts[8]);
 
 static om_status sm_build(void *state, om_diag *d)
 {
@@ -121,7 +122,8 @@ static om_status sm_build(void *state, om_diag *d)
     sm_state *m = (sm_state *)state;
     const om__bins b = {NULL, m->verts};
     if (m->verts) om__bins_make(m->scene, &m->view.light_vp, m->size, m->size, &b);
-    sm_build_rows(state, m->verts ? &b : NULL, 0, m->size);
+    uint32_t counts[8] = {0};
+    sm_build_rows(state, m->verts ? &b : NULL, 0, m->size, counts);
     return OM_OK;
 }
 
@@ -148,15 +150,17 @@ static void sm_merge(void *state, const uint32_t counts[8])
 }
 
 /* The depth pass by rows of the map: each band a target of its own rows. */
-static uint32_t sm_map_of(const void *state, const om_mat4 **vp)
+static uint32_t sm_map_of(void *state, const om_mat4 **vp)
 {
     const sm_state *m = (const sm_state *)state;
     *vp = &m->view.light_vp;
     return m->size;
 }
 
-static void sm_build_rows(const void *state, const om__bins *bins, uint32_t y0, uint32_t rows)
+static void sm_build_rows(const void *state, const om__bins *bins, uint32_t y0, uint32_t rows,
+                          uint32_t counts[8])
 {
+    (void)counts;   /* the map counts nothing */
     const sm_state *m = (const sm_state *)state;
     om_target tg = {m->size, m->size, y0, rows, m->depth + (size_t)y0 * m->size, NULL};
     om__scene_raster_hiz(m->scene, &m->view.light_vp, &tg, OM_RASTER_DEPTH, true, bins, m->hiz);
