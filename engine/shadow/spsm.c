@@ -457,21 +457,22 @@ static uint16_t centres_nearer(const om__spsm_state *m, receiver *rp, bool *have
     return use;
 }
 
-/* World-space step to the neighbouring eye pixel on the same triangle (for AA). */
-static om_vec3 pixel_step(const om_strip *st, size_t i, int axis)
+/* World-space steps (for AA) to the next pixel's centre along x and along y, on the
+ * sample's own triangle (its plane), by the eye pass's own perspective-correct point:
+ * where that pixel shows the same triangle, its sample's point to the bit. From the
+ * triangle, not from the neighbouring samples, so the steps are the same in any strip
+ * or band (the next row may lie in another). */
+static void pixel_steps(const om__spsm_state *m, const om_strip *st, size_t i, om_vec3 *sx, om_vec3 *sy)
 {
-    uint32_t x = (uint32_t)(i % st->width), y = (uint32_t)(i / st->width);
-    const om_sample *s = &st->samples[i], *o = NULL;
-    float sign = 1.0f;
-    if (axis == 0) {
-        if (x + 1 < st->width && st->samples[i + 1].tri == s->tri) o = &st->samples[i + 1];
-        else if (x > 0 && st->samples[i - 1].tri == s->tri) { o = &st->samples[i - 1]; sign = -1.0f; }
-    } else {
-        if (y + 1 < st->rows && st->samples[i + st->width].tri == s->tri) o = &st->samples[i + st->width];
-        else if (y > 0 && st->samples[i - st->width].tri == s->tri) { o = &st->samples[i - st->width]; sign = -1.0f; }
-    }
-    if (!o) return om__v3(0, 0, 0);
-    return om__scale(om__v3(o->p[0] - s->p[0], o->p[1] - s->p[1], o->p[2] - s->p[2]), sign);
+    const om_sample *s = &st->samples[i];
+    const uint32_t x = (uint32_t)(i % st->width), y = st->y0 + (uint32_t)(i / st->width);
+    om__persp_tri c;
+    om__persp_setup(m->scene, &m->view.cam_vp, s->tri, &c);
+    const float kx = 2.0f / (float)st->width, ky = 2.0f / (float)st->height;
+    const float fx = ((float)x + 0.5f) * kx - 1.0f, fy = 1.0f - ((float)y + 0.5f) * ky;
+    const om_vec3 p = om__v3(s->p[0], s->p[1], s->p[2]);
+    *sx = om__sub(om__persp_point(&c, ((float)x + 1.5f) * kx - 1.0f, fy), p);
+    *sy = om__sub(om__persp_point(&c, fx, 1.0f - ((float)y + 1.5f) * ky), p);
 }
 
 /* The occluders the pattern `keep` keeps in the 3x3 of texel (tx, ty) (distinct
@@ -629,7 +630,7 @@ OM_NOINLINE static uint8_t recover(om__spsm_state *m, const om_strip *st, size_t
     uint16_t use = 0;   /* the candidate centres that join the outline, once asked */
     bool have_use = false;
     om_vec3 sx = om__v3(0, 0, 0), sy = sx;
-    if (K > 1) { sx = pixel_step(st, i, 0); sy = pixel_step(st, i, 1); }
+    if (K > 1) pixel_steps(m, st, i, &sx, &sy);
     for (uint32_t s = 0; s < K; s++) {
         sample_pt q = p;
         int64_t qx = px, qy = py;
