@@ -238,30 +238,38 @@ static void hybrid_bands(void)
     for (int k = 0; k < 3; k++) om_jobs_stop(pools[k]);
 }
 
-/* rtw's warped map by bands: the exact map (with the light's bins, which pass over the
- * triangles that miss a band's grid rows, and without) and the warped vertices' map
- * (every band splits every triangle alike), with forward analysis too: the same frame
- * and counters (triangles drawn among them) as inline. */
-static void rtw_map_bands(void)
+/* Settings that change how a method works by bands, on 2 and 5 backwards jobs, whole
+ * and through strips of 40, against the inline frame (frame and counters):
+ *  - rtw's warped map by bands: the exact map (with the light's bins, which pass over
+ *    the triangles that miss a band's grid rows, and without: the counters hold the
+ *    triangles drawn, counted in the band of a triangle's first grid row), the warped
+ *    vertices' map (every band splits every triangle alike), forward analysis;
+ *  - spsm's resolve by bands with AA (its sub-samples' steps must not come from the
+ *    next row, which another band holds) and the fine plain map. */
+static void settings_by_bands(void)
 {
     h_scene hs;
     if (!h_scene_parse(&hs, om_scene_default_text())) return;
-    const om_method *m = om_method_find("rtw");
-    static const char *const sets[] = {"map=512", "map=300 rtw.exact=0", "map=256 rtw.analysis=2 rtw.sigma=0"};
-    for (int i = 0; i < 3; i++) {
-        frame_out one = render_set(&hs.s, m, sets[i], 96, 72, 0, NULL, NULL, 1, 0, true);
-        CHECK_MSG(one.st == OM_OK && one.ms.counters[1] > 0, "rtw %s: inline frame", sets[i]);
-        for (uint32_t n = 2; n <= 5; n += 3)
-            for (int lean = 0; lean < 2; lean++) {
-                frame_out o = render_set(&hs.s, m, sets[i], 96, 72, 0, backwards, NULL, n,
-                                         om_frame_bytes_jobs(m, lean ? NULL : &hs.s, n), !lean);
-                CHECK_MSG(o.st == OM_OK && o.jobs == n, "rtw %s: %u jobs ran %u", sets[i], n, o.jobs);
-                CHECK_MSG(o.hash == one.hash, "rtw %s: %u bands%s change the frame", sets[i], n,
-                          lean ? " without bins" : "");
-                CHECK_MSG(!memcmp(o.ms.counters, one.ms.counters, sizeof o.ms.counters),
-                          "rtw %s: %u bands change the counters (drawn %u, inline %u)", sets[i], n,
-                          (unsigned)o.ms.counters[1], (unsigned)one.ms.counters[1]);
-            }
+    static const char *const sets[][2] = {
+        {"rtw", "map=512"}, {"rtw", "map=300 rtw.exact=0"}, {"rtw", "map=256 rtw.analysis=2 rtw.sigma=0"},
+        {"spsm", "map=256 spsm.aa=4"}, {"spsm", "map=512 spsm.aa=3 spsm.fine=1 spsm.records=1"},
+    };
+    for (size_t i = 0; i < sizeof sets / sizeof sets[0]; i++) {
+        const om_method *m = om_method_find(sets[i][0]);
+        for (uint32_t rows = 0; rows <= 40; rows += 40) {
+            frame_out one = render_set(&hs.s, m, sets[i][1], 96, 72, rows, NULL, NULL, 1, 0, true);
+            CHECK_MSG(one.st == OM_OK, "%s %s: inline frame", m->name, sets[i][1]);
+            for (uint32_t n = 2; n <= 5; n += 3)
+                for (int lean = 0; lean < (rows ? 1 : 2); lean++) {   /* strips' bins come first */
+                    frame_out o = render_set(&hs.s, m, sets[i][1], 96, 72, rows, backwards, NULL, n,
+                                             om_frame_bytes_jobs(m, lean ? NULL : &hs.s, n), !lean);
+                    CHECK_MSG(o.st == OM_OK && o.jobs == n, "%s %s strips %u%s: %u jobs ran %u", m->name, sets[i][1], rows, lean ? " lean" : "", n, o.jobs);
+                    CHECK_MSG(o.hash == one.hash, "%s %s strips %u: %u bands%s change the frame", m->name,
+                              sets[i][1], rows, n, lean ? " without bins" : "");
+                    CHECK_MSG(!memcmp(o.ms.counters, one.ms.counters, sizeof o.ms.counters),
+                              "%s %s strips %u: %u bands change the counters", m->name, sets[i][1], rows, n);
+                }
+        }
     }
     h_scene_free(&hs);
 }
@@ -271,5 +279,5 @@ void suite_threads(void)
     RUN(same_bits);
     RUN(fewer_jobs);
     RUN(hybrid_bands);
-    RUN(rtw_map_bands);
+    RUN(settings_by_bands);
 }

@@ -55,16 +55,17 @@ METHODS(DECLARE)
 static const om_method *const methods[] = {METHODS(ENTRY) NULL};
 
 /* The methods whose resolve runs by bands on the host's threads (frame.h, om__bands):
- * those whose resolve only reads the state once it is built (hybrid: its map lookup
- * by bands, its irregular pass after them). asm (its resolve moves a cache and the
- * tree's use marks), spsm (its lookup moves a window of decoded texels) and izb
- * (per-strip lists in the state) resolve a strip at a time. */
+ * those whose resolve only reads the state once it is built (spsm's window of decoded
+ * texels is the band's own; hybrid: its map lookup by bands, its irregular pass after
+ * them). asm (its resolve moves a cache and the tree's use marks) and izb (per-strip
+ * lists in the state) resolve a strip at a time. */
 #define BANDED(X)            \
     X(none, OM_WITH_NONE)    \
     X(ref, OM_WITH_REF)      \
     X(sm, OM_WITH_SM)        \
     X(rtw, OM_WITH_RTW)      \
-    X(hybrid, OM_WITH_HYBRID)
+    X(hybrid, OM_WITH_HYBRID) \
+    X(spsm, OM_WITH_SPSM)
 
 #define DECLARE_BANDS(m, on) extern const om__bands om__bands_##m;
 BANDED(DECLARE_BANDS)

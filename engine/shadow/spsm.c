@@ -115,9 +115,7 @@ static om_status spsm_init(void **state, om_arena *a, const om_method_cfg *mc, c
         if ((st = om_arena_alloc(a, (size_t)2 * m->size * m->fwords * sizeof(uint32_t), 16, &p, d))) return st;
         m->fneed = (uint32_t *)p;
     }
-    m->t4_at = (size_t)-1;
-    m->t_have = 0;
-    m->bd_have = false;
+    om__spsm_win_reset(&m->win);
     om__spsm_qtable_build(&m->q);
     om__spsm_tangent_build(m->lut);
     *state = m;
@@ -190,6 +188,9 @@ static om_status spsm_observe(void *state, const om_strip *st, om_diag *d)
 
 /* ---------------------------------------------------------------- lookup (4) */
 
+/* The lookup's counts (om__bands' counts[8]), added to the state's after a strip. */
+enum { N_SAMPLES, N_LIT, N_SHADOWED, N_UNCERTAIN, N_RECOVERED };
+
 /* Decodes texel k of the 3x3 (k = (dy + 1) * 3 + dx + 1) into t[k]: its vertices and
  * plane; the edges are set up when a test first needs them (edges). */
 static void decode(const om__spsm_state *m, int64_t tx, int64_t ty, om__spsm_dtri t[9], int k)
@@ -260,7 +261,7 @@ static void move_entry(om__spsm_dtri *to, const om__spsm_dtri *from)
     }
 }
 
-static void shift_window(om__spsm_state *m, int dx, int dy)
+static void shift_window(om__spsm_win *w, int dx, int dy)
 {
     const int64_t sx = -(int64_t)dx * OM_SUBPIX, sy = -(int64_t)dy * OM_SUBPIX;
     uint32_t have = 0;
@@ -270,9 +271,9 @@ static void shift_window(om__spsm_state *m, int dx, int dy)
             const int c = dx >= 0 ? cc : 2 - cc, ocol = c + dx;
             if (orow < 0 || orow > 2 || ocol < 0 || ocol > 2) continue;
             const int from = orow * 3 + ocol, to = r * 3 + c;
-            if (!((m->t_have >> from) & 1u)) continue;
-            om__spsm_dtri *t = &m->t[to];
-            if (to != from) move_entry(t, &m->t[from]);
+            if (!((w->t_have >> from) & 1u)) continue;
+            om__spsm_dtri *t = &w->t[to];
+            if (to != from) move_entry(t, &w->t[from]);
             t->cx += sx;
             t->cy += sy;
             for (int i = 0; i < 3; i++) {
@@ -286,7 +287,7 @@ static void shift_window(om__spsm_state *m, int dx, int dy)
             have |= 1u << to;
         }
     }
-    m->t_have = have;
+    w->t_have = have;
 }
 
 /* The entry's edge functions, set up on first use. Neighbours often hold the same
@@ -443,14 +444,14 @@ static bool plain_shadow(const uint32_t *buf, int64_t side, int64_t step, const 
     return true;
 }
 
-/* Which of the outline's candidate centres (m->cand) hold something nearer than the
+/* Which of the outline's candidate centres (w->cand) hold something nearer than the
  * sample's own plane carried there: bit c for cand[c]. Sets the receiver plane. */
-static uint16_t centres_nearer(const om__spsm_state *m, receiver *rp, bool *have_rp, const om_sample *smp,
+static uint16_t centres_nearer(const om__spsm_state *m, const om__spsm_win *w, receiver *rp, bool *have_rp, const om_sample *smp,
                                int64_t tx, int64_t ty, int64_t px, int64_t py)
 {
     uint16_t use = 0;
-    for (int c = 0; c < m->ncand; c++) {
-        const int k = m->cand_k[c], dx = k % 3 - 1, dy = k / 3 - 1;
+    for (int c = 0; c < w->ncand; c++) {
+        const int k = w->cand_k[c], dx = k % 3 - 1, dy = k / 3 - 1;
         if (!*have_rp) { *rp = receiver_plane(m, smp); *have_rp = true; }
         if (centre_test(m, rp, tx + dx, ty + dy, px - dx * OM_SUBPIX, py - dy * OM_SUBPIX)) use |= (uint16_t)(1u << c);
     }
@@ -478,18 +479,18 @@ static void pixel_steps(const om__spsm_state *m, const om_strip *st, size_t i, o
 /* The occluders the pattern `keep` keeps in the 3x3 of texel (tx, ty) (distinct
  * triangles), their outline, and the texel centres that may extend it. Out of line:
  * it runs once per texel and pattern. */
-static void occluders_of(om__spsm_state *m, om__spsm_dtri t[9], uint16_t keep, int64_t tx, int64_t ty)
+static void occluders_of(const om__spsm_state *m, om__spsm_win *w, om__spsm_dtri t[9], uint16_t keep, int64_t tx, int64_t ty)
 {
-    m->nocc = 0;
-    m->ncand = 0;
+    w->nocc = 0;
+    w->ncand = 0;
     for (int k = 0; k < 9; k++) {
         if (!((keep >> k) & 1u) || !t[k].ok) continue;
         edges(t, k);
         int j = 0;   /* neighbours often hold the same triangle */
-        while (j < m->nocc && (memcmp(m->occ[j]->e.x, t[k].e.x, sizeof t[k].e.x) ||
-                               memcmp(m->occ[j]->e.y, t[k].e.y, sizeof t[k].e.y)))
+        while (j < w->nocc && (memcmp(w->occ[j]->e.x, t[k].e.x, sizeof t[k].e.x) ||
+                               memcmp(w->occ[j]->e.y, t[k].e.y, sizeof t[k].e.y)))
             j++;
-        if (j == m->nocc) m->occ[m->nocc++] = &t[k];
+        if (j == w->nocc) w->occ[w->nocc++] = &t[k];
         /* the texel's centre, when the plain map saw this occluder's surface there
          * but its stored triangle does not reach it */
         const int64_t x = tx + k % 3 - 1, y = ty + k / 3 - 1;
@@ -499,46 +500,46 @@ static void occluders_of(om__spsm_state *m, om__spsm_dtri t[9], uint16_t keep, i
         if (fabs(om__spsm_plane_at(&t[k], t[k].cx, t[k].cy) - (double)c) >
             om__spsm_tol_at(&t[k], t[k].cx, t[k].cy) + OM__SPSM_LINK_DZ)
             continue;
-        m->cand[m->ncand].x = t[k].cx;
-        m->cand[m->ncand].y = t[k].cy;
-        m->cand[m->ncand].owner = j;
-        m->cand_k[m->ncand++] = (uint8_t)k;
+        w->cand[w->ncand].x = t[k].cx;
+        w->cand[w->ncand].y = t[k].cy;
+        w->cand[w->ncand].owner = j;
+        w->cand_k[w->ncand++] = (uint8_t)k;
     }
     /* one triangle's hull is itself (hits decides there), but its points may be
      * extended */
-    om__spsm_outline_build(&m->bd, m->occ, m->nocc);
-    if (m->nocc < 2) m->bd.nh = 0;
-    m->bd_keep = keep;
-    m->bx_pts = 0;   /* none built yet (0 is never asked for) */
-    m->bd_have = true;
+    om__spsm_outline_build(&w->bd, w->occ, w->nocc);
+    if (w->nocc < 2) w->bd.nh = 0;
+    w->bd_keep = keep;
+    w->bx_pts = 0;   /* none built yet (0 is never asked for) */
+    w->bd_have = true;
 }
 
 /* Whether (qx, qy) lies inside the outline extended by the candidate centres in `use`
  * (built once per set). */
-static bool inside_extended(om__spsm_state *m, uint16_t use, int64_t qx, int64_t qy)
+static bool inside_extended(om__spsm_win *w, uint16_t use, int64_t qx, int64_t qy)
 {
-    if (use != m->bx_pts) {
+    if (use != w->bx_pts) {
         om__spsm_outline_pt pts[9];
         int npts = 0;
-        for (int c = 0; c < m->ncand; c++)
-            if (use >> c & 1u) pts[npts++] = m->cand[c];
-        om__spsm_outline_extend(&m->bx, &m->bd, pts, npts);
-        m->bx_pts = use;
+        for (int c = 0; c < w->ncand; c++)
+            if (use >> c & 1u) pts[npts++] = w->cand[c];
+        om__spsm_outline_extend(&w->bx, &w->bd, pts, npts);
+        w->bx_pts = use;
     }
-    return om__spsm_outline_inside(&m->bx, qx, qy);
+    return om__spsm_outline_inside(&w->bx, qx, qy);
 }
 
-OM_NOINLINE static uint8_t recover(om__spsm_state *m, const om_strip *st, size_t i, const sample_pt *pp,
-                                   int64_t tx, int64_t ty);
+OM_NOINLINE static uint8_t recover(const om__spsm_state *m, om__spsm_win *w, uint32_t n[8], const om_strip *st,
+                                   size_t i, const sample_pt *pp, int64_t tx, int64_t ty);
 
 /* The whole lookup of one sample; returns the term value (255 lit, 0 shadowed, partial
  * with AA). */
-static uint8_t lookup(om__spsm_state *m, const om_strip *st, size_t i)
+static uint8_t lookup(const om__spsm_state *m, om__spsm_win *w, uint32_t n[8], const om_strip *st, size_t i)
 {
     const om_sample *smp = &st->samples[i];
     om_vec3 pw = om__v3(smp->p[0], smp->p[1], smp->p[2]);
     sample_pt p = project(m, pw);
-    if (!p.ok) { m->lit++; return 255; }
+    if (!p.ok) { n[N_LIT]++; return 255; }
     const int64_t tx = texel_of(m, p.x), ty = texel_of(m, p.y);
     /* the sample relative to its texel's centre */
     const int64_t ox = tx * OM_SUBPIX + OM_SUBPIX / 2, oy = ty * OM_SUBPIX + OM_SUBPIX / 2;
@@ -550,49 +551,49 @@ static uint8_t lookup(om__spsm_state *m, const om_strip *st, size_t i)
      * does not cover the sample but lies in its plane (the other half of a floor quad):
      * it too was the nearest thing in the texel. That halves the uncertain samples at
      * no measured cost in accuracy. */
-    om__spsm_dtri *t = m->t;
+    om__spsm_dtri *t = w->t;
     size_t at = (size_t)ty * m->size + (size_t)tx;
-    if (at != m->t4_at) {
-        const int64_t dx = m->t4_at == (size_t)-1 ? 9 : tx - (int64_t)(m->t4_at % m->size),
-                      dy = m->t4_at == (size_t)-1 ? 9 : ty - (int64_t)(m->t4_at / m->size);
-        if (dx >= -1 && dx <= 1 && dy >= -1 && dy <= 1) shift_window(m, (int)dx, (int)dy);
-        else m->t_have = 0;
-        if (!(m->t_have & (1u << 4))) { decode(m, tx, ty, t, 4); m->t_have |= 1u << 4; }
-        m->t4_at = at;
-        m->bd_have = false;
+    if (at != w->t4_at) {
+        const int64_t dx = w->t4_at == (size_t)-1 ? 9 : tx - (int64_t)(w->t4_at % m->size),
+                      dy = w->t4_at == (size_t)-1 ? 9 : ty - (int64_t)(w->t4_at / m->size);
+        if (dx >= -1 && dx <= 1 && dy >= -1 && dy <= 1) shift_window(w, (int)dx, (int)dy);
+        else w->t_have = 0;
+        if (!(w->t_have & (1u << 4))) { decode(m, tx, ty, t, 4); w->t_have |= 1u << 4; }
+        w->t4_at = at;
+        w->bd_have = false;
     }
-    if (t[4].empty) { m->lit++; return 255; }
+    if (t[4].empty) { n[N_LIT]++; return 255; }
     if (t[4].ok) {
         double z = om__spsm_plane_at(&t[4], px, py), tol = om__spsm_tol_at(&t[4], px, py);
         if (z < p.z - tol) {
-            if (om__tri2_covers(edges(t, 4), px, py)) { m->shadowed++; return 0; }
+            if (om__tri2_covers(edges(t, 4), px, py)) { n[N_SHADOWED]++; return 0; }
         } else if (z <= p.z + tol && tol <= OM__SPSM_TOL0 + LIT_CAP) {
-            m->lit++;
+            n[N_LIT]++;
             return 255;
         }
     }
     /* 4.1 shadowed: Algorithm 1 on the 3x3 neighbourhood */
     for (int k = 0; k < 9; k++) {
         if (k == 4) continue;
-        if (!((m->t_have >> k) & 1u)) { decode(m, tx, ty, t, k); m->t_have |= 1u << k; }
+        if (!((w->t_have >> k) & 1u)) { decode(m, tx, ty, t, k); w->t_have |= 1u << k; }
         if (t[k].ok) edges(t, k);
-        if (hits(&t[k], px, py, p.z)) { m->shadowed++; return 0; }
+        if (hits(&t[k], px, py, p.z)) { n[N_SHADOWED]++; return 0; }
     }
-    return recover(m, st, i, &p, tx, ty);
+    return recover(m, w, n, st, i, &p, tx, ty);
 }
 
 /* 4.2 for an uncertain sample: its term. Out of line: few samples come here, and the
  * decisions above stay small enough to sit in the strip's loop. p is the sample's
- * projection, (tx, ty) its texel, whose 3x3 is decoded in m->t. */
-OM_NOINLINE static uint8_t recover(om__spsm_state *m, const om_strip *st, size_t i, const sample_pt *pp,
-                                   int64_t tx, int64_t ty)
+ * projection, (tx, ty) its texel, whose 3x3 is decoded in w->t. */
+OM_NOINLINE static uint8_t recover(const om__spsm_state *m, om__spsm_win *w, uint32_t n[8], const om_strip *st,
+                                   size_t i, const sample_pt *pp, int64_t tx, int64_t ty)
 {
     const om_sample *smp = &st->samples[i];
     const om_vec3 pw = om__v3(smp->p[0], smp->p[1], smp->p[2]);
     const sample_pt p = *pp;
     const int64_t ox = tx * OM_SUBPIX + OM_SUBPIX / 2, oy = ty * OM_SUBPIX + OM_SUBPIX / 2;
     const int64_t px = p.x - ox, py = p.y - oy;
-    om__spsm_dtri *t = m->t;
+    om__spsm_dtri *t = w->t;
 
     /* 4.2 uncertain: the silhouette from partial geometry. Consistent depth tests give
      * the 3x3 pattern: a texel holds an occluder when its triangle reaches nearer than
@@ -600,7 +601,7 @@ OM_NOINLINE static uint8_t recover(om__spsm_state *m, const om_strip *st, size_t
      * guards keep the receiver out of it: its own flat neighbours fail the second test,
      * and a triangle wholly behind the sample's own tangent plane (a curved receiver's
      * neighbours, near its terminator) cannot block the way to the light. */
-    m->uncertain++;
+    n[N_UNCERTAIN]++;
     unsigned pat = 0;
     receiver rp = {0.0, 0.0, 0.0, false};
     bool have_rp = false;
@@ -620,10 +621,10 @@ OM_NOINLINE static uint8_t recover(om__spsm_state *m, const om_strip *st, size_t
     /* The occluders the pattern keeps and their outline depend on nothing but the texel
      * and `keep`: the next uncertain sample in this texel with the same pattern reuses
      * them. */
-    if (!m->bd_have || m->bd_keep != tg->keep) occluders_of(m, t, tg->keep, tx, ty);
-    const om__spsm_dtri *const *occ = m->occ;
-    const int nocc = m->nocc;
-    const om__spsm_boundary *bd = &m->bd;
+    if (!w->bd_have || w->bd_keep != tg->keep) occluders_of(m, w, t, tg->keep, tx, ty);
+    const om__spsm_dtri *const *occ = w->occ;
+    const int nocc = w->nocc;
+    const om__spsm_boundary *bd = &w->bd;
 
     /* The decision at one point of the pixel. */
     uint32_t K = m->cfg.spsm_aa > 1 ? m->cfg.spsm_aa : 1, nlit = 0;
@@ -640,8 +641,8 @@ OM_NOINLINE static uint8_t recover(om__spsm_state *m, const om_strip *st, size_t
             double a = ((double)s + 0.5) / (double)K - 0.5;
             double g = ((double)s + 0.5) * 0.6180339887498949;
             double b = g - floor(g) - 0.5;
-            om_vec3 w = om__add(pw, om__add(om__scale(sx, (float)a), om__scale(sy, (float)b)));
-            q = project(m, w);
+            om_vec3 at = om__add(pw, om__add(om__scale(sx, (float)a), om__scale(sy, (float)b)));
+            q = project(m, at);
             if (!q.ok) q = p;
             qx = q.x - ox;
             qy = q.y - oy;
@@ -651,9 +652,9 @@ OM_NOINLINE static uint8_t recover(om__spsm_state *m, const om_strip *st, size_t
         if (K > 1)
             for (int k = 0; k < nocc && !shadow; k++) shadow = hits(occ[k], qx, qy, q.z);
         if (!shadow && bd->nh) shadow = om__spsm_outline_inside(bd, qx, qy);
-        if (!shadow && m->ncand) {
-            if (!have_use) { use = centres_nearer(m, &rp, &have_rp, smp, tx, ty, px, py); have_use = true; }
-            if (use) shadow = inside_extended(m, use, qx, qy);
+        if (!shadow && w->ncand) {
+            if (!have_use) { use = centres_nearer(m, w, &rp, &have_rp, smp, tx, ty, px, py); have_use = true; }
+            if (use) shadow = inside_extended(w, use, qx, qy);
         }
         if (!shadow && tg->keep == 511) shadow = centre_test(m, &rp, tx, ty, px, py);   /* rp set */
         if (!shadow) {
@@ -664,25 +665,58 @@ OM_NOINLINE static uint8_t recover(om__spsm_state *m, const om_strip *st, size_t
         nlit += !shadow;
     }
     if (nlit == K) return 255;
-    m->recovered++;
+    n[N_RECOVERED]++;
     uint8_t v = (uint8_t)((255 * nlit + K / 2) / K);
     return v == 255 ? 254 : v;   /* partly shadowed is never "lit" */
+}
+
+/* The terms of the strip's (or band's) rows, with window w; counts in n (N_...). */
+static void resolve_rows(const om__spsm_state *m, om__spsm_win *w, om_strip *st, uint32_t n[8])
+{
+    size_t k = (size_t)st->rows * st->width;
+    for (size_t i = 0; i < k; i++) {
+        om_term *t = &st->terms[i];
+        t->r = t->g = t->b = 255;
+        if (!(t->flags & OM_TERM_EXPOSED)) continue;
+        n[N_SAMPLES]++;
+        t->r = t->g = t->b = lookup(m, w, n, st, i);
+    }
+}
+
+static void add_counts(om__spsm_state *m, const uint32_t n[8])
+{
+    m->samples += n[N_SAMPLES];
+    m->lit += n[N_LIT];
+    m->shadowed += n[N_SHADOWED];
+    m->uncertain += n[N_UNCERTAIN];
+    m->recovered += n[N_RECOVERED];
 }
 
 static om_status spsm_resolve(void *state, om_strip *st, om_diag *d)
 {
     (void)d;
     om__spsm_state *m = (om__spsm_state *)state;
-    size_t n = (size_t)st->rows * st->width;
-    for (size_t i = 0; i < n; i++) {
-        om_term *t = &st->terms[i];
-        t->r = t->g = t->b = 255;
-        if (!(t->flags & OM_TERM_EXPOSED)) continue;
-        m->samples++;
-        t->r = t->g = t->b = lookup(m, st, i);
-    }
+    uint32_t n[8] = {0};
+    resolve_rows(m, &m->win, st, n);
+    add_counts(m, n);
     return OM_OK;
 }
+
+/* Bands (om__bands): each with a window of its job's, from nothing; the map and the
+ * state are only read. The counts are added after the strip. */
+static void spsm_band(const void *state, om_strip *st, void *scratch, uint32_t counts[8])
+{
+    om__spsm_win *w = (om__spsm_win *)scratch;
+    om__spsm_win_reset(w);
+    resolve_rows((const om__spsm_state *)state, w, st, counts);
+}
+
+static void spsm_merge(void *state, const uint32_t counts[8])
+{
+    add_counts((om__spsm_state *)state, counts);
+}
+
+const om__bands om__bands_spsm = {spsm_band, spsm_merge, sizeof(om__spsm_win), NULL, NULL, NULL};
 
 static bool spsm_observes(const void *state)
 {

@@ -186,8 +186,8 @@ om_status om__spsm_build(void *state, om_diag *d)
 {
     (void)d;
     om__spsm_state *m = (om__spsm_state *)state;
-    m->t4_at = (size_t)-1;   /* no texel index: the map is about to change */
-    m->bd_have = false;
+    m->win.t4_at = (size_t)-1;   /* no texel index: the map is about to change */
+    m->win.bd_have = false;
     m->needed = grow_needs(m);
     /* The plain map at texel centres, for the fallback of 4.2, is the rasterizer's own
      * depth pass, made alongside the conservative one. Without AA the lookup reads it

@@ -25,6 +25,39 @@ typedef struct om__spsm_cfg {
                               samples along fine rims), 0: at texel centres */
 } om__spsm_cfg;
 
+/* The lookup's moving parts. Its 3x3 of decoded texels: consecutive samples mostly
+ * fall in the same texel, and the 3x3 around it depends on nothing but the map and
+ * that texel's index, so it is kept from one sample to the next while `t4_at` names
+ * the texel (and what it shares with the next texel's 3x3 is kept too: shift_window):
+ * bit k of `t_have` says t[k] is decoded. The recovery's occluders (pointers into t)
+ * and outline for the pattern `bd_keep` of the texel t4_at, while bd_have; and the
+ * texel centres that may join the outline (cand_k: their texels): those nearer than
+ * the sample, which varies, do. bd is the outline without them, bx with those in
+ * bx_pts (a superset of bd's hulls: points only join pieces).
+ * Nothing in it changes an answer, only the work: a strip resolves with the state's
+ * own, a band with one of its job's (om__spsm_win_reset first). */
+typedef struct om__spsm_win {
+    om__spsm_dtri t[9];
+    size_t t4_at;
+    uint32_t t_have;
+    const om__spsm_dtri *occ[9];
+    int nocc;
+    om__spsm_outline_pt cand[9];
+    uint8_t cand_k[9];
+    int ncand;
+    uint16_t bx_pts;
+    om__spsm_boundary bd, bx;
+    uint16_t bd_keep;
+    bool bd_have;
+} om__spsm_win;
+
+/* Forgets what the window holds (all of it, so that nothing is read unset). */
+static inline void om__spsm_win_reset(om__spsm_win *w)
+{
+    memset(w, 0, sizeof *w);
+    w->t4_at = (size_t)-1;
+}
+
 typedef struct om__spsm_state {
     const om_scene *scene;
     om__spsm_cfg cfg;
@@ -48,28 +81,7 @@ typedef struct om__spsm_state {
     om__spsm_tangent lut[512];
     /* per frame */
     uint32_t samples, lit, shadowed, uncertain, recovered, needed;
-    /* The lookup's 3x3 of decoded texels. Consecutive samples mostly fall in the same
-     * texel, and the 3x3 around it depends on nothing but the map and that texel's
-     * index, so it is kept from one sample to the next while `t4_at` names the texel
-     * (and what it shares with the next texel's 3x3 is kept too: shift_window): bit k
-     * of `t_have` says t[k] is decoded. The build forgets it. */
-    om__spsm_dtri t[9];
-    size_t t4_at;
-    uint32_t t_have;
-    /* The recovery's occluders (pointers into t) and outline for the pattern `bd_keep`
-     * of the texel t4_at, while bd_have. */
-    const om__spsm_dtri *occ[9];
-    int nocc;
-    /* and the texel centres that may join the outline (cand_k: their texels): those
-     * nearer than the sample, which varies, do. bd is the outline without them, bx
-     * with those in bx_pts (a superset of bd's hulls: points only join pieces). */
-    om__spsm_outline_pt cand[9];
-    uint8_t cand_k[9];
-    int ncand;
-    uint16_t bx_pts;
-    om__spsm_boundary bd, bx;
-    uint16_t bd_keep;
-    bool bd_have;
+    om__spsm_win win;            /* the lookup's, a strip at a time */
 } om__spsm_state;
 
 /* A depth plane: z at grid point (ox, oy), slopes gx, gy per grid unit. */
