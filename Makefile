@@ -124,9 +124,19 @@ check: $(O)/run-tests $(O)/ombra $(FUZZ_TARGETS:%=$(O)/fuzz-replay-%) $(O)/embed
 	sh tests/embed/readme.sh
 	sh tests/methods.sh $(O)
 
+# Every method rendered on 2 threads, whole and through strips, by the command $(1)
+# (under $(2), a checker or nothing), into directory $(3): the sanitizers and valgrind
+# see the frame's jobs as well as the suite's threaded tests.
+THREADED_RENDERS = for m in $$($(1) methods | awk 'NF == 0 {exit} {print $$1}'); do \
+	  for s in 0 40; do \
+	    $(2) $(1) render --quiet --size 160x120 --method $$m --map 512 --threads 2 \
+	      $$([ $$s -gt 0 ] && echo --strip $$s) --out $(3)/threads.ppm || exit 1; \
+	  done; done; echo "every method on 2 threads, whole frame and strips: clean"
+
 test-sanitize:
 	$(MAKE) --no-print-directory check CC=clang OPT=-O1 O=build/san \
 	  EXTRA="-fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer"
+	@$(call THREADED_RENDERS,build/san/ombra,,build/san)
 
 # The threaded tests and a threaded render of every method under clang's
 # ThreadSanitizer: the frame's jobs must share nothing they write.
@@ -175,9 +185,10 @@ fuzz: $(O)/ombra
 
 # The suite under valgrind memcheck (no sanitizers in this build).
 test-valgrind:
-	$(MAKE) --no-print-directory $(O)/valgrind/run-tests O=$(O)/valgrind OPT=-O1
+	$(MAKE) --no-print-directory $(O)/valgrind/run-tests $(O)/valgrind/ombra O=$(O)/valgrind OPT=-O1
 	OM_TEST_QUICK=1 valgrind --error-exitcode=1 --leak-check=full --errors-for-leak-kinds=definite -q \
 	  $(O)/valgrind/run-tests
+	@$(call THREADED_RENDERS,$(O)/valgrind/ombra,valgrind --error-exitcode=1 -q,$(O)/valgrind)
 
 # make install PREFIX=/usr/local DESTDIR=: the library, the header, the command and a
 # pkg-config file (`pkg-config --cflags --libs ombra`); make uninstall removes them.
