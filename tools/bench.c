@@ -6,7 +6,8 @@
  * front dashed), against the first frame's time (the method's init, where ref builds
  * its BVH, plus a frame) and, for the exact methods, the first frame's time against
  * triangle count. A method joins every table and chart by its registry entry alone (at
- * its defaults until it has a line in `sweeps`).
+ * its defaults until it has a line in `sweeps`). Then the scaling table: each method
+ * at its defaults on each scene, its frames on 1, 2 and the machine's cores.
  * Names are checked before any work; a run that fails writes nothing, and the files
  * of one that succeeds replace the old ones together (om_out). */
 #define _POSIX_C_SOURCE 200809L
@@ -34,6 +35,8 @@ static const char bench_help[] =
     "  --runs N          frames per point; times are their median (default 3)\n"
     "  --threads N       threads each frame runs on (default: the CPUs online); the\n"
     "                    CSV's threads column says how many jobs ran at once\n"
+    "  --no-scaling      leave out the scaling table (each method at its defaults on\n"
+    "                    1, 2 and the machine's cores: median frame, speed-up on 1)\n"
     "  --tri-sweep       also time the exact methods on 1K..1M random triangles\n"
     "  --out DIR         where bench.csv and the charts go (default out/bench)\n";
 
@@ -485,16 +488,77 @@ static int write_outputs(const char *dir, char **names, size_t nn, const cli_poi
     return st == OM_OK ? 0 : cli_error(NULL, &d, st);
 }
 
+/* The scaling table: each method of the sweep at its defaults on each scene, `runs`
+ * frames on each of 1, 2 and the machine's cores threads (one after another, in that
+ * order, a fresh state each): the median frame (init apart) and its speed-up on one
+ * thread. The pool is the user's again afterwards. */
+static int scaling(const char *cmd, char **names, size_t nn, const uint32_t *sw, const uint32_t *sh,
+                   uint32_t w, uint32_t h, const char *methods, int runs, const char *threads)
+{
+    uint32_t counts[3] = {1, 2, om_cpus_online()};
+    const int nc = counts[2] > 2 ? 3 : 2;
+    printf("\nscaling: median frame in ms (%d frames) on 1, 2%s threads; speed-up on 1\n", runs,
+           nc == 3 ? " and the machine's cores" : " (the machine's cores)");
+    printf("%-12s %-6s", "scene", "meth");
+    for (int c = 0; c < nc; c++) {
+        char head[16];
+        snprintf(head, sizeof head, "%u thr", counts[c]);
+        printf(c ? " %10s %7s" : " %10s", head, "speedup");
+    }
+    printf("\n");
+    int rc = 0;
+    for (size_t si = 0; si < nn && !rc; si++) {
+        om_diag d;
+        memset(&d, 0, sizeof d);
+        cli_scene cs;
+        om_view v;
+        uint8_t *mask = NULL;
+        om_status st = cli_load_named(names[si], &cs, &d);
+        if (st == OM_OK && (st = cli_scene_view(&cs, sw[si] ? sw[si] : w, sw[si] ? sh[si] : h, &v, &d)) == OM_OK &&
+            !(mask = malloc((size_t)v.cam.width * v.cam.height)))
+            st = cli_oom(&d);
+        for (size_t k = 0; k < om_method_count() && st == OM_OK && !rc; k++) {
+            const om_method *m = om_method_at(k);
+            if ((cli_sweep(m) && !cli_sweep(m)[0]) || !in_list(methods, m->name)) continue;
+            om_method_cfg cfg;
+            om_method_cfg_default(&cfg, m);
+            printf("%-12s %-6s", base_name(names[si]), m->name);
+            double one = 0.0;
+            for (int c = 0; c < nc && st == OM_OK; c++) {
+                char arg[16];
+                snprintf(arg, sizeof arg, "%u", counts[c]);
+                if (!cli_threads_start(cmd, arg)) { rc = 1; break; }
+                cli_point p;
+                memset(&p, 0, sizeof p);
+                st = cli_measure(m, &cfg, &cs, &v, runs, mask, NULL, &p, &d);
+                if (st != OM_OK) break;
+                if (!c) one = p.total;
+                printf(" %10.2f", p.total);
+                if (c) printf(" %6.2fx%c", p.total > 0.0 ? one / p.total : 0.0, p.threads == counts[c] ? ' ' : '*');
+                fflush(stdout);
+            }
+            printf("\n");
+        }
+        if (st != OM_OK && !rc) rc = cli_error(names[si], &d, st);
+        free(mask);
+        cli_scene_free(&cs);
+    }
+    if (!rc) printf("(* fewer jobs ran than threads asked)\n");
+    if (!rc && !cli_threads_start(cmd, threads)) rc = 1;
+    return rc;
+}
+
 int cmd_bench(int argc, char **argv)
 {
     const char *scenes = "default,random-10K", *methods = NULL, *dir = "out/bench";
     uint32_t w = 0, h = 0, runs = 3;
-    bool tri_sweep = false;
+    bool tri_sweep = false, scale = true;
     const char *threads = NULL;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) { fputs(bench_help, stdout); return 0; }
         if (!strcmp(a, "--tri-sweep")) { tri_sweep = true; continue; }
+        if (!strcmp(a, "--no-scaling")) { scale = false; continue; }
         if (!v) return cli_usage_error(argv[0], "unknown option or missing value: '%s'", a);
         if (!strcmp(a, "--scenes")) scenes = v;
         else if (!strcmp(a, "--methods")) methods = v;
@@ -653,8 +717,10 @@ int cmd_bench(int argc, char **argv)
             printf("%-12s %-5s %-28s %9.2f %9.2f %9.2f %11zu %8.4f%% %8.3f%%\n", p->scene, p->method,
                    p->setting, p->total, p->init, p->resolve, p->bytes, 100 * share, 100 * edge);
         }
-        rc = write_outputs(dir, names, nn, pts, np, tris, (const double (*)[4])ty, tn, tnames, ntri,
-                           tri_sweep);
+        if (scale) rc = scaling(argv[0], names, nn, sw, sh, w, h, methods, (int)runs, threads);
+        if (!rc)
+            rc = write_outputs(dir, names, nn, pts, np, tris, (const double (*)[4])ty, tn, tnames, ntri,
+                               tri_sweep);
     }
     if (!rc) printf("wrote %s/bench.csv and the charts beside it\n", dir);
     free(pts);

@@ -15,8 +15,8 @@
 #include <string.h>
 
 static const char report_help[] =
-    "usage: ombra report [--scenes LIST] [--size WxH] [--runs N] [--out DIR] [--tri-sweep]\n"
-    "                    [--equal-memory] [--cross DIR]\n"
+    "usage: ombra report [--scenes LIST] [--size WxH] [--runs N] [--threads N] [--out DIR]\n"
+    "                    [--tri-sweep] [--equal-memory] [--cross DIR]\n"
     "\n"
     "Runs 'ombra bench' with the same options, then writes DIR/index.html: per scene the\n"
     "charts, the table and crops where the methods disagree most (default: the default\n"
@@ -24,7 +24,8 @@ static const char report_help[] =
     "(say, a big scene smaller than the rest); DIR/stability.csv, when there, adds the\n"
     "stability section. --equal-memory adds each method's best setting within memory\n"
     "budgets of 64 KiB to 16 MiB. The small-machines section reads what 'make cross-test'\n"
-    "wrote into the --cross directory (default out/cross).\n";
+    "wrote into the --cross directory (default out/cross). --threads N: the threads\n"
+    "each frame runs on (default: the CPUs online), which the page states.\n";
 
 #define CROP_MAX 64
 #define ZOOM 3
@@ -309,6 +310,7 @@ static void step(int i, int n, const char *what, const char *name)
 int cmd_report(int argc, char **argv)
 {
     const char *scenes = "default", *dir = "out/report", *size = NULL, *runs = "3", *cross = "out/cross";
+    const char *threads = NULL;
     bool tri = false, memory = false;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -321,6 +323,7 @@ int cmd_report(int argc, char **argv)
         else if (!strcmp(a, "--size")) size = v;
         else if (!strcmp(a, "--runs")) runs = v;
         else if (!strcmp(a, "--cross")) cross = v;
+        else if (!strcmp(a, "--threads")) threads = v;
         else return cli_usage_error("report", "unknown option '%s'", a);
         i++;
     }
@@ -330,8 +333,10 @@ int cmd_report(int argc, char **argv)
     for (const char *p = scenes; *p; p++) nscenes += *p == ',';
     const int nsteps = 3 + (int)nscenes + memory;
     step(1, nsteps, "the sweep: ombra bench", NULL);
-    char *bargv[12] = {"report", "--scenes", (char *)scenes, "--runs", (char *)runs, "--out", (char *)dir};
-    int bargc = 7;
+    char *bargv[16] = {"report", "--scenes", (char *)scenes, "--runs", (char *)runs, "--out", (char *)dir,
+                       "--no-scaling"};
+    int bargc = 8;
+    if (threads) { bargv[bargc++] = "--threads"; bargv[bargc++] = (char *)threads; }
     if (size) { bargv[bargc++] = "--size"; bargv[bargc++] = (char *)size; }
     if (tri) bargv[bargc++] = "--tri-sweep";
     int rc = cmd_bench(bargc, bargv);   /* its usage errors name 'report' (argv[0]) */
@@ -363,9 +368,12 @@ int cmd_report(int argc, char **argv)
                "</style>\n</head>\n<body>\n<h1>ombra: hard shadows, accuracy against speed</h1>\n"
                "<p>Every method renders the same visible samples; accuracy is the share of samples "
                "whose binary shadow state differs from the exact reference (<code>ref</code>). "
-               "Times are medians of %s frames on one core; a method's init (where "
-               "<code>ref</code> builds its BVH) is its own stage, paid again whenever the scene "
-               "changes. All the numbers are in <code>bench.csv</code> beside this page.</p>\n", runs);
+               "Times are medians of %s frames, each on %u thread%s (<code>--threads</code>; "
+               "the <code>threads</code> column of <code>bench.csv</code> says how many jobs "
+               "ran); a method's init (where <code>ref</code> builds its BVH) is its own stage, "
+               "on one thread, paid again whenever the scene changes. All the numbers are in "
+               "<code>bench.csv</code> beside this page.</p>\n",
+            runs, cli_threads(), cli_threads() == 1 ? "" : "s");
     memcpy(list, scenes, strlen(scenes) + 1);
     fprintf(f, "<p>Scenes:");
     for (char *name = strtok(list, ","); name; name = strtok(NULL, ",")) {
