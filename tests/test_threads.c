@@ -244,8 +244,11 @@ static void hybrid_bands(void)
  *    the triangles that miss a band's grid rows, and without: the counters hold the
  *    triangles drawn, counted in the band of a triangle's first grid row), the warped
  *    vertices' map (every band splits every triangle alike), forward analysis;
- *  - spsm's resolve by bands with AA (its sub-samples' steps must not come from the
- *    next row, which another band holds) and the fine plain map. */
+ *  - spsm's map by bands (a triangle touching one texel row of the whole map, not of
+ *    its band, takes its nearest vertex's depth; the fine map's rows are two of the
+ *    map's; with the light's bins and without) and its resolve by bands with AA (its
+ *    sub-samples' steps must not come from the next row, which another band holds),
+ *    with the fine plain map, its points all made or only those the lookup reads. */
 static void settings_by_bands(void)
 {
     h_scene hs;
@@ -253,6 +256,7 @@ static void settings_by_bands(void)
     static const char *const sets[][2] = {
         {"rtw", "map=512"}, {"rtw", "map=300 rtw.exact=0"}, {"rtw", "map=256 rtw.analysis=2 rtw.sigma=0"},
         {"spsm", "map=256 spsm.aa=4"}, {"spsm", "map=512 spsm.aa=3 spsm.fine=1 spsm.records=1"},
+        {"spsm", "map=1024 spsm.fine=1 spsm.records=2"}, {"spsm", "map=64"},
     };
     for (size_t i = 0; i < sizeof sets / sizeof sets[0]; i++) {
         const om_method *m = om_method_find(sets[i][0]);

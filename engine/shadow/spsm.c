@@ -716,7 +716,8 @@ static void spsm_merge(void *state, const uint32_t counts[8])
     add_counts((om__spsm_state *)state, counts);
 }
 
-const om__bands om__bands_spsm = {spsm_band, spsm_merge, sizeof(om__spsm_win), NULL, NULL, NULL};
+const om__bands om__bands_spsm = {spsm_band, spsm_merge, sizeof(om__spsm_win), om__spsm_map_of,
+                                   om__spsm_build_rows, NULL};
 
 static bool spsm_observes(const void *state)
 {

@@ -38,7 +38,7 @@ static uint32_t grow_needs(om__spsm_state *m)
     return count;
 }
 typedef struct build_ctx {
-    om__spsm_state *m;
+    const om__spsm_state *m;     /* its buffers written at the band's rows only */
     double zx, zy;               /* the plane whose codes are cached */
     uint8_t qx, qy;
     bool have;
@@ -51,9 +51,30 @@ typedef struct build_ctx {
 } build_ctx;
 
 /* One texel x of row y touched by t: the depth test and, for the winner, its record. */
+/* Texel rows of the whole map whose squares meet a triangle's bounding box, first and
+ * last: the rasterizer's conservative bounds (raster.c) before a band clamps them to
+ * its own rows, so that a band decides as the whole map would. */
+static int64_t texel_floor(int64_t a)
+{
+    return a >= 0 ? a >> OM_SUBPIX_BITS : -((OM_SUBPIX - 1 - a) >> OM_SUBPIX_BITS);
+}
+
+static bool one_row(const om__spsm_state *m, const om__tri2 *e)
+{
+    int64_t lo = e->y[0], hi = e->y[0];
+    for (int i = 1; i < 3; i++) {
+        if (e->y[i] < lo) lo = e->y[i];
+        if (e->y[i] > hi) hi = e->y[i];
+    }
+    int64_t y0 = texel_floor(lo - 1), y1 = texel_floor(hi);
+    if (y0 < 0) y0 = 0;
+    if (y1 > (int64_t)m->size - 1) y1 = (int64_t)m->size - 1;
+    return y0 == y1;
+}
+
 static void texel(build_ctx *b, int32_t x, int32_t y, const om__rtri *t)
 {
-    om__spsm_state *m = b->m;
+    const om__spsm_state *m = b->m;
     const om__tri2 *e = &t->e;
     const double H = OM_SUBPIX / 2;
     double cx = (double)((int64_t)x * OM_SUBPIX) + H - (double)e->x[0];
@@ -69,7 +90,7 @@ static void texel(build_ctx *b, int32_t x, int32_t y, const om__rtri *t)
     const int64_t kx = (int64_t)x * OM_SUBPIX, ky = (int64_t)y * OM_SUBPIX;
     /* a triangle touching this texel alone lies inside it: its nearest vertex is the
      * answer (at the map's edge the bounds are clamped, and zmin stays a lower bound) */
-    const bool alone = t->minx == t->maxx && t->miny == t->maxy;
+    const bool alone = t->minx == t->maxx && t->miny == t->maxy && one_row(m, e);
     if (!alone && !om__tri2_covers(e, kx + (t->zx > 0 ? 0 : OM_SUBPIX), ky + (t->zy > 0 ? 0 : OM_SUBPIX))) {
         const om__spsm_zplane p = {t->z0, t->zx, t->zy, e->x[0], e->y[0]};
         double zc = om__spsm_clipped_min(e->x, e->y, kx, ky, OM_SUBPIX, &p);
@@ -112,15 +133,16 @@ static void texel(build_ctx *b, int32_t x, int32_t y, const om__rtri *t)
     om__spsm_pack_row(&m->tex[i], t, x, y, b->qx, b->qy, b->vy);
 }
 
-/* Sets a buffer to the far plane (empty) at the needed texels, a word of them at a time. */
-static void clear_needed(const om__spsm_state *m, uint32_t *buf)
+/* Sets rows [y0, y0 + rows) of a buffer to the far plane (empty) at the needed texels,
+ * a word of them at a time. */
+static void clear_needed(const om__spsm_state *m, uint32_t *buf, uint32_t y0, uint32_t rows)
 {
-    if (!m->marks) {   /* every texel is needed: one pass over the buffer */
-        const size_t n = (size_t)m->size * m->size;
-        for (size_t i = 0; i < n; i++) buf[i] = 0xFFFFFFFFu;
+    if (!m->marks) {   /* every texel is needed: one pass over the rows */
+        const size_t n = (size_t)rows * m->size;
+        for (size_t i = 0; i < n; i++) buf[(size_t)y0 * m->size + i] = 0xFFFFFFFFu;
         return;
     }
-    for (uint32_t y = 0; y < m->size; y++)
+    for (uint32_t y = y0; y < y0 + rows; y++)
         for (uint32_t j = 0; j < m->words; j++) {
             if (!m->need[(size_t)y * m->words + j]) continue;
             const uint32_t x0 = j * 32, x1 = x0 + 32 < m->size ? x0 + 32 : m->size;
@@ -159,17 +181,32 @@ static void no_span(void *user, int32_t y, int32_t x0, int32_t x1, const om__rtr
 }
 
 /* Every triangle of the scene through r, from the light, back faces of closed shapes
- * culled. */
-static void raster_scene(const om__spsm_state *m, om_raster *r)
+ * culled. With bins (made for the light's matrix on the map's grid, om__bins_make), a
+ * triangle whose rows miss the target's is passed over and, on the map's own grid
+ * (fine = 1), one that needs no clipping goes straight to om__raster_snapped, as
+ * om__raster_tri would send it; on the fine map (fine = 2) a map row is two of its
+ * rows. The same texels either way. */
+static void raster_scene(const om__spsm_state *m, om_raster *r, const om__bins *bins, uint32_t fine)
 {
     const om_scene *s = m->scene;
+    const uint32_t y0 = r->target->y0, y1 = r->target->y0 + r->target->rows - 1;
+    const uint32_t *rows = bins ? bins->rows : NULL;
+    const om__vsnap *vs = bins && fine == 1 ? bins->verts : NULL;
     om__cull cl;
     om__cull_begin(&cl, s, &m->view.light_vp);
     for (uint32_t t = 0; t < s->ntris; t++) {
+        if (rows && ((rows[t] & 0xFFFFu) * fine > y1 || (rows[t] >> 16) * fine + fine - 1 < y0)) continue;
         r->cull_back = om__cull_next(&cl, t);
         const uint32_t *ix = s->idx + (size_t)t * 3;
+        if (vs && vs[ix[0]].x != INT32_MIN && vs[ix[1]].x != INT32_MIN && vs[ix[2]].x != INT32_MIN) {
+            const int64_t x[3] = {vs[ix[0]].x, vs[ix[1]].x, vs[ix[2]].x};
+            const int64_t y[3] = {vs[ix[0]].y, vs[ix[1]].y, vs[ix[2]].y};
+            const uint32_t z[3] = {vs[ix[0]].z, vs[ix[1]].z, vs[ix[2]].z};
+            om__raster_snapped(r, x, y, z, t);
+            continue;
+        }
         om_vec4 c[3];
-        for (int k = 0; k < 3; k++) c[k] = om__mat_apply(&m->view.light_vp, s->verts[ix[k]]);
+        om__clip_tri(s, &m->view.light_vp, t, c);
         om__raster_tri(r, c, t);
     }
 }
@@ -182,50 +219,61 @@ static void span(void *user, int32_t y, int32_t x0, int32_t x1, const om__rtri *
     for (int32_t x = om__mask_next(row, x0, x1); x <= x1; x = om__mask_next(row, x + 1, x1)) texel(b, x, y, t);
 }
 
-om_status om__spsm_build(void *state, om_diag *d)
+/* What the map's rows share, on the calling thread (om__bands.map_of): the texels the
+ * lookup will read, and with spsm.fine the fine map's points (those cleared). */
+uint32_t om__spsm_map_of(void *state, const om_mat4 **vp)
 {
-    (void)d;
     om__spsm_state *m = (om__spsm_state *)state;
     m->win.t4_at = (size_t)-1;   /* no texel index: the map is about to change */
     m->win.bd_have = false;
     m->needed = grow_needs(m);
+    if (m->fine && m->cfg.spsm_aa <= 1 && m->marks) grow_fine_needs(m);
+    *vp = &m->view.light_vp;
+    return m->size;
+}
+
+/* Rows [y0, y0 + rows) of the map (om__bands.build_rows): every buffer of a texel (or a
+ * fine point) in them is written by this band alone. */
+void om__spsm_build_rows(const void *state, const om__bins *bins, uint32_t y0, uint32_t rows, uint32_t counts[8])
+{
+    (void)counts;   /* the needs were counted before the bands */
+    const om__spsm_state *m = (const om__spsm_state *)state;
+    const size_t S = m->size;
     /* The plain map at texel centres, for the fallback of 4.2, is the rasterizer's own
      * depth pass, made alongside the conservative one. Without AA the lookup reads it
      * inside the 3x3 too, so both buffers are cleared and written at the needed texels
      * only; sub-samples reach beyond, so with AA the plain map is made whole. */
     const bool whole_plain = m->cfg.spsm_aa > 1;
-    om_target tc = {m->size, m->size, 0, m->size, m->cdepth, NULL};
+    om_target tc = {m->size, m->size, y0, rows, m->cdepth + (size_t)y0 * S, NULL};
     if (whole_plain) om__target_clear(&tc);
-    else clear_needed(m, m->cdepth);
-    clear_needed(m, m->depth);
+    else clear_needed(m, m->cdepth, y0, rows);
+    clear_needed(m, m->depth, y0, rows);
     /* texels are not cleared: one whose depth is still the far plane's is empty */
-    om_target tg = {m->size, m->size, 0, m->size, m->depth, NULL};
+    om_target tg = {m->size, m->size, y0, rows, m->depth + (size_t)y0 * S, NULL};
     build_ctx b;
     memset(&b, 0, sizeof b);
     b.m = m;
     om_raster r;
+    memset(&r, 0, sizeof r);
     r.target = &tg;
     r.mode = OM_RASTER_CONSERVATIVE;
     r.span = span;
     r.user = &b;
     r.centres = &tc;
-    r.centre_mask = whole_plain ? NULL : m->need;
-    r.grid_x = r.grid_y = NULL;
-    r.grid_xs = r.grid_ys = NULL;
-    r.grid_shift = r.grid_buckets = 0;
+    r.centre_mask = whole_plain ? NULL : m->need + (size_t)y0 * m->words;
     r.mask_words = m->words;
     /* A light ray that meets a closed shape's back face has met a front face before
      * it, so a back face is never the occluder a record should describe: culled, the
      * record of a rim texel is more often the grazing front face the ray really hits
      * (default scene, mismatches at maps 512 / 1024 / 2048 / 4096: 5,838 / 1,278 /
      * 458 / 163 -> 5,789 / 1,268 / 328 / 133). The plain depth is the same. */
-    raster_scene(m, &r);
-    if (!m->fine) return OM_OK;
+    raster_scene(m, &r, bins, 1);
+    if (!m->fine) return;
     /* The plain map at twice the resolution, at the points the lookup reads (all of
      * them with AA), for plain_shadow: a second pass, since its grid is not the
-     * records'. */
+     * records'. Its rows 2 y0 .. belong to this band. */
     const uint32_t F = 2 * m->size;
-    om_target tf = {F, F, 0, F, m->fdepth, NULL};
+    om_target tf = {F, F, 2 * y0, 2 * rows, m->fdepth + (size_t)2 * y0 * F, NULL};
     r.target = &tf;
     r.user = NULL;
     if (whole_plain || !m->marks) {
@@ -236,14 +284,23 @@ om_status om__spsm_build(void *state, om_diag *d)
         r.centres = NULL;
         r.centre_mask = NULL;
     } else {
-        /* the points needed: the depth pass that runs alongside a conservative one
-         * (the same depths), with nothing for the conservative one to do */
-        grow_fine_needs(m);
+        /* the points needed (cleared by map_of): the depth pass that runs alongside a
+         * conservative one (the same depths), with nothing for the conservative one to
+         * do */
         r.span = no_span;
         r.centres = &tf;
-        r.centre_mask = m->fneed;
+        r.centre_mask = m->fneed + (size_t)2 * y0 * m->fwords;
         r.mask_words = m->fwords;
     }
-    raster_scene(m, &r);
+    raster_scene(m, &r, bins, 2);
+}
+
+om_status om__spsm_build(void *state, om_diag *d)
+{
+    (void)d;
+    om__spsm_state *m = (om__spsm_state *)state;
+    const om_mat4 *vp;
+    uint32_t counts[8] = {0};
+    om__spsm_build_rows(m, NULL, 0, om__spsm_map_of(m, &vp), counts);
     return OM_OK;
 }

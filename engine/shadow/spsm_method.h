@@ -119,7 +119,11 @@ static inline double om__spsm_clipped_min(const int64_t X[3], const int64_t Y[3]
     return best;
 }
 
-/* The build (spsm_build.c): the records the lookup will read, from the marks. */
+/* The build (spsm_build.c): the records the lookup will read, from the marks; by bands
+ * of the map's rows (om__bands: map_of on the calling thread, then build_rows for
+ * each band), or all at once. */
 om_status om__spsm_build(void *state, om_diag *d);
+uint32_t om__spsm_map_of(void *state, const om_mat4 **vp);
+void om__spsm_build_rows(const void *state, const om__bins *bins, uint32_t y0, uint32_t rows, uint32_t counts[8]);
 
 #endif
