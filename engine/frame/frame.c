@@ -40,7 +40,7 @@ static size_t map_bins_bytes(const om__bands *b, const om_scene *s)
 
 size_t om_frame_bytes_jobs(const om_method *m, const om_scene *s, uint32_t threads)
 {
-    if (threads <= 1) return 0;
+    if (!OM_WITH_JOBS || threads <= 1) return 0;
     const om__bands *b = m ? om__method_bands(m) : NULL;
     return (size_t)threads * BANDS_PER_JOB *
                (om_arena_need(sizeof(job_slot), 8) + (b ? om_arena_need(b->scratch ? b->scratch : 1, 16) : 0)) +
@@ -203,7 +203,7 @@ static bool carve_bins(om_arena *fa, const om_scene *s, om__bins *b)
 static void prepare(frame_ctx *c, bool eye, bool mark, om_frame_stats *fs)
 {
     uint64_t t0 = now(c->fd);
-    if (c->jobs > 1) {
+    if (OM_WITH_JOBS && c->jobs > 1) {
         c->eye = eye;
         c->mark = mark;
         run_bands(c, STAGE_PREPARE);
@@ -232,7 +232,7 @@ static void carve_jobs(frame_ctx *c, om_arena *fa, size_t keep)
 {
     const om_frame_desc *fd = c->fd;
     c->jobs = 1;
-    if (!fd->parallel_for || fd->threads <= 1) return;
+    if (!OM_WITH_JOBS || !fd->parallel_for || fd->threads <= 1) return;
     const om__bands *b = om__method_bands(fd->method);
     size_t per = om_frame_bytes_jobs(fd->method, NULL, 2) / 2;
     size_t left = om_arena_left(fa), fit = left > keep ? (left - keep) / per : 0;
@@ -306,14 +306,14 @@ om_status om_render_frame(const om_frame_desc *fd, om_arena *fa, om_frame_stats 
         size_t keep = (single ? bins_bytes(s) : 0) + map_bins_bytes(b, s);
         carve_jobs(&c, fa, om_arena_left(fa) >= keep + om_frame_bytes_jobs(m, NULL, 2) ? keep : 0);
     }
-    if (single && c.jobs > 1) eye_bins = carve_bins(fa, s, &bins);
+    if (single && OM_WITH_JOBS && c.jobs > 1) eye_bins = carve_bins(fa, s, &bins);
     if (eye_bins) {
         uint64_t tb = now(fd);
         om__bins_make(s, &view.cam_vp, W, H, &bins);
         fs->ns_eye += now(fd) - tb;
         c.bins = &bins;
     }
-    if (c.jobs > 1 && c.bands && c.bands->build_rows) carve_bins(fa, s, &c.map_bins);
+    if (OM_WITH_JOBS && c.jobs > 1 && c.bands && c.bands->build_rows) carve_bins(fa, s, &c.map_bins);
     fs->jobs = c.jobs;
     const bool observes = (m->flags & OM_METHOD_OBSERVES) && (!m->observes || m->observes(fd->method_state));
     const bool fit = view.light.kind == OM_LIGHT_DIRECTIONAL;
@@ -346,7 +346,7 @@ om_status om_render_frame(const om_frame_desc *fd, om_arena *fa, om_frame_stats 
         have_terms = single;   /* observe leaves the strip as marked */
     }
     t0 = now(fd);
-    if (c.jobs > 1 && c.bands && c.bands->build_rows) build_map(&c);
+    if (OM_WITH_JOBS && c.jobs > 1 && c.bands && c.bands->build_rows) build_map(&c);
     else st = m->build(fd->method_state, d);
     fs->ns_build += now(fd) - t0;
     if (st != OM_OK) goto done;
@@ -354,7 +354,7 @@ om_status om_render_frame(const om_frame_desc *fd, om_arena *fa, om_frame_stats 
         strip_at(&c, y, rows);
         prepare(&c, !have_samples, !have_terms, fs);
         t0 = now(fd);
-        if (c.bands) {
+        if (OM_WITH_JOBS && c.bands) {
             for (uint32_t j = 0; j < BANDS_PER_JOB * c.jobs; j++)
                 memset(c.slots[j].counts, 0, sizeof c.slots[j].counts);
             run_bands(&c, STAGE_RESOLVE);
@@ -369,7 +369,7 @@ om_status om_render_frame(const om_frame_desc *fd, om_arena *fa, om_frame_stats 
         fs->ns_resolve += now(fd) - t0;
         if (st != OM_OK) goto done;
         t0 = now(fd);
-        if (c.jobs > 1) run_bands(&c, STAGE_SHADE);
+        if (OM_WITH_JOBS && c.jobs > 1) run_bands(&c, STAGE_SHADE);
         else om__shade_strip(s, &view, fd->shade, &c.strip, fd->fb);
         fs->ns_shade += now(fd) - t0;
         fs->strips++;

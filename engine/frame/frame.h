@@ -10,6 +10,19 @@
 #include <string.h>
 #include <math.h>
 
+/* OM_WITH_JOBS (0 or 1): whether the engine carries the code that runs a frame on the
+ * host's threads (bands, om__bands). 1 by default, but 0 on Cortex-M cores (ACLE's
+ * __ARM_ARCH_PROFILE 'M': one core), so that a firmware carries none of it; a frame
+ * then runs inline whatever parallel-for it is handed, and om_frame_bytes_jobs is 0.
+ * The same frames either way. */
+#ifndef OM_WITH_JOBS
+#if defined(__ARM_ARCH_PROFILE) && __ARM_ARCH_PROFILE == 'M'
+#define OM_WITH_JOBS 0
+#else
+#define OM_WITH_JOBS 1
+#endif
+#endif
+
 /* Renders rows [st->y0, st->y0 + st->rows) of the camera view into `tg` (depth and
  * triangle id, strip-sized) and resolves st->samples: the exact point of the visible
  * triangle under each pixel centre, by perspective-correct barycentrics. `bins` may be

@@ -76,6 +76,7 @@ BANDED(DECLARE_BANDS)
 
 const om__bands *om__method_bands(const om_method *m_)
 {
+    if (!OM_WITH_JOBS) return NULL;   /* (frame.h) none linked */
     BANDED(BANDS)
     (void)m_;
     return NULL;

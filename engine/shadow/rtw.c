@@ -411,7 +411,7 @@ static uint32_t render_exact(const om__rtw *m, om_raster *r, const om__bins *bin
     om__cull_begin(&cl, s, &m->view.light_vp);
     uint32_t drawn = 0;
     for (uint32_t t = 0; t < s->ntris; t++) {
-        if (rows) {
+        if (OM_WITH_JOBS && rows) {
             const uint32_t r0 = rows[t] & 0xFFFFu, r1 = rows[t] >> 16;
             if (r0 > r1) continue;   /* covers nothing */
             /* rows at the image's edges were clamped there: open-ended */
@@ -425,6 +425,10 @@ static uint32_t render_exact(const om__rtw *m, om_raster *r, const om__bins *bin
         for (int k = 0; k < 3; k++)
             ok = ok && om__finite(c[k].x) && om__finite(c[k].y) && om__finite(c[k].z) && om__finite(c[k].w);
         if (!ok) continue;
+        if (!OM_WITH_JOBS) {   /* one band, the whole map: every fill counts (frame.h) */
+            drawn += (uint32_t)om__raster_tri_on(r, c, t, OM_LIGHT_GRID, OM_LIGHT_GRID);
+            continue;
+        }
         int64_t gx[9], gy[9];
         uint32_t gz[9];
         const int n = om__clip_project(c, OM_LIGHT_GRID, OM_LIGHT_GRID, gx, gy, gz);

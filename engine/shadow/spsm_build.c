@@ -90,7 +90,7 @@ static void texel(build_ctx *b, int32_t x, int32_t y, const om__rtri *t)
     const int64_t kx = (int64_t)x * OM_SUBPIX, ky = (int64_t)y * OM_SUBPIX;
     /* a triangle touching this texel alone lies inside it: its nearest vertex is the
      * answer (at the map's edge the bounds are clamped, and zmin stays a lower bound) */
-    const bool alone = t->minx == t->maxx && t->miny == t->maxy && one_row(m, e);
+    const bool alone = t->minx == t->maxx && t->miny == t->maxy && (!OM_WITH_JOBS || one_row(m, e));
     if (!alone && !om__tri2_covers(e, kx + (t->zx > 0 ? 0 : OM_SUBPIX), ky + (t->zy > 0 ? 0 : OM_SUBPIX))) {
         const om__spsm_zplane p = {t->z0, t->zx, t->zy, e->x[0], e->y[0]};
         double zc = om__spsm_clipped_min(e->x, e->y, kx, ky, OM_SUBPIX, &p);
@@ -190,8 +190,8 @@ static void raster_scene(const om__spsm_state *m, om_raster *r, const om__bins *
 {
     const om_scene *s = m->scene;
     const uint32_t y0 = r->target->y0, y1 = r->target->y0 + r->target->rows - 1;
-    const uint32_t *rows = bins ? bins->rows : NULL;
-    const om__vsnap *vs = bins && fine == 1 ? bins->verts : NULL;
+    const uint32_t *rows = OM_WITH_JOBS && bins ? bins->rows : NULL;   /* (frame.h) */
+    const om__vsnap *vs = OM_WITH_JOBS && bins && fine == 1 ? bins->verts : NULL;
     om__cull cl;
     om__cull_begin(&cl, s, &m->view.light_vp);
     for (uint32_t t = 0; t < s->ntris; t++) {
