@@ -243,7 +243,7 @@ static void hybrid_bands(void)
  *  - rtw's warped map by bands: the exact map (with the light's bins, which pass over
  *    the triangles that miss a band's grid rows, and without: the counters hold the
  *    triangles drawn, counted in the band of a triangle's first grid row), the warped
- *    vertices' map (every band splits every triangle alike), forward analysis;
+ *    vertices' map (the first band makes it whole), forward analysis;
  *  - spsm's map by bands (a triangle touching one texel row of the whole map, not of
  *    its band, takes its nearest vertex's depth; the fine map's rows are two of the
  *    map's; with the light's bins and without) and its resolve by bands with AA (its

@@ -443,9 +443,7 @@ static uint32_t render_exact(const om__rtw *m, om_raster *r, const om__bins *bin
     return drawn;
 }
 
-/* The warped map with warped vertices (rtw_exact 0): every band walks and splits every
- * triangle (the cap on splitting counts them all, so each band splits alike) and fills
- * its own rows; the count is the same in every band. */
+/* The warped map with warped vertices (rtw_exact 0), into r's target. */
 static uint32_t render_tess(const om__rtw *m, om_raster *r)
 {
     const om_scene *s = m->scene;
@@ -495,6 +493,13 @@ static void rtw_build_rows(const void *state, const om__bins *bins, uint32_t y0,
                            uint32_t counts[8])
 {
     const om__rtw *m = (const om__rtw *)state;
+    /* Warped vertices (rtw.exact 0): the cap on splitting counts the pieces of the
+     * whole map in triangle order, so a band would split every triangle to fill its
+     * rows; the first band makes the whole map, the others nothing. */
+    if (!m->cfg.rtw_exact) {
+        if (y0 > 0) return;
+        rows = m->size;
+    }
     om_target tg = {m->size, m->size, y0, rows, m->depth + (size_t)y0 * m->size, NULL};
     om__target_clear(&tg);
     om__hiz_clear(m->hiz, &tg);   /* bands start on multiples of 16 rows: no tile shared */
@@ -502,12 +507,7 @@ static void rtw_build_rows(const void *state, const om__bins *bins, uint32_t y0,
     memset(&r, 0, sizeof r);
     r.target = &tg;
     r.mode = OM_RASTER_DEPTH;
-    if (m->cfg.rtw_exact) {
-        counts[2] += render_exact(m, &r, bins);
-    } else {
-        const uint32_t drawn = render_tess(m, &r);
-        if (y0 == 0) counts[2] += drawn;
-    }
+    counts[2] += m->cfg.rtw_exact ? render_exact(m, &r, bins) : render_tess(m, &r);
 }
 
 /* The exact map's inverse-warped grid and its indexes, which every row reads. */
