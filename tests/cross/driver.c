@@ -12,8 +12,9 @@
  *   stab-t0@WxH      a stability case (the fast camera: ASM nodes replaced every frame)
  *   stab-t1@WxH      at time 0 and then 0.5 with the method's state carried over
  *
- * at 160x120 and 320x240 with the embedded configuration (maps of 96 texels, a 192 KiB
- * ASM cap, a 64-cell RTW importance map: what fits a microcontroller), and, where
+ * at 160x120 and 320x240 with the embedded configuration (maps of 96 texels, 64 for
+ * spsm and hybrid, a 96 KiB ASM cap, a 64-cell RTW importance map: what fits a
+ * microcontroller), and, where
  * OM_CROSS_BIG is defined (hosted targets), at 640x480 with maps of 1024. After the
  * default@160x120 lines come "bytes" lines with each method's arena peak and minimum
  * (they depend on pointer size, so they are not compared). OM_CROSS_ONLY selects
@@ -70,10 +71,11 @@ static unsigned char method_mem[OM_CROSS_METHOD_MEM];
  * triangle, 12 a vertex), without which every strip would walk the whole scene */
 #ifdef OM_CROSS_COUNT
 static unsigned char frame_mem[160 * OM_CROSS_ROWS * 48 + (320u << 10)];
+static uint8_t pixels[160 * OM_CROSS_ROWS * 2];   /* one strip: part of the footprint */
 #else
 static unsigned char frame_mem[FRAME_PIXELS * 48];
-#endif
 static uint8_t pixels[FRAME_PIXELS * 2];
+#endif
 
 #ifndef OM_CROSS_COUNT
 typedef struct hashes { uint64_t img, mask; } hashes;
@@ -148,10 +150,13 @@ static void method_cfg(om_method_cfg *c, const om_method *m, const size_cfg *sz,
 {
     om_method_cfg_default(c, m);
     if (sz->embedded) {
-        /* small enough for small machines, the same everywhere (the hashes must agree) */
-        om_method_cfg_set(c, "map", 96, NULL);
-        om_method_cfg_set(c, "hybrid.map", 96, NULL);
-        om_method_cfg_set(c, "asm.cap", 192u << 10, NULL);
+        /* small enough for small machines, the same everywhere (the hashes must agree):
+         * each method's whole footprint on the small scene at 160x120 within 256 KiB
+         * (the counting firmware checks it), which takes spsm's 24-byte texels a map of
+         * 64 and asm a cap of 96 KiB */
+        om_method_cfg_set(c, "map", strcmp(m->name, "spsm") ? 96 : 64, NULL);
+        om_method_cfg_set(c, "hybrid.map", 64, NULL);
+        om_method_cfg_set(c, "asm.cap", 96u << 10, NULL);
         om_method_cfg_set(c, "rtw.importance", 64, NULL);
     } else {
         om_method_cfg_set(c, "map", 1024, NULL);
@@ -167,17 +172,39 @@ static void method_cfg(om_method_cfg *c, const om_method *m, const size_cfg *sz,
 /* Instructions per frame on the Cortex-M4 board (`make cross-test`, OM_CROSS_COUNT):
  * each method renders the small and the default scene at 160x120 through strips of
  * OM_CROSS_ROWS rows into RGB565, with the embedded configuration, and prints
- *   count SCENE METHOD INSTRUCTIONS EYE OBSERVE BUILD RESOLVE SHADE METHOD_B FRAME_B SCENE_B
- * (instructions of the frame and of its stages; the arenas' peak bytes). asm is
- * counted on its second frame, when its tiles are cached, as a frame of a running
- * application would be. Under qemu-system-arm -icount shift=0 the board's clock ticks
- * one nanosecond per instruction; the MPS2's CMSDK timer 0 (0x40000000) counts down
- * at 25 MHz, so one tick is 40 instructions. For profiling, OM_CROSS_COUNT_ONLY="sm"
- * counts one method and OM_CROSS_COUNT_SMALL the small scene alone (then qemu's
- * `-d exec,nochain,in_asm` log, summed per function, says where they go). The strips
- * go nowhere: a device would send them to its display, and the count is the
- * engine's. */
+ *   count SCENE METHOD INSTRUCTIONS EYE OBSERVE BUILD RESOLVE SHADE METHOD_B FRAME_B
+ *         SCENE_B MIN_B STATIC_B STACK_B WHOLE_B
+ * (instructions of the frame and of its stages; the arenas' peak bytes, the method's
+ * minimum by its bytes query, the firmware's other static data, the stack's deepest
+ * point and the sum of all these: the whole footprint). asm is counted on its second
+ * frame, when its tiles are cached, as a frame of a running application would be.
+ *
+ * On the small scene the whole footprint must stay within WHOLE (256 KiB, issue
+ * #29's target): the frame arena gets what om_frame_bytes_scene asks, and the method
+ * what its bytes query asks for one pass where that fits the rest, else the rest (it
+ * then works in smaller pieces); a method whose minimum does not fit prints "too big",
+ * one whose footprint ends over prints "over", and both fail the run. The default
+ * scene (a 462 KB scene arena) is beyond that; there a method gets up to 256 KiB.
+ *
+ * Under qemu-system-arm -icount shift=0 the board's clock ticks one nanosecond per
+ * instruction; the MPS2's CMSDK timer 0 (0x40000000) counts down at 25 MHz, so one
+ * tick is 40 instructions. For profiling, OM_CROSS_COUNT_ONLY="sm" counts one method
+ * and OM_CROSS_COUNT_SMALL the small scene alone (then qemu's `-d exec,nochain,in_asm`
+ * log, summed per function, says where they go). The strips go nowhere: a device
+ * would send them to its display, and the count is the engine's. */
 #define CMSDK_TIMER0 ((volatile uint32_t *)0x40000000u)
+#ifndef OM_CROSS_WHOLE
+#define OM_CROSS_WHOLE (256u << 10)
+#endif
+#define WHOLE ((size_t)OM_CROSS_WHOLE)
+/* The stack the budget leaves room for; the run fails if it goes deeper. */
+#define STACK_ROOM (24u << 10)
+/* How much of the stack is painted to find its deepest point. */
+#define STACK_PAINT (64u << 10)
+#define PAINT 0x5AA5C33Cu
+
+/* The linker script's ends of .data, .bss and the stack (platform/cortex-m/mps2.ld). */
+extern uint32_t __data_start, __data_end, __bss_start, __bss_end, __stack_top;
 
 static uint64_t count_now(void *user)
 {
@@ -185,7 +212,45 @@ static uint64_t count_now(void *user)
     return (uint64_t)(0xFFFFFFFFu - CMSDK_TIMER0[1]) * 40u;
 }
 
-static void count_scene(const char *tag, const char *text, int *bad)
+/* .data and .bss but for the three arenas' buffers: the strip's pixels, the C
+ * library's and the driver's own (the engine has none: tests/freestanding.sh). */
+static size_t static_bytes(void)
+{
+    const size_t all = (size_t)((uintptr_t)&__data_end - (uintptr_t)&__data_start) +
+                       (size_t)((uintptr_t)&__bss_end - (uintptr_t)&__bss_start);
+    return all - sizeof scene_mem - sizeof method_mem - sizeof frame_mem;
+}
+
+/* The stack's lowest STACK_PAINT bytes, up to just below the caller, filled with PAINT;
+ * stack_depth then finds the lowest word that changed. Both run between frames,
+ * outside what is counted. */
+static __attribute__((noinline)) void stack_paint(void)
+{
+    volatile uint32_t here = 0;
+    volatile uint32_t *p = (volatile uint32_t *)((uintptr_t)&__stack_top - STACK_PAINT);
+    const uintptr_t below = (uintptr_t)&here - 64;
+    while ((uintptr_t)p < below) *p++ = PAINT;
+}
+
+static __attribute__((noinline)) size_t stack_depth(void)
+{
+    volatile uint32_t *p = (volatile uint32_t *)((uintptr_t)&__stack_top - STACK_PAINT);
+    while (p < &__stack_top && *p == PAINT) p++;
+    return (size_t)((uintptr_t)&__stack_top - (uintptr_t)p);
+}
+
+static void say(const char *what, const char *tag, const char *method)
+{
+    line l = {{0}, 0};
+    put_s(&l, what);
+    put_s(&l, ": ");
+    put_s(&l, tag);
+    put_s(&l, " ");
+    put_s(&l, method);
+    om_host_puts(l.buf);
+}
+
+static void count_scene(const char *tag, const char *text, int whole, int *bad)
 {
     static const size_cfg sz = {160, 120, OM_CROSS_ROWS, 1, "@160x120"};
     om_arena sa;
@@ -200,6 +265,14 @@ static void count_scene(const char *tag, const char *text, int *bad)
     cam.width = sz.w;
     cam.height = sz.h;
     if (om_view_init(&v, &cam, &light, &s, &d) != OM_OK) { *bad |= fail(tag, "-", "view", &d); return; }
+    const size_t frame_need = om_frame_bytes_scene(&s, sz.w, sz.rows), stat = static_bytes();
+    /* what a method may take: all that is left of WHOLE, or (default scene) 256 KiB */
+    size_t room = sizeof method_mem;
+    if (whole) {
+        const size_t rest = sa.peak + frame_need + stat + STACK_ROOM;
+        room = rest < WHOLE ? WHOLE - rest : 0;
+        if (room > sizeof method_mem) room = sizeof method_mem;
+    }
     for (size_t k = 0; k < om_method_count(); k++) {
         const om_method *m = om_method_at(k);
 #ifdef OM_CROSS_COUNT_ONLY
@@ -210,17 +283,13 @@ static void count_scene(const char *tag, const char *text, int *bad)
         size_t mn, full;
         om_arena ma, fa;
         void *state;
-        if (m->bytes(&cfg, &s, sz.w, sz.h, &mn, &full) != OM_OK || mn > sizeof method_mem) {
-            line l = {{0}, 0};
-            put_s(&l, "too big: ");
-            put_s(&l, tag);
-            put_s(&l, " ");
-            put_s(&l, m->name);
-            om_host_puts(l.buf);
+        if (m->bytes(&cfg, &s, sz.w, sz.h, &mn, &full) != OM_OK || mn > room) {
+            say("too big", tag, m->name);
             *bad = 1;
             continue;
         }
-        om_arena_init(&ma, method_mem, full < sizeof method_mem ? full : sizeof method_mem, "method");
+        stack_paint();
+        om_arena_init(&ma, method_mem, full < room ? full : room, "method");
         if (m->init(&state, &ma, &cfg, &s, sz.w, sz.h, &d) != OM_OK) { *bad |= fail(tag, m->name, "init", &d); continue; }
         om_shade_cfg shade;
         om_shade_cfg_default(&shade);
@@ -233,16 +302,18 @@ static void count_scene(const char *tag, const char *text, int *bad)
         uint64_t n = 0;
         size_t frame_peak = 0;
         for (int f = 0; f < (strcmp(m->name, "asm") ? 1 : 2); f++) {
-            om_arena_init(&fa, frame_mem, sizeof frame_mem, "frame");
+            om_arena_init(&fa, frame_mem, whole ? frame_need : sizeof frame_mem, "frame");
             const uint64_t t0 = count_now(NULL);
             if (om_render_frame(&fd, &fa, &fs, &d) != OM_OK) { *bad |= fail(tag, m->name, "render", &d); n = 0; break; }
             n = count_now(NULL) - t0;
             frame_peak = fa.peak;
         }
         if (!n) continue;
+        const size_t stack = stack_depth();
+        const size_t all = sa.peak + frame_peak + ma.peak + stat + stack;
         line l = {{0}, 0};
         const uint64_t fig[] = {n, fs.ns_eye, fs.ns_observe, fs.ns_build, fs.ns_resolve, fs.ns_shade,
-                                ma.peak, frame_peak, sa.peak};
+                                ma.peak, frame_peak, sa.peak, mn, stat, stack, all};
         put_s(&l, "count ");
         put_s(&l, tag);
         put_s(&l, " ");
@@ -252,6 +323,10 @@ static void count_scene(const char *tag, const char *text, int *bad)
             put_dec(&l, fig[i]);
         }
         om_host_puts(l.buf);
+        if (whole && (all > WHOLE || stack > STACK_ROOM)) {
+            say(all > WHOLE ? "over its whole budget" : "stack deeper than its room", tag, m->name);
+            *bad = 1;
+        }
     }
 }
 
@@ -261,9 +336,9 @@ int om_cross_main(void)
     CMSDK_TIMER0[2] = 0xFFFFFFFFu;   /* reload */
     CMSDK_TIMER0[1] = 0xFFFFFFFFu;   /* value */
     CMSDK_TIMER0[0] = 1;             /* enable */
-    count_scene("small", om_scene_small_text(), &bad);
+    count_scene("small", om_scene_small_text(), 1, &bad);
 #ifndef OM_CROSS_COUNT_SMALL
-    count_scene("default", om_scene_default_text(), &bad);
+    count_scene("default", om_scene_default_text(), 0, &bad);
 #endif
     return bad;
 }
