@@ -269,7 +269,8 @@ static void odd_lights(void)
 }
 
 /* The reference at its least memory (no vertex cache, leaves of 32, boxes found from
- * the vertices during the build) gives exactly the one-pass terms. */
+ * the vertices during the build), and just below its one-pass size (the vertex cache
+ * and the 3-D walk, without the packets), gives exactly the one-pass terms. */
 static void ref_small_equals_fast(void)
 {
     h_scene hs;
@@ -289,29 +290,37 @@ static void ref_small_equals_fast(void)
     cam.width = W;
     cam.height = H;
     CHECK_OK(om_view_init(&v, &cam, &light, &hs.s, NULL));
-    unsigned char *mem = malloc(mn), *fmem = malloc(om_frame_bytes(W, H)), *px = malloc(W * H * 3);
-    om_arena ma, fa;
-    om_arena_init(&ma, mem, mn, "method");
-    om_arena_init(&fa, fmem, om_frame_bytes(W, H), "frame");
-    void *state;
-    CHECK_OK(m->init(&state, &ma, &c, &hs.s, W, H, NULL));
-    om_framebuffer fb = {OM_RGB888, W, H, W * 3, px};
-    om_shade_cfg shade;
-    om_shade_cfg_default(&shade);
-    om_frame_desc fd;
-    memset(&fd, 0, sizeof fd);
-    fd.scene = &hs.s; fd.view = &v; fd.method = m; fd.method_state = state; fd.shade = &shade;
-    fd.fb = &fb;
-    /* terms out through a strip callback */
-    struct cap { om_term *t; } cp = {small};
-    fd.user = &cp;
-    fd.on_strip = capture_terms;
-    CHECK_OK(om_render_frame(&fd, &fa, NULL, NULL));
-    CHECK(!memcmp(fast, small, sizeof fast));
-    CHECK(ma.peak <= mn);
-    free(mem);
-    free(fmem);
-    free(px);
+    for (int k = 0; k < 2; k++) {
+        const size_t size = k ? full - 1 : mn;
+        unsigned char *mem = malloc(size), *fmem = malloc(om_frame_bytes(W, H)), *px = malloc(W * H * 3);
+        om_arena ma, fa;
+        om_arena_init(&ma, mem, size, "method");
+        om_arena_init(&fa, fmem, om_frame_bytes(W, H), "frame");
+        void *state;
+        CHECK_OK(m->init(&state, &ma, &c, &hs.s, W, H, NULL));
+        om_framebuffer fb = {OM_RGB888, W, H, W * 3, px};
+        om_shade_cfg shade;
+        om_shade_cfg_default(&shade);
+        om_frame_desc fd;
+        memset(&fd, 0, sizeof fd);
+        fd.scene = &hs.s; fd.view = &v; fd.method = m; fd.method_state = state; fd.shade = &shade;
+        fd.fb = &fb;
+        /* terms out through a strip callback */
+        struct cap { om_term *t; } cp = {small};
+        fd.user = &cp;
+        fd.on_strip = capture_terms;
+        memset(small, 0, sizeof small);
+        CHECK_OK(om_render_frame(&fd, &fa, NULL, NULL));
+        CHECK(!memcmp(fast, small, sizeof fast));
+        om_method_stats ms;
+        m->stats(state, &ms);
+        CHECK(ma.peak <= size);
+        if (k) CHECK(ms.bytes_used > mn && ms.bytes_used < full / 2);   /* the middle mode */
+        else CHECK(ma.peak <= mn);
+        free(mem);
+        free(fmem);
+        free(px);
+    }
     h_scene_free(&hs);
 }
 
