@@ -181,7 +181,7 @@ static void method_cfg(om_method_cfg *c, const om_method *m, const size_cfg *sz,
  *
  * On the small scene the whole footprint must stay within WHOLE (256 KiB, issue
  * #29's target): the frame arena gets what om_frame_bytes_scene asks, and the method
- * what its bytes query asks for one pass where that fits the rest, else the rest (it
+ * what its bytes query calls full where that fits the rest, else the rest (it
  * then works in smaller pieces); a method whose minimum does not fit prints "too big",
  * one whose footprint ends over prints "over", and both fail the run. The default
  * scene (a 462 KB scene arena) is beyond that; there a method gets up to 256 KiB.
