@@ -183,7 +183,7 @@ static void method_cfg(om_method_cfg *c, const om_method *m, const size_cfg *sz,
  * #29's target): the frame arena gets what om_frame_bytes_scene asks, and the method
  * what its bytes query calls full where that fits the rest, else the rest (it
  * then works in smaller pieces); a method whose minimum does not fit prints "too big",
- * one whose footprint ends over prints "over", and both fail the run. The default
+ * one whose footprint ends over prints "over its whole budget", and both fail the run. The default
  * scene (a 462 KB scene arena) is beyond that; there a method gets up to 256 KiB.
  *
  * Under qemu-system-arm -icount shift=0 the board's clock ticks one nanosecond per
