@@ -7,6 +7,7 @@
 #include "harness.h"
 #include "../platform/platform.h"
 
+#include <stdio.h>
 #include <stdlib.h>
 
 /* Jobs in reverse order on the calling thread: no job may depend on another's order. */
@@ -163,48 +164,10 @@ static void fewer_jobs(void)
 static frame_out hybrid_frame(const om_scene *s, uint32_t pool, uint32_t rows, om_parallel_for_fn pf,
                               void *host, uint32_t threads)
 {
-    frame_out o;
-    memset(&o, 0, sizeof o);
     const om_method *m = om_method_find("hybrid");
-    om_camera cam;
-    om_light light;
-    om_view v;
-    om_diag d;
-    om_scene_at(s, 0.0f, &cam, &light);
-    cam.width = 160;
-    cam.height = 120;
-    if ((o.st = om_view_init(&v, &cam, &light, s, &d))) return o;
-    om_method_cfg c;
-    om_method_cfg_default(&c, m);
-    if ((o.st = om_method_cfg_set(&c, "izb.pool", pool, &d))) return o;
-    size_t mn, full;
-    if ((o.st = m->bytes(&c, s, 160, 120, &mn, &full))) return o;
-    uint32_t r = rows ? rows : 120;
-    size_t fbytes = om_frame_bytes_scene(s, 160, r) + om_frame_bytes_jobs(m, s, threads);
-    void *mm = malloc(full), *fm = malloc(fbytes), *px = malloc((size_t)160 * r * 3);
-    om_arena ma, fa;
-    om_arena_init(&ma, mm, full, "method");
-    om_arena_init(&fa, fm, fbytes, "frame");
-    void *state;
-    if ((o.st = m->init(&state, &ma, &c, s, 160, 120, &d)) == OM_OK) {
-        om_framebuffer fb = {OM_RGB888, 160, r, 160 * 3, (uint8_t *)px};
-        om_shade_cfg shade;
-        om_shade_cfg_default(&shade);
-        om_frame_desc fd;
-        memset(&fd, 0, sizeof fd);
-        fd.scene = s; fd.view = &v; fd.method = m; fd.method_state = state; fd.shade = &shade;
-        fd.strip_rows = rows; fd.fb = &fb; fd.on_strip = on_strip; fd.user = &o.hash;
-        fd.parallel_for = pf; fd.parallel_user = host; fd.threads = threads;
-        o.hash = OM_HASH_INIT;
-        om_frame_stats fs;
-        o.st = om_render_frame(&fd, &fa, &fs, &d);
-        o.jobs = fs.jobs;
-        m->stats(state, &o.ms);
-    }
-    free(mm);
-    free(fm);
-    free(px);
-    return o;
+    char set[32];
+    snprintf(set, sizeof set, "izb.pool=%u", pool);
+    return render_set(s, m, set, 160, 120, rows, pf, host, threads, om_frame_bytes_jobs(m, s, threads), true);
 }
 
 static void hybrid_bands(void)
