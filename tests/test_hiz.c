@@ -106,7 +106,7 @@ static void draw(uint32_t *depth, bool with_hiz, uint32_t band, const int64_t *g
 {
     for (uint32_t y0 = 0; y0 < HH; y0 += band ? band : HH) {
         om_target t = {HW, HH, y0, band && y0 + band < HH ? band : HH - y0, depth + (size_t)y0 * HW, NULL};
-        om_raster r = {&t, OM_RASTER_DEPTH, NULL, NULL, NULL, NULL, 0, false, gx, gy, NULL, NULL, 0, 0};
+        om_raster r = {&t, OM_RASTER_DEPTH, NULL, NULL, NULL, NULL, 0, false, gx, gy, NULL, NULL, 0, 0, NULL, 0};
         om__target_clear(&t);
         om__hiz_clear(with_hiz ? hiz_buf : NULL, &t);
         for (int k = 0; k < NTRI; k++)
@@ -182,7 +182,7 @@ static void hiz_clipped_huge(void)
             }
         for (int pass = 0; pass < 2; pass++) {
             om_target t = {HW, HH, 0, HH, pass ? coarse : plain, NULL};
-            om_raster r = {&t, OM_RASTER_DEPTH, NULL, NULL, NULL, NULL, 0, false, NULL, NULL, NULL, NULL, 0, 0};
+            om_raster r = {&t, OM_RASTER_DEPTH, NULL, NULL, NULL, NULL, 0, false, NULL, NULL, NULL, NULL, 0, 0, NULL, 0};
             om__target_clear(&t);
             om__hiz_clear(pass ? hiz_buf : NULL, &t);
             for (int k = 0; k < NTRI; k++) om__raster_tri_on_hiz(&r, pass ? hiz_buf : NULL, c[k], (uint32_t)k, HW, HH);

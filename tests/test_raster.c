@@ -67,7 +67,7 @@ static void add_coverage(const om_vec4 c[3], uint32_t w, uint32_t h)
 {
     om_target t = target(w, h);
     om__target_clear(&t);
-    om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL, NULL, NULL, 0, false, NULL, NULL, NULL, NULL, 0, 0};
+    om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL, NULL, NULL, 0, false, NULL, NULL, NULL, NULL, 0, 0, NULL, 0};
     om__raster_tri(&r, c, 7);
     for (uint32_t i = 0; i < w * h; i++) count_buf[i] += id_buf[i] == 7;
 }
@@ -336,7 +336,7 @@ static void huge_ground(float half)
     for (int i = 0; i < 4; i++) c[i] = om__mat_apply(&vp, q[i]);
     om_target t = target(W, H);
     om__target_clear(&t);
-    om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL, NULL, NULL, 0, false, NULL, NULL, NULL, NULL, 0, 0};
+    om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL, NULL, NULL, 0, false, NULL, NULL, NULL, NULL, 0, 0, NULL, 0};
     om_vec4 t1[3] = {c[0], c[1], c[2]}, t2[3] = {c[0], c[2], c[3]};
     om__raster_tri(&r, t1, 1);
     om__raster_tri(&r, t2, 2);
@@ -440,7 +440,7 @@ static void snapped_matches_clipped(void)
             z[i] = (uint32_t)((double)c[i].z * 4294967296.0);
         }
         om_target t = target(TW, TH);
-        om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL, NULL, NULL, 0, false, NULL, NULL, NULL, NULL, 0, 0};
+        om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL, NULL, NULL, 0, false, NULL, NULL, NULL, NULL, 0, 0, NULL, 0};
         om__target_clear(&t);
         om__raster_tri(&r, c, 5);
         memcpy(d0, depth_buf, sizeof d0);
@@ -476,7 +476,7 @@ static void grid_matches_point_tests(void)
         for (int i = 0; i < GH; i++) { gy[i] = g; g += (int64_t)(rnd() % 4 ? rnd() % 600 : 0); }
         om_target t = target(GW, GH);
         t.id = NULL;
-        om_raster r = {&t, OM_RASTER_DEPTH, NULL, NULL, NULL, NULL, 0, false, gx, gy, NULL, NULL, 0, 0};
+        om_raster r = {&t, OM_RASTER_DEPTH, NULL, NULL, NULL, NULL, 0, false, gx, gy, NULL, NULL, 0, 0, NULL, 0};
         if (round % 2) {
             r.grid_shift = 4 + (uint32_t)(round / 2) % 8;
             r.grid_buckets = (uint32_t)((gx[GW - 1] > gy[GH - 1] ? gx[GW - 1] : gy[GH - 1]) >> r.grid_shift) + 1;
@@ -538,7 +538,7 @@ static void fill_matches_point_tests(void)
     int bad = 0, covered = 0, inexact = 0;
     for (int round = 0; round < 30; round++) {
         om_target t = target(W, H);
-        om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL, NULL, NULL, 0, false, NULL, NULL, NULL, NULL, 0, 0};
+        om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL, NULL, NULL, 0, false, NULL, NULL, NULL, NULL, 0, 0, NULL, 0};
         om__target_clear(&t);
         int nt = 0;
         for (int k = 0; k < NT; k++) {
@@ -648,7 +648,7 @@ static void conservative_superset(void)
         memset(cons, 0, sizeof cons);
         om_target t = target(TW, TH);
         cons_ctx ctx = {cons, TW};
-        om_raster r = {&t, OM_RASTER_CONSERVATIVE, cons_span, &ctx, NULL, NULL, 0, false, NULL, NULL, NULL, NULL, 0, 0};
+        om_raster r = {&t, OM_RASTER_CONSERVATIVE, cons_span, &ctx, NULL, NULL, 0, false, NULL, NULL, NULL, NULL, 0, 0, NULL, 0};
         om__raster_tri(&r, c, 1);
         for (int i = 0; i < TW * TH; i++) {
             if (count_buf[i] && !cons[i]) missing++;
@@ -662,6 +662,51 @@ static void conservative_superset(void)
     }
     CHECK_EQ_U(missing, 0);
     CHECK_EQ_U(dup, 0);
+}
+
+/* A row mask (om_raster.row_mask) passes over exactly the rows whose bit, at
+ * y >> row_shift, is clear: there no span and no centre is written; every other row
+ * gets the spans and centre depths of the unmasked pass. */
+static void conservative_row_mask(void)
+{
+    static int cons[TW * TH], masked[TW * TH];
+    static uint32_t cdep[TW * TH], mdep[TW * TH];
+    rng_state = 515;
+    for (uint32_t shift = 0; shift <= 1; shift++) {
+        uint32_t rows[(TH + 31) / 32];
+        for (size_t i = 0; i < sizeof rows / sizeof rows[0]; i++) rows[i] = (uint32_t)rnd() * 2654435761u;
+        memset(cons, 0, sizeof cons);
+        memset(masked, 0, sizeof masked);
+        om_target t = target(TW, TH), ct = {TW, TH, 0, TH, cdep, NULL}, mt = {TW, TH, 0, TH, mdep, NULL};
+        om__target_clear(&ct);
+        om__target_clear(&mt);
+        cons_ctx a = {cons, TW}, b = {masked, TW};
+        om_raster r = {&t, OM_RASTER_CONSERVATIVE, cons_span, &a, &ct, NULL, 0, false, NULL, NULL, NULL, NULL, 0, 0, NULL, 0};
+        om_raster rm = r;
+        rm.user = &b;
+        rm.centres = &mt;
+        rm.row_mask = rows;
+        rm.row_shift = shift;
+        for (int k = 0; k < 200; k++) {
+            om_vec4 c[3];
+            for (int i = 0; i < 3; i++)
+                c[i] = at((double)(rnd() % (TW * 256)), (double)(rnd() % (TH * 256)), TW, TH, (float)(rnd() % 1000) / 1000.0f);
+            om__raster_tri(&r, c, (uint32_t)k);
+            om__raster_tri(&rm, c, (uint32_t)k);
+        }
+        int wrong = 0, kept = 0, passed = 0;
+        for (int y = 0; y < TH; y++) {
+            const uint32_t ym = (uint32_t)y >> shift;
+            const bool on = rows[ym >> 5] >> (ym & 31) & 1u;
+            for (int x = 0; x < TW; x++) {
+                const int i = y * TW + x;
+                if (on) wrong += masked[i] != cons[i] || mdep[i] != cdep[i], kept += cons[i] > 0;
+                else wrong += masked[i] != 0 || mdep[i] != 0xFFFFFFFFu, passed += cons[i] > 0;
+            }
+        }
+        CHECK_EQ_U(wrong, 0);
+        CHECK(kept > 0 && passed > 0);   /* both kinds of row were drawn on */
+    }
 }
 
 static void no_span(void *user, int32_t y, int32_t x0, int32_t x1, const om__rtri *t)
@@ -691,13 +736,13 @@ static void conservative_centres_match_depth_pass(void)
         for (int i = 0; i < 3; i++) c[k][i] = at((double)x[i], (double)y[i], TW, TH, (float)(rnd() % 1000) / 1000.0f);
     }
     om_target t = target(TW, TH);
-    om_raster r = {&t, OM_RASTER_DEPTH, NULL, NULL, NULL, NULL, 0, false, NULL, NULL, NULL, NULL, 0, 0};
+    om_raster r = {&t, OM_RASTER_DEPTH, NULL, NULL, NULL, NULL, 0, false, NULL, NULL, NULL, NULL, 0, 0, NULL, 0};
     om__target_clear(&t);
     for (int k = 0; k < 60; k++) om__raster_tri(&r, c[k], (uint32_t)k);
     memcpy(plain, depth_buf, sizeof plain);
     om_target ct = {TW, TH, 0, TH, alongside, NULL}, scratch = target(TW, TH);
     om__target_clear(&ct);
-    om_raster rc = {&scratch, OM_RASTER_CONSERVATIVE, no_span, NULL, &ct, NULL, 0, false, NULL, NULL, NULL, NULL, 0, 0};
+    om_raster rc = {&scratch, OM_RASTER_CONSERVATIVE, no_span, NULL, &ct, NULL, 0, false, NULL, NULL, NULL, NULL, 0, 0, NULL, 0};
     for (int k = 0; k < 60; k++) om__raster_tri(&rc, c[k], (uint32_t)k);
     int differ = 0, written = 0;
     for (int i = 0; i < TW * TH; i++) {
@@ -740,7 +785,7 @@ static void strips_match_whole(void)
                             TW, TH, (float)(rnd() % 1000) / 1000.0f);
     om_target t = target(TW, TH);
     om__target_clear(&t);
-    om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL, NULL, NULL, 0, false, NULL, NULL, NULL, NULL, 0, 0};
+    om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL, NULL, NULL, 0, false, NULL, NULL, NULL, NULL, 0, 0, NULL, 0};
     for (int k = 0; k < 40; k++) om__raster_tri(&r, tris[k], (uint32_t)k);
     memcpy(whole_d, depth_buf, sizeof whole_d);
     memcpy(whole_i, id_buf, sizeof whole_i);
@@ -771,6 +816,7 @@ void suite_raster(void)
     RUN(fill_matches_point_tests);
     RUN(plane_nearest_at_extremes);
     RUN(conservative_superset);
+    RUN(conservative_row_mask);
     RUN(conservative_centres_match_depth_pass);
     RUN(strips_match_whole);
 }

@@ -79,7 +79,7 @@ static void conservative_is_exact_overlap(void)
         cov cv;
         memset(&cv, 0, sizeof cv);
         om_target t = {CW, CW, 0, CW, depth, NULL};
-        om_raster r = {&t, OM_RASTER_CONSERVATIVE, cov_span, &cv, NULL, NULL, 0, false, NULL, NULL, NULL, NULL, 0, 0};
+        om_raster r = {&t, OM_RASTER_CONSERVATIVE, cov_span, &cv, NULL, NULL, 0, false, NULL, NULL, NULL, NULL, 0, 0, NULL, 0};
         om__raster_tri(&r, c, 0);
         /* normal coverage: the top-left rule at texel centres */
         om__tri2 e;

@@ -210,8 +210,7 @@ void om__rtri_zplane(om__rtri *t, const uint32_t z[3])
 }
 
 /* The bounding box of three grid points (a triangle's, in any vertex order). */
-static void tri_box(const int64_t x[3], const int64_t y[3], int64_t *minX, int64_t *maxX, int64_t *minY,
-                    int64_t *maxY)
+static void tri_box(const int64_t x[3], const int64_t y[3], int64_t *minX, int64_t *maxX, int64_t *minY, int64_t *maxY)
 {
     *minX = *maxX = x[0];
     *minY = *maxY = y[0];
@@ -316,8 +315,7 @@ static void fill(const om_raster *r, om__rtri *t, const uint32_t z[3], uint32_t 
     }
 }
 
-/* depth_row over the runs of pixels of x0..x1 whose bit is set in `mask` (one row's
- * words). */
+/* depth_row over the runs of pixels of x0..x1 whose bit is set in `mask` (a row). */
 static void depth_row_masked(const om__rtri *t, const om_target *tg, int32_t y, int32_t x0, int32_t x1,
                              const uint32_t *mask)
 {
@@ -344,6 +342,8 @@ static void fill_conservative(const om_raster *r, const om__rtri *t)
     int64_t bias[3];
     for (int i = 0; i < 3; i++) bias[i] = top_left(e->a[i], e->b[i]) ? 0 : 1;
     for (int32_t y = t->miny; y <= t->maxy; y++) {
+        const uint32_t ym = (uint32_t)y >> r->row_shift;   /* rows the caller passes over */
+        if (r->row_mask && !(r->row_mask[ym >> 5] >> (ym & 31) & 1u)) continue;
         int64_t py = (int64_t)y * S + H, px0 = (int64_t)t->minx * S + H, lo, hi;
         const int64_t E[3] = {om__tri2_edge(e, 0, px0, py), om__tri2_edge(e, 1, px0, py),
                               om__tri2_edge(e, 2, px0, py)};

@@ -170,6 +170,11 @@ typedef struct om_raster {
      * the whole table. The same pixels either way. */
     const int32_t *grid_xs, *grid_ys;
     uint32_t grid_shift, grid_buckets;
+    /* Conservative mode, may be NULL: a row y of the target whose bit y >> row_shift is
+     * clear here is passed over, on the caller's word that its span and centres change
+     * nothing there, so that such a row costs a triangle one bit test, not a span. */
+    const uint32_t *row_mask;
+    uint32_t row_shift;
 } om_raster;
 
 /* Indexes a non-decreasing grid table g[0..n): start[b] = the first i with g[i] >=

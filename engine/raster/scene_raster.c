@@ -140,6 +140,8 @@ void om__scene_raster_hiz(const om_scene *s, const om_mat4 *vp, const om_target 
     r.grid_shift = r.grid_buckets = 0;
     r.mask_words = 0;
     r.cull_back = false;
+    r.row_mask = NULL;
+    r.row_shift = 0;
     om__cull cl;
     om__cull_begin(&cl, s, vp);
     om__target_clear(tg);

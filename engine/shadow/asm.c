@@ -430,7 +430,7 @@ static void render(asm_state *m, uint32_t level, uint32_t ox, uint32_t oy, uint3
     const float v0 = (float)(((double)oy - 1.0) * ic), v1 = (float)(((double)oy + T + 1.0) * ic);
     om_target tg = {T, T, 0, T, m->sdepth, m->sid};
     om__target_clear(&tg);
-    om_raster r = {&tg, OM_RASTER_DEPTH_ID, NULL, NULL, NULL, NULL, 0, false, NULL, NULL, NULL, NULL, 0, 0};
+    om_raster r = {&tg, OM_RASTER_DEPTH_ID, NULL, NULL, NULL, NULL, 0, false, NULL, NULL, NULL, NULL, 0, 0, NULL, 0};
     /* back faces of closed shapes skipped, as in every light map (om__cull); the
      * window scales x and y by s_ > 0, so windings stay */
     om__cull cl;

@@ -51,13 +51,14 @@ static size_t spsm_need(const om__spsm_cfg *c)
     size_t fine = c->spsm_fine ? om_arena_need(4 * n * sizeof(uint32_t), 16) +
                                      om_arena_need(fbits * sizeof(uint32_t), 16) : 0;
     return om_arena_need(sizeof(om__spsm_state), 16) + om_arena_need(n * sizeof(om__spsm_texel), 16) +
-           om_arena_need(n * sizeof(uint32_t), 16) * 2 + om_arena_need(bits * sizeof(uint32_t), 16) * 2 + fine;
+           om_arena_need(n * sizeof(uint32_t), 16) * 2 + om_arena_need(bits * sizeof(uint32_t), 16) * 2 +
+           om_arena_need(row_words(c->map_size) * sizeof(uint32_t), 16) + fine;
 }
 
 static size_t map_bytes(const om__spsm_state *m)
 {
     return (size_t)m->size * m->size * (sizeof(om__spsm_texel) + (m->fine ? 6 : 2) * sizeof(uint32_t)) +
-           ((size_t)m->size * m->words * 2 + (m->fine ? (size_t)2 * m->size * m->fwords : 0)) * sizeof(uint32_t);
+           ((size_t)m->size * m->words * 2 + m->words + (m->fine ? (size_t)2 * m->size * m->fwords : 0)) * sizeof(uint32_t);
 }
 
 static om_status spsm_bytes(const om_method_cfg *mc, const om_scene *s, uint32_t w, uint32_t h,
@@ -109,6 +110,8 @@ static om_status spsm_init(void **state, om_arena *a, const om_method_cfg *mc, c
     m->seen = (uint32_t *)p;
     if ((st = om_arena_alloc(a, bits * sizeof(uint32_t), 16, &p, d))) return st;
     m->need = (uint32_t *)p;
+    if ((st = om_arena_alloc(a, m->words * sizeof(uint32_t), 16, &p, d))) return st;
+    m->need_rows = (uint32_t *)p;
     if (m->fine) {
         if ((st = om_arena_alloc(a, 4 * n * sizeof(uint32_t), 16, &p, d))) return st;
         m->fdepth = (uint32_t *)p;

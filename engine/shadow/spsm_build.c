@@ -20,8 +20,9 @@ static uint32_t grow_needs(om__spsm_state *m)
         memset(m->need, 0xFF, (size_t)S * W * sizeof(uint32_t));
         return S * S;
     }
+    memset(m->need_rows, 0, W * sizeof(uint32_t));
     for (uint32_t y = 0; y < S; y++) {
-        uint32_t *out = m->need + (size_t)y * W;
+        uint32_t *out = m->need + (size_t)y * W, any = 0;
         for (uint32_t j = 0; j < W; j++) {
             uint32_t v = 0;   /* the three rows' words, each grown sideways */
             for (uint32_t r = y ? y - 1 : 0; r <= y + 1 && r < S; r++) {
@@ -32,8 +33,10 @@ static uint32_t grow_needs(om__spsm_state *m)
                 if (j + 1 < W) v |= row[j + 1] << 31;
             }
             out[j] = v;
+            any |= v;
             for (uint32_t b = v; b; b &= b - 1) count++;
         }
+        if (any) m->need_rows[y >> 5] |= 1u << (y & 31);
     }
     return count;
 }
@@ -262,6 +265,9 @@ void om__spsm_build_rows(const void *state, const om__bins *bins, uint32_t y0, u
     r.centres = &tc;
     r.centre_mask = whole_plain ? NULL : m->need + (size_t)y0 * m->words;
     r.mask_words = m->words;
+    /* rows with no needed texel: span() and the masked centres would do nothing there */
+    r.row_mask = whole_plain || !m->marks ? NULL : m->need_rows;
+    r.row_shift = 0;
     /* A light ray that meets a closed shape's back face has met a front face before
      * it, so a back face is never the occluder a record should describe: culled, the
      * record of a rim texel is more often the grazing front face the ray really hits
@@ -283,6 +289,7 @@ void om__spsm_build_rows(const void *state, const om__bins *bins, uint32_t y0, u
         r.span = NULL;
         r.centres = NULL;
         r.centre_mask = NULL;
+        r.row_mask = NULL;
     } else {
         /* the points needed (cleared by map_of): the depth pass that runs alongside a
          * conservative one (the same depths), with nothing for the conservative one to
@@ -291,6 +298,8 @@ void om__spsm_build_rows(const void *state, const om__bins *bins, uint32_t y0, u
         r.centres = &tf;
         r.centre_mask = m->fneed + (size_t)2 * y0 * m->fwords;
         r.mask_words = m->fwords;
+        r.row_mask = m->need_rows;   /* fine rows 2y and 2y + 1 are need's row y */
+        r.row_shift = 1;
     }
     raster_scene(m, &r, bins, 2);
 }

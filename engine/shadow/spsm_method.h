@@ -74,6 +74,9 @@ typedef struct om__spsm_state {
     /* Texels the lookup will read, one bit each, `words` 32-bit words per row: `seen`
      * (the samples' texels, from observe) grown by one texel into `need` (build). */
     uint32_t *seen, *need;
+    /* need_rows: bit y set when row y of need has any bit (the build passes over the
+     * others: with marks, nothing in them is read) */
+    uint32_t *need_rows;
     uint32_t words;
     bool marks;                  /* observe marks texels (spsm.records); else need is full */
     om_view view;
