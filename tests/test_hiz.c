@@ -1,4 +1,4 @@
-/* test_hiz.c — the coarse depth of depth-only targets (om__hiz_words, raster.c):
+/* test_hiz.c — the coarse depth of depth-only targets (om__hiz_words, hiz.c):
  * maps drawn with it hold exactly the bits drawn without it, over random and
  * adversarial triangles (huge ones through one point, as the slow scene of issue 24
  * makes them; flat ties; depths at 0 and 2^32 - 1; steep slivers at the slopes' limit;

@@ -217,7 +217,7 @@ bool om__raster_snapped(const om_raster *r, const int64_t x[3], const int64_t y[
  * the tiles they write and skip, without touching a texel, the tiles where their
  * depth is nowhere below the bound, so a map under thousands of huge overlapping
  * triangles costs about texels + triangles instead of their product. The same texels
- * with it or without (raster.c gives the proof). A target uses it when its rows start
+ * with it or without (hiz.c gives the proof). A target uses it when its rows start
  * on a multiple of 16 and end on one or at the image's last row (the bands of a map
  * built by bands do), so that no tile is shared by two targets. */
 size_t om__hiz_words(uint32_t width, uint32_t height);
