@@ -21,6 +21,7 @@ typedef struct frame_out {
     uint64_t hash;             /* pixels, terms and samples, strip by strip */
     om_method_stats ms;
     uint32_t jobs;
+    size_t peak;               /* the frame arena's */
     om_status st;
 } frame_out;
 
@@ -73,6 +74,7 @@ static frame_out render_set(const om_scene *s, const om_method *m, const char *s
         om_frame_stats fs;
         o.st = om_render_frame(&fd, &fa, &fs, &d);
         o.jobs = fs.jobs;
+        o.peak = fs.frame_peak;
         m->stats(state, &o.ms);
     }
     free(mm);
@@ -201,6 +203,54 @@ static void hybrid_bands(void)
     for (int k = 0; k < 3; k++) om_jobs_stop(pools[k]);
 }
 
+/* ---- izb: its tiles of exposed samples as jobs (om__pass), each with a pool of its
+ * own from the frame arena. The same terms, pixels and counters for any number of jobs
+ * and their order, whole frames and strips, one tile or many (izb.pool); a frame arena
+ * without room for two pools runs the tiles inline, the same again. */
+static void izb_pass(void)
+{
+    static const uint32_t threads[] = {2, 3, 7, 16};
+    om_jobs *pools[4];
+    const om_method *m = om_method_find("izb");
+    for (int k = 0; k < 4; k++) CHECK_OK(om_jobs_start(&pools[k], threads[k], NULL));
+    for (int li = 0; li < 2; li++) {
+        h_scene hs;
+        if (!h_scene_parse(&hs, li ? directional : om_scene_default_text())) continue;
+        for (int pi = 0; pi < 3; pi++)
+            for (uint32_t rows = 0; rows <= 24; rows += 24) {
+                static const uint32_t pool_of[] = {0, 397, 2000};
+                char set[32];
+                snprintf(set, sizeof set, "izb.pool=%u", pool_of[pi]);
+                frame_out one = render_set(&hs.s, m, set, 160, 120, rows, NULL, NULL, 1, 0, true);
+                CHECK_MSG(one.st == OM_OK && one.jobs == 1, "izb: inline frame");
+                size_t last_peak = 0;
+                /* a pool of 397 leaves many tiles a strip */
+                CHECK_MSG(pi != 1 || one.ms.counters[5] > 3 * (rows ? 120 / rows : 1), "izb pool %u: %u tiles",
+                          pool_of[pi], one.ms.counters[5]);
+                for (int k = 0; k < 6; k++) {
+                    uint32_t n = k < 4 ? threads[k] : 5;
+                    bool lean = k == 5;   /* room for the bands' slots only: the tiles inline */
+                    frame_out o = render_set(&hs.s, m, set, 160, 120, rows, k < 4 ? om_jobs_for : backwards,
+                                             k < 4 ? pools[k] : NULL, n, om_frame_bytes_jobs(m, lean ? NULL : &hs.s, n),
+                                             true);
+                    CHECK_MSG(o.st == OM_OK && o.jobs == n, "izb: %u jobs ran %u", n, o.jobs);
+                    CHECK_MSG(o.hash == one.hash && !memcmp(o.ms.counters, one.ms.counters, sizeof o.ms.counters),
+                              "izb light %d pool %u strips %u: %u threads%s change the frame", li, pool_of[pi],
+                              rows, n, k < 4 ? "" : lean ? " inline tiles" : " backwards");
+                    /* the pools of two jobs at least (keys of 24 bytes, two buffers); the
+                     * lean frame (5 jobs, as the one before it) without them */
+                    size_t pool = pool_of[pi] ? pool_of[pi] : 160 * 120;
+                    if (!lean) CHECK_MSG(o.peak > one.peak + 2 * 48 * pool, "izb %u jobs: no pools (%zu vs %zu)",
+                                         n, o.peak, one.peak);
+                    else CHECK_MSG(o.peak + 2 * 48 * pool < last_peak, "izb lean: %zu vs %zu", o.peak, last_peak);
+                    last_peak = o.peak;
+                }
+            }
+        h_scene_free(&hs);
+    }
+    for (int k = 0; k < 4; k++) om_jobs_stop(pools[k]);
+}
+
 /* Settings that change how a method works by bands, on 2 and 5 backwards jobs, whole
  * and through strips of 40, against the inline frame (frame and counters):
  *  - rtw's warped map by bands: the exact map (with the light's bins, which pass over
@@ -246,5 +296,6 @@ void suite_threads(void)
     RUN(same_bits);
     RUN(fewer_jobs);
     RUN(hybrid_bands);
+    RUN(izb_pass);
     RUN(settings_by_bands);
 }

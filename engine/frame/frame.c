@@ -38,12 +38,25 @@ static size_t map_bins_bytes(const om__bands *b, const om_scene *s)
     return b && b->build_rows && s ? bins_bytes(s) : 0;
 }
 
+/* A pass's slot: its counts and scratch (one a job at most). */
+static size_t pass_slot_bytes(size_t scratch)
+{
+    return om_arena_need(sizeof(job_slot), 8) + om_arena_need(scratch ? scratch : 1, 16);
+}
+
+/* A job's band slots: counts, and the bands' scratch. */
+static size_t band_job_bytes(const om__bands *b)
+{
+    return BANDS_PER_JOB *
+           (om_arena_need(sizeof(job_slot), 8) + (b ? om_arena_need(b->scratch ? b->scratch : 1, 16) : 0));
+}
+
 size_t om_frame_bytes_jobs(const om_method *m, const om_scene *s, uint32_t threads)
 {
     if (!OM_WITH_JOBS || threads <= 1) return 0;
     const om__bands *b = m ? om__method_bands(m) : NULL;
-    return (size_t)threads * BANDS_PER_JOB *
-               (om_arena_need(sizeof(job_slot), 8) + (b ? om_arena_need(b->scratch ? b->scratch : 1, 16) : 0)) +
+    const om__pass *p = m ? om__method_pass(m) : NULL;
+    return (size_t)threads * (band_job_bytes(b) + (p ? pass_slot_bytes(p->scratch(NULL, s)) : 0)) +
            map_bins_bytes(b, s);
 }
 
@@ -94,17 +107,20 @@ static void grow_light_box(const om_view *v, const om_strip *st, om_vec3 *lo, om
 
 /* The bands of the strip: band b is job b of the host's parallel-for, with slot b and
  * rows of its own. */
-typedef enum { STAGE_PREPARE, STAGE_RESOLVE, STAGE_SHADE, STAGE_BUILD } stage;
+typedef enum { STAGE_PREPARE, STAGE_RESOLVE, STAGE_SHADE, STAGE_BUILD, STAGE_PASS } stage;
 
 typedef struct frame_ctx {
     const om_frame_desc *fd;
     const om_view *view;
     const om__bins *bins;      /* NULL: every strip walks every triangle */
     const om__bands *bands;    /* NULL: the method resolves a strip at a time */
+    const om__pass *pass;      /* NULL: no pass of its own (or no room for one) */
     om_target tg;              /* the strip's */
     om_strip strip;
     uint32_t jobs, band_rows;
     job_slot *slots;           /* BANDS_PER_JOB * jobs of them */
+    job_slot *pass_slots;      /* the pass's, pass_max of them */
+    uint32_t pass_max, pass_jobs, pass_slots_now;   /* STAGE_PASS: K jobs on P slots */
     stage stage;
     bool eye, mark;            /* STAGE_PREPARE: run the eye pass, mark exposure */
     om__bins map_bins;         /* the light map's (rows NULL: none) */
@@ -115,6 +131,11 @@ static void band_job(void *user, uint32_t b)
 {
     const frame_ctx *c = (const frame_ctx *)user;
     const om_frame_desc *fd = c->fd;
+    if (c->stage == STAGE_PASS) {   /* slot b: jobs b, b + P, ... (om__pass) */
+        for (uint32_t k = b; k < c->pass_jobs; k += c->pass_slots_now)
+            c->pass->job(fd->method_state, &c->strip, k, c->pass_slots[b].scratch, c->pass_slots[b].counts);
+        return;
+    }
     if (c->stage == STAGE_BUILD) {
         uint32_t y0 = b * c->map_band, rows = c->map_size - y0;
         c->bands->build_rows(fd->method_state, c->map_bins.rows ? &c->map_bins : NULL, y0,
@@ -183,6 +204,24 @@ static void build_map(frame_ctx *c)
     c->bands->merge(c->fd->method_state, sum);
 }
 
+/* The method's pass over the current strip (om__pass): plan, the jobs on their slots,
+ * then their counts added up in slot order. */
+static void run_pass(frame_ctx *c)
+{
+    void *state = c->fd->method_state;
+    uint32_t k = c->pass->plan(state, &c->strip);
+    if (k == 0) return;
+    uint32_t p = k < c->pass_max ? k : c->pass_max;
+    c->pass_jobs = k;
+    c->pass_slots_now = p;
+    for (uint32_t j = 0; j < p; j++) memset(c->pass_slots[j].counts, 0, sizeof c->pass_slots[j].counts);
+    run_stage(c, STAGE_PASS, p);
+    uint32_t sum[8] = {0};
+    for (uint32_t j = 0; j < p; j++)
+        for (int i = 0; i < 8; i++) sum[i] += c->pass_slots[j].counts[i];
+    c->pass->merge(state, sum);
+}
+
 /* Bins' memory: the rows, and the vertices when they fit too. False: no room. */
 static bool carve_bins(om_arena *fa, const om_scene *s, om__bins *b)
 {
@@ -227,15 +266,25 @@ static void strip_at(frame_ctx *c, uint32_t y, uint32_t rows)
 }
 
 /* Carves the jobs' slots: as many as the host asks for and the arena holds beyond
- * `keep` bytes (at least two, or none and the frame runs inline). */
+ * `keep` bytes (at least two, or none and the frame runs inline). A method with a pass
+ * (om__pass) gets a pass slot a job, with the state's scratch; where fewer than two
+ * fit, it resolves a strip at a time (its bands unused) and the jobs are only the eye
+ * pass's and shading's. */
 static void carve_jobs(frame_ctx *c, om_arena *fa, size_t keep)
 {
     const om_frame_desc *fd = c->fd;
     c->jobs = 1;
     if (!OM_WITH_JOBS || !fd->parallel_for || fd->threads <= 1) return;
     const om__bands *b = om__method_bands(fd->method);
-    size_t per = om_frame_bytes_jobs(fd->method, NULL, 2) / 2;
-    size_t left = om_arena_left(fa), fit = left > keep ? (left - keep) / per : 0;
+    const om__pass *ps = om__method_pass(fd->method);
+    size_t per = band_job_bytes(b), pscratch = 0;
+    size_t left = om_arena_left(fa), room = left > keep ? left - keep : 0, fit = room / per;
+    if (ps) {
+        pscratch = ps->scratch(fd->method_state, fd->scene);
+        size_t with = room / (per + pass_slot_bytes(pscratch));
+        if (with >= 2) fit = with;
+        else ps = NULL, b = NULL;
+    }
     uint32_t jobs = fit < fd->threads ? (uint32_t)fit : fd->threads;
     void *p;
     const uint32_t nslots = BANDS_PER_JOB * jobs;
@@ -244,6 +293,15 @@ static void carve_jobs(frame_ctx *c, om_arena *fa, size_t keep)
     for (uint32_t j = 0; b && j < nslots; j++)
         if (om_arena_alloc(fa, b->scratch ? b->scratch : 1, 16, &c->slots[j].scratch, NULL))
             return;   /* cannot happen: `per` counted it */
+    if (ps) {
+        if (om_arena_alloc(fa, jobs * sizeof(job_slot), 8, &p, NULL)) return;
+        c->pass_slots = (job_slot *)p;
+        for (uint32_t j = 0; j < jobs; j++)
+            if (om_arena_alloc(fa, pscratch ? pscratch : 1, 16, &c->pass_slots[j].scratch, NULL))
+                return;   /* cannot happen: counted above */
+        c->pass = ps;
+        c->pass_max = jobs;
+    }
     c->bands = b;
     c->jobs = jobs;
     /* Bands of whole 16-row blocks (methods tile strips by 16 from their top row, so a
@@ -354,15 +412,18 @@ om_status om_render_frame(const om_frame_desc *fd, om_arena *fa, om_frame_stats 
         strip_at(&c, y, rows);
         prepare(&c, !have_samples, !have_terms, fs);
         t0 = now(fd);
-        if (OM_WITH_JOBS && c.bands) {
-            for (uint32_t j = 0; j < BANDS_PER_JOB * c.jobs; j++)
-                memset(c.slots[j].counts, 0, sizeof c.slots[j].counts);
-            run_bands(&c, STAGE_RESOLVE);
-            uint32_t sum[8] = {0};
-            for (uint32_t j = 0; j < BANDS_PER_JOB * c.jobs; j++)
-                for (int k = 0; k < 8; k++) sum[k] += c.slots[j].counts[k];
-            c.bands->merge(fd->method_state, sum);
-            if (c.bands->finish) c.bands->finish(fd->method_state, &c.strip);
+        if (OM_WITH_JOBS && (c.bands || c.pass)) {
+            if (c.bands) {
+                for (uint32_t j = 0; j < BANDS_PER_JOB * c.jobs; j++)
+                    memset(c.slots[j].counts, 0, sizeof c.slots[j].counts);
+                run_bands(&c, STAGE_RESOLVE);
+                uint32_t sum[8] = {0};
+                for (uint32_t j = 0; j < BANDS_PER_JOB * c.jobs; j++)
+                    for (int k = 0; k < 8; k++) sum[k] += c.slots[j].counts[k];
+                c.bands->merge(fd->method_state, sum);
+            }
+            if (c.pass) run_pass(&c);
+            if (c.bands && c.bands->finish) c.bands->finish(fd->method_state, &c.strip);
         } else {
             st = m->resolve(fd->method_state, &c.strip, d);
         }

@@ -115,6 +115,37 @@ typedef struct om__bands {
  * which alone names methods, so a firmware without one links none of its code). */
 const om__bands *om__method_bands(const om_method *m);
 
+/* A method's own pass over a strip as K jobs, each with scratch memory of its own from
+ * the frame arena: for work that does not split by rows (izb's tiles of exposed
+ * samples, each with its own pool and BSP). The contract:
+ * - scratch(state, s): bytes one job needs (aligned to 16 by the frame). With state
+ *   NULL (om_frame_bytes_jobs, before there is a state) a bound for the method's
+ *   default settings from the scene alone, 0 when s is NULL; with the state, the
+ *   exact bytes, at most that bound under the default settings.
+ * - Per strip, after the bands' resolve and merge (when the method has bands) and
+ *   before their finish: plan, on the calling thread, prepares the strip (it may write
+ *   the state and the strip's terms) and returns K; then job(state, strip, k, scratch,
+ *   counts) runs for every k in [0, K) on P = min(K, slots) slots, slot p running
+ *   k = p, p + P, ... one after another with its own scratch, in parallel with the
+ *   other slots; then merge gets the counts added up over the jobs (integer sums: the
+ *   same whatever P and the order). A job reads the state, writes only its own
+ *   samples' terms, its scratch and counts; its terms and counts must not depend on
+ *   which slot ran it or on what the scratch held before (the frame zeroes it once a
+ *   frame, not once a job).
+ * - The frame uses the pass only when it runs jobs and its arena has room for at least
+ *   two slots' scratch beside the bands' (at most one slot a job); otherwise the
+ *   method's bands are not used either and its resolve runs a strip at a time, which
+ *   must give the same terms and counts. */
+typedef struct om__pass {
+    size_t (*scratch)(const void *state, const om_scene *s);
+    uint32_t (*plan)(void *state, om_strip *strip);
+    void (*job)(const void *state, const om_strip *strip, uint32_t k, void *scratch, uint32_t counts[8]);
+    void (*merge)(void *state, const uint32_t counts[8]);
+} om__pass;
+
+/* Method m's pass; NULL for none (registry.c). */
+const om__pass *om__method_pass(const om_method *m);
+
 /* Shades a strip into fb rows 0..st->rows-1. */
 void om__shade_strip(const om_scene *s, const om_view *v, const om_shade_cfg *c,
                      const om_strip *st, om_framebuffer *fb);

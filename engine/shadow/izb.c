@@ -27,6 +27,11 @@ typedef struct izb_state {
     om__izb z;
     om__izb_cfg cfg;
     uint32_t width, height;
+    /* The pass on the host's threads (om__pass, below): the current strip's exposed
+     * samples before each row (rowsum[r], height + 1 of them; NULL without
+     * OM_WITH_JOBS), and their tiling. */
+    uint32_t *rowsum;
+    uint32_t exposed, ntiles;
 } izb_state;
 
 /* Least samples a split leaves in a leaf: a node splits only above `leaf` samples. */
@@ -94,9 +99,11 @@ static uint32_t auto_pool(const om_scene *s, uint32_t w, uint32_t h)
     return (uint32_t)(want > w ? want : w);
 }
 
-static size_t fixed_bytes(const om_scene *s, bool cache)
+/* The state, its row sums for the pass, and setup's parts. */
+static size_t fixed_bytes(const om_scene *s, uint32_t h, bool cache)
 {
-    return om_arena_need(sizeof(izb_state), 16) + parts_bytes(s, cache);
+    return om_arena_need(sizeof(izb_state), 16) +
+           (OM_WITH_JOBS ? om_arena_need(((size_t)h + 1) * sizeof(uint32_t), 4) : 0) + parts_bytes(s, cache);
 }
 
 static om_status pool_bytes(const om__izb_cfg *c, const om_scene *s, uint32_t w, uint32_t h,
@@ -105,8 +112,8 @@ static om_status pool_bytes(const om__izb_cfg *c, const om_scene *s, uint32_t w,
     if (c->izb_leaf < 1) return OM_E_INVALID;
     uint32_t one_pass = auto_pool(s, w, h), smallest = w;   /* the smallest tile: one row */
     if (c->izb_pool) one_pass = smallest = c->izb_pool;
-    *min = fixed_bytes(s, false) + pool_bytes_of(smallest, c->izb_leaf);
-    *full = fixed_bytes(s, true) + pool_bytes_of(one_pass, c->izb_leaf);
+    *min = fixed_bytes(s, h, false) + pool_bytes_of(smallest, c->izb_leaf);
+    *full = fixed_bytes(s, h, true) + pool_bytes_of(one_pass, c->izb_leaf);
     return OM_OK;
 }
 
@@ -179,6 +186,10 @@ static om_status izb_init(void **state, om_arena *a, const om_method_cfg *mc, co
     m->cfg = *c;
     m->width = w;
     m->height = h;
+    if (OM_WITH_JOBS) {
+        if ((st = om_arena_alloc(a, ((size_t)h + 1) * sizeof(uint32_t), 4, &p, d))) return st;
+        m->rowsum = (uint32_t *)p;
+    }
     if ((st = setup(&m->z, a, c, s, auto_pool(s, w, h), w, d))) return st;
     *state = m;
     return OM_OK;
@@ -207,12 +218,13 @@ static om_status izb_build(void *state, om_diag *d)
 
 /* ---- stage 1: transform */
 
-uint32_t om__izb_transform(om__izb *z, const om_strip *st, size_t *next, size_t end)
+uint32_t om__izb_transform(om__izb *z, const om_strip *st, size_t *next, size_t end, uint32_t take)
 {
     size_t i = *next;
-    uint32_t n = 0;
-    for (; i < end && n < z->cap; i++) {
+    uint32_t n = 0, taken = 0;
+    for (; i < end && taken < take; i++) {
         if (!(st->terms[i].flags & OM_TERM_EXPOSED)) continue;
+        taken++;
         om__lpoint p;
         if (!om__lspace_point(&z->ls, &st->samples[i], &p)) continue;   /* behind the light */
         /* the sample's key for the BSP, and the tile's bounds, while it is at hand */
@@ -596,23 +608,137 @@ void om__izb_raster(om__izb *z)
     }
 }
 
-void om__izb_write(const om__izb *z, om_strip *st)
+void om__izb_write(const om__izb *z, const om_strip *st)
 {
     for (uint32_t i = 0; i < z->n; i++) om__odepth_term(&z->od[i], &st->terms[z->keys[i].s & ~OM_IZB_DONE]);
+}
+
+uint32_t om__izb_tiles(const om__izb *z, uint32_t exposed)
+{
+    return exposed ? (uint32_t)(((uint64_t)exposed + z->cap - 1) / z->cap) : 0;
+}
+
+uint32_t om__izb_tile_first(uint32_t exposed, uint32_t tiles, uint32_t k)
+{
+    return (uint32_t)((uint64_t)k * exposed / tiles);
 }
 
 void om__izb_resolve(om__izb *z, om_strip *st)
 {
     size_t n = (size_t)st->rows * st->width, next = 0;
-    for (size_t i = 0; i < n; i++) st->terms[i].r = st->terms[i].g = st->terms[i].b = 255;
-    while (next < n) {
-        if (om__izb_transform(z, st, &next, n) == 0) break;
+    uint32_t exposed = 0;
+    for (size_t i = 0; i < n; i++) {
+        st->terms[i].r = st->terms[i].g = st->terms[i].b = 255;
+        exposed += (st->terms[i].flags & OM_TERM_EXPOSED) != 0;
+    }
+    const uint32_t tiles = om__izb_tiles(z, exposed);
+    for (uint32_t k = 0; k < tiles; k++) {
+        om__izb_transform(z, st, &next, n,
+                          om__izb_tile_first(exposed, tiles, k + 1) - om__izb_tile_first(exposed, tiles, k));
         om__izb_build(z);
         om__izb_raster(z);
         om__izb_write(z, st);
         z->st.tiles++;
     }
 }
+
+/* ---- the pass on the host's threads (frame.h, om__pass): one job a tile, each with a
+ * pool of the state's size in its scratch; the same tiles as om__izb_resolve, so the
+ * same terms and counts whatever the number of jobs. */
+
+static size_t up16(size_t b) { return (b + 15) / 16 * 16; }
+
+static size_t izb_pass_scratch(const void *state, const om_scene *s)
+{
+    if (state) {
+        const om__izb *z = &((const izb_state *)state)->z;
+        return pool_bytes_of(z->cap, z->leaf);
+    }
+    if (!s) return 0;
+    uint64_t most = (uint64_t)s->ntris * TILE_PER_TRI;   /* auto_pool without the image's bound */
+    return pool_bytes_of(most < TILE_LEAST ? TILE_LEAST : most > 0xFFFFFFFFu ? 0xFFFFFFFFu : (uint32_t)most, 64);
+}
+
+/* Counts every row's exposed samples (rowsum) and tiles the strip. */
+static uint32_t izb_pass_plan(void *state, om_strip *st)
+{
+    izb_state *m = (izb_state *)state;
+    m->rowsum[0] = 0;
+    for (uint32_t r = 0; r < st->rows; r++) {
+        const om_term *t = st->terms + (size_t)r * st->width;
+        uint32_t e = 0;
+        for (uint32_t x = 0; x < st->width; x++) e += (t[x].flags & OM_TERM_EXPOSED) != 0;
+        m->rowsum[r + 1] = m->rowsum[r] + e;
+    }
+    m->exposed = m->rowsum[st->rows];
+    m->ntiles = om__izb_tiles(&m->z, m->exposed);
+    if (m->ntiles == 0) {
+        size_t n = (size_t)st->rows * st->width;
+        for (size_t i = 0; i < n; i++) st->terms[i].r = st->terms[i].g = st->terms[i].b = 255;
+    }
+    return m->ntiles;
+}
+
+/* Where tile k begins in the strip: at its first exposed sample (the strip's start for
+ * the first tile, its end past the last). */
+static size_t tile_start(const izb_state *m, const om_strip *st, uint32_t k)
+{
+    if (k == 0) return 0;
+    if (k >= m->ntiles) return (size_t)st->rows * st->width;
+    const uint32_t o = om__izb_tile_first(m->exposed, m->ntiles, k);
+    uint32_t lo = 0, hi = st->rows - 1;   /* the row holding exposed sample o */
+    while (lo < hi) {
+        uint32_t mid = lo + (hi - lo + 1) / 2;
+        if (m->rowsum[mid] <= o) lo = mid;
+        else hi = mid - 1;
+    }
+    const om_term *t = st->terms + (size_t)lo * st->width;
+    uint32_t c = m->rowsum[lo], x = 0;
+    for (;; x++)
+        if ((t[x].flags & OM_TERM_EXPOSED) && c++ == o) break;
+    return (size_t)lo * st->width + x;
+}
+
+static void izb_pass_job(const void *state, const om_strip *st, uint32_t k, void *scratch, uint32_t counts[8])
+{
+    const izb_state *m = (const izb_state *)state;
+    om__izb z = m->z;   /* the scene, projection and pool's sizes; the pool is the scratch */
+    unsigned char *p = (unsigned char *)scratch;
+    z.od = (om__odepth *)p;
+    p += up16((size_t)z.cap * sizeof(om__odepth));
+    z.keys = (om__izb_key *)p;
+    p += up16((size_t)z.cap * sizeof(om__izb_key));
+    z.sorted = (om__izb_key *)p;
+    p += up16((size_t)z.cap * sizeof(om__izb_key));
+    z.nodes = (om__izb_node *)p;
+    p += up16((size_t)z.node_cap * sizeof(om__izb_node));
+    z.cells = (uint32_t *)p;
+    memset(&z.st, 0, sizeof z.st);
+    size_t next = tile_start(m, st, k), end = tile_start(m, st, k + 1);
+    for (size_t i = next; i < end; i++) st->terms[i].r = st->terms[i].g = st->terms[i].b = 255;
+    om__izb_transform(&z, st, &next, end,
+                      om__izb_tile_first(m->exposed, m->ntiles, k + 1) - om__izb_tile_first(m->exposed, m->ntiles, k));
+    om__izb_build(&z);
+    om__izb_raster(&z);
+    om__izb_write(&z, st);
+    const uint32_t v[7] = {z.st.nodes, z.st.visited, z.st.culled_shadowed, z.st.culled_depth,
+                           z.st.tested, z.st.blocked, 1};
+    for (int i = 0; i < 7; i++) counts[i] += v[i];
+}
+
+static void izb_pass_merge(void *state, const uint32_t counts[8])
+{
+    om__izb_stats *s = &((izb_state *)state)->z.st;
+    s->nodes += counts[0];
+    s->visited += counts[1];
+    s->culled_shadowed += counts[2];
+    s->culled_depth += counts[3];
+    s->tested += counts[4];
+    s->blocked += counts[5];
+    s->tiles += counts[6];
+}
+
+const om__pass om__pass_izb = {izb_pass_scratch, izb_pass_plan, izb_pass_job, izb_pass_merge};
 
 static om_status izb_resolve(void *state, om_strip *st, om_diag *d)
 {
@@ -626,7 +752,7 @@ static void izb_stats(const void *state, om_method_stats *out)
     const izb_state *m = (const izb_state *)state;
     const om__izb *z = &m->z;
     memset(out, 0, sizeof *out);
-    out->bytes_used = fixed_bytes(z->scene, z->ls.verts != NULL) + pool_bytes_of(z->cap, z->leaf);
+    out->bytes_used = fixed_bytes(z->scene, m->height, z->ls.verts != NULL) + pool_bytes_of(z->cap, z->leaf);
     static const char *const names[] = {"bsp nodes", "nodes visited", "nodes culled (shadowed)",
                                         "nodes culled (depth)", "samples tested", "tiles",
                                         "pool samples"};

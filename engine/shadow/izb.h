@@ -74,17 +74,27 @@ typedef struct om__izb_cfg {
     OM__SETTING(T, f, "izb.pool", OM_SETTING_U32, 0, 1e9, 0, \
                 "samples the pool holds, 0 = izb: 2 a triangle, 32768 to the frame; hybrid: the frame")
 
+/* A strip's tiles: its E exposed samples in om__izb_tiles(z, E) = ceil(E / pool)
+ * tiles of nearly equal size, tile k holding the exposed samples numbered
+ * [om__izb_tile_first(E, T, k), om__izb_tile_first(E, T, k + 1)) in the strip's order.
+ * The tiling depends on the strip and the pool only, so a tile gives the same counts
+ * whether the tiles run one after another (om__izb_resolve) or as jobs (izb.c's pass). */
+uint32_t om__izb_tiles(const om__izb *z, uint32_t exposed);
+uint32_t om__izb_tile_first(uint32_t exposed, uint32_t tiles, uint32_t k);
+
 /* The stages, one tile at a time (the benchmark times each):
- * transform fills the pool (the samples' keys) from strip samples [*next, end) that
- * are exposed, up to its capacity, advances *next and returns the number taken. */
-uint32_t om__izb_transform(om__izb *z, const om_strip *st, size_t *next, size_t end);
+ * transform fills the pool (the samples' keys) from the first `take` (at most the
+ * pool) exposed samples of strip samples [*next, end), advances *next past the last
+ * and returns the number kept (those in front of the light). */
+uint32_t om__izb_transform(om__izb *z, const om_strip *st, size_t *next, size_t end, uint32_t take);
 void om__izb_build(om__izb *z);
 /* Rasterizes every triangle of the scene through the BSP. */
 void om__izb_raster(om__izb *z);
 /* Writes the tile's terms into the strip. */
-void om__izb_write(const om__izb *z, om_strip *st);
+void om__izb_write(const om__izb *z, const om_strip *st);
 /* A strip's terms: 255 everywhere, then tile after tile of the exposed samples through
- * transform, build, raster, write. */
+ * transform, build, raster, write (on one thread; izb.c's pass runs the same tiles as
+ * jobs). */
 void om__izb_resolve(om__izb *z, om_strip *st);
 
 #endif

@@ -57,8 +57,8 @@ static const om_method *const methods[] = {METHODS(ENTRY) NULL};
 /* The methods whose resolve runs by bands on the host's threads (frame.h, om__bands):
  * those whose resolve only reads the state once it is built (spsm's window of decoded
  * texels is the band's own; hybrid: its map lookup by bands, its irregular pass after
- * them). asm (its resolve moves a cache and the tree's use marks) and izb (per-strip
- * lists in the state) resolve a strip at a time. */
+ * them). asm (its resolve moves a cache and the tree's use marks) resolves a strip at
+ * a time, and izb by its own pass (below). */
 #define BANDED(X)            \
     X(none, OM_WITH_NONE)    \
     X(ref, OM_WITH_REF)      \
@@ -78,6 +78,24 @@ const om__bands *om__method_bands(const om_method *m_)
 {
     if (!OM_WITH_JOBS) return NULL;   /* (frame.h) none linked */
     BANDED(BANDS)
+    (void)m_;
+    return NULL;
+}
+
+/* The methods with a pass of jobs of their own (frame.h, om__pass): izb's tiles. */
+#define PASSED(X) X(izb, OM_WITH_IZB)
+
+#define DECLARE_PASS(m, on) extern const om__pass om__pass_##m;
+PASSED(DECLARE_PASS)
+
+#define PASS_1(m) if (m_ == &om__method_##m) return &om__pass_##m;
+#define PASS_0(m)
+#define PASS(m, on) CAT(PASS_, on)(m)
+
+const om__pass *om__method_pass(const om_method *m_)
+{
+    if (!OM_WITH_JOBS) return NULL;
+    PASSED(PASS)
     (void)m_;
     return NULL;
 }

@@ -42,12 +42,15 @@ static void table_row(const bscene *b, uint32_t W, uint32_t H)
         om__izb *z = (om__izb *)state;
         size_t next = 0;
         uint64_t ns[3] = {0, 0, 0};
-        for (;;) {   /* tile after tile, as the method's default pool has them */
+        uint32_t exposed = 0;
+        for (size_t i = 0; i < n; i++) exposed += (st.terms[i].flags & OM_TERM_EXPOSED) != 0;
+        const uint32_t tiles = om__izb_tiles(z, exposed);
+        for (uint32_t k = 0; k < tiles; k++) {   /* tile after tile, as the method's default pool has them */
             uint64_t t0 = om_clock_ns(NULL);
-            uint32_t got = om__izb_transform(z, &st, &next, n);
+            om__izb_transform(z, &st, &next, n,
+                              om__izb_tile_first(exposed, tiles, k + 1) - om__izb_tile_first(exposed, tiles, k));
             uint64_t t1 = om_clock_ns(NULL);
             ns[0] += t1 - t0;
-            if (got == 0) break;
             om__izb_build(z);
             uint64_t t2 = om_clock_ns(NULL);
             om__izb_raster(z);
