@@ -217,6 +217,77 @@ static uint8_t test(const om__smlook *L, const tap *tp)
  * scene took about 1.5x sm's without the hint and 1.2x with it. The hint changes no
  * term: they are the same as testing sample by sample. */
 #define SMLOOK_BLOCK 32
+
+/* The plain map's strip with one tap and no normal offset (sm's usual settings): the
+ * operations of locate and test for that case, in their order (so the same bits),
+ * with what does not change within a strip (the map's size as a float, a
+ * directional light's texel and depth slope) worked out once rather than per sample,
+ * and the taps kept as their threshold and index alone. */
+static void strip_plain(const om__smlook *L, om_strip *st, uint32_t *samples, uint32_t *shadowed)
+{
+    const om_view *v = L->view;
+    const bool spot = v->light.kind == OM_LIGHT_SPOT;
+    const om_mat4 vp = v->light_vp;
+    const om_vec3 lpos = v->light.pos, axis = v->light_axis;
+    const uint32_t size = L->size;
+    const float fsize = (float)size, half = 0.5f * fsize;
+    const float span_per_dist = L->span_per_dist, half_near = L->half_near;
+    const float dz_num = L->dz_num, dz_den = L->dz_den;
+    const float bias_const = L->bias_const, bias_slope = L->bias_slope;
+    /* a directional light's: the same operations as texel_world's and locate's */
+    const float texel_dir = spot ? 0.0f : 2.0f / om__fabsf(v->light_proj.m[0]) / fsize;
+    const float dz_dir = spot ? 0.0f : OM_DEPTH_ONE_F * om__fabsf(v->light_proj.m[10]);
+    const uint32_t *depth = L->depth;
+    const size_t n = (size_t)st->rows * st->width;
+    uint64_t zlit[SMLOOK_BLOCK];
+    uint32_t at[SMLOOK_BLOCK], idx[SMLOOK_BLOCK];
+    uint32_t nsamples = 0, nshadowed = 0;
+    for (size_t i = 0; i < n;) {
+        int got = 0;
+        for (; i < n && got < SMLOOK_BLOCK; i++) {
+            om_term *t = &st->terms[i];
+            t->r = t->g = t->b = 255;
+            if (!(t->flags & OM_TERM_EXPOSED)) continue;
+            nsamples++;
+            const om_sample *smp = &st->samples[i];
+            const om_vec3 p = om__v3(smp->p[0], smp->p[1], smp->p[2]);
+            float dist = 1.0f, texel = texel_dir, dz = dz_dir;
+            if (spot) {
+                dist = om__dot(om__sub(p, lpos), axis);
+                texel = dist * span_per_dist / fsize;
+            }
+            const float cosang = smp->nl;
+            const float tanang = cosang > 0.0995f ? om__sqrtf(1.0f - cosang * cosang) / cosang : 10.0f;
+            const float bias = bias_const + bias_slope * texel * tanang;
+            const om_vec4 q = om__mat_apply(&vp, p);
+            if (!(q.w > 0.0f)) continue;
+            const float iw = 1.0f / q.w;
+            const float uf = (q.x * iw + 1.0f) * half;
+            const float wf = (1.0f - q.y * iw) * half;
+            const uint32_t a = texel_clamped(wf, size) * size + texel_clamped(uf, size);
+            const float z = q.z * iw * OM_DEPTH_ONE_F;
+            if (spot) {
+                const float e = dist > half_near ? dist : half_near;
+                dz = dz_num / (dz_den * e * e) * OM_DEPTH_ONE_F;
+            }
+#if defined(__GNUC__) || defined(__clang__)
+            __builtin_prefetch(&depth[a]);
+#endif
+            zlit[got] = depth_threshold(z - bias * dz);
+            at[got] = a;
+            idx[got++] = (uint32_t)i;
+        }
+        for (int j = 0; j < got; j++) {
+            const uint8_t val = zlit[j] <= depth[at[j]] ? 255 : 0;
+            om_term *t = &st->terms[idx[j]];
+            t->r = t->g = t->b = val;
+            nshadowed += val != 255;
+        }
+    }
+    *samples += nsamples;
+    *shadowed += nshadowed;
+}
+
 void om__smlook_strip(const om__smlook *Lin, om_strip *st, uint32_t *samples, uint32_t *shadowed)
 {
     /* Copies on the stack, once a strip: the terms' byte stores may alias any memory
@@ -225,6 +296,10 @@ void om__smlook_strip(const om__smlook *Lin, om_strip *st, uint32_t *samples, ui
     om__smlook look = *Lin;
     look.view = &view;
     const om__smlook *L = &look;
+    if (!L->warp_x && L->pcf == 1 && L->normal_offset == 0.0f) {
+        strip_plain(L, st, samples, shadowed);
+        return;
+    }
     const size_t n = (size_t)st->rows * st->width;
     tap taps[SMLOOK_BLOCK];
     uint32_t at[SMLOOK_BLOCK];   /* strip index of each located sample */
