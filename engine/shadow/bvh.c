@@ -15,12 +15,18 @@ static void box_empty(box *b)
 {
     for (int i = 0; i < 3; i++) { b->lo[i] = FLT_MAX; b->hi[i] = -FLT_MAX; }
 }
-static void box_grow(box *b, const float *lo, const float *hi)
+/* Selects rather than branches (a compiler makes them min and max instructions): the
+ * build's bins take their triangles in no predictable order. */
+static inline float lower(float a, float b) { return a < b ? a : b; }
+static inline float upper(float a, float b) { return a > b ? a : b; }
+static inline void box_grow(box *b, const float *lo, const float *hi)
 {
-    for (int i = 0; i < 3; i++) {
-        if (lo[i] < b->lo[i]) b->lo[i] = lo[i];
-        if (hi[i] > b->hi[i]) b->hi[i] = hi[i];
-    }
+    b->lo[0] = lower(lo[0], b->lo[0]);
+    b->lo[1] = lower(lo[1], b->lo[1]);
+    b->lo[2] = lower(lo[2], b->lo[2]);
+    b->hi[0] = upper(hi[0], b->hi[0]);
+    b->hi[1] = upper(hi[1], b->hi[1]);
+    b->hi[2] = upper(hi[2], b->hi[2]);
 }
 static float box_area(const box *b)
 {
@@ -53,29 +59,45 @@ size_t om__bvh_scratch_bytes(const om_scene *s)
     return om_arena_need((size_t)(s->ntris ? s->ntris : 1) * sizeof(box), 4);
 }
 
-typedef struct job { uint32_t node, first, count; } job;
+/* The triangles' boxes during the build: with the scratch array, tb[i] is the box of
+ * tris[i] and moves with it, so every pass reads both arrays in order; without it (an
+ * arena below the scratch's size) each box comes from the triangle's vertices (slower,
+ * the same numbers). */
+typedef struct boxes { const om_scene *s; box *tb; uint32_t *tris; } boxes;
 
-/* A triangle's box: from the scratch array when the arena had room for it, else from
- * its vertices (slower, the same numbers). */
-typedef struct boxes { const om_scene *s; const box *tb; } boxes;
-
-static box tri_box(const boxes *bx, uint32_t t)
+static box vert_box(const om_scene *s, uint32_t t)
 {
-    if (bx->tb) return bx->tb[t];
     box r;
     box_empty(&r);
     for (int k = 0; k < 3; k++) {
-        const om_vec3 *v = &bx->s->verts[bx->s->idx[3 * (size_t)t + k]];
+        const om_vec3 *v = &s->verts[s->idx[3 * (size_t)t + k]];
         float p[3] = {v->x, v->y, v->z};
         box_grow(&r, p, p);
     }
     return r;
 }
 
-static float centre(const boxes *bx, uint32_t t, int axis)
+static box box_at(const boxes *bx, uint32_t i)
 {
-    box b = tri_box(bx, t);
-    return (b.lo[axis] + b.hi[axis]) * 0.5f;
+    return bx->tb ? bx->tb[i] : vert_box(bx->s, bx->tris[i]);
+}
+
+static inline void swap_at(const boxes *bx, uint32_t i, uint32_t j)
+{
+    uint32_t t = bx->tris[i]; bx->tris[i] = bx->tris[j]; bx->tris[j] = t;
+    if (bx->tb) { box b = bx->tb[i]; bx->tb[i] = bx->tb[j]; bx->tb[j] = b; }
+}
+
+static inline float centre(const box *b, int axis)
+{
+    return (b->lo[axis] + b->hi[axis]) * 0.5f;
+}
+
+/* Grows c by the centroid of t. */
+static inline void grow_centre(box *c, const box *t)
+{
+    const float m[3] = {centre(t, 0), centre(t, 1), centre(t, 2)};
+    box_grow(c, m, m);
 }
 
 /* A centroid as an integer whose unsigned order is the floats' order (-0 equal to +0,
@@ -84,30 +106,32 @@ static float centre(const boxes *bx, uint32_t t, int axis)
  * x87 excess precision a centroid recomputed in a register and the pivot stored as a
  * float disagree, and the scans below ran past their sentinel forever), while the
  * bits of a stored float are what they are. */
-static uint32_t centre_key(const boxes *bx, uint32_t t, int axis)
+static uint32_t centre_key(const boxes *bx, uint32_t i, int axis)
 {
-    float c = centre(bx, t, axis);
+    box b = box_at(bx, i);
+    float c = centre(&b, axis);
     uint32_t u;
     memcpy(&u, &c, sizeof u);
     if (u == 0x80000000u) u = 0;
     return u & 0x80000000u ? ~u : u | 0x80000000u;
 }
 
-/* Puts the k-th smallest centroid (along axis) of tris[0..n) at k: Hoare's quickselect.
- * The scans are also kept inside [lo, hi], so that [lo, hi] shrinks every round and
- * the loop ends whatever the keys say; with consistent keys the bounds never bind,
- * and the order is the one the float comparison gave on SSE. */
-static void select_median(uint32_t *tris, const boxes *bx, uint32_t n, uint32_t k, int axis)
+/* Puts the k-th smallest centroid (along axis) of positions [first, first + n) at
+ * first + k: Hoare's quickselect. The scans are also kept inside [lo, hi], so that
+ * [lo, hi] shrinks every round and the loop ends whatever the keys say; with
+ * consistent keys the bounds never bind, and the order is the one the float
+ * comparison gave on SSE. */
+static void select_median(const boxes *bx, uint32_t first, uint32_t n, uint32_t k, int axis)
 {
     uint32_t lo = 0, hi = n - 1;
     while (lo < hi) {
-        const uint32_t pivot = centre_key(bx, tris[lo + (hi - lo) / 2], axis);
+        const uint32_t pivot = centre_key(bx, first + lo + (hi - lo) / 2, axis);
         uint32_t i = lo, j = hi;
         while (i <= j) {
-            while (i < hi && centre_key(bx, tris[i], axis) < pivot) i++;
-            while (j > lo && centre_key(bx, tris[j], axis) > pivot) j--;
+            while (i < hi && centre_key(bx, first + i, axis) < pivot) i++;
+            while (j > lo && centre_key(bx, first + j, axis) > pivot) j--;
             if (i <= j) {
-                uint32_t t = tris[i]; tris[i] = tris[j]; tris[j] = t;
+                swap_at(bx, first + i, first + j);
                 i++;
                 if (j == 0) break;
                 j--;
@@ -118,6 +142,73 @@ static void select_median(uint32_t *tris, const boxes *bx, uint32_t n, uint32_t 
         else return;
     }
 }
+
+/* The box of positions [first, end) and of their centroids. */
+static void bound_range(const boxes *bx, uint32_t first, uint32_t end, box *bb, box *cb)
+{
+    box_empty(bb);
+    box_empty(cb);
+    for (uint32_t i = first; i < end; i++) {
+        box t = box_at(bx, i);
+        box_grow(bb, t.lo, t.hi);
+        grow_centre(cb, &t);
+    }
+}
+
+/* The bin of a centroid: the same arithmetic for counting and for partitioning, so a
+ * triangle lands on the side its bin was counted on. */
+typedef struct binning { int axis; float lo, scale; } binning;
+
+static inline int bin_of(const binning *g, const box *t)
+{
+    int k = (int)((centre(t, g->axis) - g->lo) * g->scale);
+    return k < 0 ? 0 : k >= BINS ? BINS - 1 : k;
+}
+
+/* Counts and bounds the triangles of [first, end) per bin. The loops below read the
+ * scratch array directly when there is one: they are most of the build. */
+static void bin_range(const boxes *bx, const binning *g, uint32_t first, uint32_t end,
+                      uint32_t cnt[BINS], box bin[BINS])
+{
+    for (int k = 0; k < BINS; k++) { cnt[k] = 0; box_empty(&bin[k]); }
+    for (uint32_t i = first; i < end; i++) {
+        box v;
+        const box *t = bx->tb ? &bx->tb[i] : (v = vert_box(bx->s, bx->tris[i]), &v);
+        int k = bin_of(g, t);
+        cnt[k]++;
+        box_grow(&bin[k], t->lo, t->hi);
+    }
+}
+
+/* Partitions [first, end) in place, bins up to `split` first; returns where the rest
+ * begin. Each triangle is looked at once, and its centroid bounds its side's (cside). */
+static uint32_t partition_range(const boxes *bx, const binning *g, uint32_t first, uint32_t end,
+                                int split, box cside[2])
+{
+    box_empty(&cside[0]);
+    box_empty(&cside[1]);
+    uint32_t l = first, h = end;
+    while (l < h) {
+        box v;
+        const box *t = bx->tb ? &bx->tb[l] : (v = vert_box(bx->s, bx->tris[l]), &v);
+        if (bin_of(g, t) <= split) {
+            grow_centre(&cside[0], t);
+            l++;
+        } else {
+            grow_centre(&cside[1], t);
+            swap_at(bx, l, --h);
+        }
+    }
+    return l;
+}
+
+/* A node waiting on the stack: its range, depth and, when its parent's bins gave them
+ * (`known`), its centroids' box (its own box is then in the node already). */
+typedef struct job {
+    uint32_t node, first, count, depth;
+    box cb;
+    bool known;
+} job;
 
 om_status om__bvh_build(om__bvh *b, om_arena *a, const om_scene *s, uint32_t leaf, om_diag *d)
 {
@@ -133,38 +224,34 @@ om_status om__bvh_build(om__bvh *b, om_arena *a, const om_scene *s, uint32_t lea
     b->nodes = (om__bvh_node *)pn;
     b->tris = (uint32_t *)pt;
     size_t mark = om_arena_mark(a);
-    boxes bx = {s, NULL};
+    boxes bx = {s, NULL, b->tris};
     if (om_arena_left(a) >= om__bvh_scratch_bytes(s)) {
         if ((st = om_arena_alloc(a, n * sizeof(box), 4, &pb, d))) return st;
         box *tb = (box *)pb;
-        for (uint32_t t = 0; t < s->ntris; t++) tb[t] = tri_box(&bx, t);
+        for (uint32_t t = 0; t < s->ntris; t++) tb[t] = vert_box(s, t);
         bx.tb = tb;
     }
     for (uint32_t t = 0; t < s->ntris; t++) b->tris[t] = t;
     b->nnodes = 1;
     job stack[STACK];
-    int sp = 0;
-    stack[sp].node = 0; stack[sp].first = 0; stack[sp].count = s->ntris; sp++;
-    uint32_t depth_of[STACK];
-    depth_of[0] = 1;
+    memset(&stack[0], 0, sizeof stack[0]);
+    stack[0].count = s->ntris;
+    stack[0].depth = 1;
+    int sp = 1;
     while (sp > 0) {
         job j = stack[--sp];
-        uint32_t depth = depth_of[sp];
-        if (depth > b->depth) b->depth = depth;
+        const uint32_t end = j.first + j.count;
+        if (j.depth > b->depth) b->depth = j.depth;
         om__bvh_node *nd = &b->nodes[j.node];
-        box bb, cb;
-        box_empty(&bb);
-        box_empty(&cb);
-        for (uint32_t i = j.first; i < j.first + j.count; i++) {
-            box t = tri_box(&bx, b->tris[i]);
-            float c[3];
-            for (int k = 0; k < 3; k++) c[k] = (t.lo[k] + t.hi[k]) * 0.5f;
-            box_grow(&bb, t.lo, t.hi);
-            box_grow(&cb, c, c);
+        box cb = j.cb;
+        if (!j.known) {
+            /* the root, or a child of a median split: one pass for its boxes */
+            box bb;
+            bound_range(&bx, j.first, end, &bb, &cb);
+            if (j.count == 0) for (int k = 0; k < 3; k++) bb.lo[k] = bb.hi[k] = 0;
+            memcpy(nd->lo, bb.lo, sizeof bb.lo);
+            memcpy(nd->hi, bb.hi, sizeof bb.hi);
         }
-        if (j.count == 0) { box_empty(&bb); for (int k = 0; k < 3; k++) bb.lo[k] = bb.hi[k] = 0; }
-        memcpy(nd->lo, bb.lo, sizeof bb.lo);
-        memcpy(nd->hi, bb.hi, sizeof bb.hi);
         nd->first = j.first;
         nd->count = j.count;
         if (j.count <= leaf || sp + 2 > STACK || b->nnodes + 2 > cap) continue;
@@ -172,21 +259,15 @@ om_status om__bvh_build(om__bvh *b, om_arena *a, const om_scene *s, uint32_t lea
         for (int k = 1; k < 3; k++)
             if (cb.hi[k] - cb.lo[k] > cb.hi[axis] - cb.lo[axis]) axis = k;
         float ext = cb.hi[axis] - cb.lo[axis];
-        uint32_t mid;
+        uint32_t mid = j.first;   /* no useful bin boundary: the median below */
+        /* what the bins say of the two sides: their boxes and their centroids' boxes */
+        box side[2], cside[2];
         if (ext > 0.0f) {
             /* Binned SAH: count and bound the triangles per bin, sweep both ways. */
-            uint32_t cnt[BINS] = {0};
+            uint32_t cnt[BINS];
             box bin[BINS];
-            for (int k = 0; k < BINS; k++) box_empty(&bin[k]);
-            float scale = (float)BINS / ext;
-            for (uint32_t i = j.first; i < j.first + j.count; i++) {
-                box t = tri_box(&bx, b->tris[i]);
-                float c = (t.lo[axis] + t.hi[axis]) * 0.5f;
-                int k = (int)((c - cb.lo[axis]) * scale);
-                k = k < 0 ? 0 : k >= BINS ? BINS - 1 : k;
-                cnt[k]++;
-                box_grow(&bin[k], t.lo, t.hi);
-            }
+            const binning g = {axis, cb.lo[axis], (float)BINS / ext};
+            bin_range(&bx, &g, j.first, end, cnt, bin);
             float right_area[BINS];
             uint32_t right_cnt[BINS];
             box acc;
@@ -210,36 +291,39 @@ om_status om__bvh_build(om__bvh *b, om_arena *a, const om_scene *s, uint32_t lea
                 if (cost < best) { best = cost; split = k; }
             }
             if (split >= 0) {
-                /* partition in place: bins <= split go left */
-                uint32_t lo = j.first, hi = j.first + j.count;
-                while (lo < hi) {
-                    float cc = centre(&bx, b->tris[lo], axis);
-                    int k = (int)((cc - cb.lo[axis]) * scale);
-                    k = k < 0 ? 0 : k >= BINS ? BINS - 1 : k;
-                    if (k <= split) lo++;
-                    else { uint32_t tmp = b->tris[lo]; b->tris[lo] = b->tris[--hi]; b->tris[hi] = tmp; }
-                }
-                mid = lo;
-            } else {
-                mid = j.first;   /* no useful bin boundary: the median below */
+                mid = partition_range(&bx, &g, j.first, end, split, cside);
+                /* the union of a side's bins' boxes is the union of its triangles' */
+                box_empty(&side[0]);
+                box_empty(&side[1]);
+                for (int k = 0; k < BINS; k++) box_grow(&side[k > split], bin[k].lo, bin[k].hi);
             }
-        } else {
-            mid = j.first;       /* all centroids coincide: the median below splits by count */
         }
-        if (mid < j.first + least || mid > j.first + j.count - least) {
+        bool known = mid != j.first;
+        if (mid < j.first + least || mid > end - least) {
             /* too small a child: split at the centroid median instead, which bounds the
-             * node count by the leaf size */
+             * node count by the leaf size; the children then find their own boxes */
             mid = j.first + j.count / 2;
-            select_median(b->tris + j.first, &bx, j.count, j.count / 2, axis);
+            select_median(&bx, j.first, j.count, j.count / 2, axis);
+            known = false;
         }
         uint32_t child = b->nnodes;
         b->nnodes += 2;
         nd->first = child;
         nd->count = 0;
-        stack[sp].node = child; stack[sp].first = j.first; stack[sp].count = mid - j.first;
-        depth_of[sp++] = depth + 1;
-        stack[sp].node = child + 1; stack[sp].first = mid; stack[sp].count = j.first + j.count - mid;
-        depth_of[sp++] = depth + 1;
+        for (int e = 0; e < 2; e++) {
+            job *c = &stack[sp++];
+            memset(c, 0, sizeof *c);
+            c->node = child + (uint32_t)e;
+            c->first = e ? mid : j.first;
+            c->count = e ? end - mid : mid - j.first;
+            c->depth = j.depth + 1;
+            c->known = known;
+            if (known) {
+                c->cb = cside[e];
+                memcpy(b->nodes[c->node].lo, side[e].lo, sizeof side[e].lo);
+                memcpy(b->nodes[c->node].hi, side[e].hi, sizeof side[e].hi);
+            }
+        }
     }
     om_arena_rewind(a, mark);
     return OM_OK;
