@@ -194,7 +194,7 @@ static om_status hybrid_init(void **state, om_arena *a, const om_method_cfg *mc,
      * triangle setup, it changes no result); then the pool, as set or as large as
      * the arena allows, from one row up to the frame. */
     uint32_t want = c.izb_pool ? c.izb_pool : w * h, least = c.izb_pool ? c.izb_pool : w;
-    if (om_arena_left(a) >= om__lspace_bytes(s) + mats_bytes(s) + pool_bytes(want)) {
+    if (om_arena_left(a) >= om__lspace_bytes(s) + mats_bytes(s) + pool_bytes(least)) {
         if ((st = om__lspace_init(&m->ls, a, s, d))) return st;
     } else {
         om__lspace_init_lean(&m->ls, s);
