@@ -503,6 +503,171 @@ static void odd_settings_render(void)
     h_scene_free(&hs);
 }
 
+/* A uniform number in [lo, hi) from a 64-bit LCG. */
+static double lcg_in(uint64_t *x, double lo, double hi)
+{
+    *x = *x * 6364136223846793005ull + 1442695040888963407ull;
+    return lo + (hi - lo) * (double)(*x >> 11) / 9007199254740992.0;
+}
+
+/* The float path's bounds hold, one sample at a time, against the exact values it
+ * stands for: wherever it places a sample, the exact u, v lie within its fixed-point
+ * bounds and z within ez; its depth comparisons (against stored depths chosen around
+ * the exact biased depth, where they are hardest) and its footprint decisions are the
+ * exact ones wherever it takes them; and it takes most of them. A spot and a
+ * directional light. */
+static void float_bounds_hold(void)
+{
+    static const char *const scenes[] = {
+        "camera eye 0 2.5 12 target 0 0.8 0 size 320 240\n"
+        "light spot pos 4 9 5 target 0 0 0 fov 70 near 0.5 far 40\nplane size 10 10\n",
+        "camera eye 0 4 7 target 0 0 0 size 320 240\nlight directional dir -0.4 -1 -0.3\n"
+        "plane size 10 10\n"};
+    uint64_t x = 12345;
+    for (int k = 0; k < 2; k++) {
+        h_scene hs;
+        if (!h_scene_parse(&hs, scenes[k])) return;
+        om_camera cam;
+        om_light light;
+        om_view v;
+        om_scene_at(&hs.s, 0.0f, &cam, &light);
+        CHECK_OK(om_view_init(&v, &cam, &light, &hs.s, NULL));
+        om__asm_cfg c;
+        memset(&c, 0, sizeof c);
+        c.asm_cap = 16u << 20;
+        c.bias_const = 0.01f;
+        c.bias_slope = 1.5f;
+        c.asm_tile = 64;
+        c.asm_cells = 8;
+        c.asm_root = 1024;
+        c.asm_float = 1;
+        om__asm_layout l;
+        CHECK_OK(om__asm_layout_of(&l, &c, 100, NULL));
+        om__asm_pctx pc;
+        om__asm_pctx_begin(&pc, &l, &c, &v);
+        CHECK(pc.fix > 0);
+        uint32_t placed = 0, tried = 0, decided = 0, compared = 0, finer = 0, finer_asked = 0;
+        for (int i = 0; i < 20000; i++) {
+            om_sample smp;
+            smp.p[0] = (float)lcg_in(&x, -5, 5);
+            smp.p[1] = (float)lcg_in(&x, 0, 2.5);
+            smp.p[2] = (float)lcg_in(&x, -5, 5);
+            double n0 = lcg_in(&x, -1, 1), n1 = lcg_in(&x, 0.05, 1), n2 = lcg_in(&x, -1, 1);
+            double nl = sqrt(n0 * n0 + n1 * n1 + n2 * n2);
+            smp.n[0] = (float)(n0 / nl);
+            smp.n[1] = (float)(n1 / nl);
+            smp.n[2] = (float)(n2 / nl);
+            smp.tri = 1;
+            smp.nl = 0.0f;
+            om__asm_fpt f;
+            om__asm_pt p;
+            tried++;
+            if (!om__asm_fpt_uv(&pc, &smp, &f)) continue;
+            placed++;
+            CHECK_MSG(om__asm_pt_uv(&pc, &smp, &p), "sample %d: placed in float, not exactly", i);
+            const double one = (double)(1u << pc.fix);
+            const double fu = floor(p.u * one), fv = floor(p.v * one);
+            CHECK_MSG(f.u0 <= fu && fu <= f.u1 && f.v0 <= fv && fv <= f.v1,
+                      "sample %d: u %.17g v %.17g outside [%u, %u] x [%u, %u] / 2^%u", i, p.u, p.v, f.u0, f.u1,
+                      f.v0, f.v1, pc.fix);
+            CHECK_MSG(fabs((double)f.z - p.z) <= (double)f.ez, "sample %d: z %.17g, float %g +- %g", i, p.z,
+                      (double)f.z, (double)f.ez);
+            om__asm_fpt_bias(&pc, &smp, &f, true);
+            om__asm_pt_bias(&pc, &smp, &p, true);
+            for (uint32_t L = 0; L <= l.max_level; L++) {
+                const double zl = p.z - p.bias_c - p.bias_s * (1.0 / l.scale[L]);
+                /* stored depths around the exact biased depth, out to 2^-12 of it */
+                const double span = fabs(zl) * lcg_in(&x, 0, 1) * lcg_in(&x, 0, 1) * (1.0 / 4096) + 1.0;
+                const double dd = floor(zl + lcg_in(&x, -span, span));
+                if (!(dd >= 0.0 && dd <= 4294967295.0)) continue;
+                const uint32_t depth = (uint32_t)dd;
+                const int r = om__asm_fpt_lit(&pc, &f, L, depth);
+                compared++;
+                if (r < 0) continue;
+                decided++;
+                CHECK_MSG(r == (zl <= (double)depth), "sample %d level %u: depth %u, exact %.17g, float says %d", i,
+                          L, depth, zl, r);
+                const int g = om__asm_fpt_finer(&pc, &f, L);
+                finer_asked++;
+                if (g < 0) continue;
+                finer++;
+                CHECK_MSG(g == (p.ratio0 / l.scale[L] > 1.0), "sample %d level %u: ratio %.17g, float says %d", i,
+                          L, p.ratio0 / l.scale[L], g);
+            }
+        }
+        CHECK_MSG(placed * 10 > tried * 6, "light %d: %u of %u samples placed in float", k, placed, tried);
+        CHECK_MSG(decided * 3 > compared, "light %d: %u of %u depths decided in float", k, decided, compared);
+        CHECK_MSG(finer * 10 > finer_asked * 9, "light %d: %u of %u ratios decided", k, finer, finer_asked);
+        CHECK_MSG(decided < compared, "light %d: every depth decided: the test is too easy", k);
+        h_scene_free(&hs);
+    }
+}
+
+/* The float path (asm.float 1: each sample placed in float, with bounds, the exact
+ * double path deciding where they do not) gives the exact path's frames, counters and
+ * tree: on close-ups refined to 65,536 texels a side (where float alone could not place
+ * samples), with strips, a moving camera, a directional light and a small cap. */
+static void float_path_is_exact(void)
+{
+    /* the default scene without its camera path, seen from close (bench_asm's views) */
+    static char text[16384];
+    const char *d = om_scene_default_text();
+    size_t n = 0;
+    while (*d) {
+        const char *e = strchr(d, '\n');
+        size_t len = e ? (size_t)(e - d) + 1 : strlen(d);
+        if (strncmp(d, "key camera", 10) != 0 && strncmp(d, "camera", 6) != 0 && n + len < sizeof text - 256) {
+            memcpy(text + n, d, len);
+            n += len;
+        }
+        d += len;
+    }
+    static const char *const cams[] = {"camera eye -0.2 0.9 4.8 target -0.6 0.1 3.0\n",
+                                       "camera eye 0.8 1.4 2.6 target -1.2 0.0 0.4\n",
+                                       "camera eye 0 2.5 12 target 0 0.8 0\n"};
+    enum { BW = 160, BH = 120 };
+    static om_term terms[2][BW * BH];
+    for (int k = 0; k < 4; k++) {
+        h_scene hs;
+        if (k < 3) {
+            memcpy(text + n, cams[k], strlen(cams[k]) + 1);
+            if (!h_scene_parse(&hs, text)) return;
+        } else if (!h_scene_parse(&hs, "camera eye 0 4 7 target 0 0 0 size 80 60\n"
+                                         "light directional dir -0.4 -1 -0.3\nplane size 10 10\n"
+                                         "box size 1 1 1 translate 0 0.5 0\n"
+                                         "triangles count 300 seed 5 area 6 in -3 0.2 -3 3 2 3\n"
+                                         "key camera 0 eye 0 4 7 target 0 0 0\n"
+                                         "key camera 1 eye 3 3 5 target 0 0 0\n")) {
+            return;
+        }
+        arun r[2];
+        bool ok = true;
+        for (int j = 0; j < 2; j++) {
+            om_method_cfg c;
+            om_method_cfg_default(&c, om_method_find("asm"));
+            CHECK_OK(om_method_cfg_set(&c, "asm.cap", k == 2 ? 200000 : 8u << 20, NULL));
+            CHECK_OK(om_method_cfg_set(&c, "asm.work", 4096, NULL));
+            CHECK_OK(om_method_cfg_set(&c, "asm.float", j, NULL));
+            ok = arun_init(&r[j], &hs.s, &c, BW, BH, false) && ok;
+        }
+        uint32_t finest = 0;
+        for (int f = 0; ok && f < 6; f++) {
+            om_method_stats ms[2];
+            for (int j = 0; j < 2; j++)
+                CHECK_OK(arun_frame(&r[j], k == 3 ? 0.2f * (float)f : 0.0f, 0.0f, f % 2 ? 7 : 0, NULL,
+                                    terms[j], &ms[j]));
+            CHECK_MSG(memcmp(terms[0], terms[1], sizeof terms[0]) == 0, "view %d frame %d: terms differ", k, f);
+            for (uint32_t i = 0; i < ms[0].ncounters; i++)
+                CHECK_MSG(ms[0].counters[i] == ms[1].counters[i], "view %d frame %d: %s %u, float %u", k, f,
+                          ms[0].counter_names[i], ms[0].counters[i], ms[1].counters[i]);
+            finest = counter(&ms[1], "effective resolution");
+        }
+        if (k < 2) CHECK_MSG(finest >= 65536, "view %d refined to %u only", k, finest);
+        for (int j = 0; j < 2; j++) arun_free(&r[j]);
+        h_scene_free(&hs);
+    }
+}
+
 void suite_asm(void)
 {
     RUN(tree_layout);
@@ -512,5 +677,7 @@ void suite_asm(void)
     RUN(cap_holds_along_path);
     RUN(still_view_converges);
     RUN(runs_are_bit_identical);
+    RUN(float_bounds_hold);
+    RUN(float_path_is_exact);
     RUN(odd_settings_render);
 }

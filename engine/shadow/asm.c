@@ -77,21 +77,12 @@ typedef struct asm_state {
     om__asm_cand *cand;
     uint32_t ncand_max;
     double inv_scale[OM__ASM_MAX_LEVEL + 1];   /* a level-L texel in base texels */
-    float span_per_dist;   /* spot: frustum width per unit of distance */
-    float pix_per_dist;    /* eye: pixel height per unit of distance */
+    om__asm_pctx pc;       /* what a sample's setup reads (asm_point.c) */
     uint32_t cache;        /* the last leaf found by resolve, or OM__ASM_NONE */
     om__asm_tile cache_tile;
     uint32_t samples, shadowed, analysed, straddling, candidates, rebuilds;
 } asm_state;
 
-/* What the analysis and the lookup need of one sample. */
-typedef struct asm_pt {
-    double u, v;           /* base texels, x right, y down */
-    double z;              /* light depth z/w * 2^32 */
-    double bias_c, bias_s; /* constant bias; slope bias for a base texel (depth units) */
-    double ratio0;         /* a base texel's surface footprint / the eye pixel's */
-    uint32_t tri;
-} asm_pt;
 
 /* The scene-sized arrays of the fast mode: projections once per frame, bounds once
  * per frame, a cull list per tile. */
@@ -229,8 +220,7 @@ static om_status asm_begin(void *state, const om_view *v, om_diag *d)
     asm_state *m = (asm_state *)state;
     if (!m) return om__fail(d, OM_E_INVALID, "asm: no state (did init fail?)");
     m->view = *v;
-    m->span_per_dist = 2.0f * (float)om__tan((double)v->light.fov_deg * OM_PI / 360.0);
-    m->pix_per_dist = 2.0f * (float)om__tan((double)v->cam.fovy_deg * OM_PI / 360.0) / (float)v->cam.height;
+    om__asm_pctx_begin(&m->pc, &m->tree.lay, &m->cfg, &m->view);
     m->samples = m->shadowed = m->analysed = m->straddling = m->candidates = m->rebuilds = 0;
     m->prepared = false;
     m->cache = OM__ASM_NONE;
@@ -520,92 +510,129 @@ static void prepare(asm_state *m)
     }
 }
 
-/* ---- one sample */
+/* ---- one sample: the float path where its bounds decide (asm_point.c), the exact
+ * one where they do not. Both give the same answer to every question asked below, so
+ * a sample may switch from one to the other at any point of its descent. */
 
-/* Where the sample lands on the light's image, and its light depth. */
-static bool setup_uv(const asm_state *m, const om_sample *smp, asm_pt *o)
+typedef struct asm_smp {
+    const om_sample *s;
+    bool analyse;          /* the analysis: the bias with the footprint ratio */
+    bool fast;             /* f places the sample */
+    bool exact, exact_bias;   /* p holds the exact place; and its bias */
+    uint32_t zl_level;     /* zl is the exact biased depth at this level */
+    double zl;
+    om__asm_fpt f;
+    om__asm_pt p;
+} asm_smp;
+
+/* Starts a sample; false where the exact path does not look it up. */
+static bool smp_begin(const asm_state *m, const om_sample *s, bool analyse, asm_smp *o)
 {
-    asm_dvec q = dapply(&m->view.light_vp, om__v3(smp->p[0], smp->p[1], smp->p[2]));
-    if (!(q.w > 0.0)) return false;
-    const double R = m->tree.lay.tile, iw = 1.0 / q.w;
-    o->u = (q.x * iw + 1.0) * 0.5 * R;
-    o->v = (1.0 - q.y * iw) * 0.5 * R;
-    o->z = q.z * iw * OM_DEPTH_ONE;
-    o->tri = smp->tri;
-    return o->u > -1e9 && o->u < 1e9 && o->v > -1e9 && o->v < 1e9 && o->z > -1e30 && o->z < 1e30;
+    o->s = s;
+    o->analyse = analyse;
+    o->exact = o->exact_bias = false;
+    o->zl_level = UINT32_MAX;
+    o->fast = m->pc.fix && om__asm_fpt_uv(&m->pc, s, &o->f);
+    if (o->fast) return true;
+    o->exact = true;
+    return om__asm_pt_uv(&m->pc, s, &o->p);
 }
 
-/* Its bias and, with `analyse`, the footprint ratio, which only the analysis needs. */
-static void setup_bias(const asm_state *m, const om_sample *smp, asm_pt *o, bool analyse)
+static const om__asm_pt *smp_exact(const asm_state *m, asm_smp *o, bool bias)
 {
-    const om_view *v = &m->view;
-    const double R = m->tree.lay.tile;
-    om_vec3 p = om__v3(smp->p[0], smp->p[1], smp->p[2]);
-    om_vec3 n = om__v3(smp->n[0], smp->n[1], smp->n[2]);
-    om_vec3 e = om__sub(v->cam.eye, p);
-    if (om__dot(n, e) < 0.0f) n = om__scale(n, -1.0f);
-    /* A base texel's world size across the light ray, and depth units per world unit
-     * along it, as the conventional map computes them. */
-    om_vec3 l = om__to_light(v, p);
-    double texel, dz;
-    if (v->light.kind == OM_LIGHT_SPOT) {
-        float dist = om__dot(om__sub(p, v->light.pos), v->light_axis);
-        double f = v->light.zfar, nn = v->light.znear, ee = dist > nn * 0.5f ? dist : nn * 0.5;
-        texel = (double)dist * m->span_per_dist / R;
-        dz = f * nn / ((f - nn) * ee * ee) * OM_DEPTH_ONE;
-    } else {
-        texel = 2.0 / fabs((double)v->light_proj.m[0]) / R;
-        dz = OM_DEPTH_ONE * fabs((double)v->light_proj.m[10]);
+    if (!o->exact) {
+        o->exact = true;
+        (void)om__asm_pt_uv(&m->pc, o->s, &o->p);   /* true: the float path placed it */
     }
-    float cosl = om__dot(n, l);
-    double tanl = cosl > 0.0995f ? sqrt(1.0 - (double)cosl * cosl) / cosl : 10.0;
-    o->bias_c = (double)m->cfg.bias_const * dz;
-    o->bias_s = (double)m->cfg.bias_slope * texel * tanl * dz;
-    o->ratio0 = 0.0;
-    if (!analyse) return;
-    /* Footprints on the surface (sections 3.1 and 4.1, computed rather than read from a
-     * mip-map): an eye pixel spans dist * 2 tan(fovy / 2) / height across the view ray,
-     * a texel its size across the light ray; on the surface each covers that squared
-     * over the cosine between the normal and its ray (clamped at 0.1). The ratio kept
-     * is linear: the square root of the paper's ratio of projected areas. */
-    float de = sqrtf(om__dot(e, e));
-    float cose = de > 0.0f ? fabsf(om__dot(n, e)) / de : 1.0f;
-    if (cose < 0.1f) cose = 0.1f;
-    if (cosl < 0.1f) cosl = 0.1f;
-    double pix = (double)de * m->pix_per_dist;
-    o->ratio0 = pix > 0.0 ? texel / pix * sqrt((double)cose / (double)cosl) : 0.0;
+    if (bias && !o->exact_bias) {
+        o->exact_bias = true;
+        om__asm_pt_bias(&m->pc, o->s, &o->p, o->analyse);
+    }
+    return &o->p;
 }
 
-/* Section 4.2: the polygon ID first; when it differs, the depth comparison. */
-static inline bool texel_lit(const om__asm_tile *tl, uint32_t x, uint32_t y, const asm_pt *p, double zl)
-{
-    size_t i = (size_t)y * tl->size + x;
-    if (tl->id16 ? tl->id16[i] == (uint16_t)p->tri : tl->id32[i] == p->tri) return true;
-    return zl <= (double)tl->depth[i];
-}
-
-static inline double level_z(const asm_state *m, const asm_pt *p, uint32_t level)
+static inline double level_z(const asm_state *m, const om__asm_pt *p, uint32_t level)
 {
     return p->z - p->bias_c - p->bias_s * m->inv_scale[level];
 }
 
-static bool straddles(const om__asm_tile *tl, uint32_t x, uint32_t y, const asm_pt *p, double zl)
+/* The sample's texel on `level`'s grid, where the float path decides it. */
+static inline bool fast_grid(const asm_state *m, const asm_smp *o, uint32_t level, uint32_t *gx,
+                             uint32_t *gy)
 {
-    bool c = texel_lit(tl, x, y, p, zl);
+    if (!o->fast) return false;
+    const uint32_t sh = m->pc.shift[level];
+    *gx = o->f.u0 >> sh;
+    *gy = o->f.v0 >> sh;
+    return *gx == o->f.u1 >> sh && *gy == o->f.v1 >> sh;
+}
+
+static inline uint32_t clamp_in(uint32_t g, uint32_t o, uint32_t size)
+{
+    return g < o ? 0u : g - o >= size ? size - 1 : g - o;
+}
+
+/* The sample's texel in a tile, clamped: as om__asm_find does it. */
+static inline void smp_texel(const asm_state *m, asm_smp *o, const om__asm_tile *tl, uint32_t *x, uint32_t *y)
+{
+    const uint32_t level = tl->node->level;
+    uint32_t gx, gy;
+    if (fast_grid(m, o, level, &gx, &gy)) {
+        *x = clamp_in(gx, tl->node->ox, tl->size);
+        *y = clamp_in(gy, tl->node->oy, tl->size);
+        return;
+    }
+    const om__asm_pt *p = smp_exact(m, o, false);
+    const double s = m->tree.lay.scale[level];
+    double lx = floor(p->u * s - (double)tl->node->ox), ly = floor(p->v * s - (double)tl->node->oy);
+    *x = !(lx > 0.0) ? 0u : lx >= (double)tl->size ? tl->size - 1 : (uint32_t)lx;
+    *y = !(ly > 0.0) ? 0u : ly >= (double)tl->size ? tl->size - 1 : (uint32_t)ly;
+}
+
+/* The biased depth at `level` against a stored one (the exact one once a level). */
+static bool smp_depth_lit(const asm_state *m, asm_smp *o, uint32_t level, uint32_t depth)
+{
+    if (o->fast) {
+        if (!o->f.bias) om__asm_fpt_bias(&m->pc, o->s, &o->f, o->analyse);
+        const int r = om__asm_fpt_lit(&m->pc, &o->f, level, depth);
+        if (r >= 0) return r == 1;
+    }
+    if (o->zl_level != level) {
+        o->zl = level_z(m, smp_exact(m, o, true), level);
+        o->zl_level = level;
+    }
+    return o->zl <= (double)depth;
+}
+
+/* Section 4.2: the polygon ID first; when it differs, the biased depth. */
+static inline bool smp_lit(const asm_state *m, asm_smp *o, const om__asm_tile *tl, uint32_t x, uint32_t y)
+{
+    const size_t i = (size_t)y * tl->size + x;
+    if (tl->id16 ? tl->id16[i] == (uint16_t)o->s->tri : tl->id32[i] == o->s->tri) return true;
+    return smp_depth_lit(m, o, tl->node->level, tl->depth[i]);
+}
+
+/* Whether `level`'s texel is larger on the surface than the eye's pixel. */
+static bool smp_finer(const asm_state *m, asm_smp *o, uint32_t level)
+{
+    if (o->fast) {
+        if (!o->f.bias) om__asm_fpt_bias(&m->pc, o->s, &o->f, o->analyse);
+        const int r = om__asm_fpt_finer(&m->pc, &o->f, level);
+        if (r >= 0) return r == 1;
+    }
+    return smp_exact(m, o, true)->ratio0 * m->inv_scale[level] > 1.0;
+}
+
+/* The sample's own test disagrees across the 3x3 texels around it. */
+static bool straddles(const asm_state *m, asm_smp *o, const om__asm_tile *tl, uint32_t x, uint32_t y)
+{
+    bool c = smp_lit(m, o, tl, x, y);
     uint32_t x0 = x ? x - 1 : 0, y0 = y ? y - 1 : 0;
     uint32_t x1 = x + 1 < tl->size ? x + 1 : x, y1 = y + 1 < tl->size ? y + 1 : y;
     for (uint32_t j = y0; j <= y1; j++)
         for (uint32_t i = x0; i <= x1; i++)
-            if (texel_lit(tl, i, j, p, zl) != c) return true;
+            if (smp_lit(m, o, tl, i, j) != c) return true;
     return false;
-}
-
-/* The texel of (u, v) (level-grid texels) in a tile, clamped: as om__asm_find does it. */
-static inline void texel_of(const om__asm_tile *tl, double u, double v, uint32_t *x, uint32_t *y)
-{
-    double lx = floor(u - (double)tl->node->ox), ly = floor(v - (double)tl->node->oy);
-    *x = !(lx > 0.0) ? 0u : lx >= (double)tl->size ? tl->size - 1 : (uint32_t)lx;
-    *y = !(ly > 0.0) ? 0u : ly >= (double)tl->size ? tl->size - 1 : (uint32_t)ly;
 }
 
 static om_status asm_observe(void *state, const om_strip *st, om_diag *d)
@@ -623,18 +650,16 @@ static om_status asm_observe(void *state, const om_strip *st, om_diag *d)
         for (uint32_t x = (uint32_t)((stride - (3u * gy) % stride) % stride); x < st->width; x += stride) {
             size_t i = (size_t)y * st->width + x;
             if (!(st->terms[i].flags & OM_TERM_EXPOSED)) continue;
-            asm_pt p;
-            if (!setup_uv(m, &st->samples[i], &p)) continue;
-            setup_bias(m, &st->samples[i], &p, true);
+            asm_smp o;
+            if (!smp_begin(m, &st->samples[i], true, &o)) continue;
             m->analysed++;
             uint32_t index = OM__ASM_ROOT, level = 0;
             for (;;) {
                 om__asm_tile tl;
                 uint32_t tx, ty;
                 bool want = false;
-                float nreq = 0.0f;
                 om__asm_tile_of(t, index, &tl);
-                texel_of(&tl, p.u * l->scale[level], p.v * l->scale[level], &tx, &ty);
+                smp_texel(m, &o, &tl, &tx, &ty);
                 tl.node->stamp = t->frame;
                 uint32_t c = (ty / tl.cp) * tl.cells + tx / tl.cp;
                 uint32_t child = tl.child[c];
@@ -652,9 +677,7 @@ static om_status asm_observe(void *state, const om_strip *st, om_diag *d)
                     }
                     om__asm_node_at(t, child)->benefit++;
                 } else {
-                    double r = p.ratio0 * m->inv_scale[level];
-                    want = r > 1.0 && straddles(&tl, tx, ty, &p, level_z(m, &p, level));
-                    nreq = (float)(ncell * r * r);
+                    want = smp_finer(m, &o, level) && straddles(m, &o, &tl, tx, ty);
                     if (child != OM__ASM_NONE && want) om__asm_node_at(t, child)->benefit++;
                 }
                 if (child != OM__ASM_NONE) {
@@ -664,6 +687,8 @@ static om_status asm_observe(void *state, const om_strip *st, om_diag *d)
                 }
                 if (want && level < l->max_level) {
                     /* Section 3.1: N_required = N_current * (texel area / pixel area). */
+                    const double r = smp_exact(m, &o, true)->ratio0 * m->inv_scale[level];
+                    const float nreq = (float)(ncell * r * r);
                     tl.ben[c]++;
                     if (nreq > tl.need[c]) tl.need[c] = nreq;
                     m->straddling++;
@@ -713,29 +738,77 @@ static om_status asm_build(void *state, om_diag *d)
     return OM_OK;
 }
 
-/* The deepest node over (u, v): the last leaf when it still is, else a descent. */
-static void find(asm_state *m, double u, double v, om__asm_tile *tl, uint32_t *tx, uint32_t *ty)
+/* The last leaf a lookup found (section 4.3's cache): the state's for a strip at a
+ * time, a band's own (its scratch) on the host's threads. */
+typedef struct asm_cache {
+    uint32_t index;        /* OM__ASM_NONE: empty */
+    om__asm_tile tile;
+} asm_cache;
+
+/* The deepest node over the sample and its texel there, reading the tree only: the
+ * cached leaf when it still holds the sample, else a descent from the root, which
+ * refills the cache and says so (*moved). */
+static void smp_find(const asm_state *m, asm_smp *o, asm_cache *c, om__asm_tile *tl, uint32_t *tx,
+                     uint32_t *ty, bool *moved)
 {
-    om__asm_tree *t = &m->tree;
-    if (m->cache != OM__ASM_NONE) {
-        const om__asm_tile *c = &m->cache_tile;
-        const double s = t->lay.scale[c->node->level];   /* the descent's own arithmetic */
-        double lx = floor(u * s - (double)c->node->ox), ly = floor(v * s - (double)c->node->oy);
-        if (lx >= 0.0 && ly >= 0.0 && lx < (double)c->size && ly < (double)c->size) {
-            uint32_t x = (uint32_t)lx, y = (uint32_t)ly;
-            if (c->child[(y / c->cp) * c->cells + x / c->cp] == OM__ASM_NONE) {
-                c->node->stamp = t->frame;
-                *tl = *c;
-                *tx = x;
-                *ty = y;
-                return;
-            }
+    /* om__asm_tile_of hands out the tree's arrays; nothing here writes them */
+    om__asm_tree *t = (om__asm_tree *)&m->tree;
+    if (c->index != OM__ASM_NONE) {
+        const om__asm_tile *ct = &c->tile;
+        const om__asm_node *n = ct->node;
+        uint32_t gx, gy, x = 0, y = 0;
+        bool in;
+        if (fast_grid(m, o, n->level, &gx, &gy)) {
+            in = gx >= n->ox && gy >= n->oy && gx - n->ox < ct->size && gy - n->oy < ct->size;
+            if (in) x = gx - n->ox, y = gy - n->oy;
+        } else {
+            const om__asm_pt *p = smp_exact(m, o, false);
+            const double s = t->lay.scale[n->level];   /* the descent's own arithmetic */
+            double lx = floor(p->u * s - (double)n->ox), ly = floor(p->v * s - (double)n->oy);
+            in = lx >= 0.0 && ly >= 0.0 && lx < (double)ct->size && ly < (double)ct->size;
+            if (in) x = (uint32_t)lx, y = (uint32_t)ly;
+        }
+        if (in && ct->child[(y / ct->cp) * ct->cells + x / ct->cp] == OM__ASM_NONE) {
+            *tl = *ct;
+            *tx = x;
+            *ty = y;
+            return;
         }
     }
-    uint32_t k = om__asm_find(t, u, v, true, tx, ty);
-    om__asm_tile_of(t, k, tl);
-    m->cache = k;
-    m->cache_tile = *tl;
+    uint32_t index = OM__ASM_ROOT;
+    for (;;) {
+        om__asm_tile_of(t, index, tl);
+        smp_texel(m, o, tl, tx, ty);
+        const uint32_t child = tl->child[(*ty / tl->cp) * tl->cells + *tx / tl->cp];
+        if (child == OM__ASM_NONE) break;
+        index = child;
+    }
+    c->index = index;
+    c->tile = *tl;
+    *moved = true;
+}
+
+/* A lookup uses its leaf and every node above it (section 3.2's "recently used"). A
+ * leaf the cache hands out again was stamped with its path when it was found. */
+static void stamp_path(om__asm_tree *t, uint32_t index)
+{
+    for (;;) {
+        om__asm_node *n = om__asm_node_at(t, index);
+        n->stamp = t->frame;
+        if (index == OM__ASM_ROOT) return;
+        index = n->parent;
+    }
+}
+
+/* One exposed sample: 1 lit, 0 shadowed (behind the light or off every grid: lit). */
+static int resolve_one(const asm_state *m, const om_sample *s, asm_cache *c, bool *moved)
+{
+    asm_smp o;
+    if (!smp_begin(m, s, false, &o)) return 1;
+    uint32_t tx, ty;
+    om__asm_tile tl;
+    smp_find(m, &o, c, &tl, &tx, &ty, moved);
+    return smp_lit(m, &o, &tl, tx, ty);
 }
 
 static om_status asm_resolve(void *state, om_strip *st, om_diag *d)
@@ -744,27 +817,24 @@ static om_status asm_resolve(void *state, om_strip *st, om_diag *d)
     asm_state *m = (asm_state *)state;
     size_t n = (size_t)st->rows * st->width;
     prepare(m);
+    asm_cache c = {m->cache, m->cache_tile};
     for (size_t i = 0; i < n; i++) {
         om_term *t = &st->terms[i];
         t->r = t->g = t->b = 255;
         if (!(t->flags & OM_TERM_EXPOSED)) continue;
         m->samples++;
-        asm_pt p;
-        if (!setup_uv(m, &st->samples[i], &p)) continue;
-        uint32_t tx, ty;
-        om__asm_tile tl;
-        find(m, p.u, p.v, &tl, &tx, &ty);
-        /* Section 4.2: the polygon ID first; the bias is only needed when it differs. */
-        size_t k = (size_t)ty * tl.size + tx;
-        if (tl.id16 ? tl.id16[k] == (uint16_t)p.tri : tl.id32[k] == p.tri) continue;
-        setup_bias(m, &st->samples[i], &p, false);
-        if (!(level_z(m, &p, tl.node->level) <= (double)tl.depth[k])) {
+        bool moved = false;
+        if (!resolve_one(m, &st->samples[i], &c, &moved)) {
             t->r = t->g = t->b = 0;
             m->shadowed++;
         }
+        if (moved) stamp_path(&m->tree, c.index);
     }
+    m->cache = c.index;
+    m->cache_tile = c.tile;
     return OM_OK;
 }
+
 
 static void asm_stats(const void *state, om_method_stats *out)
 {
@@ -802,6 +872,8 @@ static const om_setting settings[] = {
     SET(asm_stride, "asm.stride", OM_SETTING_U32, 1, 1024, 8, "analyse one visible sample in N"),
     SET(asm_cost_a, "asm.a", OM_SETTING_F32, 0, 1e6, 1.0 / 4096.0, "node cost per required texel"),
     SET(asm_cost_b, "asm.b", OM_SETTING_F32, 0, 1e6, 1, "node cost, constant part"),
+    SET(asm_float, "asm.float", OM_SETTING_U32, 0, 1, OM_ASM_FLOAT,
+        "1: place samples in float first (same frames; 1 where double is software)"),
 };
 
 #undef SET

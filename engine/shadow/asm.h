@@ -40,7 +40,19 @@ typedef struct om__asm_cfg {
     uint32_t asm_work;     /* per-frame work budget, in cost units */
     uint32_t asm_stride;   /* analyse one visible sample in asm_stride (the paper: 8) */
     float asm_cost_a, asm_cost_b;   /* cost of a node: a * texels required + b */
+    uint32_t asm_float;    /* place samples in float first (asm_point.c): same frames */
 } om__asm_cfg;
+
+/* asm.float's default: on where double is software (the FPU of a Cortex-M4F is single
+ * precision; M0 and M3 have none), where the float path costs a tenth of the exact
+ * one; off where double is hardware, which the float path's bounds only slow down. */
+#ifndef OM_ASM_FLOAT
+#if defined(__arm__) && !(defined(__ARM_FP) && (__ARM_FP & 8))
+#define OM_ASM_FLOAT 1
+#else
+#define OM_ASM_FLOAT 0
+#endif
+#endif
 
 /* The head of every pool item (and of the root). */
 typedef struct om__asm_node {
@@ -156,5 +168,85 @@ uint32_t om__asm_candidates(om__asm_tree *t, bool base, float a, float b, om__as
 uint32_t om__asm_cand_pop(om__asm_cand *heap, uint32_t n, om__asm_cand *best);
 /* Upper bound of om__asm_candidates' count for a layout. */
 uint64_t om__asm_cand_max(const om__asm_layout *l);
+
+/* ---- one sample's place on the light's image (asm_point.c) */
+
+/* What a sample's setup reads of the frame (om__asm_pctx_begin). */
+typedef struct om__asm_pctx {
+    const om_view *view;
+    double R;              /* the base's texels per side (asm.tile) */
+    float bias_const, bias_slope;
+    float span_per_dist;   /* spot: frustum width per unit of distance */
+    float pix_per_dist;    /* eye: pixel height per unit of distance */
+    float dir_texel, dir_dz;   /* directional: texel and depth scale, in float */
+    /* The float path (om__asm_fpt): 0 where it is off (asm.float 0, or a level's scale
+     * not a power of two), else the fraction bits of its fixed-point base texels; per
+     * level the shift from them to the level's texels, and the level's texel in base
+     * texels. */
+    uint32_t fix;
+    uint32_t shift[OM__ASM_MAX_LEVEL + 1];
+    float inv_scale[OM__ASM_MAX_LEVEL + 1];
+    uint32_t fast_levels;  /* levels below this have a shift */
+} om__asm_pctx;
+
+void om__asm_pctx_begin(om__asm_pctx *c, const om__asm_layout *l, const om__asm_cfg *cfg,
+                        const om_view *v);
+
+/* The exact place, in double: what the analysis and the lookup decide by. */
+typedef struct om__asm_pt {
+    double u, v;           /* base texels, x right, y down */
+    double z;              /* light depth z/w * 2^32 */
+    double bias_c, bias_s; /* constant bias; slope bias for a base texel (depth units) */
+    double ratio0;         /* a base texel's surface footprint / the eye pixel's */
+    uint32_t tri;
+} om__asm_pt;
+
+/* u, v, z; false where the sample is behind the light or off any grid (no lookup). */
+bool om__asm_pt_uv(const om__asm_pctx *c, const om_sample *smp, om__asm_pt *o);
+/* Its bias and, with `analyse`, the footprint ratio. */
+void om__asm_pt_bias(const om__asm_pctx *c, const om_sample *smp, om__asm_pt *o, bool analyse);
+
+/* The same place in float (a Cortex-M4F's FPU runs it; double is software there),
+ * with bounds on how far the exact values can lie: every decision taken from it is
+ * the one the exact values would take, and one it cannot take falls to them. u and v
+ * are kept as fixed-point bounds (base texels * 2^fix, floored) that hold the exact
+ * u and v: on a grid 2^a times finer, the texel is decided where both bounds give it. */
+typedef struct om__asm_fpt {
+    uint32_t u0, u1, v0, v1;
+    float z, ez;           /* z/w * 2^32, and a bound on its distance to the exact z */
+    float bc, bs;          /* the bias terms (relative error within 2^-17) */
+    float ratio0;          /* analysis: 0 where it is not decided */
+    bool bias;             /* bc, bs (and ratio0 when asked) are set */
+} om__asm_fpt;
+
+/* false: the float path cannot place this sample (the exact one decides it). */
+bool om__asm_fpt_uv(const om__asm_pctx *c, const om_sample *smp, om__asm_fpt *o);
+void om__asm_fpt_bias(const om__asm_pctx *c, const om_sample *smp, om__asm_fpt *o, bool analyse);
+
+/* Whether the biased depth at `level` is lit against a stored depth: 1 lit, 0
+ * shadowed, -1 too close to tell in float. The bias must be set. */
+static inline int om__asm_fpt_lit(const om__asm_pctx *c, const om__asm_fpt *f, uint32_t level,
+                                  uint32_t depth)
+{
+    const float is = c->inv_scale[level], bsl = f->bs * is;
+    const float zl = f->z - f->bc - bsl, d = (float)depth;
+    /* the bias terms' and z's bounds, the subtractions' rounding, the stored depth's
+     * rounding to float (2^-24 of it) and some room */
+    const float M = f->ez + (om__fabsf(f->z) + om__fabsf(f->bc) + om__fabsf(bsl)) * 0x1p-17f +
+                    d * 0x1p-22f + 4.0f;
+    if (zl + M <= d) return 1;
+    if (zl - M > d) return 0;
+    return -1;
+}
+
+/* Whether ratio0 * inv_scale[level] > 1: 1, 0, or -1 too close (or not set). */
+static inline int om__asm_fpt_finer(const om__asm_pctx *c, const om__asm_fpt *f, uint32_t level)
+{
+    if (!(f->ratio0 > 0.0f)) return -1;
+    const float r = f->ratio0 * c->inv_scale[level];
+    if (r > 1.0f + 0x1p-15f) return 1;
+    if (r < 1.0f - 0x1p-15f) return 0;
+    return -1;
+}
 
 #endif
