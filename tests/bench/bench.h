@@ -46,6 +46,7 @@ int bench_run_hooked(const bscene *b, const char *method, const om_method_cfg *c
 
 #define OM_BENCHES \
     X(bench_raster) \
+    X(bench_raster_sweep) \
     X(bench_shadow) \
     X(bench_izb) \
     X(bench_rtw) \

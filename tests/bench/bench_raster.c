@@ -1,7 +1,9 @@
 /* bench_raster.c — the rasterizer's figures: the eye pass at 1024x768 (depth + id,
  * then visible samples) and the depth-only light pass at 1024x1024 and 2048x2048, for
  * the default scene, for 100K random small triangles above a floor and for 1,000
- * triangles over the whole map; each without and with the coarse depth. */
+ * triangles over the whole map; each without and with the coarse depth. Then
+ * (bench_raster_sweep) the same passes on random 1K..1M triangles in ms and triangles
+ * per second, the figures issue 29's desktop targets are stated in. */
 #include "bench.h"
 
 static void bench_eye(const bscene *b, uint32_t W, uint32_t H)
@@ -86,4 +88,61 @@ void bench_raster(void)
     }
     bench_free(&def);
     bench_free(&rnd);
+}
+
+/* One pass, RUNS times: its median in ms. */
+static double time_pass(const bscene *b, const om_mat4 *vp, om_target *tg, om_raster_mode mode, bool cull)
+{
+    uint64_t t[RUNS];
+    for (int r = 0; r < RUNS; r++) {
+        uint64_t t0 = om_clock_ns(NULL);
+        om__scene_raster(&b->s, vp, tg, mode, cull, NULL);
+        t[r] = om_clock_ns(NULL) - t0;
+    }
+    return bench_median_ns(t, RUNS);
+}
+
+/* The light depth pass (plain, as every map draws a scene of small triangles) at
+ * 1024^2 and 2048^2 and the eye pass at 1024x768 (its raster, then raster and visible
+ * samples), on random N = 1K..1M: ms and million triangles a second, single thread. */
+void bench_raster_sweep(void)
+{
+    static const unsigned counts[] = {1000, 10000, 100000, 1000000};
+    const size_t big = (size_t)2048 * 2048;
+    uint32_t *depth = malloc(big * 4), *id = malloc((size_t)1024 * 768 * 4);
+    om_sample *smp = malloc((size_t)1024 * 768 * sizeof *smp);
+    for (int k = 0; k < 4; k++) {
+        bscene b;
+        if (bench_load_random(&b, counts[k])) break;
+        om_view v;
+        om_diag d;
+        if (om_view_init(&v, &b.s.camera, &b.s.light, &b.s, &d) != OM_OK) {
+            fprintf(stderr, "bench: %s\n", d.msg);
+            bench_free(&b);
+            break;
+        }
+        const double n = (double)b.s.ntris;
+        for (uint32_t size = 1024; size <= 2048; size *= 2) {
+            om_target tg = {size, size, 0, size, depth, NULL};
+            const double ms = time_pass(&b, &v.light_vp, &tg, OM_RASTER_DEPTH, true);
+            printf("sweep %-12s light depth pass %ux%u: %8.2f ms, %7.2f M tris/s\n", b.name, size, size,
+                   ms, n / ms / 1e3);
+        }
+        om_target eye = {1024, 768, 0, 768, depth, id};
+        om_strip st = {1024, 768, 0, 768, smp, NULL};
+        uint64_t t[RUNS];
+        for (int r = 0; r < RUNS; r++) {
+            uint64_t t0 = om_clock_ns(NULL);
+            om__scene_raster(&b.s, &v.cam_vp, &eye, OM_RASTER_DEPTH_ID, false, NULL);
+            om__eye_pass(&b.s, &v, &eye, &st, NULL);
+            t[r] = om_clock_ns(NULL) - t0;
+        }
+        const double ms = time_pass(&b, &v.cam_vp, &eye, OM_RASTER_DEPTH_ID, false), all = bench_median_ns(t, RUNS);
+        printf("sweep %-12s eye raster 1024x768:       %8.2f ms, %7.2f M tris/s; with samples %8.2f ms, %7.2f M tris/s\n",
+               b.name, ms, n / ms / 1e3, all, n / all / 1e3);
+        bench_free(&b);
+    }
+    free(depth);
+    free(id);
+    free(smp);
 }
