@@ -3,7 +3,7 @@
  * sub-pixel vertices), clipping at the near and far planes, coordinates that would
  * overflow 32-bit setup, conservative coverage, the point-in-triangle test, and the
  * entry for triangles already on the grid, the plain depth pass made alongside a
- * conservative one, and depth passes on rectilinear grids. */
+ * conservative one, depth passes on rectilinear grids, and non-finite vertices. */
 #include "test.h"
 #include "../engine/raster/raster.h"
 #include "../engine/core/core.h"
@@ -801,6 +801,32 @@ static void strips_match_whole(void)
     CHECK_EQ_U(diff, 0);
 }
 
+/* A triangle with a vertex coordinate that is infinite or NaN draws nothing, whichever
+ * coordinate it is: w = +inf passes every clip plane's test and would project to the
+ * image's centre, so it is the case a fast path could let through. */
+static void non_finite_vertices_draw_nothing(void)
+{
+    om_target t = target(TW, TH);
+    om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL, NULL, NULL, 0, false, NULL, NULL, NULL, NULL, 0, 0, NULL, 0};
+    const om_vec4 tri[3] = {at(100, 100, TW, TH, 0.5f), at(7000, 300, TW, TH, 0.5f), at(900, 7900, TW, TH, 0.5f)};
+    om__target_clear(&t);
+    CHECK_EQ_U((uint32_t)om__raster_tri(&r, tri, 1), 1);   /* as given, it draws */
+    const float bad[3] = {INFINITY, -INFINITY, NAN};
+    uint32_t drawn = 0, touched = 0;
+    for (int k = 0; k < 3; k++)
+        for (int c = 0; c < 4; c++)
+            for (int b = 0; b < 3; b++) {
+                om_vec4 v[3] = {tri[0], tri[1], tri[2]};
+                float *f = c == 0 ? &v[k].x : c == 1 ? &v[k].y : c == 2 ? &v[k].z : &v[k].w;
+                *f = bad[b];
+                om__target_clear(&t);
+                drawn += (uint32_t)om__raster_tri(&r, v, 2);
+                for (uint32_t i = 0; i < TW * TH; i++) touched += depth_buf[i] != 0xFFFFFFFFu;
+            }
+    CHECK_EQ_U(drawn, 0);
+    CHECK_EQ_U(touched, 0);
+}
+
 void suite_raster(void)
 {
     RUN(hand_checked_masks);
@@ -819,4 +845,5 @@ void suite_raster(void)
     RUN(conservative_row_mask);
     RUN(conservative_centres_match_depth_pass);
     RUN(strips_match_whole);
+    RUN(non_finite_vertices_draw_nothing);
 }

@@ -86,14 +86,25 @@ static float plane_dist(int plane, const cvert *v, float gx, float gy)
 
 static float guard(uint32_t size) { return 1.0f + 2.0f * (float)OM_GUARD_PX / (float)size; }
 
+/* om__outcode with the guard band's extents gx, gy (guard) worked out by the caller,
+ * once a triangle: plane_dist's six expressions, written out. */
+static inline unsigned outcode_g(const om_vec4 *v, float gx, float gy)
+{
+    return (unsigned)!(v->z >= 0.0f) | (unsigned)!(v->w - v->z >= 0.0f) << 1 |
+           (unsigned)!(v->x + gx * v->w >= 0.0f) << 2 | (unsigned)!(gx * v->w - v->x >= 0.0f) << 3 |
+           (unsigned)!(v->y + gy * v->w >= 0.0f) << 4 | (unsigned)!(gy * v->w - v->y >= 0.0f) << 5;
+}
+
+/* outcode_g(v, gx, gy) == 0, without the mask (an int, for &: no branches). */
+static inline int inside_g(const om_vec4 *v, float gx, float gy)
+{
+    return (v->z >= 0.0f) & (v->w - v->z >= 0.0f) & (v->x + gx * v->w >= 0.0f) & (gx * v->w - v->x >= 0.0f) &
+           (v->y + gy * v->w >= 0.0f) & (gy * v->w - v->y >= 0.0f);
+}
+
 unsigned om__outcode(const om_vec4 *v, uint32_t width, uint32_t height)
 {
-    cvert c = {v->x, v->y, v->z, v->w};
-    float gx = guard(width), gy = guard(height);
-    unsigned mask = 0;
-    for (int p = 0; p < 6; p++)
-        if (!(plane_dist(p, &c, gx, gy) >= 0.0f)) mask |= 1u << p;
-    return mask;
+    return outcode_g(v, guard(width), guard(height));
 }
 
 /* The intersection is always computed from the inside vertex towards the outside one,
@@ -117,7 +128,7 @@ int om__clip_project(const om_vec4 clip[3], uint32_t width, uint32_t height,
     float gx = guard(width), gy = guard(height);
     unsigned outside_all = 0x3F, outside_any = 0;
     for (int i = 0; i < 3; i++) {
-        unsigned mask = om__outcode(&clip[i], width, height);
+        unsigned mask = outcode_g(&clip[i], gx, gy);
         buf[0][i].x = clip[i].x;
         buf[0][i].y = clip[i].y;
         buf[0][i].z = clip[i].z;
@@ -518,9 +529,31 @@ void om__fill_grid_row(const om_raster *r, const om__rtri *t, int32_t y, int32_t
     grid_row(r, t, y, lo, hi);
 }
 
-static bool snapped(const om_raster *r, uint32_t *hiz, const int64_t x[3], const int64_t y[3],
-                    const uint32_t z[3], uint32_t id)
+static const uint32_t *zdepths(const om_vec4 *zc, uint32_t zb[3])
 {
+    for (int i = 0; i < 3; i++) zb[i] = om__zdepth(zc[i].z, zc[i].w);
+    return zb;
+}
+
+/* The range om__tri2_setup accepts, tested before snapped's bounds as the setup would
+ * refuse the same triangles; om__project's vertices are always in it (below 2^26). */
+static bool in_range(const int64_t x[3], const int64_t y[3])
+{
+    for (int i = 0; i < 3; i++)
+        if (x[i] > OM_TRI2_MAX_COORD || x[i] < -OM_TRI2_MAX_COORD || y[i] > OM_TRI2_MAX_COORD ||
+            y[i] < -OM_TRI2_MAX_COORD)
+            return false;
+    return true;
+}
+
+/* A triangle on the grid (x, y) into r's target. Its depths are z, or when z is NULL
+ * those of clip-space vertices zc (om__zdepth, as om__project gives them), worked out
+ * only once the triangle is known to reach a pixel: most of a detailed scene's
+ * triangles hold no pixel centre, and each depth is a 64-bit division. */
+static bool snapped(const om_raster *r, uint32_t *hiz, const int64_t x[3], const int64_t y[3],
+                    const uint32_t *z, const om_vec4 *zc, uint32_t id)
+{
+    uint32_t zb[3];
     const bool cons = r->mode == OM_RASTER_CONSERVATIVE;
     /* The snapped triangle's own orientation decides, the one its coverage has: for a
      * closed surface, every texel centre a back face covers is then also covered by a
@@ -532,18 +565,16 @@ static bool snapped(const om_raster *r, uint32_t *hiz, const int64_t x[3], const
     if (r->mode != OM_RASTER_DEPTH || (hiz && !om__hiz_fits(r->target))) hiz = NULL;
     if (r->grid_x) {
         if (!om__tri2_setup(&t.e, x, y, !cons) || !bounds_grid(&t, r)) return false;
+        if (!z) z = zdepths(zc, zb);
         om__rtri_zplane(&t, z);
         if (!(hiz && om__hiz_big(&t) && om__hiz_fill(r, hiz, &t, z))) fill_grid(r, &t);
         return true;
     }
     /* the bounds first: they need no edges, and most triangles of a detailed scene
-     * hold no pixel centre of a small target (the setup's range test comes first, as
-     * om__tri2_setup would refuse the same triangles) */
-    for (int i = 0; i < 3; i++)
-        if (x[i] > OM_TRI2_MAX_COORD || x[i] < -OM_TRI2_MAX_COORD || y[i] > OM_TRI2_MAX_COORD ||
-            y[i] < -OM_TRI2_MAX_COORD)
-            return false;
+     * hold no pixel centre of a small target (the caller has made the setup's range
+     * test: in_range) */
     if (!bounds(&t, x, y, r->target, cons) || !om__tri2_setup(&t.e, x, y, !cons)) return false;
+    if (!z) z = zdepths(zc, zb);
     if (cons) {
         om__rtri_zplane(&t, z);
         om__rtri_plane(&t, z);   /* the spans' callers test the plane beyond the triangle */
@@ -560,13 +591,13 @@ static bool snapped(const om_raster *r, uint32_t *hiz, const int64_t x[3], const
 bool om__raster_snapped(const om_raster *r, const int64_t x[3], const int64_t y[3], const uint32_t z[3],
                         uint32_t id)
 {
-    return snapped(r, NULL, x, y, z, id);
+    return in_range(x, y) && snapped(r, NULL, x, y, z, NULL, id);
 }
 
 bool om__raster_snapped_hiz(const om_raster *r, uint32_t *hiz, const int64_t x[3], const int64_t y[3],
                             const uint32_t z[3], uint32_t id)
 {
-    return snapped(r, hiz, x, y, z, id);
+    return in_range(x, y) && snapped(r, hiz, x, y, z, NULL, id);
 }
 
 int om__raster_tri(const om_raster *r, const om_vec4 clip[3], uint32_t id)
@@ -583,18 +614,41 @@ int om__raster_tri_on(const om_raster *r, const om_vec4 clip[3], uint32_t id, ui
 int om__raster_tri_on_hiz(const om_raster *r, uint32_t *hiz, const om_vec4 clip[3], uint32_t id,
                           uint32_t width, uint32_t height)
 {
+    return om__raster_tri_guarded(r, hiz, clip, id, width, height, om__guard_band(width, height));
+}
+
+om__guard om__guard_band(uint32_t width, uint32_t height)
+{
+    om__guard g = {guard(width), guard(height)};
+    return g;
+}
+
+int om__raster_tri_guarded(const om_raster *r, uint32_t *hiz, const om_vec4 clip[3], uint32_t id,
+                           uint32_t width, uint32_t height, om__guard g)
+{
     int64_t gx[9], gy[9];
     uint32_t gz[9];
+    /* A triangle inside every plane, as most are, is what om__clip_project would hand
+     * back unclipped: its vertices projected, the depths left until needed. Every
+     * inside test fails on a NaN and on an infinite x, y or z, so of the non-finite
+     * vertices only w = +inf gets this far, and it is refused as below. */
+    if (inside_g(&clip[0], g.x, g.y) & inside_g(&clip[1], g.x, g.y) & inside_g(&clip[2], g.x, g.y)) {
+        if (!((clip[0].w - clip[0].w) + (clip[1].w - clip[1].w) + (clip[2].w - clip[2].w) == 0.0f)) return 0;
+        for (int i = 0; i < 3; i++)
+            if (!om__project_xy(&clip[i], width, height, &gx[i], &gy[i])) return 0;
+        return snapped(r, hiz, gx, gy, NULL, clip, id);
+    }
+    /* finite: v - v is 0, and NaN for an infinity or a NaN, which the sum keeps */
     for (int i = 0; i < 3; i++)
-        if (!om__finite(clip[i].x) || !om__finite(clip[i].y) || !om__finite(clip[i].z) ||
-            !om__finite(clip[i].w))
+        if (!((clip[i].x - clip[i].x) + (clip[i].y - clip[i].y) + (clip[i].z - clip[i].z) +
+              (clip[i].w - clip[i].w) == 0.0f))
             return 0;
     int n = om__clip_project(clip, width, height, gx, gy, gz);
     int filled = 0;
     for (int k = 1; k + 1 < n; k++) {
         int64_t tx[3] = {gx[0], gx[k], gx[k + 1]}, ty[3] = {gy[0], gy[k], gy[k + 1]};
         uint32_t tz[3] = {gz[0], gz[k], gz[k + 1]};
-        filled += snapped(r, hiz, tx, ty, tz, id);
+        filled += snapped(r, hiz, tx, ty, tz, NULL, id);
     }
     return filled;
 }

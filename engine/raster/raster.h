@@ -229,6 +229,13 @@ bool om__raster_snapped_hiz(const om_raster *r, uint32_t *hiz, const int64_t x[3
                             const uint32_t z[3], uint32_t id);
 int om__raster_tri_on_hiz(const om_raster *r, uint32_t *hiz, const om_vec4 clip[3], uint32_t id,
                           uint32_t width, uint32_t height);
+/* om__raster_tri_on_hiz with the guard band's extents in clip units (|x| <= x w,
+ * |y| <= y w: om__guard_band of the same width and height) worked out once, for a
+ * caller that draws many triangles onto one image. */
+typedef struct om__guard { float x, y; } om__guard;
+om__guard om__guard_band(uint32_t width, uint32_t height);
+int om__raster_tri_guarded(const om_raster *r, uint32_t *hiz, const om_vec4 clip[3], uint32_t id,
+                           uint32_t width, uint32_t height, om__guard g);
 
 /* Which of the six clip planes (near, far, four guard-band sides) a vertex is outside
  * of, as a bit mask; 0 means it needs no clipping. */

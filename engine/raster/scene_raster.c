@@ -149,6 +149,7 @@ void om__scene_raster_hiz(const om_scene *s, const om_mat4 *vp, const om_target 
     const uint32_t y0 = tg->y0, y1 = tg->y0 + tg->rows - 1;
     const uint32_t *rows = bins ? bins->rows : NULL;
     const om__vsnap *vs = bins ? bins->verts : NULL;
+    const om__guard g = om__guard_band(tg->width, tg->height);
     for (uint32_t t = 0; t < s->ntris; t++) {
         if (rows && ((rows[t] & 0xFFFFu) > y1 || rows[t] >> 16 < y0)) continue;
         r.cull_back = cull && om__cull_next(&cl, t);
@@ -162,6 +163,6 @@ void om__scene_raster_hiz(const om_scene *s, const om_mat4 *vp, const om_target 
         }
         om_vec4 c[3];
         om__clip_tri(s, vp, t, c);
-        om__raster_tri_on_hiz(&r, hiz, c, t, tg->width, tg->height);
+        om__raster_tri_guarded(&r, hiz, c, t, tg->width, tg->height, g);
     }
 }
