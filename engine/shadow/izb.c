@@ -64,8 +64,6 @@ static uint32_t node_bound(uint32_t samples, uint32_t leaf)
     return 2 * (leaves ? leaves : 1) + 1 + 2 * cells_bound(samples);
 }
 
-/* The per-frame vertex projection is kept only when the arena has room for one pass
- * (it speeds up triangle setup, it changes no result). */
 /* Arena bytes of setup's parts: the material depths and, with `cache`, the per-frame
  * vertex projection; and of a pool of `samples` with its BSP nodes. */
 static size_t parts_bytes(const om_scene *s, bool cache)
@@ -125,8 +123,22 @@ static om_status izb_bytes(const om_method_cfg *mc, const om_scene *s, uint32_t 
     return pool_bytes(&c, s, w, h, min, full);
 }
 
-/* Carves z's parts from `a`: the vertex projection when the arena also holds a pool of
- * `want` samples beside it, then the pool: c->izb_pool samples when set, else the
+/* The largest pool from `least` up to `want` samples that `bytes` hold; 0 when not even
+ * `least` does. */
+static uint32_t pool_fit(size_t bytes, uint32_t least, uint32_t want, uint32_t leaf)
+{
+    if (pool_bytes_of(least, leaf) > bytes) return 0;
+    uint32_t cap = least, hi = want;
+    while (cap < hi) {
+        uint32_t mid = cap + (hi - cap + 1) / 2;
+        if (pool_bytes_of(mid, leaf) <= bytes) cap = mid;
+        else hi = mid - 1;
+    }
+    return cap;
+}
+
+/* Carves z's parts from `a`: the vertex projection when the arena holds it and a pool
+ * at least half as large as without it, then the pool: c->izb_pool samples when set, else the
  * largest from `least` up to `want` that fits. The caller has checked the minimum. */
 static om_status setup(om__izb *z, om_arena *a, const om__izb_cfg *c, const om_scene *s,
                        uint32_t want, uint32_t least, om_diag *d)
@@ -136,7 +148,15 @@ static om_status setup(om__izb *z, om_arena *a, const om__izb_cfg *c, const om_s
     z->scene = s;
     z->leaf = c->izb_leaf;
     if (c->izb_pool) want = least = c->izb_pool;
-    if (om_arena_left(a) >= parts_bytes(s, true) + pool_bytes_of(want, z->leaf)) {
+    /* The vertex projection when the pool keeps at least half the samples it would
+     * have without it: without it, every tile sets up every triangle of the scene
+     * (clipping and projecting in double), which costs far more than the tiles that
+     * half the pool adds (on the Cortex-M4, strips of 8 rows: 88 M instructions a frame
+     * of the small scene's 95 M went to that setup). */
+    size_t left0 = om_arena_left(a), with_cache = parts_bytes(s, true), lean = parts_bytes(s, false);
+    uint32_t p_with = left0 >= with_cache ? pool_fit(left0 - with_cache, least, want, z->leaf) : 0;
+    uint32_t p_lean = left0 >= lean ? pool_fit(left0 - lean, least, want, z->leaf) : 0;
+    if (p_with && (uint64_t)p_with * 2 >= p_lean) {
         if ((st = om__lspace_init(&z->ls, a, s, d))) return st;
     } else {
         om__lspace_init_lean(&z->ls, s);
@@ -146,13 +166,8 @@ static om_status setup(om__izb *z, om_arena *a, const om__izb_cfg *c, const om_s
     z->mat_od = (om__odepth *)p;
     for (uint32_t i = 0; i < s->nmats; i++) z->mat_od[i] = om__material_odepth(&s->mats[i]);
     /* The pool: as configured, or as many samples as the arena holds, up to one pass. */
-    uint32_t cap = least, hi = want;
-    size_t left = om_arena_left(a);
-    while (cap < hi) {   /* largest pool that fits */
-        uint32_t mid = cap + (hi - cap + 1) / 2;
-        if (pool_bytes_of(mid, z->leaf) <= left) cap = mid;
-        else hi = mid - 1;
-    }
+    uint32_t cap = pool_fit(om_arena_left(a), least, want, z->leaf);
+    if (!cap) cap = least;   /* (the caller checked the minimum: the carve below fails) */
     z->cap = cap;
     z->node_cap = node_bound(cap, z->leaf);
     if ((st = om_arena_alloc(a, (size_t)cap * sizeof(om__odepth), 16, &p, d))) return st;
@@ -242,6 +257,7 @@ uint32_t om__izb_transform(om__izb *z, const om_strip *st, size_t *next, size_t 
     }
     *next = i;
     z->n = n;
+    z->taken = taken;
     return n;
 }
 
@@ -539,6 +555,45 @@ static uint32_t cell_at(const om__izb *z, uint32_t cx, uint32_t cy)
     return z->cells[zcode_xy(cx, cy)];
 }
 
+/* Could a triangle whose projected vertices have bounds [lox, hix] x [loy, hiy] and
+ * nearest depth zlo block a sample of node ni's subtree? Only an open sample inside
+ * those bounds and farther than zlo: the culls visit() and the predicate make, before
+ * any setup (which, clipping and projecting in double, costs a Cortex-M4 far more). */
+typedef struct vbox { int32_t lox, loy, hix, hiy; uint32_t zlo, clo, chi; } vbox;
+
+static bool reaches(const om__izb *z, uint32_t ni, const vbox *b)
+{
+    const om__izb_node *nd = &z->nodes[ni];
+    if (!nd->open || b->zlo >= nd->zmax || b->lox > nd->x1 || b->hix < nd->x0 || b->loy > nd->y1 ||
+        b->hiy < nd->y0)
+        return false;
+    if (nd->child) return reaches(z, nd->child, b) || reaches(z, nd->child + 1, b);
+    uint32_t first = nd->first, end = first + nd->count;
+    if (z->keys[first].code > b->chi || z->keys[end - 1].code < b->clo) return false;
+    while (end - first > 1) {   /* the first key whose code can be in the bounds (as visit) */
+        uint32_t mid = first + (end - first) / 2;
+        if (z->keys[mid - 1].code < b->clo) first = mid;
+        else end = mid;
+    }
+    for (const om__izb_key *k = &z->keys[first], *e = &z->keys[nd->first + nd->count]; k < e && k->code <= b->chi; k++)
+        if (!(k->s & OM_IZB_DONE) && b->zlo < k->z && k->x >= b->lox && k->x <= b->hix && k->y >= b->loy &&
+            k->y <= b->hiy)
+            return true;
+    return false;
+}
+
+/* The box's codes (its corners clamped to the tile's keys, which it meets). */
+static void vbox_codes(const om__izb *z, vbox *b)
+{
+    om__izb_key lo, hi;
+    lo.x = b->lox > z->kx0 ? b->lox : z->kx0;
+    lo.y = b->loy > z->ky0 ? b->loy : z->ky0;
+    hi.x = b->hix < z->kx1 ? b->hix : z->kx1;
+    hi.y = b->hiy < z->ky1 ? b->hiy : z->ky1;
+    b->clo = zcode(&lo, z->kx0, z->ky0, z->zshift);
+    b->chi = zcode(&hi, z->kx0, z->ky0, z->zshift);
+}
+
 /* A triangle whose bounds cover at most DIRECT cells goes straight to their nodes;
  * with its projected vertices at hand (no clipping), the nodes are first checked
  * against the vertices' bounds and nearest depth, so that a triangle over no open,
@@ -574,6 +629,7 @@ void om__izb_raster(om__izb *z)
             if (b->z < zlo) zlo = b->z;
             if (c->z < zlo) zlo = c->z;
             if (zlo >= root->zmax || !cell_range(z, lox, loy, hix, hiy, &cr)) continue;
+            vbox vb = {lox, loy, hix, hiy, zlo, 0, 0};
             if ((uint64_t)(cr.x1 - cr.x0 + 1) * (cr.y1 - cr.y0 + 1) <= DIRECT) {
                 nhit = 0;
                 for (uint32_t cy = cr.y0; cy <= cr.y1; cy++)
@@ -586,6 +642,14 @@ void om__izb_raster(om__izb *z)
                             hit[nhit++] = ni;
                     }
                 if (nhit == 0) continue;
+                /* and then by their samples */
+                vbox_codes(z, &vb);
+                int i = 0;
+                while (i < nhit && !reaches(z, hit[i], &vb)) i++;
+                if (i == nhit) continue;
+            } else {
+                vbox_codes(z, &vb);
+                if (!reaches(z, 0, &vb)) continue;
             }
         }
         om__ltri lt;
@@ -618,23 +682,19 @@ uint32_t om__izb_tiles(const om__izb *z, uint32_t exposed)
     return exposed ? (uint32_t)(((uint64_t)exposed + z->cap - 1) / z->cap) : 0;
 }
 
-uint32_t om__izb_tile_first(uint32_t exposed, uint32_t tiles, uint32_t k)
+uint32_t om__izb_tile_first(const om__izb *z, uint32_t exposed, uint32_t k)
 {
-    return (uint32_t)((uint64_t)k * exposed / tiles);
+    const uint64_t o = (uint64_t)k * z->cap;
+    return o < exposed ? (uint32_t)o : exposed;
 }
 
 void om__izb_resolve(om__izb *z, om_strip *st)
 {
     size_t n = (size_t)st->rows * st->width, next = 0;
-    uint32_t exposed = 0;
-    for (size_t i = 0; i < n; i++) {
-        st->terms[i].r = st->terms[i].g = st->terms[i].b = 255;
-        exposed += (st->terms[i].flags & OM_TERM_EXPOSED) != 0;
-    }
-    const uint32_t tiles = om__izb_tiles(z, exposed);
-    for (uint32_t k = 0; k < tiles; k++) {
-        om__izb_transform(z, st, &next, n,
-                          om__izb_tile_first(exposed, tiles, k + 1) - om__izb_tile_first(exposed, tiles, k));
+    for (size_t i = 0; i < n; i++) st->terms[i].r = st->terms[i].g = st->terms[i].b = 255;
+    for (;;) {   /* pool after pool of exposed samples: om__izb_tiles' tiles */
+        om__izb_transform(z, st, &next, n, z->cap);
+        if (z->taken == 0) break;
         om__izb_build(z);
         om__izb_raster(z);
         om__izb_write(z, st);
@@ -685,7 +745,7 @@ static size_t tile_start(const izb_state *m, const om_strip *st, uint32_t k)
 {
     if (k == 0) return 0;
     if (k >= m->ntiles) return (size_t)st->rows * st->width;
-    const uint32_t o = om__izb_tile_first(m->exposed, m->ntiles, k);
+    const uint32_t o = om__izb_tile_first(&m->z, m->exposed, k);
     uint32_t lo = 0, hi = st->rows - 1;   /* the row holding exposed sample o */
     while (lo < hi) {
         uint32_t mid = lo + (hi - lo + 1) / 2;
@@ -717,7 +777,7 @@ static void izb_pass_job(const void *state, const om_strip *st, uint32_t k, void
     size_t next = tile_start(m, st, k), end = tile_start(m, st, k + 1);
     for (size_t i = next; i < end; i++) st->terms[i].r = st->terms[i].g = st->terms[i].b = 255;
     om__izb_transform(&z, st, &next, end,
-                      om__izb_tile_first(m->exposed, m->ntiles, k + 1) - om__izb_tile_first(m->exposed, m->ntiles, k));
+                      om__izb_tile_first(&m->z, m->exposed, k + 1) - om__izb_tile_first(&m->z, m->exposed, k));
     om__izb_build(&z);
     om__izb_raster(&z);
     om__izb_write(&z, st);

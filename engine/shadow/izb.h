@@ -53,6 +53,7 @@ typedef struct om__izb {
     uint32_t node_cap;
     uint32_t leaf;
     uint32_t n, nnodes;    /* samples and nodes of the current tile */
+    uint32_t taken;        /* exposed samples its transform took (n of them kept) */
     int32_t kx0, ky0, kx1, ky1;   /* the bounds of the tile's keys */
     om__izb_stats st;
 } om__izb;
@@ -75,17 +76,18 @@ typedef struct om__izb_cfg {
                 "samples the pool holds, 0 = izb: 2 a triangle, 32768 to the frame; hybrid: the frame")
 
 /* A strip's tiles: its E exposed samples in om__izb_tiles(z, E) = ceil(E / pool)
- * tiles of nearly equal size, tile k holding the exposed samples numbered
- * [om__izb_tile_first(E, T, k), om__izb_tile_first(E, T, k + 1)) in the strip's order.
+ * tiles, tile k holding the exposed samples numbered [om__izb_tile_first(z, E, k),
+ * om__izb_tile_first(z, E, k + 1)) in the strip's order: full pools, the rest last.
  * The tiling depends on the strip and the pool only, so a tile gives the same counts
  * whether the tiles run one after another (om__izb_resolve) or as jobs (izb.c's pass). */
 uint32_t om__izb_tiles(const om__izb *z, uint32_t exposed);
-uint32_t om__izb_tile_first(uint32_t exposed, uint32_t tiles, uint32_t k);
+uint32_t om__izb_tile_first(const om__izb *z, uint32_t exposed, uint32_t k);
 
 /* The stages, one tile at a time (the benchmark times each):
  * transform fills the pool (the samples' keys) from the first `take` (at most the
  * pool) exposed samples of strip samples [*next, end), advances *next past the last
- * and returns the number kept (those in front of the light). */
+ * and returns the number kept (those in front of the light; z->taken: how many it
+ * took). */
 uint32_t om__izb_transform(om__izb *z, const om_strip *st, size_t *next, size_t end, uint32_t take);
 void om__izb_build(om__izb *z);
 /* Rasterizes every triangle of the scene through the BSP. */

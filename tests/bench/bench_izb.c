@@ -48,7 +48,7 @@ static void table_row(const bscene *b, uint32_t W, uint32_t H)
         for (uint32_t k = 0; k < tiles; k++) {   /* tile after tile, as the method's default pool has them */
             uint64_t t0 = om_clock_ns(NULL);
             om__izb_transform(z, &st, &next, n,
-                              om__izb_tile_first(exposed, tiles, k + 1) - om__izb_tile_first(exposed, tiles, k));
+                              om__izb_tile_first(z, exposed, k + 1) - om__izb_tile_first(z, exposed, k));
             uint64_t t1 = om_clock_ns(NULL);
             ns[0] += t1 - t0;
             om__izb_build(z);
