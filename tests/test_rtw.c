@@ -3,7 +3,8 @@
  * division by an all-zero map), shared edges staying closed in the warped map, the
  * exact map holding the occlusion predicate's depths at its texels' points, the paper's
  * accuracy claim on the default scene, tessellation helping the warped-vertex map,
- * budgets and determinism. */
+ * budgets and determinism; the backward analysis's float shortcuts agreeing with its
+ * double arithmetic. */
 #include "test.h"
 #include "harness.h"
 #include "../engine/shadow/rtw.h"
@@ -596,6 +597,89 @@ static void importance_follows_small_maps(void)
     h_scene_free(&hs);
 }
 
+/* The backward analysis's cell in float (om__rtw_cell_axis) is the one its double
+ * arithmetic gives whenever it answers: at random, next to cell edges (a few float
+ * steps either side) and at the map's ends, for several importance sides. */
+static void float_cell_is_the_double_one(void)
+{
+    static const uint32_t ns[] = {8, 64, 100, 512, 8192};
+    uint32_t s = 7;
+    unsigned long long wrong = 0, edge_answered = 0, random = 0, random_unsure = 0;
+    for (int a = 0; a < 5; a++) {
+        const uint32_t n = ns[a];
+        const float nf = (float)n, hn = 0.5f * nf;
+        for (int it = 0; it < 40000; it++) {
+            const float w = 0.01f + (float)(rng(&s) % 100000) / 1000.0f;
+            float x;
+            const bool at_random = it % 4 == 0;
+            if (at_random) {
+                x = ((float)(rng(&s) % 2000001) / 1000000.0f - 1.0f) * 1.25f * w;
+            } else {   /* cell edge e (from one before the map to one after), then steps */
+                const int e = (int)(rng(&s) % (n + 3)) - 1;
+                x = (float)((2.0 * e / n - 1.0) * w);
+                for (int j = (int)(rng(&s) % 81) - 40; j; j += j < 0 ? 1 : -1)
+                    x = nextafterf(x, j < 0 ? -INFINITY : INFINITY);
+            }
+            const int32_t got = om__rtw_cell_axis(x * (1.0f / w), hn, nf);
+            const double u = ((double)x * (1.0 / (double)w) + 1.0) * 0.5;
+            int32_t want = -1;
+            if (u >= 0.0 && u <= 1.0) {
+                const uint32_t i = (uint32_t)(u * (double)n);
+                want = (int32_t)(i > n - 1 ? n - 1 : i);
+            }
+            if (got != -2) {
+                wrong += got != want;
+                edge_answered += !at_random;
+            }
+            random += at_random;
+            random_unsure += at_random && got == -2;
+            if (got != -2 && got != want && wrong < 5)
+                fprintf(stderr, "  n %u x %a w %a: float cell %d, double %d\n", n, (double)x, (double)w, got, want);
+        }
+    }
+    CHECK_EQ_U(wrong, 0);
+    CHECK(edge_answered > 0);   /* not every near-edge sample falls back */
+    CHECK_MSG(random_unsure * 200 < random, "%llu of %llu random samples fell back", random_unsure, random);
+}
+
+/* The bound the backward analysis skips samples by (om__rtw_importance_above) never
+ * skips one whose importance exceeds the cell's: just below each sample's own
+ * importance it must answer yes, and it should answer no a little above. */
+static void importance_bound_holds(const om__rtw *m, void *user)
+{
+    unsigned long long *no_above = (unsigned long long *)user;
+    const om_view *v = &m->view;
+    uint32_t s = 11;
+    unsigned long long wrong = 0;
+    for (unsigned funcs = 0; funcs < 16; funcs++)
+        for (int it = 0; it < 4000; it++) {
+            /* points around the scene, many near the camera's near plane and far away */
+            const float sc = it % 3 == 0 ? 0.05f : it % 3 == 1 ? 5.0f : 200.0f;
+            om_vec3 p = om__v3(v->cam.eye.x + ((float)(rng(&s) % 20001) / 10000.0f - 1.0f) * sc,
+                               v->cam.eye.y + ((float)(rng(&s) % 20001) / 10000.0f - 1.0f) * sc,
+                               v->cam.eye.z + ((float)(rng(&s) % 20001) / 10000.0f - 1.0f) * sc);
+            om_vec3 n = om__v3((float)(rng(&s) % 2001) / 1000.0f - 1.0f, (float)(rng(&s) % 2001) / 1000.0f - 1.0f,
+                               (float)(rng(&s) % 2001) / 1000.0f - 1.0f);
+            const float imp = om__rtw_point_importance(v, funcs, p, n);
+            if (imp > 0.0f) wrong += !om__rtw_importance_above(v, funcs, p, n, nextafterf(imp, 0.0f));
+            *no_above += !om__rtw_importance_above(v, funcs, p, n, imp * 1.001f);
+        }
+    CHECK_EQ_U(wrong, 0);
+}
+
+static void importance_bound(void)
+{
+    h_scene hs;
+    if (!h_scene_parse(&hs, om_scene_default_text())) return;
+    om_method_cfg c;
+    om_method_cfg_default(&c, om_method_find("rtw"));
+    CHECK_OK(om_method_cfg_set(&c, "map", 64, NULL));
+    unsigned long long no_above = 0;
+    CHECK_OK(run_rtw(&hs.s, &c, 64, 48, 0, NULL, importance_bound_holds, &no_above));
+    CHECK(no_above > 16 * 4000 / 2);
+    h_scene_free(&hs);
+}
+
 void suite_rtw(void)
 {
     RUN(uniform_is_identity);
@@ -610,4 +694,6 @@ void suite_rtw(void)
     RUN(budget_and_determinism);
     RUN(pcf_footprints);
     RUN(importance_follows_small_maps);
+    RUN(float_cell_is_the_double_one);
+    RUN(importance_bound);
 }

@@ -67,6 +67,33 @@ double om__rtw_max_density(const int32_t *P, uint32_t n);
  * tested against the camera's frustum). n need not face the camera. */
 float om__rtw_point_importance(const om_view *v, unsigned funcs, om_vec3 p, om_vec3 n);
 
+/* Whether om__rtw_point_importance(v, funcs, p, n) may exceed cur (>= 0): false only
+ * when it certainly does not, from float arithmetic (the importance itself takes a
+ * double quotient, soft-float on a Cortex-M4F); the backward analysis skips it then. */
+bool om__rtw_importance_above(const om_view *v, unsigned funcs, om_vec3 p, om_vec3 nrm, float cur);
+
+/* The importance cell along one axis of a sample whose light-clip coordinate over w,
+ * r = x * (1 / w) in float (for v: -(y * (1 / w))), lies at, with hn = n / 2: the cell
+ * the backward analysis's double arithmetic gives, floor(((double)x / w + 1) / 2 * n),
+ * -1 when that is outside [0, 1], and -2 when float cannot be sure (a NaN, or within
+ * about n 2^-20 of a cell edge: the caller asks the double arithmetic then).
+ *
+ * Why it is sure otherwise: t = (r + 1) * hn in float is within hn (|x/w| + 1) 2^-22
+ * of the exact value (four roundings, 1 / w included) and the double within 2^-50 of
+ * it; with a margin of four times that, when no cell edge lies in [t - margin, t +
+ * margin] both give the same cell, and when t + margin < 0 or t - margin > n both are
+ * outside. In line: the backward analysis runs it twice a sample. */
+static inline int32_t om__rtw_cell_axis(float r, float hn, float n)
+{
+    const float t = (r + 1.0f) * hn, margin = (om__fabsf(r) + 1.0f) * hn * 0x1p-20f;
+    const float lo = t - margin, hi = t + margin;
+    if (lo > 0.0f && hi < n) {
+        const int32_t i = (int32_t)lo;
+        return i == (int32_t)hi ? i : -2;
+    }
+    return hi < 0.0f || lo > n ? -1 : -2;
+}
+
 /* ---- the method's configuration and state (rtw.c) */
 
 /* What rtw's settings (rtw.c) set: the depth test's, and the warp's. */

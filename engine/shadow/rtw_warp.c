@@ -117,6 +117,7 @@ typedef struct imp_ctx {
     unsigned funcs;
     float row[4];
     double nn, ff, span;   /* span = ff - nn */
+    float nnf, fff, spanf; /* the same in float (importance_above) */
     om_vec3 eye;
 } imp_ctx;
 
@@ -128,11 +129,31 @@ static imp_ctx imp_ctx_of(const om_view *v, unsigned funcs)
     k.nn = v->cam.znear;
     k.ff = v->cam.zfar;
     k.span = k.ff - k.nn;
+    k.nnf = v->cam.znear;
+    k.fff = v->cam.zfar;
+    k.spanf = k.fff - k.nnf;
     k.eye = v->cam.eye;
     return k;
 }
 
-/* In line: the backward analysis runs it for every exposed sample. */
+/* Section 5.4: 1 + beta clamp(-normal . view direction, 0, 1), with the normal turned
+ * to the camera (the side the camera sees), so only the angle counts. All float. */
+static inline float normal_factor(const imp_ctx *k, om_vec3 p, om_vec3 nrm)
+{
+    om_vec3 e = om__sub(p, k->eye);
+    float l2 = om__dot(e, e), c = om__dot(nrm, e);
+    c = l2 > 0.0f ? om__fabsf(c) / om__sqrtf(l2) : 0.0f;
+    return 1.0f + OM_RTW_BETA * (c > 1.0f ? 1.0f : c);
+}
+
+/* Section 5.2's view depth: minus the view matrix's depth row at p, in float. */
+static inline float view_depth(const imp_ctx *k, om_vec3 p)
+{
+    return -(k->row[0] * p.x + k->row[1] * p.y + k->row[2] * p.z + k->row[3]);
+}
+
+/* In line: the backward analysis runs it for every exposed sample it cannot rule out
+ * (importance_above). */
 static inline float point_importance(const imp_ctx *k, om_vec3 p, om_vec3 nrm)
 {
     float imp = 1.0f;
@@ -141,25 +162,51 @@ static inline float point_importance(const imp_ctx *k, om_vec3 p, om_vec3 nrm)
          * distance q from the eye. Our depth is z/w in [0, 1], and 1 - z/w is
          * near (far - q) / (q (far - near)) for a point at view depth q. Only the view
          * matrix's depth row is needed. */
-        double d = -(double)(k->row[0] * p.x + k->row[1] * p.y + k->row[2] * p.z + k->row[3]);
+        double d = (double)view_depth(k, p);
         double id = d > k->nn ? k->nn * (k->ff - d) / (d * k->span) : 1.0;
         imp *= (float)(id > 0.0 ? id : 0.0);
     }
-    if (k->funcs & OM_RTW_NORMAL) {
-        /* Section 5.4: 1 + beta clamp(-normal . view direction, 0, 1), with the normal
-         * turned to the camera (the side the camera sees), so only the angle counts. */
-        om_vec3 e = om__sub(p, k->eye);
-        float l2 = om__dot(e, e), c = om__dot(nrm, e);
-        c = l2 > 0.0f ? fabsf(c) / sqrtf(l2) : 0.0f;
-        imp *= 1.0f + OM_RTW_BETA * (c > 1.0f ? 1.0f : c);
-    }
+    if (k->funcs & OM_RTW_NORMAL) imp *= normal_factor(k, p, nrm);
     return imp;
+}
+
+/* Whether point_importance(k, p, nrm) may exceed `cur` (>= 0): false only when it
+ * certainly does not. The distance term in float is within 5 roundings of the exact
+ * quotient (its operands are floats, so far - d and far - near are rounded once each),
+ * i.e. a relative 5.01 * 2^-24, and the double one rounded to float within 1.01 *
+ * 2^-24: 2^-18 above the float quotient bounds the float of the double. Rounding is
+ * monotonic, so the same product with the normal factor bounds the importance. Outside
+ * 2^-100..2^100 (no underflow, no overflow) it answers true. The double quotient is
+ * soft-float on a Cortex-M4F, and most samples of a cell are not its largest. */
+static inline bool importance_above(const imp_ctx *k, om_vec3 p, om_vec3 nrm, float cur)
+{
+    float ub = 1.0f;
+    if (k->funcs & OM_RTW_DIST) {
+        const float d = view_depth(k, p);
+        if (d > k->nnf) {
+            const float num = k->fff - d;
+            if (!(num > 0.0f)) return false;   /* the term is 0: the importance is 0 */
+            const float a = k->nnf * num, b = d * k->spanf;
+            if (!(a > 0x1p-100f && a < 0x1p100f && b > 0x1p-100f && b < 0x1p100f)) return true;
+            const float q = a / b;
+            if (!(q > 0x1p-100f && q < 0x1p100f)) return true;
+            ub = q * (1.0f + 0x1p-18f);
+        }
+    }
+    if (k->funcs & OM_RTW_NORMAL) ub *= normal_factor(k, p, nrm);
+    return ub > cur;
 }
 
 float om__rtw_point_importance(const om_view *v, unsigned funcs, om_vec3 p, om_vec3 nrm)
 {
     const imp_ctx k = imp_ctx_of(v, funcs);
     return point_importance(&k, p, nrm);
+}
+
+bool om__rtw_importance_above(const om_view *v, unsigned funcs, om_vec3 p, om_vec3 nrm, float cur)
+{
+    const imp_ctx k = imp_ctx_of(v, funcs);
+    return importance_above(&k, p, nrm, cur);
 }
 
 void om__rtw_importance_begin(om__rtw *m)
@@ -188,24 +235,35 @@ void om__rtw_observe_strip(om__rtw *m, const om_strip *st)
     unsigned funcs = m->cfg.rtw_analysis == OM_RTW_FORWARD ? 0u
                                                            : m->cfg.rtw_funcs & (OM_RTW_DIST | OM_RTW_NORMAL);
     const imp_ctx k = imp_ctx_of(v, funcs);
+    const float *a = v->light_vp.m;
+    const float nf = (float)m->n, hn = 0.5f * nf;
     size_t count = (size_t)st->rows * st->width;
     for (size_t i = 0; i < count; i++) {
         if (!(st->terms[i].flags & OM_TERM_EXPOSED)) continue;
         const om_sample *smp = &st->samples[i];
         om_vec3 p = om__v3(smp->p[0], smp->p[1], smp->p[2]);
         /* x, y and w of the light's clip coordinates (z is not needed here) */
-        const float *a = v->light_vp.m;
         float qx = a[0] * p.x + a[1] * p.y + a[2] * p.z + a[3];
         float qy = a[4] * p.x + a[5] * p.y + a[6] * p.z + a[7];
         float qw = a[12] * p.x + a[13] * p.y + a[14] * p.z + a[15];
         if (!(qw > 0.0f)) continue;
-        double iw = 1.0 / (double)qw;
-        double u = ((double)qx * iw + 1.0) * 0.5, w = (1.0 - (double)qy * iw) * 0.5;
-        if (!(u >= 0.0 && u <= 1.0 && w >= 0.0 && w <= 1.0)) continue;
-        size_t c = cell_of(m, u, w);
-        float val = point_importance(&k, p, om__v3(smp->n[0], smp->n[1], smp->n[2]));
+        const float iwf = 1.0f / qw;
+        const int32_t ci = om__rtw_cell_axis(qx * iwf, hn, nf), cj = om__rtw_cell_axis(-(qy * iwf), hn, nf);
+        size_t c;
+        if (ci == -1 || cj == -1) continue;   /* certainly outside */
+        if (ci >= 0 && cj >= 0) {
+            c = (size_t)cj * m->n + (size_t)ci;
+        } else {   /* near a cell edge: the double arithmetic decides */
+            double iw = 1.0 / (double)qw;
+            double u = ((double)qx * iw + 1.0) * 0.5, w = (1.0 - (double)qy * iw) * 0.5;
+            if (!(u >= 0.0 && u <= 1.0 && w >= 0.0 && w <= 1.0)) continue;
+            c = cell_of(m, u, w);
+        }
+        const om_vec3 nrm = om__v3(smp->n[0], smp->n[1], smp->n[2]);
         m->seen[c >> 3] |= (uint8_t)(1u << (c & 7));
         /* "only keeping the highest value point" (section 6.3) */
+        if (!importance_above(&k, p, nrm, m->imp[c])) continue;
+        float val = point_importance(&k, p, nrm);
         if (val > m->imp[c]) m->imp[c] = val;
     }
 }
