@@ -3,8 +3,8 @@
  * division by an all-zero map), shared edges staying closed in the warped map, the
  * exact map holding the occlusion predicate's depths at its texels' points, the paper's
  * accuracy claim on the default scene, tessellation helping the warped-vertex map,
- * budgets and determinism; the backward analysis's float shortcuts agreeing with its
- * double arithmetic. */
+ * budgets and determinism; the backward analysis's and the lookup's float shortcuts
+ * agreeing with the double arithmetic they stand for. */
 #include "test.h"
 #include "harness.h"
 #include "../engine/shadow/rtw.h"
@@ -680,6 +680,157 @@ static void importance_bound(void)
     h_scene_free(&hs);
 }
 
+/* The lookup's bias texel in float (om__rtw_div_dens) is smlookup.c's double
+ * quotient whenever it answers: at random and for quotients next to halfway between
+ * two floats, over the densities a table can hold. */
+static void float_division_is_the_double_one(void)
+{
+    uint32_t s = 5;
+    unsigned long long wrong = 0, random = 0, random_unsure = 0;
+    for (int it = 0; it < 400000; it++) {
+        uint64_t D = (1ull << 24) + (((uint64_t)rng(&s) << 20 | rng(&s)) >> (rng(&s) % 44));
+        float t;
+        const bool at_random = it % 2 == 0;
+        if (at_random) {
+            t = (float)(rng(&s) % 1000000 + 1) * 1e-5f * (float)(1u << (rng(&s) % 8));
+        } else {   /* D near 2^43 picked so that the quotient is within about 2^-44 of
+                      halfway between two floats (within 2^-53, where the double's own
+                      rounding decides, now and then) */
+            const float q = (float)(rng(&s) % 1000000 + 1) * 1e-4f;
+            const double mid = ((double)q + (double)nextafterf(q, INFINITY)) * 0.5;
+            t = (float)(mid * (double)((1ull << 42) + ((uint64_t)rng(&s) << 18)) / OM_RTW_ONE);
+            D = (uint64_t)floor((double)t * OM_RTW_ONE / mid + 0.5);
+        }
+        const double dens = (double)D / (double)OM_RTW_ONE;
+        float rcp[2];
+        om__rtw_rcp(D, rcp);
+        const float got = om__rtw_div_dens(t, rcp), want = (float)((double)t / dens);
+        if (got >= 0.0f) {
+            wrong += got != want;
+            if (got != want && wrong < 5)
+                fprintf(stderr, "  t %a D %llu: float %a, double %a\n", (double)t, (unsigned long long)D,
+                        (double)got, (double)want);
+        }
+        random += at_random;
+        random_unsure += at_random && got < 0.0f;
+    }
+    CHECK_EQ_U(wrong, 0);
+    CHECK_MSG(random_unsure * 1000 < random, "%llu of %llu random quotients fell back", random_unsure, random);
+}
+
+/* The lookup's warped texel in float (om__rtw_texel_axis) is smlookup.c's double warp
+ * whenever it answers: at random and a few float steps from texel edges, over tables
+ * of random importance. */
+static void float_warp_is_the_double_one(void)
+{
+    static const uint32_t ns[] = {8, 64, 512};
+    static const uint32_t sizes[] = {96, 1000, 4096};
+    static double I[512];
+    static int32_t P[513];
+    uint32_t s = 9;
+    unsigned long long wrong = 0, random = 0, random_unsure = 0, edge_answered = 0;
+    for (int a = 0; a < 3; a++)
+        for (int b = 0; b < 3; b++) {
+            const uint32_t n = ns[a], size = sizes[b];
+            for (uint32_t k = 0; k < n; k++) I[k] = rng(&s) % 4 == 0 ? 0.0 : (double)(rng(&s) % 1000) + 1.0;
+            om__rtw_table(I, n, P);
+            for (int it = 0; it < 20000; it++) {
+                const float w = 0.01f + (float)(rng(&s) % 100000) / 1000.0f;
+                float x;
+                const bool at_random = it % 4 == 0;
+                if (at_random) {
+                    x = ((float)(rng(&s) % 2000001) / 1000000.0f - 1.0f) * w;
+                } else {   /* the unwarped point of texel edge j, then a few float steps */
+                    const double c = (double)(rng(&s) % (size + 1)) / size * OM_RTW_ONE;
+                    uint32_t k = 0;
+                    while (k + 1 < n && P[k + 1] <= c) k++;
+                    const double f = P[k + 1] > P[k] ? (c - P[k]) / (P[k + 1] - P[k]) : 0.0;
+                    const int j = (int)(rng(&s) % (2u << (rng(&s) % 16))) - (1 << (rng(&s) % 16));
+                    x = (float)((2.0 * ((double)k + f) / n - 1.0) * w * (1.0 + j * 0x1p-24));
+                }
+                uint32_t kk = 0;
+                const int32_t got = om__rtw_texel_axis(P, n, size, x * (1.0f / w), &kk);
+                const double u = ((double)x * (1.0 / (double)w) + 1.0) * 0.5;
+                if (got >= 0) {
+                    double dens;
+                    const double X = om__rtw_apply(P, n, u, &dens) * size;
+                    const uint32_t want_k = (uint32_t)(u * n) > n - 1 ? n - 1 : (uint32_t)(u * n);
+                    const bool bad = !(u > 0.0 && u < 1.0) || got != (int32_t)floor(X) || kk != want_k ||
+                                     dens != (double)(P[kk + 1] - P[kk]) * n / OM_RTW_ONE;
+                    wrong += bad;
+                    edge_answered += !at_random;
+                    if (bad && wrong < 5)
+                        fprintf(stderr, "  n %u size %u x %a w %a: float texel %d, double %.17g\n", n, size,
+                                (double)x, (double)w, got, X);
+                }
+                random += at_random;
+                random_unsure += at_random && got < 0;
+            }
+        }
+    CHECK_EQ_U(wrong, 0);
+    CHECK(edge_answered > 1000);
+    /* the margin grows with a super-cell's magnification: these random tables reach
+     * 100x and more, real ones fall back far less (the lookup test) */
+    CHECK_MSG(random_unsure * 20 < random, "%llu of %llu random samples fell back", random_unsure, random);
+}
+
+/* The float lookup gives smlookup.c's terms and counts, on samples on the floor
+ * (where the bias decides) and anywhere in the scene, after a frame's map. */
+typedef struct lookup_probe { unsigned long long differ, shadowed, lit; float extent; } lookup_probe;
+
+static void lookup_is_smlookups(const om__rtw *m, void *user)
+{
+    lookup_probe *pr = (lookup_probe *)user;
+    enum { N = 4096 };
+    static om_sample smp[N];
+    static om_term a[N], b[N];
+    uint32_t s = 3;
+    for (int round = 0; round < 8; round++) {
+        for (int i = 0; i < N; i++) {
+            const bool floor_pt = i % 2 == 0;
+            const float x = ((float)(rng(&s) % 20001) / 10000.0f - 1.0f) * pr->extent;
+            const float z = ((float)(rng(&s) % 20001) / 10000.0f - 1.0f) * pr->extent;
+            const float y = floor_pt ? 0.0f : (float)(rng(&s) % 10001) / 10000.0f * 4.0f;
+            smp[i].p[0] = x; smp[i].p[1] = y; smp[i].p[2] = z;
+            smp[i].n[0] = 0.0f; smp[i].n[1] = 1.0f; smp[i].n[2] = 0.0f;
+            smp[i].tri = 0;
+            smp[i].nl = (float)(rng(&s) % 10001) / 10000.0f;
+            a[i].flags = b[i].flags = rng(&s) % 8 ? OM_TERM_EXPOSED : 0;
+        }
+        om_strip sa = {N, 1, 0, 1, smp, a}, sb = {N, 1, 0, 1, smp, b};
+        uint32_t na = 0, sha = 0, nb = 0, shb = 0;
+        om__rtw_lookup_strip(m, &sa, &na, &sha);
+        om__smlook_strip(&m->look, &sb, &nb, &shb);
+        pr->differ += na != nb || sha != shb || memcmp(a, b, sizeof a) != 0;
+        pr->shadowed += shb;
+        pr->lit += nb - shb;
+    }
+}
+
+static void float_lookup_is_smlookups(void)
+{
+    static const char *dir_scene =
+        "camera eye 0 3 6 target 0 0 0 size 160 120\nlight directional dir -0.3 -1 -0.2\n"
+        "plane size 16 16\ntriangles count 3000 seed 9 area 12 in -2 0.5 -2 2 2 2\n";
+    for (int sc = 0; sc < 2; sc++) {
+        h_scene hs;
+        if (!h_scene_parse(&hs, sc ? dir_scene : om_scene_default_text())) return;
+        static const uint32_t maps[] = {96, 1024};
+        for (int k = 0; k < 2; k++) {
+            om_method_cfg c;
+            om_method_cfg_default(&c, om_method_find("rtw"));
+            CHECK_OK(om_method_cfg_set(&c, "map", maps[k], NULL));
+            CHECK_OK(om_method_cfg_set(&c, "rtw.importance", k ? 0 : 64, NULL));
+            lookup_probe pr = {0, 0, 0, sc ? 2.5f : 8.0f};
+            CHECK_OK(run_rtw(&hs.s, &c, 160, 120, 0, NULL, lookup_is_smlookups, &pr));
+            CHECK_MSG(pr.differ == 0, "scene %d map %u: %llu strips differ", sc, maps[k], pr.differ);
+            CHECK_MSG(pr.shadowed > 1000 && pr.lit > 1000, "scene %d map %u: %llu shadowed, %llu lit", sc,
+                      maps[k], pr.shadowed, pr.lit);
+        }
+        h_scene_free(&hs);
+    }
+}
+
 void suite_rtw(void)
 {
     RUN(uniform_is_identity);
@@ -696,4 +847,7 @@ void suite_rtw(void)
     RUN(importance_follows_small_maps);
     RUN(float_cell_is_the_double_one);
     RUN(importance_bound);
+    RUN(float_division_is_the_double_one);
+    RUN(float_warp_is_the_double_one);
+    RUN(float_lookup_is_smlookups);
 }

@@ -12,7 +12,8 @@
  *            vertices). With rtw_exact 0, the paper's way: vertices are warped after
  *            the perspective divide (4.3), long edges tessellated first (6.1)
  *   resolve  (d) lookup: the sample's light coordinates are warped (4.4) and tested
- *            with the conventional map's bias rules, in warped texels (smlookup.c)
+ *            with the conventional map's bias rules, in warped texels (smlookup.c;
+ *            in float here where that gives the same bits)
  * All state lives in the method's arena; nothing persists between frames but the
  * buffers. */
 #include "shadow.h"
@@ -542,13 +543,185 @@ void om__rtw_render_map(om__rtw *m)
     m->tris_drawn = counts[2];
 }
 
-/* ---------------------------------------------------------------- lookup */
+/* ---------------------------------------------------------------- lookup in float */
+
+/* smlookup.c's warped test takes the sample's light coordinates, their warp and the
+ * bias texel's division by the warp's density in double, which a Cortex-M4F runs in
+ * software (about 2,600 instructions a sample). Here the same test runs in float: what
+ * the double arithmetic decides (the warped texel on each axis, the bias texel) comes
+ * from float where a proven bound leaves no doubt, and the rest is smlookup.c's float
+ * arithmetic, the same operations in the same order. A sample float is unsure of (next
+ * to a texel or super-cell edge, a quotient next to halfway between floats, outside
+ * the light's image) goes to smlookup.c alone, and so do the settings this path leaves
+ * out (a normal offset, PCF). Tests compare the terms, and each piece next to its
+ * edges, with smlookup.c's. */
+
+void om__rtw_rcp(uint64_t D, float rcp[2])
+{
+    const double r = (double)(1u << 30) / (double)D;   /* D < 2^44: exact in double */
+    rcp[0] = (float)r;
+    rcp[1] = (float)(r - (double)rcp[0]);               /* the difference is exact */
+}
+
+/* a * b - p exactly for p = a * b in float (Dekker's product by Veltkamp's 12-bit
+ * halves: no fused multiply-add needed; exact while nothing over- or underflows). */
+static inline float prod_err(float a, float b, float p)
+{
+    const float ca = 4097.0f * a, ah = ca - (ca - a), al = a - ah;
+    const float cb = 4097.0f * b, bh = cb - (cb - b), bl = b - bh;
+    return ((ah * bh - p) + ah * bl + al * bh) + al * bl;
+}
+
+/* A float's bits and back, through a union (C99; memcpy is a call in a freestanding
+ * firmware). */
+typedef union fbits { float f; uint32_t u; } fbits;
+static inline float float_at(uint32_t bits)
+{
+    fbits x;
+    x.u = bits;
+    return x.f;
+}
+
+/* Q = t 2^30 / D is within 2^-45.9 Q of r + err: t (rcp[0] + rcp[1]) is within 2^-47.9
+ * of it, the product's error is exact and the two roundings after it add 2^-47 and
+ * 2^-48. The float nearest Q, and nearest its double (2^-53 Q from it), is then r
+ * while err keeps 2^-38 r clear of halfway to r's neighbour on its side. */
+static inline float div_dens(float t, const float rcp[2])
+{
+    if (!(t > 0x1p-60f && t < 0x1p60f)) return -1.0f;
+    const float p = t * rcp[0];
+    const float s = prod_err(t, rcp[0], p) + t * rcp[1];
+    const float r = p + s, err = s - (r - p);   /* r + err = p + s exactly: |s| < |p| */
+    fbits rb;
+    rb.f = r;
+    const uint32_t b = rb.u;
+    const float up = float_at(b + 1) - r, dn = r - float_at(b - 1), tol = r * 0x1p-38f;
+    return (err >= 0.0f ? 2.0f * err < up - tol : -2.0f * err < dn - tol) ? r : -1.0f;
+}
+
+float om__rtw_div_dens(float t, const float rcp[2])
+{
+    return div_dens(t, rcp);
+}
+
+/* The double warp: t = u n, cell c, X = (P[c] + (t - c)(P[c+1] - P[c])) size / 2^30.
+ * In float, t is within mt / 3.9 of the exact value (om__rtw_cell_axis) and t - c is
+ * exact (c <= t < c + 1); P's entries to float, the product and the sum are each
+ * within 64 of theirs (values below 2^30 + 2^7), and X rounds within X 2^-24 <=
+ * 64 S: X is within S (224 + (P[c+1] - P[c]) mt / 3.9) of the exact value, the double
+ * within 2^-50 size. The margin is four times that. */
+static inline int32_t texel_axis(const int32_t *P, uint32_t n, uint32_t size, float r, uint32_t *k)
+{
+    const float nf = (float)n, hn = 0.5f * nf;
+    const int32_t c = om__rtw_cell_axis(r, hn, nf);
+    if (c < 0) return -2;
+    const float t = (r + 1.0f) * hn, mt = (om__fabsf(r) + 1.0f) * hn * 0x1p-20f;
+    const float B = (float)(P[c + 1] - P[c]), S = (float)size * 0x1p-30f;
+    const float X = ((float)P[c] + (t - (float)c) * B) * S, M = (mt * B + 1024.0f) * S;
+    const float lo = X - M, hi = X + M;
+    *k = (uint32_t)c;
+    if (!(lo >= 0.0f)) return -2;
+    const int32_t i = (int32_t)lo;
+    return i == (int32_t)hi ? i : -2;
+}
+
+int32_t om__rtw_texel_axis(const int32_t *P, uint32_t n, uint32_t size, float r, uint32_t *k)
+{
+    return texel_axis(P, n, size, r, k);
+}
+
+/* smlookup.c's depth_threshold: the least stored depth a biased depth z is not behind. */
+static inline uint64_t depth_threshold(float z)
+{
+    if (z != z) return (1ull << 32) + 1;
+    if (!(z > 0.0f)) return 0;
+    if (!(z < OM_DEPTH_ONE_F)) return 1ull << 32;
+    const uint32_t t = (uint32_t)z;
+    return (uint64_t)t + ((float)t < z);
+}
+
+static inline uint32_t clamp_texel(int32_t x, uint32_t size)
+{
+    return x < 0 ? 0u : (uint32_t)x >= size ? size - 1 : (uint32_t)x;
+}
+
+/* smlookup.c's locate for a warped map without normal offset, in float: 1 located
+ * (the threshold and the texel), 0 behind the light, -1 unsure. */
+static int locate_f(const om__rtw *m, const om_view *v, const om_sample *smp, uint64_t *zlit, uint32_t *at)
+{
+    const om__smlook *L = &m->look;
+    const om_vec3 p = om__v3(smp->p[0], smp->p[1], smp->p[2]);
+    const bool spot = v->light.kind == OM_LIGHT_SPOT;
+    const float dist = spot ? om__dot(om__sub(p, v->light.pos), v->light_axis) : 1.0f;
+    const float span = spot ? dist * L->span_per_dist : 2.0f / om__fabsf(v->light_proj.m[0]);
+    const om_vec4 q = om__mat_apply(&v->light_vp, p);
+    if (!(q.w > 0.0f)) return 0;
+    const float iw = 1.0f / q.w;
+    uint32_t kx = 0, ky = 0;
+    const int32_t cx = texel_axis(m->px, m->n, m->size, q.x * iw, &kx);
+    const int32_t cy = texel_axis(m->py, m->n, m->size, -(q.y * iw), &ky);
+    if (cx < 0 || cy < 0) return -1;
+    /* the smaller density of the two axes, so the larger reciprocal */
+    const bool by_x = om__rtw_dens(m->px, m->n, kx) <= om__rtw_dens(m->py, m->n, ky);
+    const float texel = div_dens(span / (float)L->size, by_x ? m->rcp_x + 2 * kx : m->rcp_y + 2 * ky);
+    if (texel < 0.0f) return -1;
+    const float cosang = smp->nl;
+    const float tanang = cosang > 0.0995f ? om__sqrtf(1.0f - cosang * cosang) / cosang : 10.0f;
+    const float bias = L->bias_const + L->bias_slope * texel * tanang;
+    const float z = q.z * iw * OM_DEPTH_ONE_F;
+    float dz;
+    if (spot) {
+        const float e = dist > L->half_near ? dist : L->half_near;
+        dz = L->dz_num / (L->dz_den * e * e) * OM_DEPTH_ONE_F;
+    } else {
+        dz = OM_DEPTH_ONE_F * om__fabsf(v->light_proj.m[10]);
+    }
+    *zlit = depth_threshold(z - bias * dz);
+    *at = clamp_texel(cy, m->size) * m->size + clamp_texel(cx, m->size);
+    return 1;
+}
+
+void om__rtw_lookup_strip(const om__rtw *m, om_strip *st, uint32_t *samples, uint32_t *shadowed)
+{
+    const om__smlook *L = &m->look;
+    if (L->normal_offset != 0.0f || L->pcf != 1) {
+        om__smlook_strip(L, st, samples, shadowed);
+        return;
+    }
+    /* a copy, as smlookup.c takes: the terms' byte stores may alias the view */
+    const om_view view = *L->view;
+    const size_t n = (size_t)st->rows * st->width;
+    uint32_t nsamples = 0, nshadowed = 0;
+    for (size_t i = 0; i < n; i++) {
+        om_term *t = &st->terms[i];
+        t->r = t->g = t->b = 255;
+        if (!(t->flags & OM_TERM_EXPOSED)) continue;
+        uint64_t z = 0;
+        uint32_t at = 0;
+        const int got = locate_f(m, &view, &st->samples[i], &z, &at);
+        if (got < 0) {   /* smlookup.c decides, on a strip of this one sample */
+            om_strip one = *st;
+            one.rows = one.width = 1;
+            one.samples = &st->samples[i];
+            one.terms = t;
+            om__smlook_strip(L, &one, &nsamples, &nshadowed);
+            continue;
+        }
+        nsamples++;
+        if (!got) continue;
+        const uint8_t val = z <= L->depth[at] ? 255 : 0;
+        t->r = t->g = t->b = val;
+        nshadowed += val != 255;
+    }
+    *samples += nsamples;
+    *shadowed += nshadowed;
+}
 
 static om_status rtw_resolve(void *state, om_strip *st, om_diag *d)
 {
     (void)d;
     om__rtw *m = (om__rtw *)state;
-    om__smlook_strip(&m->look, st, &m->samples, &m->shadowed);
+    om__rtw_lookup_strip(m, st, &m->samples, &m->shadowed);
     return OM_OK;
 }
 
@@ -556,7 +729,7 @@ static om_status rtw_resolve(void *state, om_strip *st, om_diag *d)
 static void rtw_band(const void *state, om_strip *st, void *scratch, uint32_t counts[8])
 {
     (void)scratch;
-    om__smlook_strip(&((const om__rtw *)state)->look, st, &counts[0], &counts[1]);
+    om__rtw_lookup_strip((const om__rtw *)state, st, &counts[0], &counts[1]);
 }
 
 /* The resolve's counts after each strip, the map's (counts[2]) after the build. */

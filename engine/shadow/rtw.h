@@ -94,6 +94,29 @@ static inline int32_t om__rtw_cell_axis(float r, float hn, float n)
     return hi < 0.0f || lo > n ? -1 : -2;
 }
 
+/* ---- the lookup in float (rtw.c): the warped depth test of smlookup.c, whose warp
+ * is double arithmetic (soft-float on a Cortex-M4F), by float arithmetic that is
+ * proven to give the same bits and says so, or says it cannot be sure. */
+
+/* The density the lookup divides the bias texel by, of super-cell k: (P[k+1] - P[k])
+ * n, at least 2^24 (smlookup.c's floor of 1/64, in 2^-30 units). */
+static inline uint64_t om__rtw_dens(const int32_t *P, uint32_t n, uint32_t k)
+{
+    const uint64_t D = (uint64_t)(uint32_t)(P[k + 1] - P[k]) * n;
+    return D > (1u << 24) ? D : (1u << 24);
+}
+/* rcp[0] + rcp[1] = 2^30 / D within 2^-47 of it (rcp[0] the float nearest). */
+void om__rtw_rcp(uint64_t D, float rcp[2]);
+/* (float)((double)t / (D / 2^30)), the lookup's bias texel in warped texels, from
+ * rcp = om__rtw_rcp(D); -1 when float cannot be sure (t outside 2^-60..2^60, or the
+ * quotient within 2^-38 of halfway between two floats). */
+float om__rtw_div_dens(float t, const float rcp[2]);
+/* The warped texel (floor of the warped coordinate times size) of a sample whose light
+ * coordinate is r = x * (1 / w) (as om__rtw_cell_axis), as smlookup.c's double warp
+ * gives it, and its super-cell in *k; -2 when float cannot be sure or the sample is not
+ * strictly inside the light's image. */
+int32_t om__rtw_texel_axis(const int32_t *P, uint32_t n, uint32_t size, float r, uint32_t *k);
+
 /* ---- the method's configuration and state (rtw.c) */
 
 /* What rtw's settings (rtw.c) set: the depth test's, and the warp's. */
@@ -122,6 +145,9 @@ typedef struct om__rtw {
     uint8_t *seen;             /* n * n bits: a visible sample fell in the cell */
     uint32_t *fdepth, *fid;    /* forward / hybrid: the n x n light depth image */
     double *cols, *rows, *scratch, *kernel;
+    /* After the tables (om__rtw_build_tables), in cols' and rows' memory: per super-cell
+     * k, 2^30 / D(k) as a float pair (om__rtw_rcp), D(k) its density (om__rtw_dens) */
+    float *rcp_x, *rcp_y;
     int32_t *px, *py;          /* warp tables, n + 1 each */
     uint32_t *depth;           /* size * size warped shadow map */
     uint32_t *hiz;             /* its coarse depth (om__hiz_words); NULL: no room */
@@ -148,6 +174,9 @@ void om__rtw_importance_finish(om__rtw *m);
  * Build runs finish, tables and the map in turn; each may run again on its own (the
  * bench times the stages so). */
 void om__rtw_build_tables(om__rtw *m);
+
+/* The terms of a strip, the same as om__smlook_strip(&m->look, ...) gives. */
+void om__rtw_lookup_strip(const om__rtw *m, om_strip *st, uint32_t *samples, uint32_t *shadowed);
 
 /* Renders the warped shadow map of this frame's tables (rtw.c; called by build). */
 void om__rtw_render_map(om__rtw *m);

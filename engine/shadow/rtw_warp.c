@@ -373,4 +373,12 @@ void om__rtw_build_tables(om__rtw *m)
     om__rtw_table(m->rows, m->n, m->py);
     m->dens_x = om__rtw_max_density(m->px, m->n);
     m->dens_y = om__rtw_max_density(m->py, m->n);
+    /* the lookup's reciprocal densities, where the collapsed importances were (2n
+     * floats in n doubles; the next frame's tables make those again) */
+    m->rcp_x = (float *)(void *)m->cols;
+    m->rcp_y = (float *)(void *)m->rows;
+    for (uint32_t k = 0; k < m->n; k++) {
+        om__rtw_rcp(om__rtw_dens(m->px, m->n, k), m->rcp_x + 2 * k);
+        om__rtw_rcp(om__rtw_dens(m->py, m->n, k), m->rcp_y + 2 * k);
+    }
 }
