@@ -1,10 +1,12 @@
 /* test_spsm.c — Sub-Pixel Shadow Maps: conservative coverage against an exact overlap
  * test, the 128-bit texel's packing, the derivative code's error profile (section 3.4),
  * the pattern table, accuracy against the reference and the conventional map (the
- * default scene, a dense mesh), bit-identical frames, budgets and statistics. */
+ * default scene, a dense mesh), bit-identical frames, budgets and statistics; the
+ * lookup's float depth tests against the double ones. */
 #include "test.h"
 #include "harness.h"
 #include "../engine/shadow/spsm.h"
+#include "../engine/shadow/spsm_lookup.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -545,6 +547,76 @@ static void odd_inputs(void)
     }
 }
 
+/* The lookup's depth tests in float (om__spsm_below_f, om__spsm_tol_within_f) give the
+ * double arithmetic's answers whenever they answer: records with random codes, points
+ * around the texel, depths at random and next to each test's threshold, with and
+ * without the cap. */
+static uint32_t next_rand(uint32_t *s)
+{
+    *s = *s * 1664525u + 1013904223u;
+    return *s >> 8;
+}
+
+static void float_tests_are_the_double_ones(void)
+{
+    static om__spsm_qtable q;
+    om__spsm_qtable_build(&q);
+    uint32_t s = 13;
+    unsigned long long wrong = 0, far_answered = 0, near_answered = 0, far = 0;
+    const double u = 65536.0 * OM_SPSM_DSCALE / (double)OM_SUBPIX;
+    for (int it = 0; it < 300000; it++) {
+        om__spsm_dtri t;
+        memset(&t, 0, sizeof t);
+        t.cx = (int64_t)(next_rand(&s) % 3) * OM_SUBPIX - OM_SUBPIX;
+        t.cy = (int64_t)(next_rand(&s) % 3) * OM_SUBPIX - OM_SUBPIX;
+        t.z = (double)(next_rand(&s) & 0xFFFF) * 65536.0;
+        const uint8_t qx = (uint8_t)(next_rand(&s) % 255), qy = (uint8_t)(next_rand(&s) % 255);
+        t.gx = q.dec[qx] * u;
+        t.gy = q.dec[qy] * u;
+        t.ex = q.err[qx] * u;
+        t.ey = q.err[qy] * u;
+        t.zf = (float)t.z; t.gxf = (float)t.gx; t.gyf = (float)t.gy; t.exf = (float)t.ex; t.eyf = (float)t.ey;
+        int64_t px = (int64_t)(next_rand(&s) % 769) - 384;
+        const int64_t py = (int64_t)(next_rand(&s) % 769) - 384;
+        if (it % 8 == 3 && t.ex > 0.0) {   /* tol next to the lit cap: the x offset that reaches it */
+            const double need = (1.5 + 64.0) * 65536.0 - 1.5 * 65536.0 - t.ey * fabs((double)(py - t.cy));
+            const double dx = floor(need / t.ex + 0.5);
+            if (dx > 0.0 && dx < 1e6) px = t.cx + (int64_t)dx;
+        }
+        const double plane = om__spsm_plane_at(&t, px, py), tol = om__spsm_tol_at(&t, px, py);
+        const int mode = it % 4;   /* - tol, + tol, - capped tol, tol against a cap */
+        const double cap = mode == 2 ? 1.5 * 65536.0 + 16.0 * 65536.0 : 1.5 * 65536.0 + 64.0 * 65536.0;
+        const double used = mode == 2 ? (tol < cap ? tol : cap) : tol;
+        /* the depth that puts the plane on the threshold, then near or far from it */
+        double z = mode == 1 ? plane - used : plane + used;
+        const uint32_t r = next_rand(&s) % 4;
+        z += r == 0 ? 0.0 : r == 1 ? (double)((int)(next_rand(&s) % 65) - 32) : (double)((int)(next_rand(&s) % 2000001) - 1000000);
+        if (!(z >= 0.0 && z <= 4294967295.0)) continue;
+        const uint32_t zi = (uint32_t)z;   /* depths are whole raw units */
+        const double pz = zi;
+        const float pzf = (float)zi;
+        int got, want;
+        if (mode == 3) {
+            got = om__spsm_tol_within_f(&t, px, py, (float)cap);
+            want = tol <= cap;
+        } else {
+            got = om__spsm_below_f(&t, px, py, pzf, mode == 1 ? 1.0f : -1.0f, mode == 2 ? (float)cap : 0.0f);
+            want = mode == 1 ? plane <= pz + tol : plane < pz - used;
+        }
+        far += r >= 2;
+        if (got >= 0) {
+            far_answered += r >= 2;
+            near_answered += r == 1;
+            wrong += got != want;
+            if (got != want && wrong < 5)
+                fprintf(stderr, "  mode %d plane %.17g tol %.17g pz %u: float %d, double %d\n", mode, plane, tol, zi, got, want);
+        }
+    }
+    CHECK_EQ_U(wrong, 0);
+    CHECK(near_answered > 1000);
+    CHECK_MSG(far_answered * 10 > far * 9, "%llu of %llu answered away from the threshold", far_answered, far);
+}
+
 void suite_spsm(void)
 {
     RUN(conservative_is_exact_overlap);
@@ -561,4 +633,5 @@ void suite_spsm(void)
     RUN(aa_only_at_uncertain_samples);
     RUN(stats_and_budget);
     RUN(odd_inputs);
+    RUN(float_tests_are_the_double_ones);
 }

@@ -135,7 +135,7 @@ static om_status spsm_begin(void *state, const om_view *v, om_diag *d)
     return OM_OK;
 }
 
-typedef struct sample_pt { int64_t x, y; double z; bool ok; } sample_pt;
+typedef struct sample_pt { int64_t x, y; double z; float zf; bool ok; } sample_pt;
 
 static sample_pt project(const om__spsm_state *m, om_vec3 p)
 {
@@ -144,6 +144,7 @@ static sample_pt project(const om__spsm_state *m, om_vec3 p)
     uint32_t z = 0;
     s.ok = om__project(&q, m->size, m->size, &s.x, &s.y, &z);
     s.z = z;
+    s.zf = (float)z;
     return s;
 }
 
@@ -227,6 +228,11 @@ static void decode(const om__spsm_state *m, int64_t tx, int64_t ty, om__spsm_dtr
     o->gy = m->q.dec[r->qy] * u;
     o->ex = m->q.err[r->qx] * u;
     o->ey = m->q.err[r->qy] * u;
+    o->zf = (float)o->z;
+    o->gxf = (float)o->gx;
+    o->gyf = (float)o->gy;
+    o->exf = (float)o->ex;
+    o->eyf = (float)o->ey;
     o->have_cmin = false;
     o->have_vz = false;
 }
@@ -255,6 +261,11 @@ static void move_entry(om__spsm_dtri *to, const om__spsm_dtri *from)
     to->gy = from->gy;
     to->ex = from->ex;
     to->ey = from->ey;
+    to->zf = from->zf;
+    to->gxf = from->gxf;
+    to->gyf = from->gyf;
+    to->exf = from->exf;
+    to->eyf = from->eyf;
     to->cmin = from->cmin;
     to->have_cmin = from->have_cmin;
     to->have_vz = from->have_vz;
@@ -322,9 +333,11 @@ static double pat_tol(const om__spsm_dtri *t, int64_t px, int64_t py)
 
 /* Algorithm 1: the stored triangle covers the point in 2-D and is nearer there (its
  * edges set up: edges). */
-static bool hits(const om__spsm_dtri *t, int64_t px, int64_t py, double pz)
+static bool hits(const om__spsm_dtri *t, int64_t px, int64_t py, double pz, float pzf)
 {
-    return t->ok && om__tri2_covers(&t->e, px, py) && om__spsm_plane_at(t, px, py) < pz - om__spsm_tol_at(t, px, py);
+    if (!t->ok || !om__tri2_covers(&t->e, px, py)) return false;
+    const int below = om__spsm_below_f(t, px, py, pzf, -1.0f, 0.0f);
+    return below >= 0 ? below == 1 : om__spsm_plane_at(t, px, py) < pz - om__spsm_tol_at(t, px, py);
 }
 
 /* Figure 9: the least depth the triangle reaches inside its texel's square, found where
@@ -567,10 +580,19 @@ static uint8_t lookup(const om__spsm_state *m, om__spsm_win *w, uint32_t n[8], c
     }
     if (t[4].empty) { n[N_LIT]++; return 255; }
     if (t[4].ok) {
-        double z = om__spsm_plane_at(&t[4], px, py), tol = om__spsm_tol_at(&t[4], px, py);
-        if (z < p.z - tol) {
+        /* in float where that is sure of the double's answers (om__spsm_below_f) */
+        int below = om__spsm_below_f(&t[4], px, py, p.zf, -1.0f, 0.0f), on = 0, close = 0;
+        if (below == 0) on = om__spsm_below_f(&t[4], px, py, p.zf, 1.0f, 0.0f);
+        if (on == 1) close = om__spsm_tol_within_f(&t[4], px, py, (float)(OM__SPSM_TOL0 + LIT_CAP));
+        if (below < 0 || on < 0 || close < 0) {
+            const double z = om__spsm_plane_at(&t[4], px, py), tol = om__spsm_tol_at(&t[4], px, py);
+            below = z < p.z - tol;
+            on = z <= p.z + tol;
+            close = tol <= OM__SPSM_TOL0 + LIT_CAP;
+        }
+        if (below) {
             if (om__tri2_covers(edges(t, 4), px, py)) { n[N_SHADOWED]++; return 0; }
-        } else if (z <= p.z + tol && tol <= OM__SPSM_TOL0 + LIT_CAP) {
+        } else if (on && close) {
             n[N_LIT]++;
             return 255;
         }
@@ -580,7 +602,7 @@ static uint8_t lookup(const om__spsm_state *m, om__spsm_win *w, uint32_t n[8], c
         if (k == 4) continue;
         if (!((w->t_have >> k) & 1u)) { decode(m, tx, ty, t, k); w->t_have |= 1u << k; }
         if (t[k].ok) edges(t, k);
-        if (hits(&t[k], px, py, p.z)) { n[N_SHADOWED]++; return 0; }
+        if (hits(&t[k], px, py, p.z, p.zf)) { n[N_SHADOWED]++; return 0; }
     }
     return recover(m, w, n, st, i, &p, tx, ty);
 }
@@ -610,7 +632,10 @@ OM_NOINLINE static uint8_t recover(const om__spsm_state *m, om__spsm_win *w, uin
     bool have_rp = false;
     for (int k = 0; k < 9; k++) {
         /* cheapest test first; the receiver's plane only when a texel needs it */
-        if (t[k].empty || !(om__spsm_plane_at(&t[k], px, py) < p.z - pat_tol(&t[k], px, py))) continue;
+        if (t[k].empty) continue;
+        const int below = om__spsm_below_f(&t[k], px, py, p.zf, -1.0f, (float)(OM__SPSM_TOL0 + PAT_CAP));
+        if (below == 0 || (below < 0 && !(om__spsm_plane_at(&t[k], px, py) < p.z - pat_tol(&t[k], px, py))))
+            continue;
         if (!have_rp) { rp = receiver_plane(m, smp); have_rp = true; }
         if (t[k].ok && behind_receiver(&t[k], &rp, px, py)) continue;
         if (!t[k].have_cmin) {
@@ -653,7 +678,7 @@ OM_NOINLINE static uint8_t recover(const om__spsm_state *m, om__spsm_win *w, uin
         bool shadow = false;
         /* at the sample itself the lookup found no hit in the whole 3x3 */
         if (K > 1)
-            for (int k = 0; k < nocc && !shadow; k++) shadow = hits(occ[k], qx, qy, q.z);
+            for (int k = 0; k < nocc && !shadow; k++) shadow = hits(occ[k], qx, qy, q.z, q.zf);
         if (!shadow && bd->nh) shadow = om__spsm_outline_inside(bd, qx, qy);
         if (!shadow && w->ncand) {
             if (!have_use) { use = centres_nearer(m, w, &rp, &have_rp, smp, tx, ty, px, py); have_use = true; }

@@ -23,6 +23,7 @@ typedef struct om__spsm_dtri {
     int64_t rx[3], ry[3];        /* the vertices as decoded (e holds them reordered) */
     int64_t cx, cy;              /* this texel's centre */
     double z, gx, gy, ex, ey;    /* centre depth, slopes and their error bounds */
+    float zf, gxf, gyf, exf, eyf;   /* the same rounded to float (om__spsm_below_f) */
     double cmin;                 /* consistent_min, once computed (have_cmin) */
     bool have_cmin;
     double vz[3], vtol[3];       /* plane and pat_tol at the vertices rx, ry (have_vz) */
@@ -52,6 +53,47 @@ static inline double om__spsm_plane_at(const om__spsm_dtri *t, int64_t px, int64
 static inline double om__spsm_tol_at(const om__spsm_dtri *t, int64_t px, int64_t py)
 {
     return OM__SPSM_TOL0 + t->ex * fabs((double)(px - t->cx)) + t->ey * fabs((double)(py - t->cy));
+}
+
+/* The depth tests of the lookup in float, for a CPU whose double is a library call (a
+ * Cortex-M4F): whether om__spsm_plane_at(t, px, py) lies below pz + sign * tol, tol
+ * being om__spsm_tol_at(t, px, py), capped at `cap` when cap > 0 (tol < cap ? tol :
+ * cap), as the double arithmetic decides it with < or <= (1 below, 0 not), or -1 when
+ * float cannot be sure. pz is the double depth rounded to float.
+ *
+ * Why it is sure otherwise: every value is a sum of at most six terms, each within
+ * 2^-24 of its double (conversions) and each float operation adds at most 2^-24 of
+ * the sum of their magnitudes S, at most 14 roundings in all, under 2^-20 S; the double
+ * arithmetic's own error is under 2^-49 S. A difference beyond 2^-19 S has the same
+ * sign in both, and so does the cap's choice; equality lies inside that band, so < and
+ * <= agree outside it. Offsets beyond 2^20 grid units (exact in float below 2^24) and
+ * non-finite values answer -1. */
+static inline int om__spsm_below_f(const om__spsm_dtri *t, int64_t px, int64_t py, float pz, float sign,
+                                   float cap)
+{
+    const int64_t ix = px - t->cx, iy = py - t->cy;
+    if (ix < -(1 << 20) || ix > (1 << 20) || iy < -(1 << 20) || iy > (1 << 20)) return -1;
+    const float dx = (float)ix, dy = (float)iy;
+    const float gdx = t->gxf * dx, gdy = t->gyf * dy, a = t->zf + gdx + gdy;
+    float tol = (float)OM__SPSM_TOL0 + t->exf * om__fabsf(dx) + t->eyf * om__fabsf(dy);
+    const float e = (om__fabsf(t->zf) + om__fabsf(gdx) + om__fabsf(gdy) + om__fabsf(pz) + tol) * 0x1p-19f;
+    if (cap > 0.0f) {
+        if (tol > cap + e) tol = cap;
+        else if (!(tol < cap - e)) return -1;
+    }
+    const float d = a - (pz + sign * tol);
+    return d < -e ? 1 : d > e ? 0 : -1;
+}
+
+/* Whether om__spsm_tol_at(t, px, py) <= cap as the double arithmetic finds it (1, 0),
+ * or -1 when float cannot be sure (the same bounds). */
+static inline int om__spsm_tol_within_f(const om__spsm_dtri *t, int64_t px, int64_t py, float cap)
+{
+    const int64_t ix = px - t->cx, iy = py - t->cy;
+    if (ix < -(1 << 20) || ix > (1 << 20) || iy < -(1 << 20) || iy > (1 << 20)) return -1;
+    const float tol = (float)OM__SPSM_TOL0 + t->exf * om__fabsf((float)ix) + t->eyf * om__fabsf((float)iy);
+    const float e = tol * 0x1p-19f;
+    return tol < cap - e ? 1 : tol > cap + e ? 0 : -1;
 }
 
 /* Builds the outline of the occluders occ[0..nocc) (distinct triangles, their edges
