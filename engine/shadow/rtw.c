@@ -721,7 +721,8 @@ static om_status rtw_resolve(void *state, om_strip *st, om_diag *d)
 {
     (void)d;
     om__rtw *m = (om__rtw *)state;
-    om__rtw_lookup_strip(m, st, &m->samples, &m->shadowed);
+    if (OM_FAST_FLOAT) om__rtw_lookup_strip(m, st, &m->samples, &m->shadowed);
+    else om__smlook_strip(&m->look, st, &m->samples, &m->shadowed);
     return OM_OK;
 }
 
@@ -729,7 +730,9 @@ static om_status rtw_resolve(void *state, om_strip *st, om_diag *d)
 static void rtw_band(const void *state, om_strip *st, void *scratch, uint32_t counts[8])
 {
     (void)scratch;
-    om__rtw_lookup_strip((const om__rtw *)state, st, &counts[0], &counts[1]);
+    const om__rtw *m = (const om__rtw *)state;
+    if (OM_FAST_FLOAT) om__rtw_lookup_strip(m, st, &counts[0], &counts[1]);
+    else om__smlook_strip(&m->look, st, &counts[0], &counts[1]);
 }
 
 /* The resolve's counts after each strip, the map's (counts[2]) after the build. */

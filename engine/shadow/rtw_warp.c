@@ -237,6 +237,7 @@ void om__rtw_observe_strip(om__rtw *m, const om_strip *st)
     const imp_ctx k = imp_ctx_of(v, funcs);
     const float *a = v->light_vp.m;
     const float nf = (float)m->n, hn = 0.5f * nf;
+    (void)nf; (void)hn;
     size_t count = (size_t)st->rows * st->width;
     for (size_t i = 0; i < count; i++) {
         if (!(st->terms[i].flags & OM_TERM_EXPOSED)) continue;
@@ -247,10 +248,14 @@ void om__rtw_observe_strip(om__rtw *m, const om_strip *st)
         float qy = a[4] * p.x + a[5] * p.y + a[6] * p.z + a[7];
         float qw = a[12] * p.x + a[13] * p.y + a[14] * p.z + a[15];
         if (!(qw > 0.0f)) continue;
-        const float iwf = 1.0f / qw;
-        const int32_t ci = om__rtw_cell_axis(qx * iwf, hn, nf), cj = om__rtw_cell_axis(-(qy * iwf), hn, nf);
+        int32_t ci = -2, cj = -2;   /* unsure: the double arithmetic decides */
+        if (OM_FAST_FLOAT) {
+            const float iwf = 1.0f / qw;
+            ci = om__rtw_cell_axis(qx * iwf, hn, nf);
+            cj = om__rtw_cell_axis(-(qy * iwf), hn, nf);
+            if (ci == -1 || cj == -1) continue;   /* certainly outside */
+        }
         size_t c;
-        if (ci == -1 || cj == -1) continue;   /* certainly outside */
         if (ci >= 0 && cj >= 0) {
             c = (size_t)cj * m->n + (size_t)ci;
         } else {   /* near a cell edge: the double arithmetic decides */
@@ -262,7 +267,7 @@ void om__rtw_observe_strip(om__rtw *m, const om_strip *st)
         const om_vec3 nrm = om__v3(smp->n[0], smp->n[1], smp->n[2]);
         m->seen[c >> 3] |= (uint8_t)(1u << (c & 7));
         /* "only keeping the highest value point" (section 6.3) */
-        if (!importance_above(&k, p, nrm, m->imp[c])) continue;
+        if (OM_FAST_FLOAT && !importance_above(&k, p, nrm, m->imp[c])) continue;
         float val = point_importance(&k, p, nrm);
         if (val > m->imp[c]) m->imp[c] = val;
     }

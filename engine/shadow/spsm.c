@@ -336,7 +336,7 @@ static double pat_tol(const om__spsm_dtri *t, int64_t px, int64_t py)
 static bool hits(const om__spsm_dtri *t, int64_t px, int64_t py, double pz, float pzf)
 {
     if (!t->ok || !om__tri2_covers(&t->e, px, py)) return false;
-    const int below = om__spsm_below_f(t, px, py, pzf, -1.0f, 0.0f);
+    const int below = OM_FAST_FLOAT ? om__spsm_below_f(t, px, py, pzf, -1.0f, 0.0f) : -1;
     return below >= 0 ? below == 1 : om__spsm_plane_at(t, px, py) < pz - om__spsm_tol_at(t, px, py);
 }
 
@@ -581,7 +581,7 @@ static uint8_t lookup(const om__spsm_state *m, om__spsm_win *w, uint32_t n[8], c
     if (t[4].empty) { n[N_LIT]++; return 255; }
     if (t[4].ok) {
         /* in float where that is sure of the double's answers (om__spsm_below_f) */
-        int below = om__spsm_below_f(&t[4], px, py, p.zf, -1.0f, 0.0f), on = 0, close = 0;
+        int below = OM_FAST_FLOAT ? om__spsm_below_f(&t[4], px, py, p.zf, -1.0f, 0.0f) : -1, on = 0, close = 0;
         if (below == 0) on = om__spsm_below_f(&t[4], px, py, p.zf, 1.0f, 0.0f);
         if (on == 1) close = om__spsm_tol_within_f(&t[4], px, py, (float)(OM__SPSM_TOL0 + LIT_CAP));
         if (below < 0 || on < 0 || close < 0) {
@@ -633,7 +633,8 @@ OM_NOINLINE static uint8_t recover(const om__spsm_state *m, om__spsm_win *w, uin
     for (int k = 0; k < 9; k++) {
         /* cheapest test first; the receiver's plane only when a texel needs it */
         if (t[k].empty) continue;
-        const int below = om__spsm_below_f(&t[k], px, py, p.zf, -1.0f, (float)(OM__SPSM_TOL0 + PAT_CAP));
+        const int below =
+            OM_FAST_FLOAT ? om__spsm_below_f(&t[k], px, py, p.zf, -1.0f, (float)(OM__SPSM_TOL0 + PAT_CAP)) : -1;
         if (below == 0 || (below < 0 && !(om__spsm_plane_at(&t[k], px, py) < p.z - pat_tol(&t[k], px, py))))
             continue;
         if (!have_rp) { rp = receiver_plane(m, smp); have_rp = true; }
