@@ -30,12 +30,14 @@ uint32_t om_format_bpp(om_format f)
 /* The clamps compare the float's bits as an integer, which orders non-negative
  * floats as their values (and puts every negative one, -0 too, at or below 0): the
  * same answers as float comparisons for the finite values shading makes, without a
- * transfer of the float unit's flags per comparison. */
+ * transfer of the float unit's flags per comparison. The upper one is at 256.0f,
+ * whose bits an ARM comparison takes as an immediate (255.0f's it must load): below
+ * it the truncation of 255.x is 255 anyway. */
 static uint8_t to8(float v)
 {
     union { float f; int32_t i; } b;
     b.f = v * 255.0f + 0.5f;
-    return b.i <= 0 ? 0 : b.i >= 0x437F0000 /* 255.0f */ ? 255 : (uint8_t)b.f;
+    return b.i <= 0 ? 0 : b.i >= 0x43800000 /* 256.0f */ ? 255 : (uint8_t)b.f;
 }
 
 /* In line with a constant format (shade_row's callers): the switch then goes. */
@@ -56,21 +58,40 @@ static inline void put(om_format f, uint8_t *px, uint8_t r, uint8_t g, uint8_t b
 /* One row of the strip into the framebuffer row `px`, `bpp` bytes a pixel. The cosine
  * is the one the exposure marks kept in the sample (om__exposed), the same bits as
  * working it out here. A blocked term adds k * 0 = 0 to the ambient light (k is
- * finite), so it is skipped. */
+ * finite), so it is skipped. What is the same for many pixels is worked out once:
+ * the background's pixel, the light of a grey term (one channel's operations give
+ * all three), and the pixel of the last material drawn with ambient light alone,
+ * which depends on the material only. */
 static inline void shade_row(const om_scene *s, const om_shade_cfg *c, const om_sample *smp,
                              const om_term *t, uint32_t width, om_format f, uint32_t bpp, uint8_t *px)
 {
+    uint8_t bg[3], dark[3] = {0, 0, 0};
+    put(f, bg, c->bg_r, c->bg_g, c->bg_b);
+    const float amb = c->ambient, direct = 1.0f - c->ambient;
+    uint32_t dark_mat = UINT32_MAX;
     for (uint32_t x = 0; x < width; x++, smp++, t++, px += bpp) {
-        if (smp->tri == OM_NO_TRI) { put(f, px, c->bg_r, c->bg_g, c->bg_b); continue; }
-        const om_material *m = &s->mats[s->tri_mat[smp->tri]];
-        float lr = c->ambient, lg = c->ambient, lb = c->ambient;
-        if ((t->flags & OM_TERM_EXPOSED) && (t->r | t->g | t->b)) {
-            float k = smp->nl * (1.0f - c->ambient) * (1.0f / 255.0f);
-            lr += k * (float)t->r;
-            lg += k * (float)t->g;
-            lb += k * (float)t->b;
+        if (smp->tri == OM_NO_TRI) {
+            for (uint32_t k = 0; k < bpp; k++) px[k] = bg[k];
+            continue;
         }
-        put(f, px, to8(m->r * lr), to8(m->g * lg), to8(m->b * lb));
+        const uint32_t mi = s->tri_mat[smp->tri];
+        const om_material *m = &s->mats[mi];
+        if ((t->flags & OM_TERM_EXPOSED) && (t->r | t->g | t->b)) {
+            const float k = smp->nl * direct * (1.0f / 255.0f);
+            const float lr = amb + k * (float)t->r;
+            float lg = lr, lb = lr;
+            if (t->g != t->r || t->b != t->r) {
+                lg = amb + k * (float)t->g;
+                lb = amb + k * (float)t->b;
+            }
+            put(f, px, to8(m->r * lr), to8(m->g * lg), to8(m->b * lb));
+            continue;
+        }
+        if (mi != dark_mat) {
+            dark_mat = mi;
+            put(f, dark, to8(m->r * amb), to8(m->g * amb), to8(m->b * amb));
+        }
+        for (uint32_t k = 0; k < bpp; k++) px[k] = dark[k];
     }
 }
 
