@@ -218,30 +218,112 @@ static uint8_t test(const om__smlook *L, const tap *tp)
  * term: they are the same as testing sample by sample. */
 #define SMLOOK_BLOCK 32
 
-/* The plain map's strip with one tap and no normal offset (sm's usual settings): the
+/* The plain map with one tap and no normal offset (sm's usual settings): the
  * operations of locate and test for that case, in their order (so the same bits),
  * with what does not change within a strip (the map's size as a float, a
- * directional light's texel and depth slope) worked out once rather than per sample,
- * and the taps kept as their threshold and index alone. */
+ * directional light's texel and depth slope) worked out once rather than per sample. */
+typedef struct plain {
+    om_mat4 vp;
+    om_vec3 lpos, axis;
+    bool spot;
+    uint32_t size;
+    float fsize, half, span_per_dist, half_near, dz_num, dz_den, bias_const, bias_slope;
+    float texel_dir, dz_dir;   /* a directional light's: as texel_world and locate make them */
+} plain;
+
+/* A sample's threshold and texel index; false when it is behind the light. `spot`
+ * is P->spot, a constant where the callers are inlined. */
+static inline bool plain_locate(const plain *P, const bool spot, const om_sample *smp,
+                                uint64_t *zlit, uint32_t *at)
+{
+    const om_vec3 p = om__v3(smp->p[0], smp->p[1], smp->p[2]);
+    float dist = 1.0f, texel = P->texel_dir, dz = P->dz_dir;
+    if (spot) {
+        dist = om__dot(om__sub(p, P->lpos), P->axis);
+        texel = dist * P->span_per_dist / P->fsize;
+    }
+    const float cosang = smp->nl;
+    const float tanang = cosang > 0.0995f ? om__sqrtf(1.0f - cosang * cosang) / cosang : 10.0f;
+    const float bias = P->bias_const + P->bias_slope * texel * tanang;
+    const om_vec4 q = om__mat_apply(&P->vp, p);
+    if (!(q.w > 0.0f)) return false;
+    const float iw = 1.0f / q.w;
+    const float uf = (q.x * iw + 1.0f) * P->half;
+    const float wf = (1.0f - q.y * iw) * P->half;
+    *at = texel_clamped(wf, P->size) * P->size + texel_clamped(uf, P->size);
+    const float z = q.z * iw * OM_DEPTH_ONE_F;
+    if (spot) {
+        const float e = dist > P->half_near ? dist : P->half_near;
+        dz = P->dz_num / (P->dz_den * e * e) * OM_DEPTH_ONE_F;
+    }
+    *zlit = depth_threshold(z - bias * dz);
+    return true;
+}
+
+/* A microcontroller's loads take a cycle or two: there (OM_SMLOOK_DIRECT, 1 on
+ * Cortex-M cores; define it 1 elsewhere to try it) each sample is tested as soon as it
+ * is located, and its term written once. The same terms either way. */
+#ifndef OM_SMLOOK_DIRECT
+#if defined(__ARM_ARCH_PROFILE) && __ARM_ARCH_PROFILE == 'M'
+#define OM_SMLOOK_DIRECT 1
+#else
+#define OM_SMLOOK_DIRECT 0
+#endif
+#endif
+#if OM_SMLOOK_DIRECT
+static inline void plain_tests(const plain *P, const bool spot, const uint32_t *depth, om_strip *st,
+                               size_t n, uint32_t *samples, uint32_t *shadowed)
+{
+    uint32_t nsamples = 0, nshadowed = 0;
+    for (size_t i = 0; i < n; i++) {
+        om_term *t = &st->terms[i];
+        uint8_t val = 255;
+        if (t->flags & OM_TERM_EXPOSED) {
+            nsamples++;
+            uint64_t zlit;
+            uint32_t at;
+            if (plain_locate(P, spot, &st->samples[i], &zlit, &at) && !(zlit <= depth[at])) {
+                val = 0;
+                nshadowed++;
+            }
+        }
+        t->r = t->g = t->b = val;
+    }
+    *samples += nsamples;
+    *shadowed += nshadowed;
+}
+#endif
+
 static void strip_plain(const om__smlook *L, om_strip *st, uint32_t *samples, uint32_t *shadowed)
 {
     const om_view *v = L->view;
-    const bool spot = v->light.kind == OM_LIGHT_SPOT;
-    const om_mat4 vp = v->light_vp;
-    const om_vec3 lpos = v->light.pos, axis = v->light_axis;
-    const uint32_t size = L->size;
-    const float fsize = (float)size, half = 0.5f * fsize;
-    const float span_per_dist = L->span_per_dist, half_near = L->half_near;
-    const float dz_num = L->dz_num, dz_den = L->dz_den;
-    const float bias_const = L->bias_const, bias_slope = L->bias_slope;
-    /* a directional light's: the same operations as texel_world's and locate's */
-    const float texel_dir = spot ? 0.0f : 2.0f / om__fabsf(v->light_proj.m[0]) / fsize;
-    const float dz_dir = spot ? 0.0f : OM_DEPTH_ONE_F * om__fabsf(v->light_proj.m[10]);
+    plain P;
+    P.vp = v->light_vp;
+    P.lpos = v->light.pos;
+    P.axis = v->light_axis;
+    P.spot = v->light.kind == OM_LIGHT_SPOT;
+    P.size = L->size;
+    P.fsize = (float)L->size;
+    P.half = 0.5f * P.fsize;
+    P.span_per_dist = L->span_per_dist;
+    P.half_near = L->half_near;
+    P.dz_num = L->dz_num;
+    P.dz_den = L->dz_den;
+    P.bias_const = L->bias_const;
+    P.bias_slope = L->bias_slope;
+    P.texel_dir = P.spot ? 0.0f : 2.0f / om__fabsf(v->light_proj.m[0]) / P.fsize;
+    P.dz_dir = P.spot ? 0.0f : OM_DEPTH_ONE_F * om__fabsf(v->light_proj.m[10]);
     const uint32_t *depth = L->depth;
     const size_t n = (size_t)st->rows * st->width;
+    uint32_t nsamples = 0, nshadowed = 0;
+#if OM_SMLOOK_DIRECT
+    if (P.spot) plain_tests(&P, true, depth, st, n, &nsamples, &nshadowed);
+    else plain_tests(&P, false, depth, st, n, &nsamples, &nshadowed);
+#else
+    /* Blocks, as om__smlook_strip's (below), with the taps kept as their threshold
+     * and index alone. */
     uint64_t zlit[SMLOOK_BLOCK];
     uint32_t at[SMLOOK_BLOCK], idx[SMLOOK_BLOCK];
-    uint32_t nsamples = 0, nshadowed = 0;
     for (size_t i = 0; i < n;) {
         int got = 0;
         for (; i < n && got < SMLOOK_BLOCK; i++) {
@@ -249,33 +331,12 @@ static void strip_plain(const om__smlook *L, om_strip *st, uint32_t *samples, ui
             t->r = t->g = t->b = 255;
             if (!(t->flags & OM_TERM_EXPOSED)) continue;
             nsamples++;
-            const om_sample *smp = &st->samples[i];
-            const om_vec3 p = om__v3(smp->p[0], smp->p[1], smp->p[2]);
-            float dist = 1.0f, texel = texel_dir, dz = dz_dir;
-            if (spot) {
-                dist = om__dot(om__sub(p, lpos), axis);
-                texel = dist * span_per_dist / fsize;
-            }
-            const float cosang = smp->nl;
-            const float tanang = cosang > 0.0995f ? om__sqrtf(1.0f - cosang * cosang) / cosang : 10.0f;
-            const float bias = bias_const + bias_slope * texel * tanang;
-            const om_vec4 q = om__mat_apply(&vp, p);
-            if (!(q.w > 0.0f)) continue;
-            const float iw = 1.0f / q.w;
-            const float uf = (q.x * iw + 1.0f) * half;
-            const float wf = (1.0f - q.y * iw) * half;
-            const uint32_t a = texel_clamped(wf, size) * size + texel_clamped(uf, size);
-            const float z = q.z * iw * OM_DEPTH_ONE_F;
-            if (spot) {
-                const float e = dist > half_near ? dist : half_near;
-                dz = dz_num / (dz_den * e * e) * OM_DEPTH_ONE_F;
-            }
+            if (plain_locate(&P, P.spot, &st->samples[i], &zlit[got], &at[got])) {
 #if defined(__GNUC__) || defined(__clang__)
-            __builtin_prefetch(&depth[a]);
+                __builtin_prefetch(&depth[at[got]]);
 #endif
-            zlit[got] = depth_threshold(z - bias * dz);
-            at[got] = a;
-            idx[got++] = (uint32_t)i;
+                idx[got++] = (uint32_t)i;
+            }
         }
         for (int j = 0; j < got; j++) {
             const uint8_t val = zlit[j] <= depth[at[j]] ? 255 : 0;
@@ -284,6 +345,7 @@ static void strip_plain(const om__smlook *L, om_strip *st, uint32_t *samples, ui
             nshadowed += val != 255;
         }
     }
+#endif
     *samples += nsamples;
     *shadowed += nshadowed;
 }
