@@ -67,8 +67,26 @@ typedef struct hsample {
 } hsample;
 #define DONE 0x80000000u
 
+/* Where a double operation is a software routine (the Cortex-M4F's FPU is single
+ * precision, the M0 and M3 have none), the lookup's plane test and the small
+ * triangles' updates of the map try single precision first and use double only
+ * where the float's error bound leaves the answer open; elsewhere double costs what
+ * float does and runs alone. The answers are the same either way (the float answers
+ * only where the double would answer alike), and so the map and the frames. */
+#ifndef OM_HYBRID_FLOAT_FIRST
+#if defined(__arm__) && !(defined(__ARM_FP) && (__ARM_FP & 8))
+#define OM_HYBRID_FLOAT_FIRST 1
+#else
+#define OM_HYBRID_FLOAT_FIRST 0
+#endif
+#endif
+
 /* Texels per side of a block (the coarse level a triangle looks at first). */
 #define BLOCK 4
+
+/* Grid bounds and a depth: a projected triangle's bounds and nearest vertex depth
+ * (vbox_of), or a tile's samples' bounds and farthest depth. */
+typedef struct vbox { int32_t lox, loy, hix, hiy; uint32_t z; } vbox;
 
 /* hybrid's configuration: the sample pool's size and its map's side. */
 typedef struct hybrid_cfg {
@@ -95,6 +113,7 @@ typedef struct hybrid_state {
      * of a block's samples, bzmax (0: none a triangle could block). */
     hsample *raw, *smp;
     uint32_t *rtex, *tend, *bzmax;
+    vbox box;              /* the tile's samples' bounds and farthest depth */
     uint32_t cap;          /* samples the pool holds */
     uint32_t lit, shadowed, uncertain, setups, tested, tiles;
 } hybrid_state;
@@ -364,8 +383,6 @@ static trange texels_in(const hybrid_state *m, int64_t lox, int64_t loy, int64_t
 
 /* A projected triangle's bounds and nearest vertex depth; false when it needs
  * clipping (or the projection is not kept). */
-typedef struct vbox { int32_t lox, loy, hix, hiy; uint32_t zlo; } vbox;
-
 static bool vbox_of(const hybrid_state *m, uint32_t t, vbox *v)
 {
     if (!m->ls.verts) return false;
@@ -374,7 +391,7 @@ static bool vbox_of(const hybrid_state *m, uint32_t t, vbox *v)
     if (a->x == INT32_MIN || b->x == INT32_MIN || c->x == INT32_MIN) return false;
     v->lox = v->hix = a->x;
     v->loy = v->hiy = a->y;
-    v->zlo = a->z;
+    v->z = a->z;
     if (b->x < v->lox) v->lox = b->x;
     if (b->x > v->hix) v->hix = b->x;
     if (c->x < v->lox) v->lox = c->x;
@@ -383,8 +400,8 @@ static bool vbox_of(const hybrid_state *m, uint32_t t, vbox *v)
     if (b->y > v->hiy) v->hiy = b->y;
     if (c->y < v->loy) v->loy = c->y;
     if (c->y > v->hiy) v->hiy = c->y;
-    if (b->z < v->zlo) v->zlo = b->z;
-    if (c->z < v->zlo) v->zlo = c->z;
+    if (b->z < v->z) v->z = b->z;
+    if (c->z < v->z) v->z = c->z;
     return true;
 }
 
@@ -416,9 +433,23 @@ static bool add_small(hybrid_state *m, uint32_t t)
                 h->gx = h->gy = 0.0f;
                 h->z = FLT_MAX;
             }
+#if OM_HYBRID_FLOAT_FIRST
+            /* Most small triangles lie behind what the texel holds already: single
+             * precision says so first where it can (as in plane_at_or_beyond: the
+             * float is within s 2^-20 of the exact value, s the sum of its terms'
+             * magnitudes, and f_down goes below a value by at most 2 + 4e-6 of it),
+             * and then the double would leave z as it is. */
+            const float gxf = h->gx, gyf = h->gy;
+            const float a = gxf * (float)(int32_t)(x0 - xc), b = gyf * (float)(int32_t)(y0 - yc);
+            const float c = gxf > 0.0f ? gxf * (float)(int32_t)(x1 - x0) : 0.0f;
+            const float e = gyf > 0.0f ? gyf * (float)(int32_t)(y1 - y0) : 0.0f;
+            const float zf = (float)v.z, lo = zf - a - b - c - e - 1.0f;
+            const float err = (zf + om__fabsf(a) + om__fabsf(b) + c + e + 1.0f) * 0x1p-20f;
+            if ((lo - err) - (om__fabsf(lo) + err) * 4e-6f - 2.0f >= h->z) continue;
+#endif
             double gx = h->gx, gy = h->gy;
             double p0 = gx * (double)(x0 - xc) + gy * (double)(y0 - yc);
-            float z = f_down(least_diff((double)v.zlo, 0.0, 0.0, p0, gx, gy, x1 - x0, y1 - y0) - 1.0);
+            float z = f_down(least_diff((double)v.z, 0.0, 0.0, p0, gx, gy, x1 - x0, y1 - y0) - 1.0);
             if (z < h->z) h->z = z;
         }
     return true;
@@ -445,6 +476,27 @@ static om_status hybrid_build(void *state, om_diag *d)
     return OM_OK;
 }
 
+/* Is the texel's plane at offset (dx, dy) from its centre at depth z (zi, as an
+ * integer) or beyond? The test is in double; with OM_HYBRID_FLOAT_FIRST single
+ * precision answers first where it can. The float's value is within
+ * (|h->z| + |gx dx| + |gy dy| + z) 2^-21 of the exact one (the conversions of dx, dy
+ * and z, two products and two sums, each within 2^-24 of its magnitude), and the
+ * double's within 2^-50 of that: more than e = that sum times 2^-19 away from z, the
+ * float answers as the double would, the same on every CPU. */
+static inline bool plane_at_or_beyond(const htexel *h, int64_t dx, int64_t dy, double z, uint32_t zi)
+{
+#if OM_HYBRID_FLOAT_FIRST
+    /* dx, dy: a sample is within 2^26 of the grid (om__snap_xy), so int32 converts */
+    const float a = h->gx * (float)(int32_t)dx, b = h->gy * (float)(int32_t)dy, fz = (float)zi;
+    const float v = h->z + a + b, e = (om__fabsf(h->z) + om__fabsf(a) + om__fabsf(b) + fz) * 0x1p-19f;
+    if (v - e >= fz) return true;
+    if (v + e < fz) return false;
+#else
+    (void)zi;
+#endif
+    return (double)h->z + (double)h->gx * (double)dx + (double)h->gy * (double)dy >= z;
+}
+
 /* The map's answer for a sample: 1 certainly lit, 2 certainly shadowed (t set to 0),
  * 0 uncertain, with *tex its texel. */
 static inline int classify(const hybrid_state *m, const om__lpoint *p, om_term *t, int64_t *tex)
@@ -453,10 +505,18 @@ static inline int classify(const hybrid_state *m, const om__lpoint *p, om_term *
     const htexel *h = &m->map[ty * (int64_t)m->side + tx];
     *tex = ty * (int64_t)m->side + tx;
     int64_t xc = tx * m->T + m->T / 2, yc = ty * m->T + m->T / 2;
-    if (h->z == FLT_MAX ||
-        (double)h->z + (double)h->gx * (double)(p->x - xc) + (double)h->gy * (double)(p->y - yc) >= p->z)
+#if OM_HYBRID_FLOAT_FIRST
+    const uint32_t z = (uint32_t)p->z;   /* a whole depth unit (om__lspace_point) */
+    if (h->z == FLT_MAX || plane_at_or_beyond(h, p->x - xc, p->y - yc, p->z, z))
         return 1;   /* the term is already 255 */
-    if ((double)h->hi < p->z && h->cid != p->tri) {
+    /* hi < z exactly, for a whole z: floor(hi) < z (a float is whole from 2^24) */
+    const bool below = h->hi < 0.0f || (h->hi < 4294967296.0f && (uint32_t)h->hi < z);
+#else
+    if (h->z == FLT_MAX || plane_at_or_beyond(h, p->x - xc, p->y - yc, p->z, 0))
+        return 1;   /* the term is already 255 */
+    const bool below = (double)h->hi < p->z;
+#endif
+    if (below && h->cid != p->tri) {
         t->r = t->g = t->b = 0;
         return 2;
     }
@@ -471,13 +531,37 @@ int om__hybrid_decide(void *state, const om__lpoint *p, om_term *t)
 
 const om__lspace *om__hybrid_lspace(const void *state) { return &((const hybrid_state *)state)->ls; }
 
+static inline int32_t min3(int32_t a, int32_t b, int32_t c) { return a < b ? (a < c ? a : c) : (b < c ? b : c); }
+static inline int32_t max3(int32_t a, int32_t b, int32_t c) { return a > b ? (a > c ? a : c) : (b > c ? b : c); }
+
+/* vbox_of against the tile's samples, an axis at a time: -1 when the triangle's
+ * bounds miss theirs or it is nowhere nearer than their farthest (it blocks none of
+ * them), 1 with v its bounds, 0 when it needs clipping (or the projection is not
+ * kept). */
+static int vbox_near(const hybrid_state *m, uint32_t t, vbox *v)
+{
+    if (!m->ls.verts) return 0;
+    const uint32_t *ix = m->scene->idx + (size_t)t * 3;
+    const om__lvert *a = &m->ls.verts[ix[0]], *b = &m->ls.verts[ix[1]], *c = &m->ls.verts[ix[2]];
+    if (a->x == INT32_MIN || b->x == INT32_MIN || c->x == INT32_MIN) return 0;
+    const vbox *x = &m->box;
+    v->lox = min3(a->x, b->x, c->x);
+    v->hix = max3(a->x, b->x, c->x);
+    if (v->hix < x->lox || v->lox > x->hix) return -1;
+    v->loy = min3(a->y, b->y, c->y);
+    v->hiy = max3(a->y, b->y, c->y);
+    if (v->hiy < x->loy || v->loy > x->hiy) return -1;
+    v->z = a->z < b->z ? (a->z < c->z ? a->z : c->z) : (b->z < c->z ? b->z : c->z);
+    return v->z >= x->z ? -1 : 1;
+}
+
 /* Does a block that r reaches hold a sample farther than depth z? (A triangle whose
  * every depth plus bound is at z or beyond blocks none there.) */
-static bool any_farther(const hybrid_state *m, const trange *r, double z)
+static bool any_farther(const hybrid_state *m, const trange *r, uint32_t z)
 {
     for (uint32_t by = r->y0 / BLOCK; by <= r->y1 / BLOCK; by++)
         for (uint32_t bx = r->x0 / BLOCK; bx <= r->x1 / BLOCK; bx++)
-            if ((double)m->bzmax[by * m->bside + bx] > z) return true;
+            if (m->bzmax[by * m->bside + bx] > z) return true;
     return false;
 }
 
@@ -485,15 +569,15 @@ static bool any_farther(const hybrid_state *m, const trange *r, double z)
  * vertex? */
 static bool any_within(const hybrid_state *m, const trange *r, const vbox *v)
 {
+    const int32_t lox = v->lox, hix = v->hix, loy = v->loy, hiy = v->hiy;
+    const uint32_t z = v->z;
     for (uint32_t ty = r->y0; ty <= r->y1; ty++)
         for (uint32_t tx = r->x0; tx <= r->x1; tx++) {
             size_t tex = (size_t)ty * m->side + tx;
-            for (uint32_t i = tex ? m->tend[tex - 1] : 0; i < m->tend[tex]; i++) {
-                const hsample *q = &m->smp[i];
-                if (!(q->idx & DONE) && q->x >= v->lox && q->x <= v->hix && q->y >= v->loy && q->y <= v->hiy &&
-                    q->z > v->zlo)
+            const hsample *q = m->smp + (tex ? m->tend[tex - 1] : 0), *end = m->smp + m->tend[tex];
+            for (; q < end; q++)
+                if (q->x >= lox && q->x <= hix && q->y >= loy && q->y <= hiy && q->z > z && !(q->idx & DONE))
                     return true;
-            }
         }
     return false;
 }
@@ -505,10 +589,20 @@ static void sort_tile(hybrid_state *m, uint32_t n)
     size_t nt = (size_t)m->side * m->side;
     memset(m->bzmax, 0, (size_t)m->bside * m->bside * sizeof *m->bzmax);
     memset(m->tend, 0, nt * sizeof *m->tend);
+    vbox *x = &m->box;
+    x->lox = x->loy = INT32_MAX;
+    x->hix = x->hiy = INT32_MIN;
+    x->z = 0;
     for (uint32_t i = 0; i < n; i++) {
+        const hsample *q = &m->raw[i];
         uint32_t t = m->rtex[i], b = t / m->side / BLOCK * m->bside + t % m->side / BLOCK;
         m->tend[t]++;
-        if (m->raw[i].z > m->bzmax[b]) m->bzmax[b] = m->raw[i].z;
+        if (q->z > m->bzmax[b]) m->bzmax[b] = q->z;
+        if (q->x < x->lox) x->lox = q->x;
+        if (q->x > x->hix) x->hix = q->x;
+        if (q->y < x->loy) x->loy = q->y;
+        if (q->y > x->hiy) x->hiy = q->y;
+        if (q->z > x->z) x->z = q->z;
     }
     uint32_t sum = 0;
     for (size_t t = 0; t < nt; t++) {   /* counts -> starts */
@@ -538,12 +632,16 @@ static uint32_t cast(hybrid_state *m, uint32_t t)
 {
     const om_scene *s = m->scene;
     vbox v;
-    if (vbox_of(m, t, &v)) {
+    const int near = vbox_near(m, t, &v);
+    if (near < 0) return 0;
+    if (near > 0) {
         /* The triangle's bounds are its vertices', its plane's depth lies within
-         * theirs: the culls below, before any setup; and where its bounds reach a few
+         * theirs: the culls, before any setup. First against the bounds of all the
+         * tile's samples (a tile of a few rows of the image lies in a small part of
+         * the light's grid), then of its blocks; and where its bounds reach a few
          * texels, whether any open sample there lies within them, farther. */
         trange r = texels_in(m, v.lox, v.loy, v.hix, v.hiy);
-        if (!any_farther(m, &r, (double)v.zlo)) return 0;
+        if (!any_farther(m, &r, v.z)) return 0;
         if ((r.x1 - r.x0 + 1) * (r.y1 - r.y0 + 1) <= 4 && !any_within(m, &r, &v)) return 0;
     }
     om__ltri lt;
