@@ -249,8 +249,8 @@ om_status om__bvh_build(om__bvh *b, om_arena *a, const om_scene *s, uint32_t lea
             box bb;
             bound_range(&bx, j.first, end, &bb, &cb);
             if (j.count == 0) for (int k = 0; k < 3; k++) bb.lo[k] = bb.hi[k] = 0;
-            memcpy(nd->lo, bb.lo, sizeof bb.lo);
-            memcpy(nd->hi, bb.hi, sizeof bb.hi);
+            memcpy(nd->box.w.lo, bb.lo, sizeof bb.lo);
+            memcpy(nd->box.w.hi, bb.hi, sizeof bb.hi);
         }
         nd->first = j.first;
         nd->count = j.count;
@@ -320,8 +320,8 @@ om_status om__bvh_build(om__bvh *b, om_arena *a, const om_scene *s, uint32_t lea
             c->known = known;
             if (known) {
                 c->cb = cside[e];
-                memcpy(b->nodes[c->node].lo, side[e].lo, sizeof side[e].lo);
-                memcpy(b->nodes[c->node].hi, side[e].hi, sizeof side[e].hi);
+                memcpy(b->nodes[c->node].box.w.lo, side[e].lo, sizeof side[e].lo);
+                memcpy(b->nodes[c->node].box.w.hi, side[e].hi, sizeof side[e].hi);
             }
         }
     }
@@ -333,7 +333,7 @@ static bool hits(const om__bvh_node *n, const float o[3], const float inv[3], fl
 {
     float t0 = 0.0f, t1 = tmax;
     for (int k = 0; k < 3; k++) {
-        float a = (n->lo[k] - m - o[k]) * inv[k], b = (n->hi[k] + m - o[k]) * inv[k];
+        float a = (n->box.w.lo[k] - m - o[k]) * inv[k], b = (n->box.w.hi[k] + m - o[k]) * inv[k];
         if (a > b) { float t = a; a = b; b = t; }
         if (a > t0) t0 = a;
         if (b < t1) t1 = b;

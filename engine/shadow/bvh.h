@@ -1,16 +1,29 @@
 /* bvh.h — a bounding volume hierarchy over a scene's triangles, built once in an arena
  * (binned surface-area heuristic; a node splits while it holds more than `leaf`
  * triangles, and never into a child of fewer than half that, so the node count is
- * bounded by the leaf size) and walked along shadow segments. Nodes are 32 bytes; a
- * node with count 0 is inner and its children sit at `first` and `first + 1`. */
+ * bounded by the leaf size) and walked along shadow segments (or, re-bounded on the
+ * light's grid each frame, by ref_light.h). Nodes are 32 bytes; a node with count 0 is
+ * inner and its children sit at `first` and `first + 1`. */
 #ifndef OM_BVH_H
 #define OM_BVH_H
 
 #include "../core/core.h"
 
 
+/* A box on the light's grid (ref_light.h): the grid bounds and nearest light depth
+ * (rounded down; UINT32_MAX: none) of the triangles under a node. */
+typedef struct om__bvh_gbox {
+    int32_t lox, loy, hix, hiy;
+    uint32_t zmin, unused;
+} om__bvh_gbox;
+
+/* The build's 3-D box (w), which the walk along a segment reads; a walk on the light's
+ * grid re-bounds the nodes every frame in the same bytes (g), in place of it. */
 typedef struct om__bvh_node {
-    float lo[3], hi[3];
+    union {
+        struct { float lo[3], hi[3]; } w;
+        om__bvh_gbox g;
+    } box;
     uint32_t first, count;
 } om__bvh_node;
 

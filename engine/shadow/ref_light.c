@@ -43,16 +43,38 @@ static void box_union(om__lbox *x, const om__lbox *a)
     if (a->zmin < x->zmin) x->zmin = a->zmin;
 }
 
+static int32_t to_i32(int64_t v)
+{
+    return v < INT32_MIN ? INT32_MIN : v > INT32_MAX ? INT32_MAX : (int32_t)v;
+}
+
+/* A triangle with a vertex that needs clipping passes om__lspace_maybe whatever the
+ * sample, so its box is that of what clipping leaves of it (om__lspace_tri, once a
+ * frame): a sample it blocks is covered by one of its sub-triangles, so inside their
+ * grid bounds, and is farther than that sub-triangle's nearest depth plus its bound, so
+ * farther than lt.zmin (om__blocks). Nothing left inside the light's frustum: no box,
+ * it blocks nothing. Without this a clipped floor's box, and every box above it, would
+ * hold every sample. */
+static void clipped_box(om__lbox *x, const om__lspace *ls, uint32_t t)
+{
+    om__ltri lt;
+    box_none(x);
+    if (!om__lspace_tri(ls, t, &lt)) return;
+    x->lox = to_i32(lt.lox);
+    x->loy = to_i32(lt.loy);
+    x->hix = to_i32(lt.hix);
+    x->hiy = to_i32(lt.hiy);
+    x->zmin = lt.zmin;
+}
+
 static void tri_box(om__lbox *x, const om__lspace *ls, uint32_t t)
 {
     const uint32_t *ix = ls->scene->idx + (size_t)t * 3;
     box_none(x);
     for (int k = 0; k < 3; k++) {
         const om__lvert *v = &ls->verts[ix[k]];
-        if (v->x == INT32_MIN) {   /* clipped: om__lspace_maybe passes it whatever p */
-            x->lox = x->loy = INT32_MIN;
-            x->hix = x->hiy = INT32_MAX;
-            x->zmin = -1.0;        /* light depths are at least 0 */
+        if (v->x == INT32_MIN) {
+            clipped_box(x, ls, t);
             return;
         }
         om__lbox one = {v->x, v->y, v->x, v->y, v->z};
@@ -161,5 +183,106 @@ void om__lbvh_walk_list(const om__lbvh *lb, const om__bvh *b, const uint32_t *li
         if (!holds(&nd->box, p)) continue;
         if (nd->count ? leaf(lb, b, nd, p, visit, user) : walk_from(lb, b, list[k], p, visit, user))
             return;
+    }
+}
+
+/* ---- the middle mode: the BVH's own nodes on the grid */
+
+static void gbox_grow(om__bvh_gbox *x, const om__bvh_gbox *a)
+{
+    if (a->lox < x->lox) x->lox = a->lox;
+    if (a->loy < x->loy) x->loy = a->loy;
+    if (a->hix > x->hix) x->hix = a->hix;
+    if (a->hiy > x->hiy) x->hiy = a->hiy;
+    if (a->zmin < x->zmin) x->zmin = a->zmin;
+}
+
+/* The grid box of a leaf's triangles: their projected vertices', or for one that needs
+ * clipping what is left of it (clipped_box). */
+static om__bvh_gbox leaf_gbox(const om__bvh *b, const om__bvh_node *n, const om__lspace *ls)
+{
+    om__bvh_gbox g = {INT32_MAX, INT32_MAX, INT32_MIN, INT32_MIN, UINT32_MAX, 0};
+    for (uint32_t k = n->first; k < n->first + n->count; k++) {
+        const uint32_t *ix = ls->scene->idx + (size_t)b->tris[k] * 3;
+        const om__lvert *v[3] = {&ls->verts[ix[0]], &ls->verts[ix[1]], &ls->verts[ix[2]]};
+        if (v[0]->x == INT32_MIN || v[1]->x == INT32_MIN || v[2]->x == INT32_MIN) {
+            om__lbox x;
+            clipped_box(&x, ls, b->tris[k]);
+            /* rounded down, as a sample's depth is a whole number */
+            const double z = floor(x.zmin);
+            const om__bvh_gbox one = {x.lox, x.loy, x.hix, x.hiy,
+                                      z < 0.0 ? 0u : z < 4294967295.0 ? (uint32_t)z : UINT32_MAX, 0};
+            gbox_grow(&g, &one);
+            continue;
+        }
+        for (int c = 0; c < 3; c++) {
+            const om__bvh_gbox one = {v[c]->x, v[c]->y, v[c]->x, v[c]->y, v[c]->z, 0};
+            gbox_grow(&g, &one);
+        }
+    }
+    return g;
+}
+
+void om__bvh_fit_grid(om__bvh *b, const om__lspace *ls)
+{
+    /* Children come after their node (the build appends them): one pass from the last
+     * node back bounds both children of a node before the node. */
+    for (uint32_t i = b->nnodes; i-- > 0;) {
+        om__bvh_node *n = &b->nodes[i];
+        if (n->count || !ls->scene->ntris) {   /* a leaf, or an empty scene's lone root */
+            n->box.g = leaf_gbox(b, n, ls);
+        } else {
+            om__bvh_gbox g = b->nodes[n->first].box.g;
+            gbox_grow(&g, &b->nodes[n->first + 1].box.g);
+            n->box.g = g;
+        }
+    }
+}
+
+/* All in 32 bits, which a small chip compares in one instruction; && rather than the
+ * one-pass walk's &: this walk is the small chips' (short pipelines, no prediction to
+ * miss), where most boxes fail the first or second compare. */
+static bool gholds(const om__bvh_gbox *x, int32_t px, int32_t py, uint32_t pz)
+{
+    return px >= x->lox && px <= x->hix && py >= x->loy && py <= x->hiy && x->zmin < pz;
+}
+
+/* om__lspace_maybe in 32 bits: false when triangle t's projected vertices leave p
+ * outside their grid box, or are none nearer than p; true for one that needs clipping
+ * (its leaf's box has bounded it). */
+static bool tri_maybe(const om__lspace *ls, uint32_t t, int32_t px, int32_t py, uint32_t pz)
+{
+    const uint32_t *ix = ls->scene->idx + (size_t)t * 3;
+    const om__lvert *a = &ls->verts[ix[0]], *b = &ls->verts[ix[1]], *c = &ls->verts[ix[2]];
+    if (a->x == INT32_MIN || b->x == INT32_MIN || c->x == INT32_MIN) return true;
+    if ((px < a->x && px < b->x && px < c->x) || (px > a->x && px > b->x && px > c->x) ||
+        (py < a->y && py < b->y && py < c->y) || (py > a->y && py > b->y && py > c->y))
+        return false;
+    return a->z < pz || b->z < pz || c->z < pz;
+}
+
+void om__bvh_walk_grid(const om__bvh *b, const om__lspace *ls, const om__lpoint *p,
+                       om__bvh_visit visit, void *user)
+{
+    const om__bvh_node *nd = b->nodes;
+    /* A point beyond 32 bits is held by no box but those that reach that far, as its
+     * clamped value is (boxes are clamped the same way). The depth is a whole number
+     * below 2^32 (om__lspace_point). */
+    const int32_t px = to_i32(p->x), py = to_i32(p->y);
+    const uint32_t pz = (uint32_t)p->z;
+    uint32_t stack[STACK];
+    int sp = 0;
+    if (!b->nnodes || !gholds(&nd[0].box.g, px, py, pz)) return;
+    stack[sp++] = 0;
+    while (sp > 0) {
+        const om__bvh_node *n = &nd[stack[--sp]];
+        if (n->count) {
+            for (uint32_t i = n->first; i < n->first + n->count; i++)
+                if (tri_maybe(ls, b->tris[i], px, py, pz) && visit(user, b->tris[i])) return;
+            continue;
+        }
+        /* the children are tested here, so only those that hold p are pushed */
+        if (gholds(&nd[n->first].box.g, px, py, pz)) stack[sp++] = n->first;
+        if (gholds(&nd[n->first + 1].box.g, px, py, pz)) stack[sp++] = n->first + 1;
     }
 }

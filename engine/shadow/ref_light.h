@@ -59,4 +59,14 @@ uint32_t om__lbvh_narrow(const om__lbvh *lb, const uint32_t *in, uint32_t n, con
 void om__lbvh_walk_list(const om__lbvh *lb, const om__bvh *b, const uint32_t *list, uint32_t n,
                         const om__lpoint *p, om__bvh_visit visit, void *user);
 
+/* The middle mode (the vertex projection without the memory of the boxes above):
+ * every node of b gets this frame's grid box (om__bvh_gbox) in place of its 3-D one,
+ * and the walk takes the nodes whose box holds p and is nearer somewhere, calling
+ * visit for every triangle of their leaves that om__lspace_maybe passes; stops when
+ * visit returns true. The same triangles pass as the one-pass walk's, with no bytes
+ * beyond the BVH's own. */
+void om__bvh_fit_grid(om__bvh *b, const om__lspace *ls);
+void om__bvh_walk_grid(const om__bvh *b, const om__lspace *ls, const om__lpoint *p,
+                       om__bvh_visit visit, void *user);
+
 #endif
