@@ -6,6 +6,7 @@
 #include "test.h"
 #include "harness.h"
 #include "../platform/platform.h"
+#include "../engine/shadow/asm.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -159,6 +160,94 @@ static void fewer_jobs(void)
     h_scene_free(&hs);
 }
 
+/* ---- asm: its bands look up with caches of their own and write nothing of the tree;
+ * the use stamps of their lookups are put on the tree after the bands (om__bands.
+ * finish). A state kept over frames, a still light, a moving camera and one sample
+ * in 200 analysed (so that most leaves are stamped by lookups alone, and a missing
+ * stamp changes the tree): the same frames, counters, nodes and stamps for any number
+ * of jobs and their order, frame after frame. */
+static void asm_frames(const om_scene *s, uint32_t rows, om_parallel_for_fn pf, void *host, uint32_t threads,
+                       uint64_t *hash, uint32_t counters[][8], int nframes)
+{
+    const om_method *m = om_method_find("asm");
+    enum { W = 160, H = 120 };
+    om_method_cfg c = h_cfg("asm", "asm.cap=400000 asm.stride=200");
+    size_t mn, full;
+    om_diag d;
+    CHECK_OK(m->bytes(&c, s, W, H, &mn, &full));
+    const uint32_t r = rows ? rows : H;
+    const size_t fbytes = om_frame_bytes_scene(s, W, r) + om_frame_bytes_jobs(m, s, threads);
+    void *mm = malloc(full), *fm = malloc(fbytes), *px = malloc((size_t)W * r * 3), *state = NULL;
+    om_arena ma, fa;
+    om_arena_init(&ma, mm, full, "method");
+    CHECK_OK(m->init(&state, &ma, &c, s, W, H, &d));
+    for (int f = 0; f < nframes && state; f++) {
+        om_camera cam, cam0;
+        om_light light, moving;
+        om_view v;
+        om_scene_at(s, 0.0f, &cam0, &light);   /* the light held still: the tree lives on */
+        om_scene_at(s, 0.15f * (float)f, &cam, &moving);
+        cam.width = W;
+        cam.height = H;
+        CHECK_OK(om_view_init(&v, &cam, &light, s, &d));
+        om_arena_init(&fa, fm, fbytes, "frame");
+        om_framebuffer fb = {OM_RGB888, W, r, (size_t)W * 3, (uint8_t *)px};
+        om_shade_cfg shade;
+        om_shade_cfg_default(&shade);
+        om_frame_desc fd;
+        memset(&fd, 0, sizeof fd);
+        fd.scene = s; fd.view = &v; fd.method = m; fd.method_state = state; fd.shade = &shade;
+        fd.strip_rows = rows; fd.fb = &fb; fd.on_strip = on_strip; fd.user = &hash[f];
+        fd.parallel_for = pf; fd.parallel_user = host; fd.threads = threads;
+        hash[f] = OM_HASH_INIT;
+        om_frame_stats fs;
+        CHECK_OK(om_render_frame(&fd, &fa, &fs, &d));
+        CHECK_MSG(fs.jobs == (pf ? threads : 1), "asm: %u jobs ran %u", threads, fs.jobs);
+        om_method_stats ms;
+        m->stats(state, &ms);
+        memcpy(counters[f], ms.counters, sizeof counters[f]);
+        /* and the tree: every node's place and use stamp */
+        const om__asm_tree *t = om__asm_tree_of(state);
+        uint64_t th = OM_HASH_INIT;
+        th = om_hash(th, &t->root.stamp, sizeof t->root.stamp);
+        for (uint32_t i = 0; i < t->lay.count; i++) {
+            const om__asm_node *nd = (const om__asm_node *)om_pool_item(&t->pool, i);
+            if (nd->alive) th = om_hash(om_hash(th, &i, sizeof i), nd, sizeof *nd);
+        }
+        hash[f] = om_hash(hash[f], &th, sizeof th);
+    }
+    free(mm);
+    free(fm);
+    free(px);
+}
+
+static void asm_bands(void)
+{
+    static const uint32_t threads[] = {2, 3, 4, 7, 16};
+    enum { NF = 6 };
+    om_jobs *pools[5];
+    for (int k = 0; k < 5; k++) CHECK_OK(om_jobs_start(&pools[k], threads[k], NULL));
+    for (int li = 0; li < 2; li++) {
+        h_scene hs;
+        if (!h_scene_parse(&hs, li ? directional : om_scene_default_text())) continue;
+        for (uint32_t rows = 0; rows <= 24; rows += 24) {
+            uint64_t h1[NF], hn[NF];
+            uint32_t c1[NF][8], cn[NF][8];
+            asm_frames(&hs.s, rows, NULL, NULL, 1, h1, c1, NF);
+            for (int k = 0; k < 6; k++) {
+                uint32_t n = k < 5 ? threads[k] : 5;
+                asm_frames(&hs.s, rows, k < 5 ? om_jobs_for : backwards, k < 5 ? pools[k] : NULL, n, hn, cn, NF);
+                for (int f = 0; f < NF; f++)
+                    CHECK_MSG(hn[f] == h1[f] && !memcmp(cn[f], c1[f], sizeof c1[f]),
+                              "asm light %d strips %u frame %d: %u threads%s change the frame", li, rows, f, n,
+                              k < 5 ? "" : " backwards");
+            }
+        }
+        h_scene_free(&hs);
+    }
+    for (int k = 0; k < 5; k++) om_jobs_stop(pools[k]);
+}
+
 /* ---- hybrid: its bands look the map up and mark the samples they leave uncertain;
  * the irregular pass over those runs after the bands (om__bands.finish). The same
  * terms, pixels and counters for any number of jobs and their order, whole frames and
@@ -296,6 +385,7 @@ void suite_threads(void)
     RUN(same_bits);
     RUN(fewer_jobs);
     RUN(hybrid_bands);
+    RUN(asm_bands);
     RUN(izb_pass);
     RUN(settings_by_bands);
 }

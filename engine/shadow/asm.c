@@ -836,6 +836,63 @@ static om_status asm_resolve(void *state, om_strip *st, om_diag *d)
 }
 
 
+/* By bands on the host's threads (frame.h, om__bands): each band looks up its own
+ * samples with a cache of its own and writes nothing of the state. The use stamps are
+ * the one thing a lookup leaves in the tree: a band marks each sample whose lookup
+ * descended (its term's blue one off its red), and finish, on the calling thread,
+ * finds those samples' leaves again and stamps their paths. The stamped nodes are the
+ * paths to every leaf found, whatever the bands: the stamps, the terms and the counts
+ * (added up by merge) are a strip at a time's. */
+static void asm_band(const void *state, om_strip *st, void *scratch, uint32_t counts[8])
+{
+    const asm_state *m = (const asm_state *)state;
+    asm_cache *c = (asm_cache *)scratch;
+    c->index = OM__ASM_NONE;
+    const size_t n = (size_t)st->rows * st->width;
+    for (size_t i = 0; i < n; i++) {
+        om_term *t = &st->terms[i];
+        t->r = t->g = t->b = 255;
+        if (!(t->flags & OM_TERM_EXPOSED)) continue;
+        counts[0]++;
+        bool moved = false;
+        if (!resolve_one(m, &st->samples[i], c, &moved)) {
+            t->r = t->g = t->b = 0;
+            counts[1]++;
+        }
+        if (moved) t->b ^= 1u;
+    }
+}
+
+static void asm_merge(void *state, const uint32_t counts[8])
+{
+    asm_state *m = (asm_state *)state;
+    m->samples += counts[0];
+    m->shadowed += counts[1];
+}
+
+static void asm_finish(void *state, om_strip *st)
+{
+    asm_state *m = (asm_state *)state;
+    const size_t n = (size_t)st->rows * st->width;
+    for (size_t i = 0; i < n; i++) {
+        om_term *t = &st->terms[i];
+        if (t->b == t->r) continue;
+        t->b = t->r;
+        asm_smp o;
+        asm_cache c = {OM__ASM_NONE, m->cache_tile};
+        om__asm_tile tl;
+        uint32_t tx, ty;
+        bool moved = false;
+        if (!smp_begin(m, &st->samples[i], false, &o)) continue;   /* (it was looked up) */
+        smp_find(m, &o, &c, &tl, &tx, &ty, &moved);
+        stamp_path(&m->tree, c.index);
+    }
+}
+
+const om__bands om__bands_asm = {asm_band, asm_merge, sizeof(asm_cache), NULL, NULL, asm_finish};
+
+const om__asm_tree *om__asm_tree_of(const void *state) { return &((const asm_state *)state)->tree; }
+
 static void asm_stats(const void *state, om_method_stats *out)
 {
     const asm_state *m = (const asm_state *)state;

@@ -130,6 +130,9 @@ void om__asm_tile_of(om__asm_tree *t, uint32_t index, om__asm_tile *out);
 /* The grid side of a level, R_L (as double: exact for power-of-two cells). */
 double om__asm_grid(const om__asm_layout *l, uint32_t level);
 
+/* The tree of an asm method state (om__method_asm's), for tests to read. */
+const om__asm_tree *om__asm_tree_of(const void *state);
+
 /* Bytes of the cap in use now: the root and every node in use. */
 uint64_t om__asm_bytes_in_use(const om__asm_tree *t);
 /* Deepest level in use (0: the root only). */

@@ -57,15 +57,16 @@ static const om_method *const methods[] = {METHODS(ENTRY) NULL};
 /* The methods whose resolve runs by bands on the host's threads (frame.h, om__bands):
  * those whose resolve only reads the state once it is built (spsm's window of decoded
  * texels is the band's own; hybrid: its map lookup by bands, its irregular pass after
- * them). asm (its resolve moves a cache and the tree's use marks) resolves a strip at
- * a time, and izb by its own pass (below). */
+ * them; asm: its leaf cache is the band's own, the use stamps put on the tree after
+ * them). izb (per-strip lists in the state) resolves a strip at a time. */
 #define BANDED(X)            \
     X(none, OM_WITH_NONE)    \
     X(ref, OM_WITH_REF)      \
     X(sm, OM_WITH_SM)        \
     X(rtw, OM_WITH_RTW)      \
     X(hybrid, OM_WITH_HYBRID) \
-    X(spsm, OM_WITH_SPSM)
+    X(spsm, OM_WITH_SPSM)    \
+    X(asm, OM_WITH_ASM)
 
 #define DECLARE_BANDS(m, on) extern const om__bands om__bands_##m;
 BANDED(DECLARE_BANDS)
