@@ -491,7 +491,9 @@ static int write_outputs(const char *dir, char **names, size_t nn, const cli_poi
 /* The scaling table: each method of the sweep at its defaults on each scene, `runs`
  * frames on each of 1, 2 and the machine's cores threads (one after another, in that
  * order, a fresh state each): the median frame (init apart) and its speed-up on one
- * thread. The pool is the user's again afterwards. */
+ * thread; then a row "eye" per scene, the eye pass alone (its median within the first
+ * method's frames: the bins and the visible samples of every strip). The pool is the
+ * user's again afterwards. */
 static int scaling(const char *cmd, char **names, size_t nn, const uint32_t *sw, const uint32_t *sh,
                    uint32_t w, uint32_t h, const char *methods, int runs, const char *threads)
 {
@@ -517,6 +519,9 @@ static int scaling(const char *cmd, char **names, size_t nn, const uint32_t *sw,
         if (st == OM_OK && (st = cli_scene_view(&cs, sw[si] ? sw[si] : w, sw[si] ? sh[si] : h, &v, &d)) == OM_OK &&
             !(mask = malloc((size_t)v.cam.width * v.cam.height)))
             st = cli_oom(&d);
+        double eye[3] = {0.0, 0.0, 0.0};
+        uint32_t eye_jobs[3] = {0, 0, 0};
+        bool have_eye = false;
         for (size_t k = 0; k < om_method_count() && st == OM_OK && !rc; k++) {
             const om_method *m = om_method_at(k);
             if ((cli_sweep(m) && !cli_sweep(m)[0]) || !in_list(methods, m->name)) continue;
@@ -533,9 +538,22 @@ static int scaling(const char *cmd, char **names, size_t nn, const uint32_t *sw,
                 st = cli_measure(m, &cfg, &cs, &v, runs, mask, NULL, &p, &d);
                 if (st != OM_OK) break;
                 if (!c) one = p.total;
+                if (!have_eye) {
+                    eye[c] = p.eye;
+                    eye_jobs[c] = p.threads;
+                }
                 printf(" %10.2f", p.total);
                 if (c) printf(" %6.2fx%c", p.total > 0.0 ? one / p.total : 0.0, p.threads == counts[c] ? ' ' : '*');
                 fflush(stdout);
+            }
+            printf("\n");
+            have_eye = true;
+        }
+        if (have_eye && st == OM_OK && !rc) {
+            printf("%-12s %-6s", base_name(names[si]), "eye");
+            for (int c = 0; c < nc; c++) {
+                printf(" %10.2f", eye[c]);
+                if (c) printf(" %6.2fx%c", eye[c] > 0.0 ? eye[0] / eye[c] : 0.0, eye_jobs[c] == counts[c] ? ' ' : '*');
             }
             printf("\n");
         }

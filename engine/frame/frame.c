@@ -107,7 +107,7 @@ static void grow_light_box(const om_view *v, const om_strip *st, om_vec3 *lo, om
 
 /* The bands of the strip: band b is job b of the host's parallel-for, with slot b and
  * rows of its own. */
-typedef enum { STAGE_PREPARE, STAGE_RESOLVE, STAGE_SHADE, STAGE_BUILD, STAGE_PASS } stage;
+typedef enum { STAGE_PREPARE, STAGE_RESOLVE, STAGE_SHADE, STAGE_BUILD, STAGE_PASS, STAGE_BIN_VERTS, STAGE_BIN_ROWS } stage;
 
 typedef struct frame_ctx {
     const om_frame_desc *fd;
@@ -125,6 +125,9 @@ typedef struct frame_ctx {
     bool eye, mark;            /* STAGE_PREPARE: run the eye pass, mark exposure */
     om__bins map_bins;         /* the light map's (rows NULL: none) */
     uint32_t map_size, map_band;   /* STAGE_BUILD: the map's side, rows per band */
+    const om__bins *mk;        /* STAGE_BIN_*: the bins being made, through mk_vp */
+    const om_mat4 *mk_vp;
+    uint32_t mk_w, mk_h;
 } frame_ctx;
 
 static void band_job(void *user, uint32_t b)
@@ -134,6 +137,14 @@ static void band_job(void *user, uint32_t b)
     if (c->stage == STAGE_PASS) {   /* slot b: jobs b, b + P, ... (om__pass) */
         for (uint32_t k = b; k < c->pass_jobs; k += c->pass_slots_now)
             c->pass->job(fd->method_state, &c->strip, k, c->pass_slots[b].scratch, c->pass_slots[b].counts);
+        return;
+    }
+    if (c->stage == STAGE_BIN_VERTS || c->stage == STAGE_BIN_ROWS) {
+        const uint32_t parts = BANDS_PER_JOB * c->jobs;
+        const uint32_t n = c->stage == STAGE_BIN_VERTS ? fd->scene->nverts : fd->scene->ntris;
+        const uint32_t a = (uint32_t)((uint64_t)n * b / parts), e = (uint32_t)((uint64_t)n * (b + 1) / parts);
+        if (c->stage == STAGE_BIN_VERTS) om__bins_make_verts(fd->scene, c->mk_vp, c->mk_w, c->mk_h, c->mk, a, e);
+        else om__bins_make_rows(fd->scene, c->mk_vp, c->mk_w, c->mk_h, c->mk, a, e);
         return;
     }
     if (c->stage == STAGE_BUILD) {
@@ -184,6 +195,22 @@ static void run_bands(frame_ctx *c, stage sg)
     run_stage(c, sg, (c->strip.rows + c->band_rows - 1) / c->band_rows);
 }
 
+/* om__bins_make on the host's threads: the vertices, then the triangles' rows, each
+ * cut into parts (the same bins however cut: om__bins_make_verts). */
+static void make_bins(frame_ctx *c, const om_mat4 *vp, uint32_t w, uint32_t h, const om__bins *b)
+{
+    if (!OM_WITH_JOBS || c->jobs <= 1) {
+        om__bins_make(c->fd->scene, vp, w, h, b);
+        return;
+    }
+    c->mk = b;
+    c->mk_vp = vp;
+    c->mk_w = w;
+    c->mk_h = h;
+    run_stage(c, STAGE_BIN_VERTS, BANDS_PER_JOB * c->jobs);
+    run_stage(c, STAGE_BIN_ROWS, BANDS_PER_JOB * c->jobs);
+}
+
 /* The light depth pass by bands of the map (om__bands.build_rows): with bins,
  * BANDS_PER_JOB bands a job, each setting up only its own triangles; without, one band
  * a job, since each band then walks every triangle. The bands' counts are added up
@@ -192,7 +219,7 @@ static void build_map(frame_ctx *c)
 {
     const om_mat4 *vp;
     c->map_size = c->bands->map_of(c->fd->method_state, &vp);
-    if (c->map_bins.rows) om__bins_make(c->fd->scene, vp, c->map_size, c->map_size, &c->map_bins);
+    if (c->map_bins.rows) make_bins(c, vp, c->map_size, c->map_size, &c->map_bins);
     uint32_t n = c->map_bins.rows ? BANDS_PER_JOB * c->jobs : c->jobs;
     c->map_band = ((c->map_size + n - 1) / n + 15) / 16 * 16;
     const uint32_t nb = (c->map_size + c->map_band - 1) / c->map_band;
@@ -367,7 +394,7 @@ om_status om_render_frame(const om_frame_desc *fd, om_arena *fa, om_frame_stats 
     if (single && OM_WITH_JOBS && c.jobs > 1) eye_bins = carve_bins(fa, s, &bins);
     if (eye_bins) {
         uint64_t tb = now(fd);
-        om__bins_make(s, &view.cam_vp, W, H, &bins);
+        make_bins(&c, &view.cam_vp, W, H, &bins);
         fs->ns_eye += now(fd) - tb;
         c.bins = &bins;
     }

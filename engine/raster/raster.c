@@ -95,13 +95,6 @@ static inline unsigned outcode_g(const om_vec4 *v, float gx, float gy)
            (unsigned)!(v->y + gy * v->w >= 0.0f) << 4 | (unsigned)!(gy * v->w - v->y >= 0.0f) << 5;
 }
 
-/* outcode_g(v, gx, gy) == 0, without the mask (an int, for &: no branches). */
-static inline int inside_g(const om_vec4 *v, float gx, float gy)
-{
-    return (v->z >= 0.0f) & (v->w - v->z >= 0.0f) & (v->x + gx * v->w >= 0.0f) & (gx * v->w - v->x >= 0.0f) &
-           (v->y + gy * v->w >= 0.0f) & (gy * v->w - v->y >= 0.0f);
-}
-
 unsigned om__outcode(const om_vec4 *v, uint32_t width, uint32_t height)
 {
     return outcode_g(v, guard(width), guard(height));
@@ -632,7 +625,7 @@ int om__raster_tri_guarded(const om_raster *r, uint32_t *hiz, const om_vec4 clip
      * back unclipped: its vertices projected, the depths left until needed. Every
      * inside test fails on a NaN and on an infinite x, y or z, so of the non-finite
      * vertices only w = +inf gets this far, and it is refused as below. */
-    if (inside_g(&clip[0], g.x, g.y) & inside_g(&clip[1], g.x, g.y) & inside_g(&clip[2], g.x, g.y)) {
+    if (om__inside_band(&clip[0], g) & om__inside_band(&clip[1], g) & om__inside_band(&clip[2], g)) {
         if (!((clip[0].w - clip[0].w) + (clip[1].w - clip[1].w) + (clip[2].w - clip[2].w) == 0.0f)) return 0;
         for (int i = 0; i < 3; i++)
             if (!om__project_xy(&clip[i], width, height, &gx[i], &gy[i])) return 0;

@@ -54,12 +54,12 @@ size_t om__bins_verts_bytes(const om_scene *s)
 
 /* Vertex c snapped alone, when it needs no clipping: the test om__raster_tri makes
  * first (finite, inside every plane), then its projection. */
-static bool snap_alone(const om_vec4 *c, uint32_t width, uint32_t height, om__vsnap *out)
+static bool snap_alone(const om_vec4 *c, uint32_t width, uint32_t height, om__guard g, om__vsnap *out)
 {
     int64_t x, y;
     uint32_t z;
     if (!om__finite(c->x) || !om__finite(c->y) || !om__finite(c->z) || !om__finite(c->w) ||
-        om__outcode(c, width, height) != 0 || !om__project(c, width, height, &x, &y, &z))
+        !om__inside_band(c, g) || !om__project(c, width, height, &x, &y, &z))
         return false;
     out->x = (int32_t)x;   /* |x|, |y| < 2^26 after om__project */
     out->y = (int32_t)y;
@@ -79,13 +79,27 @@ static uint32_t rows_between(int64_t lo, int64_t hi, uint32_t height)
 
 void om__bins_make(const om_scene *s, const om_mat4 *vp, uint32_t width, uint32_t height, const om__bins *b)
 {
-    const uint32_t all = (height - 1) << 16;
+    om__bins_make_verts(s, vp, width, height, b, 0, s->nverts);
+    om__bins_make_rows(s, vp, width, height, b, 0, s->ntris);
+}
+
+void om__bins_make_verts(const om_scene *s, const om_mat4 *vp, uint32_t width, uint32_t height, const om__bins *b,
+                         uint32_t v0, uint32_t v1)
+{
     om__vsnap *vs = b->verts;
-    for (uint32_t v = 0; vs && v < s->nverts; v++) {
+    const om__guard g = om__guard_band(width, height);
+    for (uint32_t v = v0; vs && v < v1 && v < s->nverts; v++) {
         const om_vec4 c = om__mat_apply(vp, s->verts[v]);
-        if (!snap_alone(&c, width, height, &vs[v])) vs[v].x = INT32_MIN;
+        if (!snap_alone(&c, width, height, g, &vs[v])) vs[v].x = INT32_MIN;
     }
-    for (uint32_t t = 0; b->rows && t < s->ntris; t++) {
+}
+
+void om__bins_make_rows(const om_scene *s, const om_mat4 *vp, uint32_t width, uint32_t height, const om__bins *b,
+                        uint32_t t0, uint32_t t1)
+{
+    const uint32_t all = (height - 1) << 16;
+    const om__vsnap *vs = b->verts;
+    for (uint32_t t = t0; b->rows && t < t1 && t < s->ntris; t++) {
         const uint32_t *ix = s->idx + (size_t)t * 3;
         if (vs && vs[ix[0]].x != INT32_MIN && vs[ix[1]].x != INT32_MIN && vs[ix[2]].x != INT32_MIN) {
             int64_t lo = vs[ix[0]].y, hi = lo;

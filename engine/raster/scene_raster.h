@@ -55,6 +55,13 @@ size_t om__bins_verts_bytes(const om_scene *s);
  * height image: the camera's for the eye pass, the light's for a light pass
  * (vertices only: om__scene_raster walks every triangle without rows). */
 void om__bins_make(const om_scene *s, const om_mat4 *vp, uint32_t width, uint32_t height, const om__bins *b);
+/* om__bins_make in parts, for a host's threads: the vertices [v0, v1) of b->verts,
+ * then, once every vertex is done, the triangles [t0, t1) of b->rows. Each entry
+ * depends on nothing but its own inputs, so any split gives the same bins. */
+void om__bins_make_verts(const om_scene *s, const om_mat4 *vp, uint32_t width, uint32_t height, const om__bins *b,
+                         uint32_t v0, uint32_t v1);
+void om__bins_make_rows(const om_scene *s, const om_mat4 *vp, uint32_t width, uint32_t height, const om__bins *b,
+                        uint32_t t0, uint32_t t1);
 
 /* Clears `tg` and rasterizes every triangle of the scene through `vp` into it: the
  * eye pass (OM_RASTER_DEPTH_ID) and the light depth passes (OM_RASTER_DEPTH); with
