@@ -617,6 +617,38 @@ static void float_tests_are_the_double_ones(void)
     CHECK_MSG(far_answered * 10 > far * 9, "%llu of %llu answered away from the threshold", far_answered, far);
 }
 
+/* om__spsm_less_f (the receiver's plane against a record's vertex, the consistent
+ * minimum against the sample) gives the double comparison whenever it answers: random
+ * planes, offsets and depths, and depths a few units from equality. */
+static void float_less_is_the_double_one(void)
+{
+    uint32_t s = 17;
+    unsigned long long wrong = 0, near_answered = 0, far = 0, far_answered = 0;
+    for (int it = 0; it < 400000; it++) {
+        const double b = (double)(next_rand(&s) & 0xFFFFFF) * 256.0 + (double)(next_rand(&s) % 256);
+        const double c = ((double)(next_rand(&s) % 2000001) - 1000000.0) * pow(2.0, (double)(next_rand(&s) % 40) - 20.0);
+        const double d = ((double)(next_rand(&s) % 2000001) - 1000000.0) * pow(2.0, (double)(next_rand(&s) % 40) - 20.0);
+        const double dx = (double)((int)(next_rand(&s) % 1537) - 768), dy = (double)((int)(next_rand(&s) % 1537) - 768);
+        const double e = 98304.0 + (double)(next_rand(&s) % 1000000);
+        const double rhs = b + c * dx + d * dy - e;
+        const uint32_t r = next_rand(&s) % 3;
+        const double a = rhs + (r == 0 ? (double)((int)(next_rand(&s) % 9) - 4) * (1.0 + fabs(rhs) * 1e-15)
+                                : r == 1 ? (double)((int)(next_rand(&s) % 129) - 64)
+                                         : (double)((int)(next_rand(&s) % 2000001) - 1000000) * 64.0);
+        const int got = om__spsm_less_f((float)a, (float)b, (float)c, (float)dx, (float)d, (float)dy, (float)e);
+        const int want = a < b + c * dx + d * dy - e;
+        far += r == 2;
+        if (got >= 0) {
+            wrong += got != want;
+            near_answered += r == 1;
+            far_answered += r == 2;
+        }
+    }
+    CHECK_EQ_U(wrong, 0);
+    CHECK(near_answered > 0);
+    CHECK_MSG(far_answered * 10 > far * 8, "%llu of %llu answered away from equality", far_answered, far);
+}
+
 void suite_spsm(void)
 {
     RUN(conservative_is_exact_overlap);
@@ -634,4 +666,5 @@ void suite_spsm(void)
     RUN(stats_and_budget);
     RUN(odd_inputs);
     RUN(float_tests_are_the_double_ones);
+    RUN(float_less_is_the_double_one);
 }

@@ -268,10 +268,13 @@ static void move_entry(om__spsm_dtri *to, const om__spsm_dtri *from)
     to->eyf = from->eyf;
     to->cmin = from->cmin;
     to->have_cmin = from->have_cmin;
+    to->cminf = from->cminf;
     to->have_vz = from->have_vz;
     if (from->have_vz) {
         memcpy(to->vz, from->vz, sizeof to->vz);
         memcpy(to->vtol, from->vtol, sizeof to->vtol);
+        memcpy(to->vzf, from->vzf, sizeof to->vzf);
+        memcpy(to->vtolf, from->vtolf, sizeof to->vtolf);
     }
 }
 
@@ -375,7 +378,7 @@ static void project_d(const om__spsm_state *m, const double w[3], double *gx, do
 /* The sample's own surface as a plane in light space: depth (raw) at grid offset
  * (dx, dy) from the sample is z + gx dx + gy dy. z/w is affine on a plane, so two
  * steps along the surface (from the geometric normal) give the slopes exactly. */
-typedef struct receiver { double z, gx, gy; bool ok; } receiver;
+typedef struct receiver { double z, gx, gy; float zf, gxf, gyf; bool ok; } receiver;
 
 static receiver receiver_plane(const om__spsm_state *m, const om_sample *smp)
 {
@@ -397,6 +400,9 @@ static receiver receiver_plane(const om__spsm_state *m, const om_sample *smp)
     r.gx = r.ok ? (az * by - bz * ay) / det : 0.0;
     r.gy = r.ok ? (ax * bz - bx * az) / det : 0.0;
     r.ok = r.ok && r.gx == r.gx && r.gy == r.gy && fabs(r.gx) < 1e30 && fabs(r.gy) < 1e30;
+    r.zf = (float)r.z;
+    r.gxf = (float)r.gx;
+    r.gyf = (float)r.gy;
     return r;
 }
 
@@ -410,12 +416,22 @@ static bool behind_receiver(om__spsm_dtri *t, const receiver *r, int64_t px, int
         for (int i = 0; i < 3; i++) {
             t->vz[i] = om__spsm_plane_at(t, t->rx[i], t->ry[i]);
             t->vtol[i] = pat_tol(t, t->rx[i], t->ry[i]);
+            t->vzf[i] = (float)t->vz[i];
+            t->vtolf[i] = (float)t->vtol[i];
         }
         t->have_vz = true;
     }
     for (int i = 0; i < 3; i++) {
-        double zr = r->z + r->gx * (double)(t->rx[i] - px) + r->gy * (double)(t->ry[i] - py);
-        if (t->vz[i] < zr - t->vtol[i]) return false;
+        const int64_t dx = t->rx[i] - px, dy = t->ry[i] - py;
+        /* offsets of a few texels: exact in float */
+        int below = -1;
+        if (OM_FAST_FLOAT && dx > -(1 << 20) && dx < (1 << 20) && dy > -(1 << 20) && dy < (1 << 20))
+            below = om__spsm_less_f(t->vzf[i], r->zf, r->gxf, (float)dx, r->gyf, (float)dy, t->vtolf[i]);
+        if (below < 0) {
+            const double zr = r->z + r->gx * (double)dx + r->gy * (double)dy;
+            below = t->vz[i] < zr - t->vtol[i];
+        }
+        if (below) return false;
     }
     return true;
 }
@@ -628,7 +644,7 @@ OM_NOINLINE static uint8_t recover(const om__spsm_state *m, om__spsm_win *w, uin
      * neighbours, near its terminator) cannot block the way to the light. */
     n[N_UNCERTAIN]++;
     unsigned pat = 0;
-    receiver rp = {0.0, 0.0, 0.0, false};
+    receiver rp = {0.0, 0.0, 0.0, 0.0f, 0.0f, 0.0f, false};
     bool have_rp = false;
     for (int k = 0; k < 9; k++) {
         /* cheapest test first; the receiver's plane only when a texel needs it */
@@ -642,9 +658,14 @@ OM_NOINLINE static uint8_t recover(const om__spsm_state *m, om__spsm_win *w, uin
         if (!t[k].have_cmin) {
             edges(t, k);
             t[k].cmin = consistent_min(&t[k]);
+            t[k].cminf = (float)t[k].cmin;
             t[k].have_cmin = true;
         }
-        if (t[k].cmin < p.z - pat_tol(&t[k], t[k].cx, t[k].cy)) pat |= 1u << k;
+        /* pat_tol at the texel's centre is OM__SPSM_TOL0: its offsets are 0 and its
+         * error bounds finite */
+        int in = OM_FAST_FLOAT ? om__spsm_less_f(t[k].cminf, p.zf, 0.0f, 0.0f, 0.0f, 0.0f, (float)OM__SPSM_TOL0) : -1;
+        if (in < 0) in = t[k].cmin < p.z - pat_tol(&t[k], t[k].cx, t[k].cy);
+        if (in) pat |= 1u << k;
     }
     const om__spsm_tangent *tg = &m->lut[pat];
     /* The occluders the pattern keeps and their outline depend on nothing but the texel

@@ -27,6 +27,7 @@ typedef struct om__spsm_dtri {
     double cmin;                 /* consistent_min, once computed (have_cmin) */
     bool have_cmin;
     double vz[3], vtol[3];       /* plane and pat_tol at the vertices rx, ry (have_vz) */
+    float cminf, vzf[3], vtolf[3];   /* the same rounded to float (om__spsm_less_f) */
     bool have_vz;
 } om__spsm_dtri;   /* a new field is moved in spsm.c's move_entry too */
 
@@ -107,6 +108,18 @@ static inline int om__spsm_tol_within_f(const om__spsm_dtri *t, int64_t px, int6
     const float tol = (float)OM__SPSM_TOL0 + t->exf * om__fabsf((float)ix) + t->eyf * om__fabsf((float)iy);
     const float e = tol * 0x1p-19f;
     return tol < cap - e ? 1 : tol > cap + e ? 0 : -1;
+}
+
+/* Whether a < b + c dx + d dy - e, each a double and the sum taken in that order, as
+ * the double arithmetic finds it (1, 0), from their floats (dx, dy exact); -1 when
+ * float cannot be sure. The bounds of om__spsm_below_f: the float sum is within 2^-20
+ * of the magnitudes' sum S, the double within 2^-49 S; beyond 2^-19 S both agree. */
+static inline int om__spsm_less_f(float a, float b, float c, float dx, float d, float dy, float e)
+{
+    const float cdx = c * dx, ddy = d * dy, r = b + cdx + ddy - e;
+    const float m = (om__fabsf(a) + om__fabsf(b) + om__fabsf(cdx) + om__fabsf(ddy) + om__fabsf(e)) * 0x1p-19f;
+    const float diff = a - r;
+    return diff < -m ? 1 : diff > m ? 0 : -1;
 }
 
 /* Builds the outline of the occluders occ[0..nocc) (distinct triangles, their edges
