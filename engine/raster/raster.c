@@ -564,9 +564,11 @@ static bool snapped(const om_raster *r, uint32_t *hiz, const int64_t x[3], const
         return true;
     }
     /* the bounds first: they need no edges, and most triangles of a detailed scene
-     * hold no pixel centre of a small target (the caller has made the setup's range
-     * test: in_range) */
-    if (!bounds(&t, x, y, r->target, cons) || !om__tri2_setup(&t.e, x, y, !cons)) return false;
+     * hold no pixel centre of a small target; the setup's range test before them, as
+     * om__tri2_setup would refuse the same triangles (after the cull, which most
+     * back faces leave by; vertices from om__project_xy, zc, are always in range) */
+    if ((!zc && !in_range(x, y)) || !bounds(&t, x, y, r->target, cons) || !om__tri2_setup(&t.e, x, y, !cons))
+        return false;
     if (!z) z = zdepths(zc, zb);
     if (cons) {
         om__rtri_zplane(&t, z);
@@ -584,13 +586,13 @@ static bool snapped(const om_raster *r, uint32_t *hiz, const int64_t x[3], const
 bool om__raster_snapped(const om_raster *r, const int64_t x[3], const int64_t y[3], const uint32_t z[3],
                         uint32_t id)
 {
-    return in_range(x, y) && snapped(r, NULL, x, y, z, NULL, id);
+    return snapped(r, NULL, x, y, z, NULL, id);
 }
 
 bool om__raster_snapped_hiz(const om_raster *r, uint32_t *hiz, const int64_t x[3], const int64_t y[3],
                             const uint32_t z[3], uint32_t id)
 {
-    return in_range(x, y) && snapped(r, hiz, x, y, z, NULL, id);
+    return snapped(r, hiz, x, y, z, NULL, id);
 }
 
 int om__raster_tri(const om_raster *r, const om_vec4 clip[3], uint32_t id)
