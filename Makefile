@@ -67,9 +67,11 @@ run: $(O)/ombra
 	$(O)/ombra report --scenes default,random-10K@320x240,random-100K@320x240,tests/stability/closeup.scene@160x120 --size 640x480 --runs 3 --tri-sweep --equal-memory --out out/report
 
 # One suite, four builds: the same tests must pass under gcc and clang at -O0 and -O2.
+# gcc -O0 also takes the paths made for microcontrollers (OM_FAST_FLOAT, core.h;
+# OM_SMLOOK_DIRECT, smlookup.c), whose frames must be the same bits.
 test:
 	$(MAKE) --no-print-directory check CC=gcc OPT=-O2 O=build/gcc-O2
-	$(MAKE) --no-print-directory check CC=gcc OPT=-O0 O=build/gcc-O0
+	$(MAKE) --no-print-directory check CC=gcc OPT="-O0 -DOM_FAST_FLOAT=1 -DOM_SMLOOK_DIRECT=1" O=build/gcc-O0
 	$(MAKE) --no-print-directory check CC=clang OPT=-O2 O=build/clang-O2
 	$(MAKE) --no-print-directory check CC=clang OPT=-O0 O=build/clang-O0
 	@for b in gcc-O0 clang-O2 clang-O0; do \

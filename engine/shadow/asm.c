@@ -929,7 +929,7 @@ static const om_setting settings[] = {
     SET(asm_stride, "asm.stride", OM_SETTING_U32, 1, 1024, 8, "analyse one visible sample in N"),
     SET(asm_cost_a, "asm.a", OM_SETTING_F32, 0, 1e6, 1.0 / 4096.0, "node cost per required texel"),
     SET(asm_cost_b, "asm.b", OM_SETTING_F32, 0, 1e6, 1, "node cost, constant part"),
-    SET(asm_float, "asm.float", OM_SETTING_U32, 0, 1, OM_ASM_FLOAT,
+    SET(asm_float, "asm.float", OM_SETTING_U32, 0, 1, OM_FAST_FLOAT,
         "1: place samples in float first (same frames; 1 where double is software)"),
 };
 

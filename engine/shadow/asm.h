@@ -43,17 +43,6 @@ typedef struct om__asm_cfg {
     uint32_t asm_float;    /* place samples in float first (asm_point.c): same frames */
 } om__asm_cfg;
 
-/* asm.float's default: on where double is software (the FPU of a Cortex-M4F is single
- * precision; M0 and M3 have none), where the float path costs a tenth of the exact
- * one; off where double is hardware, which the float path's bounds only slow down. */
-#ifndef OM_ASM_FLOAT
-#if defined(__arm__) && !(defined(__ARM_FP) && (__ARM_FP & 8))
-#define OM_ASM_FLOAT 1
-#else
-#define OM_ASM_FLOAT 0
-#endif
-#endif
-
 /* The head of every pool item (and of the root). */
 typedef struct om__asm_node {
     uint32_t parent;       /* index of the parent node (OM__ASM_ROOT for level 1) */

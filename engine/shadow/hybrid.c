@@ -67,19 +67,12 @@ typedef struct hsample {
 } hsample;
 #define DONE 0x80000000u
 
-/* Where a double operation is a software routine (the Cortex-M4F's FPU is single
- * precision, the M0 and M3 have none), the lookup's plane test and the small
- * triangles' updates of the map try single precision first and use double only
- * where the float's error bound leaves the answer open; elsewhere double costs what
- * float does and runs alone. The answers are the same either way (the float answers
- * only where the double would answer alike), and so the map and the frames. */
-#ifndef OM_HYBRID_FLOAT_FIRST
-#if defined(__arm__) && !(defined(__ARM_FP) && (__ARM_FP & 8))
-#define OM_HYBRID_FLOAT_FIRST 1
-#else
-#define OM_HYBRID_FLOAT_FIRST 0
-#endif
-#endif
+/* Where a double operation is a software routine (OM_FAST_FLOAT, core.h), the
+ * lookup's plane test and the small triangles' updates of the map try single
+ * precision first and use double only where the float's error bound leaves the
+ * answer open; elsewhere double costs what float does and runs alone. The answers
+ * are the same either way (the float answers only where the double would answer
+ * alike), and so the map and the frames. */
 
 /* Texels per side of a block (the coarse level a triangle looks at first). */
 #define BLOCK 4
@@ -433,7 +426,7 @@ static bool add_small(hybrid_state *m, uint32_t t)
                 h->gx = h->gy = 0.0f;
                 h->z = FLT_MAX;
             }
-#if OM_HYBRID_FLOAT_FIRST
+#if OM_FAST_FLOAT
             /* Most small triangles lie behind what the texel holds already: single
              * precision says so first where it can (as in plane_at_or_beyond: the
              * float is within s 2^-20 of the exact value, s the sum of its terms'
@@ -477,7 +470,7 @@ static om_status hybrid_build(void *state, om_diag *d)
 }
 
 /* Is the texel's plane at offset (dx, dy) from its centre at depth z (zi, as an
- * integer) or beyond? The test is in double; with OM_HYBRID_FLOAT_FIRST single
+ * integer) or beyond? The test is in double; with OM_FAST_FLOAT single
  * precision answers first where it can. The float's value is within
  * (|h->z| + |gx dx| + |gy dy| + z) 2^-21 of the exact one (the conversions of dx, dy
  * and z, two products and two sums, each within 2^-24 of its magnitude), and the
@@ -485,7 +478,7 @@ static om_status hybrid_build(void *state, om_diag *d)
  * float answers as the double would, the same on every CPU. */
 static inline bool plane_at_or_beyond(const htexel *h, int64_t dx, int64_t dy, double z, uint32_t zi)
 {
-#if OM_HYBRID_FLOAT_FIRST
+#if OM_FAST_FLOAT
     /* dx, dy: a sample is within 2^26 of the grid (om__snap_xy), so int32 converts */
     const float a = h->gx * (float)(int32_t)dx, b = h->gy * (float)(int32_t)dy, fz = (float)zi;
     const float v = h->z + a + b, e = (om__fabsf(h->z) + om__fabsf(a) + om__fabsf(b) + fz) * 0x1p-19f;
@@ -505,7 +498,7 @@ static inline int classify(const hybrid_state *m, const om__lpoint *p, om_term *
     const htexel *h = &m->map[ty * (int64_t)m->side + tx];
     *tex = ty * (int64_t)m->side + tx;
     int64_t xc = tx * m->T + m->T / 2, yc = ty * m->T + m->T / 2;
-#if OM_HYBRID_FLOAT_FIRST
+#if OM_FAST_FLOAT
     const uint32_t z = (uint32_t)p->z;   /* a whole depth unit (om__lspace_point) */
     if (h->z == FLT_MAX || plane_at_or_beyond(h, p->x - xc, p->y - yc, p->z, z))
         return 1;   /* the term is already 255 */

@@ -94,18 +94,7 @@ static inline int32_t om__rtw_cell_axis(float r, float hn, float n)
     return hi < 0.0f || lo > n ? -1 : -2;
 }
 
-/* OM_FAST_FLOAT: 1 where float is hardware and double a library call (a
- * single-precision FPU: the Cortex-M4F, or RV32 with F and no D); the lookups then
- * take their float paths, which give the same bits (proven, and tested) but cost a
- * CPU with a double unit more instructions than the double they stand for. A build
- * may set it either way; the frames do not change. */
-#ifndef OM_FAST_FLOAT
-#if (defined(__ARM_FP) && !(__ARM_FP & 8)) || (defined(__riscv_flen) && __riscv_flen == 32)
-#define OM_FAST_FLOAT 1
-#else
-#define OM_FAST_FLOAT 0
-#endif
-#endif
+/* Their float paths run where OM_FAST_FLOAT is 1 (core.h). */
 
 /* ---- the lookup in float (rtw.c): the warped depth test of smlookup.c, whose warp
  * is double arithmetic (soft-float on a Cortex-M4F), by float arithmetic that is

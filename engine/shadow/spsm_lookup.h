@@ -56,18 +56,7 @@ static inline double om__spsm_tol_at(const om__spsm_dtri *t, int64_t px, int64_t
     return OM__SPSM_TOL0 + t->ex * fabs((double)(px - t->cx)) + t->ey * fabs((double)(py - t->cy));
 }
 
-/* OM_FAST_FLOAT: 1 where float is hardware and double a library call (a
- * single-precision FPU: the Cortex-M4F, or RV32 with F and no D); the lookups then
- * take their float paths, which give the same bits (proven, and tested) but cost a
- * CPU with a double unit more instructions than the double they stand for. A build
- * may set it either way; the frames do not change. */
-#ifndef OM_FAST_FLOAT
-#if (defined(__ARM_FP) && !(__ARM_FP & 8)) || (defined(__riscv_flen) && __riscv_flen == 32)
-#define OM_FAST_FLOAT 1
-#else
-#define OM_FAST_FLOAT 0
-#endif
-#endif
+/* Their float paths run where OM_FAST_FLOAT is 1 (core.h). */
 
 /* The depth tests of the lookup in float, for a CPU whose double is a library call (a
  * Cortex-M4F): whether om__spsm_plane_at(t, px, py) lies below pz + sign * tol, tol
