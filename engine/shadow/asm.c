@@ -1,6 +1,7 @@
 /* asm.c — Adaptive Shadow Maps (Fernando, Fernandez, Bala, Greenberg 2001; paper 002)
- * under a user-set memory cap: the frame flow, the view-driven analysis, rendering of
- * node tiles and the lookup. The tree, its pool and its removal rules are asm_tree.c.
+ * under a user-set memory cap: the frame flow, the view-driven analysis and the lookup.
+ * Node tiles are rendered by asm_render.c; the tree, its pool and its removal rules are
+ * asm_tree.c.
  *
  * A frame:
  *  begin    takes the view. If the light's matrix differs from the one the tiles were
@@ -46,42 +47,6 @@
 OM__CFG_FITS(om__asm_cfg);
 extern const om_method om__method_asm;
 
-typedef struct asm_dvec { double x, y, z, w; } asm_dvec;
-
-typedef struct asm_state {
-    const om_scene *scene;
-    om__asm_cfg cfg;
-    om__asm_tree tree;
-    om_view view;
-    om_mat4 built_vp;      /* the light the tiles hold */
-    bool built;
-    bool prepared;         /* this frame's projections are done */
-    bool lean;             /* no per-vertex or per-triangle arrays: see render */
-    float *tbox;           /* per triangle: base-texel bounds u0, v0, u1, v1 (not lean) */
-    /* Per triangle, a bit: its bounds hold a texel centre of level 0's grid (centre[0])
-     * or level 1's (centre[1]): box_holds_centre once per frame for the levels every
-     * rebuild renders whole, so their gathers read no bounds of triangles that would
-     * write nothing (not lean). */
-    uint32_t *centre[2];
-    uint32_t *cull;        /* triangles that meet the region being rendered (not lean) */
-    /* A grid of cells over the base texels, each listing the triangles whose bounds
-     * meet it, made once per frame, so that a tile gathers from its cells instead of
-     * testing every triangle's bounds; a bit per triangle puts them back in index
-     * order. Not lean; unused in a frame whose lists would overflow `gcap`. */
-    uint32_t gside;        /* cells per side */
-    uint32_t *gstart;      /* gside^2 + 1 offsets into glist */
-    uint32_t *glist, gcap;
-    uint32_t *gbits;       /* (ntris + 31) / 32 words */
-    bool gready;           /* this frame's lists were made */
-    uint32_t *sdepth, *sid;   /* one tile of scratch for the rasterizer */
-    om__asm_cand *cand;
-    uint32_t ncand_max;
-    double inv_scale[OM__ASM_MAX_LEVEL + 1];   /* a level-L texel in base texels */
-    om__asm_pctx pc;       /* what a sample's setup reads (asm_point.c) */
-    uint32_t cache;        /* the last leaf found by resolve, or OM__ASM_NONE */
-    om__asm_tile cache_tile;
-    uint32_t samples, shadowed, analysed, straddling, candidates, rebuilds;
-} asm_state;
 
 
 /* The scene-sized arrays of the fast mode: projections once per frame, bounds once
@@ -123,7 +88,7 @@ static uint64_t cand_count(const om__asm_layout *l)
 
 static size_t asm_need(const om_scene *s, const om__asm_layout *l, bool lean)
 {
-    return om_arena_need(sizeof(asm_state), 16) + l->arena_bytes + scratch_bytes(l, cand_count(l)) +
+    return om_arena_need(sizeof(om__asm_state), 16) + l->arena_bytes + scratch_bytes(l, cand_count(l)) +
            (lean ? 0 : scene_bytes(s));
 }
 
@@ -168,8 +133,8 @@ static om_status asm_init(void **state, om_arena *a, const om_method_cfg *mc, co
     if (w < 1 || h < 1) return om__fail(d, OM_E_INVALID, "asm: image size must be at least 1x1");
     if ((st = om__need(a, asm_need(s, &l, true), "asm", d))) return st;
     const bool lean = om_arena_left(a) < asm_need(s, &l, false);
-    if ((st = om_arena_alloc(a, sizeof(asm_state), 16, &p, d))) return st;
-    asm_state *m = (asm_state *)p;
+    if ((st = om_arena_alloc(a, sizeof(om__asm_state), 16, &p, d))) return st;
+    om__asm_state *m = (om__asm_state *)p;
     m->scene = s;
     m->cfg = *c;
     m->lean = lean;
@@ -217,7 +182,7 @@ static om_status asm_init(void **state, om_arena *a, const om_method_cfg *mc, co
 
 static om_status asm_begin(void *state, const om_view *v, om_diag *d)
 {
-    asm_state *m = (asm_state *)state;
+    om__asm_state *m = (om__asm_state *)state;
     if (!m) return om__fail(d, OM_E_INVALID, "asm: no state (did init fail?)");
     m->view = *v;
     om__asm_pctx_begin(&m->pc, &m->tree.lay, &m->cfg, &m->view);
@@ -226,288 +191,6 @@ static om_status asm_begin(void *state, const om_view *v, om_diag *d)
     m->cache = OM__ASM_NONE;
     om__asm_frame(&m->tree);
     return OM_OK;
-}
-
-/* ---- rendering tiles */
-
-static asm_dvec dapply(const om_mat4 *mt, om_vec3 p)
-{
-    const float *a = mt->m;
-    asm_dvec r;
-    r.x = (double)a[0] * p.x + (double)a[1] * p.y + (double)a[2] * p.z + (double)a[3];
-    r.y = (double)a[4] * p.x + (double)a[5] * p.y + (double)a[6] * p.z + (double)a[7];
-    r.z = (double)a[8] * p.x + (double)a[9] * p.y + (double)a[10] * p.z + (double)a[11];
-    r.w = (double)a[12] * p.x + (double)a[13] * p.y + (double)a[14] * p.z + (double)a[15];
-    return r;
-}
-
-/* A triangle's bounds on the light's image in base texels (R per side), from its
- * vertices' light clip coordinates. */
-static void tri_box(const asm_dvec q[3], double R, float b[4])
-{
-    double lo_u = 0, lo_v = 0, hi_u = 0, hi_v = 0;
-    bool all = false;
-    for (int i = 0; i < 3; i++) {
-        /* Behind or on the light's plane: the triangle's image is unbounded; let the
-         * rasterizer's clipping decide for every tile. */
-        if (!(q[i].w > 1e-9 * (fabs(q[i].x) + fabs(q[i].y)))) { all = true; break; }
-        double u = (q[i].x / q[i].w + 1.0) * 0.5 * R, v = (1.0 - q[i].y / q[i].w) * 0.5 * R;
-        if (i == 0 || u < lo_u) lo_u = u;
-        if (i == 0 || v < lo_v) lo_v = v;
-        if (i == 0 || u > hi_u) hi_u = u;
-        if (i == 0 || v > hi_v) hi_v = v;
-    }
-    if (all || !(lo_u > -1e30 && hi_u < 1e30 && lo_v > -1e30 && hi_v < 1e30)) {
-        b[0] = b[1] = -FLT_MAX;
-        b[2] = b[3] = FLT_MAX;
-    } else {   /* widened by far more than float rounding: never narrower than in double */
-        b[0] = (float)(lo_u - (1.0 / 256 + fabs(lo_u) * 1e-6));
-        b[1] = (float)(lo_v - (1.0 / 256 + fabs(lo_v) * 1e-6));
-        b[2] = (float)(hi_u + (1.0 / 256 + fabs(hi_u) * 1e-6));
-        b[3] = (float)(hi_v + (1.0 / 256 + fabs(hi_v) * 1e-6));
-    }
-}
-
-static inline bool box_meets(const float *b, float u0, float v0, float u1, float v1)
-{
-    return !((b[2] < u0) | (b[0] > u1) | (b[3] < v0) | (b[1] > v1));
-}
-
-/* Whether [lo, hi] holds an integer: exact, without libm (|lo| < 1e15 converts to an
- * integer and back unchanged); wide or huge ranges hold one. */
-static inline bool holds_integer(double lo, double hi)
-{
-    if (!(hi - lo < 1.0) || !(lo > -1e15 && lo < 1e15)) return true;
-    double c = (double)(int64_t)lo;   /* towards zero: lo's ceiling, or one below it */
-    if (c < lo) c += 1.0;
-    return c <= hi;
-}
-
-/* Whether bounds b (base texels) hold a texel centre of a grid `sc` times finer on both
- * axes. The rasterizer samples a tile at its texel centres only, and a snapped triangle
- * covers none outside its vertices' box, so one whose bounds hold no centre writes
- * nothing: most of a big scene's triangles in the base and many in a root tile, each a
- * fraction of a texel there. Skipping them leaves every tile as it was. The bounds are
- * already wider than the rasterizer's snap and float x/w can move a vertex (tri_box);
- * another 1/32 texel here keeps the test from deciding on rounding at all. */
-static inline bool box_holds_centre(const float *b, double sc)
-{
-    const double e = 1.0 / 32;
-    return holds_integer((double)b[0] * sc - 0.5 - e, (double)b[2] * sc - 0.5 + e) &&
-           holds_integer((double)b[1] * sc - 0.5 - e, (double)b[3] * sc - 0.5 + e);
-}
-
-/* One triangle into the tile: its clip coordinates composed with the tile's window. */
-static void render_tri(om_raster *r, const asm_dvec q[3], double s_, double kx, double ky,
-                       uint32_t t)
-{
-    om_vec4 c[3];
-    for (int i = 0; i < 3; i++) {
-        c[i].x = (float)(q[i].x * s_ + q[i].w * kx);
-        c[i].y = (float)(q[i].y * s_ + q[i].w * ky);
-        c[i].z = (float)q[i].z;
-        c[i].w = (float)q[i].w;
-    }
-    om__raster_tri(r, c, t);
-}
-
-/* The triangles whose bounds meet the region and hold a texel centre, in index order,
- * into m->cull: every triangle's bounds tested (most miss a deep node's region). */
-static uint32_t gather_all(asm_state *m, float u0, float v0, float u1, float v1, double sc,
-                           const uint32_t *centre)
-{
-    uint32_t n = 0;
-    if (centre) {   /* a word of bits at a time: in a big scene most are clear */
-        for (uint32_t w = 0; w < (m->scene->ntris + 31) / 32; w++)
-            for (uint32_t bits = centre[w]; bits; bits &= bits - 1) {
-                const uint32_t k = w * 32 + om__ctz32(bits);
-                m->cull[n] = k;
-                n += box_meets(&m->tbox[(size_t)k * 4], u0, v0, u1, v1);
-            }
-        return n;
-    }
-    for (uint32_t k = 0; k < m->scene->ntris; k++) {
-        const float *b = &m->tbox[(size_t)k * 4];
-        m->cull[n] = k;
-        n += box_meets(b, u0, v0, u1, v1) && box_holds_centre(b, sc);
-    }
-    return n;
-}
-
-/* The cell of a base-texel coordinate, clamped to the grid (bounds beyond the map
- * fall in its border cells). */
-static uint32_t cell_of(const asm_state *m, float u)
-{
-    float f = u * (float)m->gside / (float)m->tree.lay.tile;
-    return !(f > 0.0f) ? 0 : f >= (float)(m->gside - 1) ? m->gside - 1 : (uint32_t)f;
-}
-
-/* This frame's cell lists (a counting sort of triangles by cell); gready stays false
- * when they would not fit. */
-static void grid_make(asm_state *m)
-{
-    const om_scene *s = m->scene;
-    const uint32_t G = m->gside;
-    m->gready = false;
-    memset(m->gstart, 0, ((size_t)G * G + 1) * sizeof(uint32_t));
-    uint64_t total = 0;
-    for (uint32_t k = 0; k < s->ntris; k++) {
-        const float *b = &m->tbox[(size_t)k * 4];
-        uint32_t cx0 = cell_of(m, b[0]), cy0 = cell_of(m, b[1]), cx1 = cell_of(m, b[2]), cy1 = cell_of(m, b[3]);
-        total += (uint64_t)(cx1 - cx0 + 1) * (cy1 - cy0 + 1);
-        if (total > m->gcap) return;
-        for (uint32_t cy = cy0; cy <= cy1; cy++)
-            for (uint32_t cx = cx0; cx <= cx1; cx++) m->gstart[cy * G + cx + 1]++;
-    }
-    for (uint32_t c = 0; c < G * G; c++) m->gstart[c + 1] += m->gstart[c];
-    for (uint32_t k = 0; k < s->ntris; k++) {   /* each cell's list in index order */
-        const float *b = &m->tbox[(size_t)k * 4];
-        uint32_t cx0 = cell_of(m, b[0]), cy0 = cell_of(m, b[1]), cx1 = cell_of(m, b[2]), cy1 = cell_of(m, b[3]);
-        for (uint32_t cy = cy0; cy <= cy1; cy++)
-            for (uint32_t cx = cx0; cx <= cx1; cx++) m->glist[m->gstart[cy * G + cx]++] = k;
-    }
-    for (uint32_t c = G * G; c > 0; c--) m->gstart[c] = m->gstart[c - 1];   /* back to starts */
-    m->gstart[0] = 0;
-    m->gready = true;
-}
-
-/* gather_all's result from the cells the region meets: their triangles marked in a
- * bit set (a triangle in several cells once; with `centre`, only those it has),
- * collected in index order and tested as gather_all tests them. */
-static uint32_t gather_cells(asm_state *m, float u0, float v0, float u1, float v1, double sc,
-                             const uint32_t *centre)
-{
-    const uint32_t G = m->gside;
-    uint32_t lo = UINT32_MAX, hi = 0, n = 0;
-    for (uint32_t cy = cell_of(m, v0); cy <= cell_of(m, v1); cy++)
-        for (uint32_t cx = cell_of(m, u0); cx <= cell_of(m, u1); cx++)
-            for (uint32_t i = m->gstart[cy * G + cx]; i < m->gstart[cy * G + cx + 1]; i++) {
-                uint32_t k = m->glist[i];
-                m->gbits[k >> 5] |= (centre ? centre[k >> 5] : ~0u) & 1u << (k & 31);
-                if (k < lo) lo = k;
-                if (k > hi) hi = k;
-            }
-    for (uint32_t w = lo == UINT32_MAX ? 1 : lo >> 5; w <= (hi >> 5) && lo != UINT32_MAX; w++) {
-        uint32_t bits = m->gbits[w];
-        m->gbits[w] = 0;
-        while (bits) {
-            uint32_t k = w * 32 + om__ctz32(bits);
-            bits &= bits - 1;
-            const float *b = &m->tbox[(size_t)k * 4];
-            m->cull[n] = k;
-            n += box_meets(b, u0, v0, u1, v1) && (centre || box_holds_centre(b, sc));
-        }
-    }
-    return n;
-}
-
-/* Renders texels [ox, ox + tile) x [oy, oy + tile) of level `level`'s grid into a
- * tile's depth and ids, from the triangles whose light bounds meet the region. The light's clip space is composed with the window that maps the
- * region's tile to [-1, 1] (x' = s x + k w), so the engine's rasterizer, clipping and
- * fill rule apply unchanged at any depth of the tree. */
-static void render(asm_state *m, uint32_t level, uint32_t ox, uint32_t oy, uint32_t *depth,
-                   uint16_t *id16, uint32_t *id32)
-{
-    const om__asm_layout *l = &m->tree.lay;
-    const om_scene *s = m->scene;
-    const uint32_t T = l->tile;
-    const double s_ = om__asm_grid(l, level) / (double)T;
-    const double kx = s_ - 2.0 * (double)ox / (double)T - 1.0;
-    const double ky = 1.0 - s_ + 2.0 * (double)oy / (double)T;
-    /* the region in base texels, one texel of margin against rounding */
-    const double ic = m->inv_scale[level];
-    const float u0 = (float)(((double)ox - 1.0) * ic), u1 = (float)(((double)ox + T + 1.0) * ic);
-    const float v0 = (float)(((double)oy - 1.0) * ic), v1 = (float)(((double)oy + T + 1.0) * ic);
-    om_target tg = {T, T, 0, T, m->sdepth, m->sid};
-    om__target_clear(&tg);
-    om_raster r = {&tg, OM_RASTER_DEPTH_ID, NULL, NULL, NULL, NULL, 0, false, NULL, NULL, NULL, NULL, 0, 0, NULL, 0};
-    /* back faces of closed shapes skipped, as in every light map (om__cull); the
-     * window scales x and y by s_ > 0, so windings stay */
-    om__cull cl;
-    om__cull_begin(&cl, s, &m->view.light_vp);
-    if (m->lean) {
-        /* The same triangles in the same order as the fast path below, so the same tile:
-         * projections and bounds are made per tile instead of kept per frame. */
-        for (uint32_t t = 0; t < s->ntris; t++) {
-            const uint32_t *ix = s->idx + (size_t)t * 3;
-            asm_dvec q[3];
-            float b[4];
-            for (int i = 0; i < 3; i++) q[i] = dapply(&m->view.light_vp, s->verts[ix[i]]);
-            tri_box(q, T, b);
-            if (!box_meets(b, u0, v0, u1, v1) || !box_holds_centre(b, l->scale[level])) continue;
-            r.cull_back = om__cull_next(&cl, t);
-            render_tri(&r, q, s_, kx, ky, t);
-        }
-    } else {
-        const double sc = l->scale[level];
-        const uint32_t *centre = level < 2 ? m->centre[level] : NULL;
-        /* the base covers every cell: its centre bits alone are the shorter walk */
-        uint32_t n = m->gready && level > 0 ? gather_cells(m, u0, v0, u1, v1, sc, centre)
-                                            : gather_all(m, u0, v0, u1, v1, sc, centre);
-        for (uint32_t k = 0; k < n; k++) {
-            const uint32_t t = m->cull[k];
-            const uint32_t *ix = s->idx + (size_t)t * 3;
-#if defined(__GNUC__) || defined(__clang__)
-            /* a big scene's triangles in a tile lie far apart in memory: ask for the
-             * next ones' vertices early (a hint: no effect on what is computed) */
-            if (k + 4 < n) {
-                const uint32_t *nx = s->idx + (size_t)m->cull[k + 4] * 3;
-                for (int i = 0; i < 3; i++) __builtin_prefetch(&s->verts[nx[i]]);
-            }
-            if (k + 8 < n) __builtin_prefetch(s->idx + (size_t)m->cull[k + 8] * 3);
-#endif
-            asm_dvec q[3];
-            for (int i = 0; i < 3; i++) q[i] = dapply(&m->view.light_vp, s->verts[ix[i]]);
-            r.cull_back = om__cull_next(&cl, t);
-            render_tri(&r, q, s_, kx, ky, t);
-        }
-    }
-    const size_t t2 = (size_t)T * T;
-    memcpy(depth, m->sdepth, t2 * sizeof *depth);
-    if (id16)
-        for (size_t i = 0; i < t2; i++) id16[i] = m->sid[i] == OM_NO_TRI ? (uint16_t)0xFFFFu : (uint16_t)m->sid[i];
-    else
-        memcpy(id32, m->sid, t2 * sizeof *id32);
-}
-
-static void render_node(asm_state *m, uint32_t index)
-{
-    om__asm_tile tl;
-    om__asm_tile_of(&m->tree, index, &tl);
-    render(m, tl.node->level, tl.node->ox, tl.node->oy, tl.depth, tl.id16, tl.id32);
-}
-
-/* This frame's projections (once, from the first observe or build), and the rebuild
- * when the light has moved. */
-static void prepare(asm_state *m)
-{
-    if (m->prepared) return;
-    m->prepared = true;
-    const om_scene *s = m->scene;
-    if (!m->lean) {
-        /* Projections per triangle, kept only as bounds: a tile projects again the few
-         * it renders (the same bits), which costs less than keeping every vertex's. */
-        const size_t words = ((size_t)s->ntris + 31) / 32;
-        memset(m->centre[0], 0, words * sizeof(uint32_t));
-        memset(m->centre[1], 0, words * sizeof(uint32_t));
-        for (uint32_t k = 0; k < s->ntris; k++) {
-            const uint32_t *ix = s->idx + (size_t)k * 3;
-            asm_dvec q[3];
-            for (int i = 0; i < 3; i++) q[i] = dapply(&m->view.light_vp, s->verts[ix[i]]);
-            float *b = &m->tbox[(size_t)k * 4];
-            tri_box(q, m->tree.lay.tile, b);
-            for (int i = 0; i < 2; i++)
-                m->centre[i][k >> 5] |= (uint32_t)box_holds_centre(b, m->tree.lay.scale[i]) << (k & 31);
-        }
-        grid_make(m);
-    }
-    if (!m->built || memcmp(&m->built_vp, &m->view.light_vp, sizeof m->built_vp) != 0) {
-        om__asm_tree_clear(&m->tree);
-        render_node(m, OM__ASM_ROOT);
-        m->built_vp = m->view.light_vp;
-        m->built = true;
-        m->rebuilds++;
-    }
 }
 
 /* ---- one sample: the float path where its bounds decide (asm_point.c), the exact
@@ -526,7 +209,7 @@ typedef struct asm_smp {
 } asm_smp;
 
 /* Starts a sample; false where the exact path does not look it up. */
-static bool smp_begin(const asm_state *m, const om_sample *s, bool analyse, asm_smp *o)
+static bool smp_begin(const om__asm_state *m, const om_sample *s, bool analyse, asm_smp *o)
 {
     o->s = s;
     o->analyse = analyse;
@@ -538,7 +221,7 @@ static bool smp_begin(const asm_state *m, const om_sample *s, bool analyse, asm_
     return om__asm_pt_uv(&m->pc, s, &o->p);
 }
 
-static const om__asm_pt *smp_exact(const asm_state *m, asm_smp *o, bool bias)
+static const om__asm_pt *smp_exact(const om__asm_state *m, asm_smp *o, bool bias)
 {
     if (!o->exact) {
         o->exact = true;
@@ -551,13 +234,13 @@ static const om__asm_pt *smp_exact(const asm_state *m, asm_smp *o, bool bias)
     return &o->p;
 }
 
-static inline double level_z(const asm_state *m, const om__asm_pt *p, uint32_t level)
+static inline double level_z(const om__asm_state *m, const om__asm_pt *p, uint32_t level)
 {
     return p->z - p->bias_c - p->bias_s * m->inv_scale[level];
 }
 
 /* The sample's texel on `level`'s grid, where the float path decides it. */
-static inline bool fast_grid(const asm_state *m, const asm_smp *o, uint32_t level, uint32_t *gx,
+static inline bool fast_grid(const om__asm_state *m, const asm_smp *o, uint32_t level, uint32_t *gx,
                              uint32_t *gy)
 {
     if (!o->fast) return false;
@@ -573,7 +256,7 @@ static inline uint32_t clamp_in(uint32_t g, uint32_t o, uint32_t size)
 }
 
 /* The sample's texel in a tile, clamped: as om__asm_find does it. */
-static inline void smp_texel(const asm_state *m, asm_smp *o, const om__asm_tile *tl, uint32_t *x, uint32_t *y)
+static inline void smp_texel(const om__asm_state *m, asm_smp *o, const om__asm_tile *tl, uint32_t *x, uint32_t *y)
 {
     const uint32_t level = tl->node->level;
     uint32_t gx, gy;
@@ -590,7 +273,7 @@ static inline void smp_texel(const asm_state *m, asm_smp *o, const om__asm_tile 
 }
 
 /* The biased depth at `level` against a stored one (the exact one once a level). */
-static bool smp_depth_lit(const asm_state *m, asm_smp *o, uint32_t level, uint32_t depth)
+static bool smp_depth_lit(const om__asm_state *m, asm_smp *o, uint32_t level, uint32_t depth)
 {
     if (o->fast) {
         if (!o->f.bias) om__asm_fpt_bias(&m->pc, o->s, &o->f, o->analyse);
@@ -605,7 +288,7 @@ static bool smp_depth_lit(const asm_state *m, asm_smp *o, uint32_t level, uint32
 }
 
 /* Section 4.2: the polygon ID first; when it differs, the biased depth. */
-static inline bool smp_lit(const asm_state *m, asm_smp *o, const om__asm_tile *tl, uint32_t x, uint32_t y)
+static inline bool smp_lit(const om__asm_state *m, asm_smp *o, const om__asm_tile *tl, uint32_t x, uint32_t y)
 {
     const size_t i = (size_t)y * tl->size + x;
     if (tl->id16 ? tl->id16[i] == (uint16_t)o->s->tri : tl->id32[i] == o->s->tri) return true;
@@ -613,7 +296,7 @@ static inline bool smp_lit(const asm_state *m, asm_smp *o, const om__asm_tile *t
 }
 
 /* Whether `level`'s texel is larger on the surface than the eye's pixel. */
-static bool smp_finer(const asm_state *m, asm_smp *o, uint32_t level)
+static bool smp_finer(const om__asm_state *m, asm_smp *o, uint32_t level)
 {
     if (o->fast) {
         if (!o->f.bias) om__asm_fpt_bias(&m->pc, o->s, &o->f, o->analyse);
@@ -624,7 +307,7 @@ static bool smp_finer(const asm_state *m, asm_smp *o, uint32_t level)
 }
 
 /* The sample's own test disagrees across the 3x3 texels around it. */
-static bool straddles(const asm_state *m, asm_smp *o, const om__asm_tile *tl, uint32_t x, uint32_t y)
+static bool straddles(const om__asm_state *m, asm_smp *o, const om__asm_tile *tl, uint32_t x, uint32_t y)
 {
     bool c = smp_lit(m, o, tl, x, y);
     uint32_t x0 = x ? x - 1 : 0, y0 = y ? y - 1 : 0;
@@ -638,12 +321,12 @@ static bool straddles(const asm_state *m, asm_smp *o, const om__asm_tile *tl, ui
 static om_status asm_observe(void *state, const om_strip *st, om_diag *d)
 {
     (void)d;
-    asm_state *m = (asm_state *)state;
+    om__asm_state *m = (om__asm_state *)state;
     om__asm_tree *t = &m->tree;
     const om__asm_layout *l = &t->lay;
     const uint32_t stride = m->cfg.asm_stride ? m->cfg.asm_stride : 1;
     const double ncell = (double)l->cp * l->cp;
-    prepare(m);
+    om__asm_prepare(m);
     for (uint32_t y = 0; y < st->rows; y++) {
         const uint32_t gy = st->y0 + y;
         /* one sample in `stride`, on diagonals so no column or row is favoured */
@@ -673,7 +356,7 @@ static om_status asm_observe(void *state, const om_strip *st, om_diag *d)
                             tl.ben[c]++;
                             break;
                         }
-                        render_node(m, child);
+                        om__asm_render_node(m, child);
                     }
                     om__asm_node_at(t, child)->benefit++;
                 } else {
@@ -703,9 +386,9 @@ static om_status asm_observe(void *state, const om_strip *st, om_diag *d)
 static om_status asm_build(void *state, om_diag *d)
 {
     (void)d;
-    asm_state *m = (asm_state *)state;
+    om__asm_state *m = (om__asm_state *)state;
     om__asm_tree *t = &m->tree;
-    prepare(m);
+    om__asm_prepare(m);
     /* Root tiles first, wherever samples fell, most samples first: the root level is
      * what a conventional map at asm.root would give, and every refinement hangs off it. */
     uint32_t n = om__asm_candidates(t, true, 0.0f, 0.0f, m->cand, m->ncand_max);
@@ -714,7 +397,7 @@ static om_status asm_build(void *state, om_diag *d)
         n = om__asm_cand_pop(m->cand, n, &c);
         uint32_t k = om__asm_make(t, OM__ASM_ROOT, c.cell, c.benefit);
         if (k == OM__ASM_NONE) break;   /* no room: the rest have fewer samples still */
-        render_node(m, k);
+        om__asm_render_node(m, k);
     }
     n = om__asm_candidates(t, false, m->cfg.asm_cost_a, m->cfg.asm_cost_b, m->cand, m->ncand_max);
     m->candidates = n;
@@ -731,7 +414,7 @@ static om_status asm_build(void *state, om_diag *d)
             refused = c.benefit;
             continue;
         }
-        render_node(m, k);
+        om__asm_render_node(m, k);
         spent += (double)c.cost;
     }
     m->cache = OM__ASM_NONE;
@@ -748,7 +431,7 @@ typedef struct asm_cache {
 /* The deepest node over the sample and its texel there, reading the tree only: the
  * cached leaf when it still holds the sample, else a descent from the root, which
  * refills the cache and says so (*moved). */
-static void smp_find(const asm_state *m, asm_smp *o, asm_cache *c, om__asm_tile *tl, uint32_t *tx,
+static void smp_find(const om__asm_state *m, asm_smp *o, asm_cache *c, om__asm_tile *tl, uint32_t *tx,
                      uint32_t *ty, bool *moved)
 {
     /* om__asm_tile_of hands out the tree's arrays; nothing here writes them */
@@ -801,7 +484,7 @@ static void stamp_path(om__asm_tree *t, uint32_t index)
 }
 
 /* One exposed sample: 1 lit, 0 shadowed (behind the light or off every grid: lit). */
-static int resolve_one(const asm_state *m, const om_sample *s, asm_cache *c, bool *moved)
+static int resolve_one(const om__asm_state *m, const om_sample *s, asm_cache *c, bool *moved)
 {
     asm_smp o;
     if (!smp_begin(m, s, false, &o)) return 1;
@@ -814,9 +497,9 @@ static int resolve_one(const asm_state *m, const om_sample *s, asm_cache *c, boo
 static om_status asm_resolve(void *state, om_strip *st, om_diag *d)
 {
     (void)d;
-    asm_state *m = (asm_state *)state;
+    om__asm_state *m = (om__asm_state *)state;
     size_t n = (size_t)st->rows * st->width;
-    prepare(m);
+    om__asm_prepare(m);
     asm_cache c = {m->cache, m->cache_tile};
     for (size_t i = 0; i < n; i++) {
         om_term *t = &st->terms[i];
@@ -845,7 +528,7 @@ static om_status asm_resolve(void *state, om_strip *st, om_diag *d)
  * (added up by merge) are a strip at a time's. */
 static void asm_band(const void *state, om_strip *st, void *scratch, uint32_t counts[8])
 {
-    const asm_state *m = (const asm_state *)state;
+    const om__asm_state *m = (const om__asm_state *)state;
     asm_cache *c = (asm_cache *)scratch;
     c->index = OM__ASM_NONE;
     const size_t n = (size_t)st->rows * st->width;
@@ -865,14 +548,14 @@ static void asm_band(const void *state, om_strip *st, void *scratch, uint32_t co
 
 static void asm_merge(void *state, const uint32_t counts[8])
 {
-    asm_state *m = (asm_state *)state;
+    om__asm_state *m = (om__asm_state *)state;
     m->samples += counts[0];
     m->shadowed += counts[1];
 }
 
 static void asm_finish(void *state, om_strip *st)
 {
-    asm_state *m = (asm_state *)state;
+    om__asm_state *m = (om__asm_state *)state;
     const size_t n = (size_t)st->rows * st->width;
     for (size_t i = 0; i < n; i++) {
         om_term *t = &st->terms[i];
@@ -891,11 +574,11 @@ static void asm_finish(void *state, om_strip *st)
 
 const om__bands om__bands_asm = {asm_band, asm_merge, sizeof(asm_cache), NULL, NULL, asm_finish};
 
-const om__asm_tree *om__asm_tree_of(const void *state) { return &((const asm_state *)state)->tree; }
+const om__asm_tree *om__asm_tree_of(const void *state) { return &((const om__asm_state *)state)->tree; }
 
 static void asm_stats(const void *state, om_method_stats *out)
 {
-    const asm_state *m = (const asm_state *)state;
+    const om__asm_state *m = (const om__asm_state *)state;
     const om__asm_tree *t = &m->tree;
     memset(out, 0, sizeof *out);
     out->bytes_used = asm_need(m->scene, &t->lay, m->lean);

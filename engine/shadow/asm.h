@@ -1,7 +1,8 @@
 /* asm.h — the Adaptive Shadow Map's tree (Fernando et al. 2001, paper 002): the node
  * pool carved from the user's memory cap, the cells that may hold children, and the
  * rules that create, find and remove nodes (section 3). The method itself (frame flow,
- * analysis, tile rendering, lookup) is asm.c; the tree is here so tests can drive it.
+ * analysis, lookup) is asm.c, its tile rendering asm_render.c; the tree is here so
+ * tests can drive it, and the method's state at the end, which those two share.
  *
  * Geometry. The root ("base") is one node whose tile of asm.tile texels covers the
  * light's whole image plane; it is cut into B = asm.root / asm.tile cells per side, and
@@ -240,5 +241,48 @@ static inline int om__asm_fpt_finer(const om__asm_pctx *c, const om__asm_fpt *f,
     if (r < 1.0f - 0x1p-15f) return 0;
     return -1;
 }
+
+/* ---- the method's state: asm.c's, and asm_render.c's, which renders its tiles. */
+typedef struct om__asm_dvec { double x, y, z, w; } om__asm_dvec;
+
+typedef struct om__asm_state {
+    const om_scene *scene;
+    om__asm_cfg cfg;
+    om__asm_tree tree;
+    om_view view;
+    om_mat4 built_vp;      /* the light the tiles hold */
+    bool built;
+    bool prepared;         /* this frame's projections are done */
+    bool lean;             /* no per-vertex or per-triangle arrays: see render */
+    float *tbox;           /* per triangle: base-texel bounds u0, v0, u1, v1 (not lean) */
+    /* Per triangle, a bit: its bounds hold a texel centre of level 0's grid (centre[0])
+     * or level 1's (centre[1]): box_holds_centre once per frame for the levels every
+     * rebuild renders whole, so their gathers read no bounds of triangles that would
+     * write nothing (not lean). */
+    uint32_t *centre[2];
+    uint32_t *cull;        /* triangles that meet the region being rendered (not lean) */
+    /* A grid of cells over the base texels, each listing the triangles whose bounds
+     * meet it, made once per frame, so that a tile gathers from its cells instead of
+     * testing every triangle's bounds; a bit per triangle puts them back in index
+     * order. Not lean; unused in a frame whose lists would overflow `gcap`. */
+    uint32_t gside;        /* cells per side */
+    uint32_t *gstart;      /* gside^2 + 1 offsets into glist */
+    uint32_t *glist, gcap;
+    uint32_t *gbits;       /* (ntris + 31) / 32 words */
+    bool gready;           /* this frame's lists were made */
+    uint32_t *sdepth, *sid;   /* one tile of scratch for the rasterizer */
+    om__asm_cand *cand;
+    uint32_t ncand_max;
+    double inv_scale[OM__ASM_MAX_LEVEL + 1];   /* a level-L texel in base texels */
+    om__asm_pctx pc;       /* what a sample's setup reads (asm_point.c) */
+    uint32_t cache;        /* the last leaf found by resolve, or OM__ASM_NONE */
+    om__asm_tile cache_tile;
+    uint32_t samples, shadowed, analysed, straddling, candidates, rebuilds;
+} om__asm_state;
+
+/* asm_render.c: this frame's projections, bounds and triangle grid (once a frame;
+ * a rebuild renders the base tile), and the tile of node `index` rendered. */
+void om__asm_prepare(om__asm_state *m);
+void om__asm_render_node(om__asm_state *m, uint32_t index);
 
 #endif

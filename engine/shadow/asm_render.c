@@ -1,0 +1,290 @@
+/* asm_render.c — Adaptive Shadow Maps' tiles (paper 002, section 4.2): each node's
+ * tile is a small shadow map of its square of the light's image, rendered with the
+ * engine's rasterizer from the triangles whose bounds meet it. Once a frame, prepare
+ * projects the scene and bounds each triangle in base texels, and lays a grid of cells
+ * over them so that a tile gathers its triangles from its cells; lean mode keeps none
+ * of it and tests every triangle. asm.c decides which tiles exist. */
+#include "shadow.h"
+#include "asm.h"
+
+#include <float.h>
+
+static om__asm_dvec dapply(const om_mat4 *mt, om_vec3 p)
+{
+    const float *a = mt->m;
+    om__asm_dvec r;
+    r.x = (double)a[0] * p.x + (double)a[1] * p.y + (double)a[2] * p.z + (double)a[3];
+    r.y = (double)a[4] * p.x + (double)a[5] * p.y + (double)a[6] * p.z + (double)a[7];
+    r.z = (double)a[8] * p.x + (double)a[9] * p.y + (double)a[10] * p.z + (double)a[11];
+    r.w = (double)a[12] * p.x + (double)a[13] * p.y + (double)a[14] * p.z + (double)a[15];
+    return r;
+}
+
+/* A triangle's bounds on the light's image in base texels (R per side), from its
+ * vertices' light clip coordinates. */
+static void tri_box(const om__asm_dvec q[3], double R, float b[4])
+{
+    double lo_u = 0, lo_v = 0, hi_u = 0, hi_v = 0;
+    bool all = false;
+    for (int i = 0; i < 3; i++) {
+        /* Behind or on the light's plane: the triangle's image is unbounded; let the
+         * rasterizer's clipping decide for every tile. */
+        if (!(q[i].w > 1e-9 * (fabs(q[i].x) + fabs(q[i].y)))) { all = true; break; }
+        double u = (q[i].x / q[i].w + 1.0) * 0.5 * R, v = (1.0 - q[i].y / q[i].w) * 0.5 * R;
+        if (i == 0 || u < lo_u) lo_u = u;
+        if (i == 0 || v < lo_v) lo_v = v;
+        if (i == 0 || u > hi_u) hi_u = u;
+        if (i == 0 || v > hi_v) hi_v = v;
+    }
+    if (all || !(lo_u > -1e30 && hi_u < 1e30 && lo_v > -1e30 && hi_v < 1e30)) {
+        b[0] = b[1] = -FLT_MAX;
+        b[2] = b[3] = FLT_MAX;
+    } else {   /* widened by far more than float rounding: never narrower than in double */
+        b[0] = (float)(lo_u - (1.0 / 256 + fabs(lo_u) * 1e-6));
+        b[1] = (float)(lo_v - (1.0 / 256 + fabs(lo_v) * 1e-6));
+        b[2] = (float)(hi_u + (1.0 / 256 + fabs(hi_u) * 1e-6));
+        b[3] = (float)(hi_v + (1.0 / 256 + fabs(hi_v) * 1e-6));
+    }
+}
+
+static inline bool box_meets(const float *b, float u0, float v0, float u1, float v1)
+{
+    return !((b[2] < u0) | (b[0] > u1) | (b[3] < v0) | (b[1] > v1));
+}
+
+/* Whether [lo, hi] holds an integer: exact, without libm (|lo| < 1e15 converts to an
+ * integer and back unchanged); wide or huge ranges hold one. */
+static inline bool holds_integer(double lo, double hi)
+{
+    if (!(hi - lo < 1.0) || !(lo > -1e15 && lo < 1e15)) return true;
+    double c = (double)(int64_t)lo;   /* towards zero: lo's ceiling, or one below it */
+    if (c < lo) c += 1.0;
+    return c <= hi;
+}
+
+/* Whether bounds b (base texels) hold a texel centre of a grid `sc` times finer on both
+ * axes. The rasterizer samples a tile at its texel centres only, and a snapped triangle
+ * covers none outside its vertices' box, so one whose bounds hold no centre writes
+ * nothing: most of a big scene's triangles in the base and many in a root tile, each a
+ * fraction of a texel there. Skipping them leaves every tile as it was. The bounds are
+ * already wider than the rasterizer's snap and float x/w can move a vertex (tri_box);
+ * another 1/32 texel here keeps the test from deciding on rounding at all. */
+static inline bool box_holds_centre(const float *b, double sc)
+{
+    const double e = 1.0 / 32;
+    return holds_integer((double)b[0] * sc - 0.5 - e, (double)b[2] * sc - 0.5 + e) &&
+           holds_integer((double)b[1] * sc - 0.5 - e, (double)b[3] * sc - 0.5 + e);
+}
+
+/* One triangle into the tile: its clip coordinates composed with the tile's window. */
+static void render_tri(om_raster *r, const om__asm_dvec q[3], double s_, double kx, double ky,
+                       uint32_t t)
+{
+    om_vec4 c[3];
+    for (int i = 0; i < 3; i++) {
+        c[i].x = (float)(q[i].x * s_ + q[i].w * kx);
+        c[i].y = (float)(q[i].y * s_ + q[i].w * ky);
+        c[i].z = (float)q[i].z;
+        c[i].w = (float)q[i].w;
+    }
+    om__raster_tri(r, c, t);
+}
+
+/* The triangles whose bounds meet the region and hold a texel centre, in index order,
+ * into m->cull: every triangle's bounds tested (most miss a deep node's region). */
+static uint32_t gather_all(om__asm_state *m, float u0, float v0, float u1, float v1, double sc,
+                           const uint32_t *centre)
+{
+    uint32_t n = 0;
+    if (centre) {   /* a word of bits at a time: in a big scene most are clear */
+        for (uint32_t w = 0; w < (m->scene->ntris + 31) / 32; w++)
+            for (uint32_t bits = centre[w]; bits; bits &= bits - 1) {
+                const uint32_t k = w * 32 + om__ctz32(bits);
+                m->cull[n] = k;
+                n += box_meets(&m->tbox[(size_t)k * 4], u0, v0, u1, v1);
+            }
+        return n;
+    }
+    for (uint32_t k = 0; k < m->scene->ntris; k++) {
+        const float *b = &m->tbox[(size_t)k * 4];
+        m->cull[n] = k;
+        n += box_meets(b, u0, v0, u1, v1) && box_holds_centre(b, sc);
+    }
+    return n;
+}
+
+/* The cell of a base-texel coordinate, clamped to the grid (bounds beyond the map
+ * fall in its border cells). */
+static uint32_t cell_of(const om__asm_state *m, float u)
+{
+    float f = u * (float)m->gside / (float)m->tree.lay.tile;
+    return !(f > 0.0f) ? 0 : f >= (float)(m->gside - 1) ? m->gside - 1 : (uint32_t)f;
+}
+
+/* This frame's cell lists (a counting sort of triangles by cell); gready stays false
+ * when they would not fit. */
+static void grid_make(om__asm_state *m)
+{
+    const om_scene *s = m->scene;
+    const uint32_t G = m->gside;
+    m->gready = false;
+    memset(m->gstart, 0, ((size_t)G * G + 1) * sizeof(uint32_t));
+    uint64_t total = 0;
+    for (uint32_t k = 0; k < s->ntris; k++) {
+        const float *b = &m->tbox[(size_t)k * 4];
+        uint32_t cx0 = cell_of(m, b[0]), cy0 = cell_of(m, b[1]), cx1 = cell_of(m, b[2]), cy1 = cell_of(m, b[3]);
+        total += (uint64_t)(cx1 - cx0 + 1) * (cy1 - cy0 + 1);
+        if (total > m->gcap) return;
+        for (uint32_t cy = cy0; cy <= cy1; cy++)
+            for (uint32_t cx = cx0; cx <= cx1; cx++) m->gstart[cy * G + cx + 1]++;
+    }
+    for (uint32_t c = 0; c < G * G; c++) m->gstart[c + 1] += m->gstart[c];
+    for (uint32_t k = 0; k < s->ntris; k++) {   /* each cell's list in index order */
+        const float *b = &m->tbox[(size_t)k * 4];
+        uint32_t cx0 = cell_of(m, b[0]), cy0 = cell_of(m, b[1]), cx1 = cell_of(m, b[2]), cy1 = cell_of(m, b[3]);
+        for (uint32_t cy = cy0; cy <= cy1; cy++)
+            for (uint32_t cx = cx0; cx <= cx1; cx++) m->glist[m->gstart[cy * G + cx]++] = k;
+    }
+    for (uint32_t c = G * G; c > 0; c--) m->gstart[c] = m->gstart[c - 1];   /* back to starts */
+    m->gstart[0] = 0;
+    m->gready = true;
+}
+
+/* gather_all's result from the cells the region meets: their triangles marked in a
+ * bit set (a triangle in several cells once; with `centre`, only those it has),
+ * collected in index order and tested as gather_all tests them. */
+static uint32_t gather_cells(om__asm_state *m, float u0, float v0, float u1, float v1, double sc,
+                             const uint32_t *centre)
+{
+    const uint32_t G = m->gside;
+    uint32_t lo = UINT32_MAX, hi = 0, n = 0;
+    for (uint32_t cy = cell_of(m, v0); cy <= cell_of(m, v1); cy++)
+        for (uint32_t cx = cell_of(m, u0); cx <= cell_of(m, u1); cx++)
+            for (uint32_t i = m->gstart[cy * G + cx]; i < m->gstart[cy * G + cx + 1]; i++) {
+                uint32_t k = m->glist[i];
+                m->gbits[k >> 5] |= (centre ? centre[k >> 5] : ~0u) & 1u << (k & 31);
+                if (k < lo) lo = k;
+                if (k > hi) hi = k;
+            }
+    for (uint32_t w = lo == UINT32_MAX ? 1 : lo >> 5; w <= (hi >> 5) && lo != UINT32_MAX; w++) {
+        uint32_t bits = m->gbits[w];
+        m->gbits[w] = 0;
+        while (bits) {
+            uint32_t k = w * 32 + om__ctz32(bits);
+            bits &= bits - 1;
+            const float *b = &m->tbox[(size_t)k * 4];
+            m->cull[n] = k;
+            n += box_meets(b, u0, v0, u1, v1) && (centre || box_holds_centre(b, sc));
+        }
+    }
+    return n;
+}
+
+/* Renders texels [ox, ox + tile) x [oy, oy + tile) of level `level`'s grid into a
+ * tile's depth and ids, from the triangles whose light bounds meet the region. The light's clip space is composed with the window that maps the
+ * region's tile to [-1, 1] (x' = s x + k w), so the engine's rasterizer, clipping and
+ * fill rule apply unchanged at any depth of the tree. */
+static void render(om__asm_state *m, uint32_t level, uint32_t ox, uint32_t oy, uint32_t *depth,
+                   uint16_t *id16, uint32_t *id32)
+{
+    const om__asm_layout *l = &m->tree.lay;
+    const om_scene *s = m->scene;
+    const uint32_t T = l->tile;
+    const double s_ = om__asm_grid(l, level) / (double)T;
+    const double kx = s_ - 2.0 * (double)ox / (double)T - 1.0;
+    const double ky = 1.0 - s_ + 2.0 * (double)oy / (double)T;
+    /* the region in base texels, one texel of margin against rounding */
+    const double ic = m->inv_scale[level];
+    const float u0 = (float)(((double)ox - 1.0) * ic), u1 = (float)(((double)ox + T + 1.0) * ic);
+    const float v0 = (float)(((double)oy - 1.0) * ic), v1 = (float)(((double)oy + T + 1.0) * ic);
+    om_target tg = {T, T, 0, T, m->sdepth, m->sid};
+    om__target_clear(&tg);
+    om_raster r = {&tg, OM_RASTER_DEPTH_ID, NULL, NULL, NULL, NULL, 0, false, NULL, NULL, NULL, NULL, 0, 0, NULL, 0};
+    /* back faces of closed shapes skipped, as in every light map (om__cull); the
+     * window scales x and y by s_ > 0, so windings stay */
+    om__cull cl;
+    om__cull_begin(&cl, s, &m->view.light_vp);
+    if (m->lean) {
+        /* The same triangles in the same order as the fast path below, so the same tile:
+         * projections and bounds are made per tile instead of kept per frame. */
+        for (uint32_t t = 0; t < s->ntris; t++) {
+            const uint32_t *ix = s->idx + (size_t)t * 3;
+            om__asm_dvec q[3];
+            float b[4];
+            for (int i = 0; i < 3; i++) q[i] = dapply(&m->view.light_vp, s->verts[ix[i]]);
+            tri_box(q, T, b);
+            if (!box_meets(b, u0, v0, u1, v1) || !box_holds_centre(b, l->scale[level])) continue;
+            r.cull_back = om__cull_next(&cl, t);
+            render_tri(&r, q, s_, kx, ky, t);
+        }
+    } else {
+        const double sc = l->scale[level];
+        const uint32_t *centre = level < 2 ? m->centre[level] : NULL;
+        /* the base covers every cell: its centre bits alone are the shorter walk */
+        uint32_t n = m->gready && level > 0 ? gather_cells(m, u0, v0, u1, v1, sc, centre)
+                                            : gather_all(m, u0, v0, u1, v1, sc, centre);
+        for (uint32_t k = 0; k < n; k++) {
+            const uint32_t t = m->cull[k];
+            const uint32_t *ix = s->idx + (size_t)t * 3;
+#if defined(__GNUC__) || defined(__clang__)
+            /* a big scene's triangles in a tile lie far apart in memory: ask for the
+             * next ones' vertices early (a hint: no effect on what is computed) */
+            if (k + 4 < n) {
+                const uint32_t *nx = s->idx + (size_t)m->cull[k + 4] * 3;
+                for (int i = 0; i < 3; i++) __builtin_prefetch(&s->verts[nx[i]]);
+            }
+            if (k + 8 < n) __builtin_prefetch(s->idx + (size_t)m->cull[k + 8] * 3);
+#endif
+            om__asm_dvec q[3];
+            for (int i = 0; i < 3; i++) q[i] = dapply(&m->view.light_vp, s->verts[ix[i]]);
+            r.cull_back = om__cull_next(&cl, t);
+            render_tri(&r, q, s_, kx, ky, t);
+        }
+    }
+    const size_t t2 = (size_t)T * T;
+    memcpy(depth, m->sdepth, t2 * sizeof *depth);
+    if (id16)
+        for (size_t i = 0; i < t2; i++) id16[i] = m->sid[i] == OM_NO_TRI ? (uint16_t)0xFFFFu : (uint16_t)m->sid[i];
+    else
+        memcpy(id32, m->sid, t2 * sizeof *id32);
+}
+
+void om__asm_render_node(om__asm_state *m, uint32_t index)
+{
+    om__asm_tile tl;
+    om__asm_tile_of(&m->tree, index, &tl);
+    render(m, tl.node->level, tl.node->ox, tl.node->oy, tl.depth, tl.id16, tl.id32);
+}
+
+/* This frame's projections (once, from the first observe or build), and the rebuild
+ * when the light has moved. */
+void om__asm_prepare(om__asm_state *m)
+{
+    if (m->prepared) return;
+    m->prepared = true;
+    const om_scene *s = m->scene;
+    if (!m->lean) {
+        /* Projections per triangle, kept only as bounds: a tile projects again the few
+         * it renders (the same bits), which costs less than keeping every vertex's. */
+        const size_t words = ((size_t)s->ntris + 31) / 32;
+        memset(m->centre[0], 0, words * sizeof(uint32_t));
+        memset(m->centre[1], 0, words * sizeof(uint32_t));
+        for (uint32_t k = 0; k < s->ntris; k++) {
+            const uint32_t *ix = s->idx + (size_t)k * 3;
+            om__asm_dvec q[3];
+            for (int i = 0; i < 3; i++) q[i] = dapply(&m->view.light_vp, s->verts[ix[i]]);
+            float *b = &m->tbox[(size_t)k * 4];
+            tri_box(q, m->tree.lay.tile, b);
+            for (int i = 0; i < 2; i++)
+                m->centre[i][k >> 5] |= (uint32_t)box_holds_centre(b, m->tree.lay.scale[i]) << (k & 31);
+        }
+        grid_make(m);
+    }
+    if (!m->built || memcmp(&m->built_vp, &m->view.light_vp, sizeof m->built_vp) != 0) {
+        om__asm_tree_clear(&m->tree);
+        om__asm_render_node(m, OM__ASM_ROOT);
+        m->built_vp = m->view.light_vp;
+        m->built = true;
+        m->rebuilds++;
+    }
+}
