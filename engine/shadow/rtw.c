@@ -630,21 +630,6 @@ int32_t om__rtw_texel_axis(const int32_t *P, uint32_t n, uint32_t size, float r,
     return texel_axis(P, n, size, r, k);
 }
 
-/* smlookup.c's depth_threshold: the least stored depth a biased depth z is not behind. */
-static inline uint64_t depth_threshold(float z)
-{
-    if (z != z) return (1ull << 32) + 1;
-    if (!(z > 0.0f)) return 0;
-    if (!(z < OM_DEPTH_ONE_F)) return 1ull << 32;
-    const uint32_t t = (uint32_t)z;
-    return (uint64_t)t + ((float)t < z);
-}
-
-static inline uint32_t clamp_texel(int32_t x, uint32_t size)
-{
-    return x < 0 ? 0u : (uint32_t)x >= size ? size - 1 : (uint32_t)x;
-}
-
 /* smlookup.c's locate for a warped map without normal offset, in float: 1 located
  * (the threshold and the texel), 0 behind the light, -1 unsure. */
 static int locate_f(const om__rtw *m, const om_view *v, const om_sample *smp, uint64_t *zlit, uint32_t *at)
@@ -676,8 +661,8 @@ static int locate_f(const om__rtw *m, const om_view *v, const om_sample *smp, ui
     } else {
         dz = OM_DEPTH_ONE_F * om__fabsf(v->light_proj.m[10]);
     }
-    *zlit = depth_threshold(z - bias * dz);
-    *at = clamp_texel(cy, m->size) * m->size + clamp_texel(cx, m->size);
+    *zlit = om__smlook_threshold(z - bias * dz);
+    *at = om__smlook_clamp(cy, m->size) * m->size + om__smlook_clamp(cx, m->size);
     return 1;
 }
 

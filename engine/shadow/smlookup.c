@@ -63,32 +63,15 @@ static inline int32_t texel_floor_d(double f, uint32_t size)
  * unwarped PCF taps are placed. */
 typedef struct tap { uint64_t zlit; uint32_t at; int32_t cx, cy; double u, v; } tap;
 
-/* A texel coordinate clamped to the map, in 32 bits: texel_floor's are within 16
- * texels of it. */
-static inline uint32_t clamp32(int32_t x, uint32_t size)
-{
-    return x < 0 ? 0u : (uint32_t)x >= size ? size - 1 : (uint32_t)x;
-}
 
-/* clamp32(texel_floor(f, size), size) in one step: below 0 (or NaN) the first texel,
- * from `size` on the last, between them the truncation, which is the floor there. */
+/* om__smlook_clamp(texel_floor(f, size), size) in one step: below 0 (or NaN) the
+ * first texel, from `size` on the last, between them the truncation, which is the
+ * floor there. */
 static inline uint32_t texel_clamped(float f, uint32_t size)
 {
     return f >= 0.0f ? (f < (float)size ? (uint32_t)f : size - 1) : 0u;
 }
 
-/* The least stored depth a biased sample depth z is not behind: z <= D for a stored
- * integer D exactly when ceil(z) <= D (a NaN never is: 2^32 + 1). Integer compares per
- * tap rather than conversions to double, which a Cortex-M4F runs in software. The
- * ceiling through a 32-bit conversion is exact: (float)t is z itself once z >= 2^23. */
-static inline uint64_t depth_threshold(float z)
-{
-    if (z != z) return (1ull << 32) + 1;
-    if (!(z > 0.0f)) return 0;
-    if (!(z < OM_DEPTH_ONE_F)) return 1ull << 32;
-    const uint32_t t = (uint32_t)z;
-    return (uint64_t)t + ((float)t < z);
-}
 
 /* All of the test's arithmetic; false when the sample is behind the light. */
 static bool locate(const om__smlook *L, const om_sample *smp, tap *out)
@@ -150,7 +133,7 @@ static bool locate(const om__smlook *L, const om_sample *smp, tap *out)
         }
         out->cx = texel_floor_d(u0 * L->size, L->size);
         out->cy = texel_floor_d(v0 * L->size, L->size);
-        out->at = clamp32(out->cy, L->size) * L->size + clamp32(out->cx, L->size);
+        out->at = om__smlook_clamp(out->cy, L->size) * L->size + om__smlook_clamp(out->cx, L->size);
     } else {
         out->u = out->v = 0.0;   /* no warp: taps are the map's texels */
         const float uf = (q.x * iw + 1.0f) * (0.5f * (float)L->size);
@@ -172,7 +155,7 @@ static bool locate(const om__smlook *L, const om_sample *smp, tap *out)
     } else {
         dz = OM_DEPTH_ONE_F * om__fabsf(v->light_proj.m[10]);
     }
-    out->zlit = depth_threshold(z - bias * dz);
+    out->zlit = om__smlook_threshold(z - bias * dz);
     return true;
 }
 
@@ -256,7 +239,7 @@ static inline bool plain_locate(const plain *P, const bool spot, const om_sample
         const float e = dist > P->half_near ? dist : P->half_near;
         dz = P->dz_num / (P->dz_den * e * e) * OM_DEPTH_ONE_F;
     }
-    *zlit = depth_threshold(z - bias * dz);
+    *zlit = om__smlook_threshold(z - bias * dz);
     return true;
 }
 

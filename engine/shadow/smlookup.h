@@ -59,4 +59,24 @@ void om__smlook_begin(om__smlook *L, const om_view *v);
  * below 255) into *samples, *shadowed. */
 void om__smlook_strip(const om__smlook *L, om_strip *st, uint32_t *samples, uint32_t *shadowed);
 
+/* A texel coordinate clamped to a map of `size` texels. */
+static inline uint32_t om__smlook_clamp(int32_t x, uint32_t size)
+{
+    return x < 0 ? 0u : (uint32_t)x >= size ? size - 1 : (uint32_t)x;
+}
+
+/* The least stored depth a biased sample depth z is not behind: z <= D for a stored
+ * integer D exactly when ceil(z) <= D (a NaN never is: 2^32 + 1). Integer compares per
+ * tap rather than conversions to double, which a Cortex-M4F runs in software. The
+ * ceiling through a 32-bit conversion is exact: (float)t is z itself once z >= 2^23.
+ * sm's and rtw's lookups both test with it. */
+static inline uint64_t om__smlook_threshold(float z)
+{
+    if (z != z) return (1ull << 32) + 1;
+    if (!(z > 0.0f)) return 0;
+    if (!(z < OM_DEPTH_ONE_F)) return 1ull << 32;
+    const uint32_t t = (uint32_t)z;
+    return (uint64_t)t + ((float)t < z);
+}
+
 #endif
