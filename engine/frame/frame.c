@@ -107,7 +107,7 @@ static void grow_light_box(const om_view *v, const om_strip *st, om_vec3 *lo, om
 
 /* The bands of the strip: band b is job b of the host's parallel-for, with slot b and
  * rows of its own. */
-typedef enum { STAGE_PREPARE, STAGE_RESOLVE, STAGE_SHADE, STAGE_BUILD, STAGE_PASS, STAGE_BIN_VERTS, STAGE_BIN_ROWS } stage;
+typedef enum { STAGE_PREPARE, STAGE_RESOLVE, STAGE_SHADE, STAGE_BUILD, STAGE_PASS, STAGE_PASS_SETUP, STAGE_BIN_VERTS, STAGE_BIN_ROWS } stage;
 
 typedef struct frame_ctx {
     const om_frame_desc *fd;
@@ -121,6 +121,7 @@ typedef struct frame_ctx {
     job_slot *slots;           /* BANDS_PER_JOB * jobs of them */
     job_slot *pass_slots;      /* the pass's, pass_max of them */
     uint32_t pass_max, pass_jobs, pass_slots_now;   /* STAGE_PASS: K jobs on P slots */
+    uint32_t setup_items;      /* STAGE_PASS_SETUP: the pass's per-frame items */
     stage stage;
     bool eye, mark;            /* STAGE_PREPARE: run the eye pass, mark exposure */
     om__bins map_bins;         /* the light map's (rows NULL: none) */
@@ -137,6 +138,12 @@ static void band_job(void *user, uint32_t b)
     if (c->stage == STAGE_PASS) {   /* slot b: jobs b, b + P, ... (om__pass) */
         for (uint32_t k = b; k < c->pass_jobs; k += c->pass_slots_now)
             c->pass->job(fd->method_state, &c->strip, k, c->pass_slots[b].scratch, c->pass_slots[b].counts);
+        return;
+    }
+    if (c->stage == STAGE_PASS_SETUP) {   /* part b of BANDS_PER_JOB * jobs */
+        const uint32_t parts = BANDS_PER_JOB * c->jobs, n = c->setup_items;
+        c->pass->setup(fd->method_state, (uint32_t)((uint64_t)n * b / parts),
+                       (uint32_t)((uint64_t)n * (b + 1) / parts));
         return;
     }
     if (c->stage == STAGE_BIN_VERTS || c->stage == STAGE_BIN_ROWS) {
@@ -247,6 +254,17 @@ static void run_pass(frame_ctx *c)
     for (uint32_t j = 0; j < p; j++)
         for (int i = 0; i < 8; i++) sum[i] += c->pass_slots[j].counts[i];
     c->pass->merge(state, sum);
+}
+
+/* The method's begin: with a pass that has its own (om__pass.begin), that one, then
+ * the per-frame items it leaves in parts on the host's threads. */
+static om_status begin(frame_ctx *c, const om_view *v, om_diag *d)
+{
+    void *state = c->fd->method_state;
+    if (!OM_WITH_JOBS || !c->pass || !c->pass->begin) return c->fd->method->begin(state, v, d);
+    om_status st = c->pass->begin(state, v, &c->setup_items, d);
+    if (st == OM_OK && c->setup_items) run_stage(c, STAGE_PASS_SETUP, BANDS_PER_JOB * c->jobs);
+    return st;
 }
 
 /* Bins' memory: the rows, and the vertices when they fit too. False: no room. */
@@ -417,7 +435,7 @@ om_status om_render_frame(const om_frame_desc *fd, om_arena *fa, om_frame_stats 
         if (any) om_view_fit_light(&view, s, lo, hi);
         have_samples = single;
     }
-    if ((st = m->begin(fd->method_state, &view, d)) != OM_OK) goto done;
+    if ((st = begin(&c, &view, d)) != OM_OK) goto done;
     if (observes) {
         for (uint32_t y = 0; y < H; y += rows) {
             strip_at(&c, y, rows);

@@ -141,6 +141,13 @@ typedef struct om__pass {
     uint32_t (*plan)(void *state, om_strip *strip);
     void (*job)(const void *state, const om_strip *strip, uint32_t k, void *scratch, uint32_t counts[8]);
     void (*merge)(void *state, const uint32_t counts[8]);
+    /* May be NULL (both). In place of the method's begin when the frame uses the pass:
+     * begin does what the method's begin does but for `*items` items of its per-frame
+     * work, which setup then does as jobs, setup(state, first, end) for disjoint ranges
+     * that together cover [0, *items), before the first strip's plan (izb's projection
+     * of the scene's vertices). */
+    om_status (*begin)(void *state, const om_view *v, uint32_t *items, om_diag *d);
+    void (*setup)(const void *state, uint32_t first, uint32_t end);
 } om__pass;
 
 /* Method m's pass; NULL for none (registry.c). */

@@ -210,12 +210,20 @@ static om_status izb_init(void **state, om_arena *a, const om_method_cfg *mc, co
     return OM_OK;
 }
 
+/* begin but for the projection of the scene's vertices (when they are kept): returns
+ * how many there are to project, which the pass's jobs do in ranges (izb_pass_setup). */
+static uint32_t begin_view(izb_state *m, const om_view *v)
+{
+    om__lspace_view(&m->z.ls, v);
+    memset(&m->z.st, 0, sizeof m->z.st);
+    return m->z.ls.verts ? m->z.scene->nverts : 0;
+}
+
 static om_status izb_begin(void *state, const om_view *v, om_diag *d)
 {
     (void)d;
     izb_state *m = (izb_state *)state;
-    om__lspace_begin(&m->z.ls, v);
-    memset(&m->z.st, 0, sizeof m->z.st);
+    om__lspace_project(&m->z.ls, 0, begin_view(m, v));
     return OM_OK;
 }
 
@@ -798,7 +806,23 @@ static void izb_pass_merge(void *state, const uint32_t counts[8])
     s->tiles += counts[6];
 }
 
-const om__pass om__pass_izb = {izb_pass_scratch, izb_pass_plan, izb_pass_job, izb_pass_merge};
+/* begin with the vertex projection left to the jobs, in ranges of vertices: about 200
+ * instructions a vertex on x86-64, 59 M a frame of random 100K triangles, which would
+ * otherwise hold every other thread up. */
+static om_status izb_pass_begin(void *state, const om_view *v, uint32_t *items, om_diag *d)
+{
+    (void)d;
+    *items = begin_view((izb_state *)state, v);
+    return OM_OK;
+}
+
+static void izb_pass_setup(const void *state, uint32_t first, uint32_t end)
+{
+    om__lspace_project(&((const izb_state *)state)->z.ls, first, end);
+}
+
+const om__pass om__pass_izb = {izb_pass_scratch, izb_pass_plan, izb_pass_job, izb_pass_merge,
+                               izb_pass_begin, izb_pass_setup};
 
 static om_status izb_resolve(void *state, om_strip *st, om_diag *d)
 {

@@ -66,12 +66,16 @@ static double bound(const om__lspace *ls, const om__rtri *r)
     return 2.0 * ((fabs(r->zx) + fabs(r->zy)) * (1.5 + ls->lat * iw) + ls->dep * iw + 1.0);
 }
 
-void om__lspace_begin(om__lspace *ls, const om_view *v)
+void om__lspace_view(om__lspace *ls, const om_view *v)
 {
-    const om_scene *s = ls->scene;
     ls->vp = v->light_vp;
     bound_begin(ls, v);
-    for (uint32_t i = 0; ls->verts && i < s->nverts; i++) {
+}
+
+void om__lspace_project(const om__lspace *ls, uint32_t first, uint32_t end)
+{
+    const om_scene *s = ls->scene;
+    for (uint32_t i = first; ls->verts && i < end; i++) {
         om_vec4 c = om__mat_apply(&ls->vp, s->verts[i]);
         om__lvert *o = &ls->verts[i];
         int64_t X, Y;
@@ -88,6 +92,12 @@ void om__lspace_begin(om__lspace *ls, const om_view *v)
             o->z = 0;
         }
     }
+}
+
+void om__lspace_begin(om__lspace *ls, const om_view *v)
+{
+    om__lspace_view(ls, v);
+    om__lspace_project(ls, 0, ls->scene->nverts);
 }
 
 bool om__lspace_point(const om__lspace *ls, const om_sample *smp, om__lpoint *out)

@@ -78,8 +78,14 @@ om_status om__lspace_init(om__lspace *ls, om_arena *a, const om_scene *s, om_dia
  * the same bits (a vertex inside every plane projects exactly as clipping projects it);
  * only the speed differs. */
 void om__lspace_init_lean(om__lspace *ls, const om_scene *s);
-/* Projects every vertex for this frame's light. */
+/* Projects every vertex for this frame's light: om__lspace_view, then
+ * om__lspace_project over all of them. */
 void om__lspace_begin(om__lspace *ls, const om_view *v);
+/* Its two halves: this frame's matrix and snapping bound; then the projection of
+ * vertices [first, end), which writes only theirs (so disjoint ranges may run at once,
+ * after the view). */
+void om__lspace_view(om__lspace *ls, const om_view *v);
+void om__lspace_project(const om__lspace *ls, uint32_t first, uint32_t end);
 /* Projects a sample; false when it is not in front of the light. */
 bool om__lspace_point(const om__lspace *ls, const om_sample *smp, om__lpoint *out);
 
