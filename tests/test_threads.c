@@ -1,8 +1,8 @@
 /* test_threads.c — many cores, same bits: every method's frame (pixels, terms, mask)
  * and counters with 1, 2, 3, 4, 7 and 16 threads through the platform's pool, and with
  * a parallel-for that runs its jobs backwards, against the inline frame; whole frames
- * and strips, a spot and a directional light. And the frame arena: room for N jobs
- * but not N + 1 runs N. */
+ * and strips, a spot and a directional light, each over a frame arena holding other
+ * bytes. And the frame arena: room for N jobs but not N + 1 runs N. */
 #include "test.h"
 #include "harness.h"
 #include "../platform/platform.h"
@@ -58,6 +58,10 @@ static frame_out render_set(const om_scene *s, const om_method *m, const char *s
     uint32_t r = rows ? rows : H;
     size_t fbytes = (bins ? om_frame_bytes_scene(s, W, r) : om_frame_bytes(W, r)) + job_bytes;
     void *mm = malloc(full), *fm = malloc(fbytes), *px = malloc((size_t)W * r * 3);
+    /* The frame arena filled with bytes that differ with the thread count and strips
+     * (0x00, 0xFF, NaNs...): the frame carves its per-pixel buffers and bins without
+     * zeroing them, so a byte read before it is written would change the frame. */
+    if (fm) memset(fm, (int)((threads * 0x35u + rows) & 0xFFu), fbytes);
     om_arena ma, fa;
     om_arena_init(&ma, mm, full, "method");
     om_arena_init(&fa, fm, fbytes, "frame");

@@ -39,7 +39,8 @@ static om_status budget_fail(om_arena *a, size_t asked, om_diag *d)
     return OM_E_BUDGET;
 }
 
-om_status om_arena_alloc(om_arena *a, size_t size, size_t align, void **out, om_diag *d)
+/* Carves size bytes; zeroes them when `zero`. */
+static om_status carve(om_arena *a, size_t size, size_t align, void **out, om_diag *d, bool zero)
 {
     *out = NULL;
     if (align == 0 || (align & (align - 1)) != 0 || align > 64)
@@ -57,9 +58,19 @@ om_status om_arena_alloc(om_arena *a, size_t size, size_t align, void **out, om_
     a->used += pad + size;
     if (a->used > a->peak) a->peak = a->used;
     a->carves++;
-    if (size) memset(p, 0, size);
+    if (zero && size) memset(p, 0, size);
     *out = p;
     return OM_OK;
+}
+
+om_status om_arena_alloc(om_arena *a, size_t size, size_t align, void **out, om_diag *d)
+{
+    return carve(a, size, align, out, d, true);
+}
+
+om_status om__arena_alloc_raw(om_arena *a, size_t size, size_t align, void **out, om_diag *d)
+{
+    return carve(a, size, align, out, d, false);
 }
 
 om_status om_arena_sub(om_arena *a, size_t size, const char *name, om_arena *child,

@@ -43,6 +43,12 @@ om__str om__diag_begin(om_diag *d, om_status st, char *scratch, size_t scratch_c
  * `who` and the minimum. Inits call it with their bytes query's figure. */
 om_status om__need(om_arena *a, size_t need, const char *who, om_diag *d);
 
+/* om_arena_alloc without the zeroing: the bytes are what the host's buffer held. Only
+ * for memory its user writes whole before anything reads it (the frame's per-pixel
+ * buffers and bins, megabytes that the eye pass and om__bins_make fill anyway), where
+ * zeroing them would be a pass over them on one thread. */
+om_status om__arena_alloc_raw(om_arena *a, size_t size, size_t align, void **out, om_diag *d);
+
 /* ---- bits */
 /* Index of the lowest set bit of x != 0: one instruction where the compiler offers it
  * (bit masks are scanned per texel), else a loop. */

@@ -25,6 +25,7 @@
 typedef struct job_slot {
     uint32_t counts[8];
     void *scratch;
+    size_t dirty;   /* bytes of scratch its first job zeroes (a pass slot: band_job) */
 } job_slot;
 
 static size_t bins_bytes(const om_scene *s)
@@ -136,8 +137,13 @@ static void band_job(void *user, uint32_t b)
     const frame_ctx *c = (const frame_ctx *)user;
     const om_frame_desc *fd = c->fd;
     if (c->stage == STAGE_PASS) {   /* slot b: jobs b, b + P, ... (om__pass) */
+        job_slot *sl = &c->pass_slots[b];
+        if (sl->dirty) {   /* zeroed here, on the slot's thread, not all on the caller's */
+            memset(sl->scratch, 0, sl->dirty);
+            sl->dirty = 0;
+        }
         for (uint32_t k = b; k < c->pass_jobs; k += c->pass_slots_now)
-            c->pass->job(fd->method_state, &c->strip, k, c->pass_slots[b].scratch, c->pass_slots[b].counts);
+            c->pass->job(fd->method_state, &c->strip, k, sl->scratch, sl->counts);
         return;
     }
     if (c->stage == STAGE_PASS_SETUP) {   /* part b of BANDS_PER_JOB * jobs */
@@ -267,18 +273,19 @@ static om_status begin(frame_ctx *c, const om_view *v, om_diag *d)
     return st;
 }
 
-/* Bins' memory: the rows, and the vertices when they fit too. False: no room. */
+/* Bins' memory: the rows, and the vertices when they fit too. False: no room. Not
+ * zeroed: make_bins writes every triangle's rows and every vertex before any is read. */
 static bool carve_bins(om_arena *fa, const om_scene *s, om__bins *b)
 {
     void *pb, *pv;
     b->rows = NULL;
     b->verts = NULL;
     if (!s->ntris || om_arena_left(fa) < om__bins_rows_bytes(s) ||
-        om_arena_alloc(fa, (size_t)s->ntris * sizeof(uint32_t), 8, &pb, NULL) != OM_OK)
+        om__arena_alloc_raw(fa, (size_t)s->ntris * sizeof(uint32_t), 8, &pb, NULL) != OM_OK)
         return false;
     b->rows = (uint32_t *)pb;
     if (om_arena_left(fa) >= om__bins_verts_bytes(s) &&
-        om_arena_alloc(fa, (size_t)s->nverts * sizeof(om__vsnap), 8, &pv, NULL) == OM_OK)
+        om__arena_alloc_raw(fa, (size_t)s->nverts * sizeof(om__vsnap), 8, &pv, NULL) == OM_OK)
         b->verts = (om__vsnap *)pv;
     return true;
 }
@@ -341,9 +348,13 @@ static void carve_jobs(frame_ctx *c, om_arena *fa, size_t keep)
     if (ps) {
         if (om_arena_alloc(fa, jobs * sizeof(job_slot), 8, &p, NULL)) return;
         c->pass_slots = (job_slot *)p;
-        for (uint32_t j = 0; j < jobs; j++)
-            if (om_arena_alloc(fa, pscratch ? pscratch : 1, 16, &c->pass_slots[j].scratch, NULL))
+        /* The scratch is zeroed by each slot's first job (band_job), in parallel: for
+         * izb it is megabytes a thread. */
+        for (uint32_t j = 0; j < jobs; j++) {
+            if (om__arena_alloc_raw(fa, pscratch ? pscratch : 1, 16, &c->pass_slots[j].scratch, NULL))
                 return;   /* cannot happen: counted above */
+            c->pass_slots[j].dirty = pscratch ? pscratch : 1;
+        }
         c->pass = ps;
         c->pass_max = jobs;
     }
@@ -375,10 +386,13 @@ om_status om_render_frame(const om_frame_desc *fd, om_arena *fa, om_frame_stats 
     om_status st;
     void *pd, *pi, *ps, *pt;
     size_t n = (size_t)W * rows;
-    if ((st = om_arena_alloc(fa, n * sizeof(uint32_t), 8, &pd, d)) ||
-        (st = om_arena_alloc(fa, n * sizeof(uint32_t), 8, &pi, d)) ||
-        (st = om_arena_alloc(fa, n * sizeof(om_sample), 8, &ps, d)) ||
-        (st = om_arena_alloc(fa, n * sizeof(om_term), 8, &pt, d))) {
+    /* Not zeroed (44 bytes a pixel, on one thread): every strip's eye pass clears its
+     * rows of depth and id and writes every sample, and its exposure marks (or
+     * mark_exposed) every term, before anything reads them. */
+    if ((st = om__arena_alloc_raw(fa, n * sizeof(uint32_t), 8, &pd, d)) ||
+        (st = om__arena_alloc_raw(fa, n * sizeof(uint32_t), 8, &pi, d)) ||
+        (st = om__arena_alloc_raw(fa, n * sizeof(om_sample), 8, &ps, d)) ||
+        (st = om__arena_alloc_raw(fa, n * sizeof(om_term), 8, &pt, d))) {
         om_arena_rewind(fa, mark);
         return st;
     }

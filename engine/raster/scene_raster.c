@@ -90,7 +90,11 @@ void om__bins_make_verts(const om_scene *s, const om_mat4 *vp, uint32_t width, u
     const om__guard g = om__guard_band(width, height);
     for (uint32_t v = v0; vs && v < v1 && v < s->nverts; v++) {
         const om_vec4 c = om__mat_apply(vp, s->verts[v]);
-        if (!snap_alone(&c, width, height, g, &vs[v])) vs[v].x = INT32_MIN;
+        if (!snap_alone(&c, width, height, g, &vs[v])) {
+            vs[v].x = INT32_MIN;   /* all of it: the frame's bins are not zeroed first */
+            vs[v].y = 0;
+            vs[v].z = 0;
+        }
     }
 }
 
