@@ -36,15 +36,9 @@
  * sample on a texel's border belongs to the one texel its grid point falls in, and
  * that texel's square holds the point. Everything else is uncertain.
  *
- * The uncertain samples: an irregular z-buffer of texel lists. Each tile of them
- * (izb.pool, or as many as the arena holds) is sorted by the texel its grid point
- * falls in, and each block of BLOCK x BLOCK texels keeps the farthest of their
- * depths. A triangle then reaches only the blocks its bounds touch that hold samples
- * farther than its nearest depth (with its projected vertices at hand, no clipping,
- * that is checked before any setup, so the triangles near no uncertain sample cost a
- * few comparisons), and in them the texels its edges touch. Every sample it reaches gets the
- * predicate, om__blocks; semi-transparent casters add their optical depth (integer
- * sums, the same in any order), and an opaquely shadowed sample is done. */
+ * The uncertain samples go through an irregular z-buffer of their own, a tile of them
+ * at a time (izb.pool, or as many as the arena holds; hybrid_tile.c): every test there
+ * is the predicate, om__blocks, so those answers are the reference's too. */
 #include "shadow.h"
 #include "hybrid.h"
 #include "izb.h"   /* izb.pool, the setting both take */
@@ -57,29 +51,12 @@
  * cid). */
 typedef struct htexel { float z, gx, gy, hi; uint32_t cid; } htexel;
 
-/* An uncertain sample on the light's grid (the grid fits in 27 bits, its depth is a
- * whole unit: om__lspace_point) and what blocks it so far; idx is its place in the
- * strip, with DONE set once it is opaquely shadowed. */
-typedef struct hsample {
-    int32_t x, y;
-    uint32_t z, tri, idx;
-    om__odepth od;
-} hsample;
-#define DONE 0x80000000u
-
 /* Where a double operation is a software routine (OM_FAST_FLOAT, core.h), the
  * lookup's plane test and the small triangles' updates of the map try single
  * precision first and use double only where the float's error bound leaves the
  * answer open; elsewhere double costs what float does and runs alone. The answers
  * are the same either way (the float answers only where the double would answer
  * alike), and so the map and the frames. */
-
-/* Texels per side of a block (the coarse level a triangle looks at first). */
-#define BLOCK 4
-
-/* Grid bounds and a depth: a projected triangle's bounds and nearest vertex depth
- * (vbox_of), or a tile's samples' bounds and farthest depth. */
-typedef struct vbox { int32_t lox, loy, hix, hiy; uint32_t z; } vbox;
 
 /* hybrid's configuration: the sample pool's size and its map's side. */
 typedef struct hybrid_cfg {
@@ -99,16 +76,10 @@ typedef struct hybrid_state {
     uint32_t side;         /* texels per side */
     int64_t T;             /* grid units per texel side */
     int tshift;            /* log2(T) when T is a power of two (the default sides), else -1 */
-    uint32_t bside;        /* blocks per side */
-    /* The tile: its samples as they come (raw, with each one's texel) and sorted by
-     * texel (smp): texel t's are smp[t ? tend[t - 1] : 0 .. tend[t]), in an array of
-     * their own, so the sort sweeps 4 bytes a texel, not the map; the farthest depth
-     * of a block's samples, bzmax (0: none a triangle could block). */
-    hsample *raw, *smp;
-    uint32_t *rtex, *tend, *bzmax;
-    vbox box;              /* the tile's samples' bounds and farthest depth */
+    om__hscene h;          /* what the irregular pass reads */
+    om__htile tile;        /* its tile of uncertain samples, cap of them */
     uint32_t cap;          /* samples the pool holds */
-    uint32_t lit, shadowed, uncertain, setups, tested, tiles;
+    uint32_t lit, shadowed, uncertain, tiles;   /* with the tile's setups and tested */
 } hybrid_state;
 
 #define GRID_SIDE ((int64_t)OM_LIGHT_GRID * OM_SUBPIX)   /* 2^21 grid units */
@@ -126,8 +97,6 @@ static uint32_t map_side(const hybrid_cfg *c, uint32_t w, uint32_t h)
     return side;
 }
 
-static uint32_t blocks_of(uint32_t side) { return (side + BLOCK - 1) / BLOCK; }
-
 static size_t mats_bytes(const om_scene *s)
 {
     return om_arena_need((size_t)(s->nmats ? s->nmats : 1) * sizeof(om__odepth), 4);
@@ -136,17 +105,12 @@ static size_t mats_bytes(const om_scene *s)
 /* Everything but the pool; the per-frame vertex projection with `cache`. */
 static size_t fixed_bytes(uint32_t side, const om_scene *s, bool cache)
 {
-    size_t nb = (size_t)blocks_of(side) * blocks_of(side);
     return om_arena_need(sizeof(hybrid_state), 16) + (cache ? om__lspace_bytes(s) : 0) + mats_bytes(s) +
-           om_arena_need((size_t)side * side * sizeof(htexel), 16) +
-           om_arena_need((size_t)side * side * sizeof(uint32_t), 16) + om_arena_need(nb * sizeof(uint32_t), 16);
+           om_arena_need((size_t)side * side * sizeof(htexel), 16);
 }
 
-/* A pool of n uncertain samples: both orders and each one's texel. */
-static size_t pool_bytes(uint32_t n)
-{
-    return 2 * om_arena_need((size_t)n * sizeof(hsample), 16) + om_arena_need((size_t)n * sizeof(uint32_t), 16);
-}
+/* A pool of n uncertain samples: a tile's memory (hybrid_tile.c). */
+static size_t pool_bytes(uint32_t n) { return om_arena_need(om__htile_bytes(n), 16); }
 
 static om_status need(const hybrid_cfg *c, const om_scene *s, uint32_t w, uint32_t h,
                       size_t *min, size_t *full)
@@ -190,18 +154,12 @@ static om_status hybrid_init(void **state, om_arena *a, const om_method_cfg *mc,
     m->scene = s;
     m->cfg = c;
     m->side = map_side(&c, w, h);
-    m->bside = blocks_of(m->side);
     m->T = (GRID_SIDE + m->side - 1) / m->side;
     m->tshift = -1;
     for (int b = 0; b < 62; b++)
         if (((int64_t)1 << b) == m->T) m->tshift = b;
-    size_t nb = (size_t)m->bside * m->bside;
     if ((st = carve(a, (size_t)m->side * m->side, sizeof(htexel), &p, d))) return st;
     m->map = (htexel *)p;
-    if ((st = carve(a, (size_t)m->side * m->side, sizeof(uint32_t), &p, d))) return st;
-    m->tend = (uint32_t *)p;
-    if ((st = carve(a, nb, sizeof(uint32_t), &p, d))) return st;
-    m->bzmax = (uint32_t *)p;
     /* The vertex projection only when a one-pass pool fits beside it (it speeds up
      * triangle setup, it changes no result); then the pool, as set or as large as
      * the arena allows, from one row up to the frame. */
@@ -223,12 +181,11 @@ static om_status hybrid_init(void **state, om_arena *a, const om_method_cfg *mc,
         else hi = mid - 1;
     }
     m->cap = cap;
-    if ((st = carve(a, cap, sizeof(hsample), &p, d))) return st;
-    m->raw = (hsample *)p;
-    if ((st = carve(a, cap, sizeof(hsample), &p, d))) return st;
-    m->smp = (hsample *)p;
-    if ((st = carve(a, cap, sizeof(uint32_t), &p, d))) return st;
-    m->rtex = (uint32_t *)p;
+    if ((st = om_arena_alloc(a, om__htile_bytes(cap), 16, &p, d))) return st;
+    om__htile_carve(&m->tile, p, cap);
+    m->h.scene = s;
+    m->h.ls = &m->ls;
+    m->h.mat_od = m->mat_od;
     *state = m;
     return OM_OK;
 }
@@ -238,7 +195,7 @@ static om_status hybrid_begin(void *state, const om_view *v, om_diag *d)
     (void)d;
     hybrid_state *m = (hybrid_state *)state;
     om__lspace_begin(&m->ls, v);
-    m->lit = m->shadowed = m->uncertain = m->setups = m->tested = m->tiles = 0;
+    m->lit = m->shadowed = m->uncertain = m->tiles = m->tile.setups = m->tile.tested = 0;
     return OM_OK;
 }
 
@@ -269,17 +226,6 @@ static bool square_inside(const om__tri2 *e, int64_t x0, int64_t y0, int64_t x1,
 {
     for (int i = 0; i < 3; i++)
         if ((e->a[i] > 0 ? e->a[i] * x0 : e->a[i] * x1) + (e->b[i] > 0 ? e->b[i] * y0 : e->b[i] * y1) +
-                e->c[i] < 0)
-            return false;
-    return true;
-}
-
-/* Does any point of the square [x0, x1] x [y0, y1] pass every edge of e? Each edge is
- * tested at the corner where it is largest: a square outside one edge is out. */
-static bool square_touches(const om__tri2 *e, int64_t x0, int64_t y0, int64_t x1, int64_t y1)
-{
-    for (int i = 0; i < 3; i++)
-        if ((e->a[i] > 0 ? e->a[i] * x1 : e->a[i] * x0) + (e->b[i] > 0 ? e->b[i] * y1 : e->b[i] * y0) +
                 e->c[i] < 0)
             return false;
     return true;
@@ -322,7 +268,7 @@ static void add_sub(hybrid_state *m, const om__rtri *r, double bound, uint32_t t
             int64_t x0 = tx * m->T, x1 = x0 + m->T - 1;
                 if (tx == 0) x0 = -FAR_OUT;
             if (tx == last) x1 = FAR_OUT;
-            if (!square_touches(e, x0, y0, x1, y1)) continue;
+            if (!om__square_touches(e, x0, y0, x1, y1)) continue;
             htexel *h = &m->map[ty * (int64_t)m->side + tx];
             int64_t xc = tx * m->T + m->T / 2, yc = ty * m->T + m->T / 2;
             if (h->gx != h->gx) {   /* empty (NaN): the texel takes this plane's slopes */
@@ -376,7 +322,7 @@ static trange texels_in(const hybrid_state *m, int64_t lox, int64_t loy, int64_t
 
 /* A projected triangle's bounds and nearest vertex depth; false when it needs
  * clipping (or the projection is not kept). */
-static bool vbox_of(const hybrid_state *m, uint32_t t, vbox *v)
+static bool vbox_of(const hybrid_state *m, uint32_t t, om__hbox *v)
 {
     if (!m->ls.verts) return false;
     const uint32_t *ix = m->scene->idx + (size_t)t * 3;
@@ -407,7 +353,7 @@ static bool vbox_of(const hybrid_state *m, uint32_t t, vbox *v)
  * triangle takes the full path. */
 static bool add_small(hybrid_state *m, uint32_t t)
 {
-    vbox v;
+    om__hbox v;
     if (!vbox_of(m, t, &v)) return false;
     if ((int64_t)v.hix - v.lox >= m->T - 1 && (int64_t)v.hiy - v.loy >= m->T - 1) return false;
     trange r = texels_in(m, v.lox, v.loy, v.hix, v.hiy);
@@ -524,164 +470,6 @@ int om__hybrid_decide(void *state, const om__lpoint *p, om_term *t)
 
 const om__lspace *om__hybrid_lspace(const void *state) { return &((const hybrid_state *)state)->ls; }
 
-static inline int32_t min3(int32_t a, int32_t b, int32_t c) { return a < b ? (a < c ? a : c) : (b < c ? b : c); }
-static inline int32_t max3(int32_t a, int32_t b, int32_t c) { return a > b ? (a > c ? a : c) : (b > c ? b : c); }
-
-/* vbox_of against the tile's samples, an axis at a time: -1 when the triangle's
- * bounds miss theirs or it is nowhere nearer than their farthest (it blocks none of
- * them), 1 with v its bounds, 0 when it needs clipping (or the projection is not
- * kept). */
-static int vbox_near(const hybrid_state *m, uint32_t t, vbox *v)
-{
-    if (!m->ls.verts) return 0;
-    const uint32_t *ix = m->scene->idx + (size_t)t * 3;
-    const om__lvert *a = &m->ls.verts[ix[0]], *b = &m->ls.verts[ix[1]], *c = &m->ls.verts[ix[2]];
-    if (a->x == INT32_MIN || b->x == INT32_MIN || c->x == INT32_MIN) return 0;
-    const vbox *x = &m->box;
-    v->lox = min3(a->x, b->x, c->x);
-    v->hix = max3(a->x, b->x, c->x);
-    if (v->hix < x->lox || v->lox > x->hix) return -1;
-    v->loy = min3(a->y, b->y, c->y);
-    v->hiy = max3(a->y, b->y, c->y);
-    if (v->hiy < x->loy || v->loy > x->hiy) return -1;
-    v->z = a->z < b->z ? (a->z < c->z ? a->z : c->z) : (b->z < c->z ? b->z : c->z);
-    return v->z >= x->z ? -1 : 1;
-}
-
-/* Does a block that r reaches hold a sample farther than depth z? (A triangle whose
- * every depth plus bound is at z or beyond blocks none there.) */
-static bool any_farther(const hybrid_state *m, const trange *r, uint32_t z)
-{
-    for (uint32_t by = r->y0 / BLOCK; by <= r->y1 / BLOCK; by++)
-        for (uint32_t bx = r->x0 / BLOCK; bx <= r->x1 / BLOCK; bx++)
-            if (m->bzmax[by * m->bside + bx] > z) return true;
-    return false;
-}
-
-/* Is an open sample in the texels of r inside v's bounds and farther than its nearest
- * vertex? */
-static bool any_within(const hybrid_state *m, const trange *r, const vbox *v)
-{
-    const int32_t lox = v->lox, hix = v->hix, loy = v->loy, hiy = v->hiy;
-    const uint32_t z = v->z;
-    for (uint32_t ty = r->y0; ty <= r->y1; ty++)
-        for (uint32_t tx = r->x0; tx <= r->x1; tx++) {
-            size_t tex = (size_t)ty * m->side + tx;
-            const hsample *q = m->smp + (tex ? m->tend[tex - 1] : 0), *end = m->smp + m->tend[tex];
-            for (; q < end; q++)
-                if (q->x >= lox && q->x <= hix && q->y >= loy && q->y <= hiy && q->z > z && !(q->idx & DONE))
-                    return true;
-        }
-    return false;
-}
-
-/* Sorts the tile's n samples by texel (a counting sort through tend, stable:
- * strip order within a texel) and notes each block's farthest depth. */
-static void sort_tile(hybrid_state *m, uint32_t n)
-{
-    size_t nt = (size_t)m->side * m->side;
-    memset(m->bzmax, 0, (size_t)m->bside * m->bside * sizeof *m->bzmax);
-    memset(m->tend, 0, nt * sizeof *m->tend);
-    vbox *x = &m->box;
-    x->lox = x->loy = INT32_MAX;
-    x->hix = x->hiy = INT32_MIN;
-    x->z = 0;
-    for (uint32_t i = 0; i < n; i++) {
-        const hsample *q = &m->raw[i];
-        uint32_t t = m->rtex[i], b = t / m->side / BLOCK * m->bside + t % m->side / BLOCK;
-        m->tend[t]++;
-        if (q->z > m->bzmax[b]) m->bzmax[b] = q->z;
-        if (q->x < x->lox) x->lox = q->x;
-        if (q->x > x->hix) x->hix = q->x;
-        if (q->y < x->loy) x->loy = q->y;
-        if (q->y > x->hiy) x->hiy = q->y;
-        if (q->z > x->z) x->z = q->z;
-    }
-    uint32_t sum = 0;
-    for (size_t t = 0; t < nt; t++) {   /* counts -> starts */
-        uint32_t c = m->tend[t];
-        m->tend[t] = sum;
-        sum += c;
-    }
-    for (uint32_t i = 0; i < n; i++) m->smp[m->tend[m->rtex[i]]++] = m->raw[i];   /* starts -> ends */
-}
-
-/* Could a sub-triangle of lt cover a point of texel (tx, ty)? Each edge is tested at
- * the square's corner where it is largest; the border texels reach off the grid. */
-static bool texel_touches(const hybrid_state *m, const om__ltri *lt, int64_t tx, int64_t ty)
-{
-    int64_t last = (int64_t)m->side - 1, x0 = tx * m->T, y0 = ty * m->T, x1 = x0 + m->T - 1, y1 = y0 + m->T - 1;
-    if (tx == 0) x0 = -FAR_OUT;
-    if (ty == 0) y0 = -FAR_OUT;
-    if (tx == last) x1 = FAR_OUT;
-    if (ty == last) y1 = FAR_OUT;
-    for (int k = 0; k < lt->n; k++)
-        if (square_touches(&lt->sub[k].e, x0, y0, x1, y1)) return true;
-    return false;
-}
-
-/* Triangle t against the tile's samples; returns how many it shadowed opaquely. */
-static uint32_t cast(hybrid_state *m, uint32_t t)
-{
-    const om_scene *s = m->scene;
-    vbox v;
-    const int near = vbox_near(m, t, &v);
-    if (near < 0) return 0;
-    if (near > 0) {
-        /* The triangle's bounds are its vertices', its plane's depth lies within
-         * theirs: the culls, before any setup. First against the bounds of all the
-         * tile's samples (a tile of a few rows of the image lies in a small part of
-         * the light's grid), then of its blocks; and where its bounds reach a few
-         * texels, whether any open sample there lies within them, farther. */
-        trange r = texels_in(m, v.lox, v.loy, v.hix, v.hiy);
-        if (!any_farther(m, &r, v.z)) return 0;
-        if ((r.x1 - r.x0 + 1) * (r.y1 - r.y0 + 1) <= 4 && !any_within(m, &r, &v)) return 0;
-    }
-    om__ltri lt;
-    if (!om__lspace_tri(&m->ls, t, &lt)) return 0;
-    m->setups++;
-    const om__odepth *od = &m->mat_od[s->tri_mat[t]];
-    trange r = texels_in(m, lt.lox, lt.loy, lt.hix, lt.hiy);
-    uint32_t closed = 0;
-    for (uint32_t by = r.y0 / BLOCK; by <= r.y1 / BLOCK; by++)
-        for (uint32_t bx = r.x0 / BLOCK; bx <= r.x1 / BLOCK; bx++) {
-            if ((double)m->bzmax[by * m->bside + bx] <= lt.zmin) continue;
-            uint32_t ya = by * BLOCK > r.y0 ? by * BLOCK : r.y0, yb = by * BLOCK + BLOCK - 1 < r.y1 ? by * BLOCK + BLOCK - 1 : r.y1;
-            uint32_t xa = bx * BLOCK > r.x0 ? bx * BLOCK : r.x0, xb = bx * BLOCK + BLOCK - 1 < r.x1 ? bx * BLOCK + BLOCK - 1 : r.x1;
-            for (uint32_t ty = ya; ty <= yb; ty++)
-                for (uint32_t tx = xa; tx <= xb; tx++) {
-                    size_t tex = (size_t)ty * m->side + tx;
-                    uint32_t i = tex ? m->tend[tex - 1] : 0, end = m->tend[tex];
-                    if (i == end || !texel_touches(m, &lt, tx, ty)) continue;
-                    for (; i < end; i++) {
-                        hsample *q = &m->smp[i];
-                        if ((q->idx & DONE) || q->x < lt.lox || q->x > lt.hix || q->y < lt.loy || q->y > lt.hiy)
-                            continue;
-                        om__lpoint p = {q->x, q->y, (double)q->z, q->tri};
-                        m->tested++;
-                        if (!om__blocks(&lt, &p)) continue;
-                        om__odepth_add(&q->od, od);
-                        if (om__odepth_opaque(&q->od)) {
-                            q->idx |= DONE;
-                            closed++;
-                        }
-                    }
-                }
-        }
-    return closed;
-}
-
-/* One tile of n uncertain samples (in raw): sorted by block, every triangle cast
- * until all are opaquely shadowed, the terms written. */
-static void run_tile(hybrid_state *m, om_strip *st, uint32_t n)
-{
-    sort_tile(m, n);
-    uint32_t open = n;
-    for (uint32_t t = 0; t < m->scene->ntris && open; t++) open -= cast(m, t);
-    for (uint32_t i = 0; i < n; i++) om__odepth_term(&m->smp[i].od, &st->terms[m->smp[i].idx & ~DONE]);
-    m->tiles++;
-}
-
 /* The term a band leaves on a sample its map could not decide (no certain answer is
  * ever anything but 0 or 255 in every channel); the pass after the bands overwrites
  * every one. */
@@ -703,7 +491,6 @@ static void uncertain_pass(hybrid_state *m, om_strip *st, bool banded)
             if (banded) {
                 if (!(t->flags & OM_TERM_EXPOSED) || !marked(t) || !om__lspace_point(&m->ls, &st->samples[i], &p))
                     continue;
-                tex = texel_of(m, p.y) * (int64_t)m->side + texel_of(m, p.x);
             } else {
                 t->r = t->g = t->b = 255;
                 if (!(t->flags & OM_TERM_EXPOSED) || !om__lspace_point(&m->ls, &st->samples[i], &p)) continue;
@@ -713,16 +500,17 @@ static void uncertain_pass(hybrid_state *m, om_strip *st, bool banded)
                 if (c) continue;
                 m->uncertain++;
             }
-            hsample *q = &m->raw[k];
+            om__hkey *q = &m->tile.raw[k++];
             q->x = (int32_t)p.x;
             q->y = (int32_t)p.y;
             q->z = (uint32_t)p.z;
             q->tri = p.tri;
             q->idx = (uint32_t)i;
-            memset(&q->od, 0, sizeof q->od);
-            m->rtex[k++] = (uint32_t)tex;
         }
-        if (k) run_tile(m, st, k);
+        if (k) {
+            om__htile_run(&m->h, &m->tile, k, st);
+            m->tiles++;
+        }
     }
 }
 
@@ -775,7 +563,7 @@ static void hybrid_stats(const void *state, om_method_stats *out)
     out->bytes_used = fixed_bytes(m->side, m->scene, m->ls.verts != NULL) + pool_bytes(m->cap);
     static const char *const names[] = {"certain lit", "certain shadowed", "uncertain", "triangles set up",
                                         "samples tested", "tiles", "pool samples"};
-    uint32_t v[7] = {m->lit, m->shadowed, m->uncertain, m->setups, m->tested, m->tiles, m->cap};
+    uint32_t v[7] = {m->lit, m->shadowed, m->uncertain, m->tile.setups, m->tile.tested, m->tiles, m->cap};
     for (int i = 0; i < 7; i++) {
         out->counters[i] = v[i];
         out->counter_names[i] = names[i];
@@ -786,7 +574,7 @@ static void hybrid_stats(const void *state, om_method_stats *out)
 static const om_setting settings[] = {
     OM__SET_IZB_POOL(hybrid_cfg, izb_pool),
     OM__SETTING(hybrid_cfg, hybrid_map, "hybrid.map", OM_SETTING_U32, 0, OM_MAX_DIM, 0,
-                "side of its conservative map (24 bytes a texel), 0 = half the image's side"),
+                "side of its conservative map (20 bytes a texel), 0 = half the image's side"),
 };
 
 const om_method om__method_hybrid = {
