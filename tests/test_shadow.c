@@ -148,6 +148,129 @@ static void bvh_equals_brute_force(void)
     }
 }
 
+/* om__blocks_f, the predicate in single precision, gives om__blocks' double answer
+ * whenever it gives one: random triangles written into the frame's vertex projection
+ * (wide ones, small ones and slivers, either winding, depths across the whole range),
+ * points inside, on edges and beyond, under a spot and a directional light, each with
+ * a depth next to the double's threshold (depth plus bound), a few units from it, or
+ * far from it. */
+static uint32_t rnd32(uint32_t *s)
+{
+    *s ^= *s << 13;   /* xorshift: every bit as random as the others */
+    *s ^= *s >> 17;
+    *s ^= *s << 5;
+    return *s;
+}
+
+static void float_predicate_is_the_double_one(void)
+{
+    static const char *scenes[] = {
+        "camera eye 0 5 8 target 0 0.5 0 fov 55 size 160 120\n"
+        "light spot pos 3 9 2 target 0 0 0 fov 75 near 1 far 40\n"
+        "triangles count 2 seed 3 area 1 in -3 0.3 -3 3 3 3\n",
+        "camera eye 2 4 6 target 0 0.5 0 fov 60 size 160 120\n"
+        "light directional dir -0.3 -1 -0.2\n"
+        "plane size 14 14\n"
+        "triangles count 2 seed 9 area 1 in -2 2 -2 2 3 2\n",
+    };
+    uint32_t s = 29;
+    unsigned long long wrong = 0, near = 0, near_answered = 0, far = 0, far_answered = 0, blocked = 0;
+    for (int k = 0; k < 2; k++) {
+        h_scene hs;
+        if (!h_scene_parse(&hs, scenes[k])) return;
+        om_camera cam;
+        om_light light;
+        om_view v;
+        om_scene_at(&hs.s, 0, &cam, &light);
+        CHECK_OK(om_view_init(&v, &cam, &light, &hs.s, NULL));
+        static unsigned char mem[1 << 16];
+        om_arena a;
+        om_arena_init(&a, mem, sizeof mem, "t");
+        om__lspace ls;
+        CHECK_OK(om__lspace_init(&ls, &a, &hs.s, NULL));
+        om__lspace_begin(&ls, &v);
+        const uint32_t *ix = hs.s.idx;   /* triangle 0's vertices are rewritten */
+        for (int it = 0; it < 200000; it++) {
+            const int shape = it % 5;   /* wide, small, sliver, anywhere, steep */
+            const int32_t span = shape == 1 ? (int32_t)(1u << (8 + rnd32(&s) % 8)) : 1 << 21;
+            int32_t x[3], y[3];
+            x[0] = (int32_t)(rnd32(&s) % (3u << 21)) - (1 << 21);
+            y[0] = (int32_t)(rnd32(&s) % (3u << 21)) - (1 << 21);
+            for (int i = 1; i < 3; i++) {
+                x[i] = x[0] + (int32_t)(rnd32(&s) % (2u * (uint32_t)span)) - span;
+                y[i] = y[0] + (int32_t)(rnd32(&s) % (2u * (uint32_t)span)) - span;
+            }
+            if (shape == 2) {   /* the third vertex a few units off the line of the others */
+                const double f = (double)(rnd32(&s) % 1000) / 1000.0;
+                x[2] = x[0] + (int32_t)((x[1] - x[0]) * f) + (int32_t)(rnd32(&s) % 7) - 3;
+                y[2] = y[0] + (int32_t)((y[1] - y[0]) * f) + (int32_t)(rnd32(&s) % 7) - 3;
+            }
+            for (int i = 0; i < 3; i++) {   /* the guard band's range */
+                x[i] = x[i] < -(1 << 21) ? -(1 << 21) : x[i] > 1 << 22 ? 1 << 22 : x[i];
+                y[i] = y[i] < -(1 << 21) ? -(1 << 21) : y[i] > 1 << 22 ? 1 << 22 : y[i];
+            }
+            if (shape == 3 && it % 16 == 3) x[1] = 1 << 23;   /* beyond 2^22: no answer */
+            const uint32_t zb = rnd32(&s), zr = rnd32(&s) >> (rnd32(&s) % 32);
+            for (int i = 0; i < 3; i++) {
+                uint32_t z = zb + (rnd32(&s) % (zr | 1u));
+                if (it % 7 == 0) z = rnd32(&s);
+                ls.verts[ix[i]].x = x[i];
+                ls.verts[ix[i]].y = y[i];
+                ls.verts[ix[i]].z = z;
+            }
+            if (shape == 4) {   /* the first vertex far, the others near: the depth at p
+                                   cancels most of the first vertex's */
+                ls.verts[ix[0]].z = 0xFFFFFFFFu - rnd32(&s) % 4096u;
+                ls.verts[ix[1]].z = rnd32(&s) % 65536u;
+                ls.verts[ix[2]].z = rnd32(&s) % 65536u;
+            }
+            /* a point: inside by weights, at an edge's midpoint, or anywhere near */
+            om__lpoint p;
+            p.tri = it % 50 == 0 ? 0u : 1u;
+            const uint32_t w0 = rnd32(&s) % (shape == 4 ? 20 : 1000), w1 = rnd32(&s) % (1000 - w0), w2 = 1000 - w0 - w1;
+            const int where = (int)(rnd32(&s) % 8);
+            if (where == 0) {
+                p.x = ((int64_t)x[0] + x[1]) / 2;
+                p.y = ((int64_t)y[0] + y[1]) / 2;
+            } else if (where == 1) {
+                p.x = x[0] + (int64_t)(rnd32(&s) % 2001) - 1000;
+                p.y = y[0] + (int64_t)(rnd32(&s) % 2001) - 1000;
+            } else {
+                p.x = (int64_t)floor(((double)x[0] * w0 + (double)x[1] * w1 + (double)x[2] * w2) / 1000.0);
+                p.y = (int64_t)floor(((double)y[0] * w0 + (double)y[1] * w1 + (double)y[2] * w2) / 1000.0);
+            }
+            om__ltri lt;
+            const bool set = om__lspace_tri(&ls, 0, &lt);
+            /* the depth: next to the threshold where p is inside, else anywhere */
+            double zq = (double)rnd32(&s);
+            if (set && lt.n == 1 && om__tri2_covers(&lt.sub[0].e, p.x, p.y))
+                zq = om__rtri_depth(&lt.sub[0], p.x, p.y) + lt.bound[0];
+            const uint32_t r = rnd32(&s) % 4;
+            double zt = floor(zq) + (r == 0 ? (double)((int)(rnd32(&s) % 5) - 2)
+                                     : r == 1 ? (double)((int)(rnd32(&s) % 4001) - 2000)
+                                              : (double)((int)(rnd32(&s) % 2000001) - 1000000) * 64.0);
+            if (!(zt >= 0.0 && zt <= 4294967295.0)) continue;
+            const uint32_t z = (uint32_t)zt;
+            p.z = z;
+            const int want = set && om__blocks(&lt, &p);
+            const int got = om__blocks_f(&ls, 0, &p, z);
+            blocked += want;
+            near += r <= 1;
+            far += r >= 2;
+            if (got < 0) continue;
+            near_answered += r <= 1;
+            far_answered += r >= 2;
+            if (got != want && wrong++ < 5)
+                fprintf(stderr, "  light %d it %d: threshold %.17g z %u: float %d, double %d\n", k, it, zq, z, got, want);
+        }
+        h_scene_free(&hs);
+    }
+    CHECK_EQ_U(wrong, 0);
+    CHECK_MSG(blocked > 20000, "%llu blocked", blocked);
+    CHECK_MSG(near_answered * 5 > near, "%llu of %llu answered next to the threshold", near_answered, near);
+    CHECK_MSG(far_answered * 10 > far * 8, "%llu of %llu answered away from it", far_answered, far);
+}
+
 static void transmittance_composes(void)
 {
     om_material glass = {1.0f, 0.5f, 0.0f, 0.5f};
@@ -446,6 +569,7 @@ void suite_shadow(void)
     RUN(square_under_sun);
     RUN(sphere_under_spot);
     RUN(bvh_equals_brute_force);
+    RUN(float_predicate_is_the_double_one);
     RUN(transmittance_composes);
     RUN(sm_improves_with_resolution);
     RUN(methods_agree_on_samples);

@@ -56,6 +56,12 @@ static void bound_begin(om__lspace *ls, const om_view *v)
         ls->iw0 = 1.0;
         ls->iw1 = 0.0;
     }
+    ls->iw0f = (float)ls->iw0;
+    ls->iw1f = (float)ls->iw1;
+    ls->latf = (float)ls->lat;
+    ls->depf = (float)ls->dep;
+    ls->iw0a = om__fabsf(ls->iw0f);
+    ls->iw1a = om__fabsf(ls->iw1f);
 }
 
 /* The snapping bound of a triangle whose nearest depth is zmin (occlude.h). */
@@ -100,14 +106,20 @@ void om__lspace_begin(om__lspace *ls, const om_view *v)
     om__lspace_project(ls, 0, ls->scene->nverts);
 }
 
-bool om__lspace_point(const om__lspace *ls, const om_sample *smp, om__lpoint *out)
+bool om__lspace_point_z(const om__lspace *ls, const om_sample *smp, om__lpoint *out, uint32_t *z)
 {
     om_vec4 c = om__mat_apply(&ls->vp, om__v3(smp->p[0], smp->p[1], smp->p[2]));
-    uint32_t z = 0;
+    *z = 0;
     out->tri = smp->tri;
-    const bool ok = om__project(&c, OM_LIGHT_GRID, OM_LIGHT_GRID, &out->x, &out->y, &z);
-    out->z = z;
+    const bool ok = om__project(&c, OM_LIGHT_GRID, OM_LIGHT_GRID, &out->x, &out->y, z);
+    out->z = *z;
     return ok;
+}
+
+bool om__lspace_point(const om__lspace *ls, const om_sample *smp, om__lpoint *out)
+{
+    uint32_t z;
+    return om__lspace_point_z(ls, smp, out, &z);
 }
 
 static void add_sub(const om__lspace *ls, om__ltri *lt, const int64_t x[3], const int64_t y[3],
@@ -158,6 +170,90 @@ bool om__lspace_tri(const om__lspace *ls, uint32_t t, om__ltri *lt)
         add_sub(ls, lt, x, y, z);
     }
     return lt->n > 0;
+}
+
+/* ---- the predicate in single precision (om__blocks_f)
+ *
+ * For a triangle the frame projected whole, om__lspace_tri makes one sub-triangle with
+ * its input vertex a first, and om__blocks asks, when p is inside it, whether
+ *   Q = depth + bound < z,   depth = z_a + zx dx + zy dy   (dx, dy: p - a),
+ *   bound = 2 ((|zx| + |zy|) (1.5 + lat iw) + dep iw + 1),   iw = max(0, iw0 + iw1 zmin),
+ * all in double, zx, zy the plane's gradient on the grid. Here the same expression is
+ * evaluated in float from exact integer pieces: coordinates within 2^22 (the guard
+ * band's vertices are), so every difference of two is an exact float; the edge
+ * functions at p (exact int64 products of int32) say whether p is strictly inside,
+ * strictly outside (as ref.c's sign test: then no tie rule can hold it) or on an edge
+ * (undecided); twice the area A (their sum, below 2^48) and the depth differences d1,
+ * d2 (below 2^32) become floats with one rounding each (f48).
+ *
+ * The bound, with u = 2^-24 and Sx = (|d1 y2| + |d2 y1|) / A, Sy likewise (|zx| <= Sx,
+ * |zy| <= Sy), IW = |iw0| + |iw1| zmin, and
+ *   M = z_a + Sx |dx| + Sy |dy| + 2 ((Sx + Sy) (1.5 + lat IW) + dep IW + 1)
+ * (the expression with every term made positive): each float operation rounds within
+ * u of its result and every input is within u of the double's (the conversions), so
+ * zx, zy are within 5.1u Sx, 5.1u Sy of the exact gradient, the depth within 8.3u of
+ * its part of M, iw within 4.1u IW (max(0, .) moves nothing further apart), the bound
+ * within 17u of its part, and Q within 19u M of the exact Q. The double's Q is within
+ * 2^-48 M of the exact one (the same steps at 2^-53, including a sliver's cancelling
+ * gradient, which M counts through Sx |dx|); z's float is within u z. The float's M
+ * is at most 12u below M, so e = 2^-19 (M + z), 32u, covers all of them: Q + e below z
+ * (as floats: rounding is monotonic, so a sum that rounds below a float was below
+ * it) means the double's Q is below z, blocked; Q - e above z, not blocked. Between
+ * them the double decides. The depth clamp of om__rtri_depth changes nothing: the
+ * exact depth at a point inside lies between the vertices', and clamping only moves
+ * the double's value towards it. tests/test_shadow.c calls this next to the
+ * threshold. */
+
+/* |v| < 2^48 as a float with one rounding: both halves are exact floats. */
+static inline float f48(int64_t v)
+{
+    return (float)(int32_t)(v / 16777216) * 16777216.0f + (float)(int32_t)(v % 16777216);
+}
+
+/* Within [-2^22, 2^22]. */
+static inline bool in22(int64_t v)
+{
+    return (uint64_t)(v + ((int64_t)1 << 22)) <= ((uint64_t)1 << 23);
+}
+
+int om__blocks_f(const om__lspace *ls, uint32_t t, const om__lpoint *p, uint32_t z)
+{
+    if (t == p->tri) return 0;
+    if (!ls->verts || !in22(p->x) || !in22(p->y)) return -1;
+    const uint32_t *ix = ls->scene->idx + (size_t)t * 3;
+    const om__lvert *a = &ls->verts[ix[0]], *b = &ls->verts[ix[1]], *c = &ls->verts[ix[2]];
+    if (!in22(a->x) || !in22(b->x) || !in22(c->x) || !in22(a->y) || !in22(b->y) || !in22(c->y))
+        return -1;   /* one that needs clipping (INT32_MIN) too */
+    const int32_t px = (int32_t)p->x, py = (int32_t)p->y;
+    const int32_t ax = a->x - px, ay = a->y - py, bx = b->x - px, by = b->y - py;
+    const int32_t cx = c->x - px, cy = c->y - py;
+    const int64_t eab = (int64_t)ax * by - (int64_t)ay * bx, ebc = (int64_t)bx * cy - (int64_t)by * cx;
+    const int64_t eca = (int64_t)cx * ay - (int64_t)cy * ax;
+    const int pos = (eab > 0) + (ebc > 0) + (eca > 0), neg = (eab < 0) + (ebc < 0) + (eca < 0);
+    if (pos && neg) return 0;          /* strictly outside one edge, inside another */
+    if (pos != 3 && neg != 3) return -1;   /* on an edge: the tie rule decides */
+    const float area = f48(pos ? eab + ebc + eca : -(eab + ebc + eca));
+    const float as = pos ? area : -area;   /* signed, as x1 y2 - x2 y1 */
+    const float x1 = (float)(b->x - a->x), y1 = (float)(b->y - a->y);
+    const float x2 = (float)(c->x - a->x), y2 = (float)(c->y - a->y);
+    const float d1 = f48((int64_t)b->z - a->z), d2 = f48((int64_t)c->z - a->z);
+    const uint32_t zm = a->z < b->z ? (a->z < c->z ? a->z : c->z) : (b->z < c->z ? b->z : c->z);
+    const float zmin = (float)zm, za = (float)a->z, zf = (float)z;
+    const float g1 = d1 * y2, g2 = d2 * y1, h1 = d2 * x1, h2 = d1 * x2;
+    const float zx = (g1 - g2) / as, zy = (h1 - h2) / as;
+    const float sx = (om__fabsf(g1) + om__fabsf(g2)) / area, sy = (om__fabsf(h1) + om__fabsf(h2)) / area;
+    const float dx = (float)-ax, dy = (float)-ay;
+    const float depth = za + zx * dx + zy * dy;
+    float iw = ls->iw0f + ls->iw1f * zmin;
+    if (!(iw > 0.0f)) iw = 0.0f;
+    const float q = depth + 2.0f * ((om__fabsf(zx) + om__fabsf(zy)) * (1.5f + ls->latf * iw) + ls->depf * iw + 1.0f);
+    const float iwm = ls->iw0a + ls->iw1a * zmin;
+    const float m = za + sx * om__fabsf(dx) + sy * om__fabsf(dy) +
+                    2.0f * ((sx + sy) * (1.5f + ls->latf * iwm) + ls->depf * iwm + 1.0f) + zf;
+    const float e = m * 0x1p-19f;
+    if (q + e < zf) return 1;
+    if (q - e > zf) return 0;
+    return -1;
 }
 
 /* ---- transmittance */

@@ -69,6 +69,8 @@ typedef struct om__lspace {
      * function of light depth, and the lateral (grid units) and depth rounding per
      * unit of 1/w. */
     double iw0, iw1, lat, dep;
+    /* The same in float for om__blocks_f, and |iw0|, |iw1| for its error bound. */
+    float iw0f, iw1f, latf, depf, iw0a, iw1a;
 } om__lspace;
 
 /* Bytes of the per-frame vertex projection (om__lspace_init). */
@@ -88,6 +90,8 @@ void om__lspace_view(om__lspace *ls, const om_view *v);
 void om__lspace_project(const om__lspace *ls, uint32_t first, uint32_t end);
 /* Projects a sample; false when it is not in front of the light. */
 bool om__lspace_point(const om__lspace *ls, const om_sample *smp, om__lpoint *out);
+/* The same, with the depth also as the whole number it is (*z == out->z). */
+bool om__lspace_point_z(const om__lspace *ls, const om_sample *smp, om__lpoint *out, uint32_t *z);
 
 /* A triangle on the light's grid: up to 7 sub-triangles after clipping, each with its
  * snapping bound. */
@@ -104,22 +108,6 @@ typedef struct om__ltri {
 /* Sets up triangle t; returns false when nothing of it is inside the light's frustum. */
 bool om__lspace_tri(const om__lspace *ls, uint32_t t, om__ltri *out);
 
-/* A cheap early answer for the predicate: false when triangle t certainly does not
- * block p because p lies outside the grid bounds of its three projected vertices (for
- * a triangle that needs no clipping); true when the full test is needed. */
-static inline bool om__lspace_maybe(const om__lspace *ls, uint32_t t, const om__lpoint *p)
-{
-    if (!ls->verts) return true;
-    const uint32_t *ix = ls->scene->idx + (size_t)t * 3;
-    const om__lvert *a = &ls->verts[ix[0]], *b = &ls->verts[ix[1]], *c = &ls->verts[ix[2]];
-    if (a->x == INT32_MIN || b->x == INT32_MIN || c->x == INT32_MIN) return true;
-    if ((p->x < a->x && p->x < b->x && p->x < c->x) || (p->x > a->x && p->x > b->x && p->x > c->x) ||
-        (p->y < a->y && p->y < b->y && p->y < c->y) || (p->y > a->y && p->y > b->y && p->y > c->y))
-        return false;
-    /* nearer than the sample somewhere? the plane's depth lies within its vertices' */
-    return a->z < p->z || b->z < p->z || c->z < p->z;
-}
-
 /* The predicate. */
 static inline bool om__blocks(const om__ltri *lt, const om__lpoint *p)
 {
@@ -130,6 +118,15 @@ static inline bool om__blocks(const om__ltri *lt, const om__lpoint *p)
     }
     return false;
 }
+
+/* The predicate for triangle t, where the frame projected its three vertices, in
+ * single precision (occlude.c says why its answer is the double one): 1 t blocks p,
+ * 0 it does not, -1 when it cannot say (no vertex projection, a vertex that needs
+ * clipping, coordinates beyond 2^22, p on an edge, or the depths too close for the
+ * float's error bound): then om__lspace_tri and om__blocks decide. z is p's depth as
+ * the whole number it is. For chips whose double arithmetic is a library routine
+ * (OM_FAST_FLOAT, core.h). */
+int om__blocks_f(const om__lspace *ls, uint32_t t, const om__lpoint *p, uint32_t z);
 
 /* ---- transmittance: casters multiply it, in any order with the same result. Each
  * channel is kept as an optical depth, -log2(t) in 1/4096 units, summed with

@@ -147,12 +147,18 @@ typedef struct ref_job {
     const ref_state *r;
     packet *pk;
     uint32_t samples, candidates, blocked;
+    /* The last partial transmittance turned into a term: the samples a semi-
+     * transparent caster shades in a row have the same optical depth, and each
+     * channel's term is a power of two in double (om__odepth_term). */
+    om__odepth last_od;
+    om_term last_term;
 } ref_job;
 
 typedef struct walk_ctx {
     const ref_state *r;
     ref_job *j;
     om__lpoint p;
+    uint32_t z;            /* p.z, the whole number it is */
     om__odepth od;
 } walk_ctx;
 
@@ -193,16 +199,18 @@ static bool covers(const om__lspace *ls, uint32_t t, const om__lpoint *p)
     return om__tri2_setup(&e, x, y, true) && om__tri2_covers(&e, p->x, p->y);
 }
 
-/* A triangle a walk met. om__lspace_maybe is not asked again: the walks on the grid
- * have asked it (the one-pass walk through each triangle's grid box, the middle mode's
- * directly), and without the vertex projection it passes everything. */
+/* A triangle a walk met (the walks on the grid have passed over those whose grid box
+ * misses p or whose vertices are all farther; ref_light.h). Where double arithmetic
+ * is a library routine, single precision answers first (om__blocks_f: the same
+ * answer, or none). */
 static bool visit(void *user, uint32_t tri)
 {
     walk_ctx *w = (walk_ctx *)user;
     om__ltri lt;
     w->j->candidates++;
-    if (tri == w->p.tri || !covers(&w->r->ls, tri, &w->p) ||
-        !om__lspace_tri(&w->r->ls, tri, &lt) || !om__blocks(&lt, &w->p))
+    const int f = OM_FAST_FLOAT ? om__blocks_f(&w->r->ls, tri, &w->p, w->z) : -1;
+    if (f == 0 || (f < 0 && (tri == w->p.tri || !covers(&w->r->ls, tri, &w->p) ||
+                             !om__lspace_tri(&w->r->ls, tri, &lt) || !om__blocks(&lt, &w->p))))
         return false;
     om__odepth_add(&w->od, &w->r->mat_od[w->r->scene->tri_mat[tri]]);
     return om__odepth_opaque(&w->od);
@@ -210,8 +218,15 @@ static bool visit(void *user, uint32_t tri)
 
 static void finish(const walk_ctx *w, om_term *t)
 {
-    om__odepth_term(&w->od, t);
-    if (t->r != 255 || t->g != 255 || t->b != 255) w->j->blocked++;
+    ref_job *j = w->j;
+    if (w->od.c[0] != j->last_od.c[0] || w->od.c[1] != j->last_od.c[1] || w->od.c[2] != j->last_od.c[2]) {
+        om__odepth_term(&w->od, &j->last_term);
+        j->last_od = w->od;
+    }
+    t->r = j->last_term.r;
+    t->g = j->last_term.g;
+    t->b = j->last_term.b;
+    if (t->r != 255 || t->g != 255 || t->b != 255) j->blocked++;
 }
 
 /* The shadow term of one sample against every triangle (the walk is a filter): the
@@ -224,9 +239,9 @@ static void shade_sample(ref_job *j, const om_sample *smp, om_term *t)
     w.r = r;
     w.j = j;
     memset(&w.od, 0, sizeof w.od);
-    if (!om__lspace_point(&r->ls, smp, &w.p)) return;
+    if (!om__lspace_point_z(&r->ls, smp, &w.p, &w.z)) return;
     if (r->mode == CACHE) {
-        om__bvh_walk_grid(&r->bvh, &r->ls, &w.p, visit, &w);
+        om__bvh_walk_grid(&r->bvh, &r->ls, &w.p, w.z, visit, &w);
         finish(&w, t);
         return;
     }
@@ -284,6 +299,7 @@ static void shade_block(ref_job *j, om_strip *st, uint32_t x0, uint32_t y0, uint
             w.r = r;
             w.j = j;
             w.p = pk->p[y * TILE + x];
+            w.z = (uint32_t)w.p.z;   /* a whole number below 2^32 (om__lspace_point) */
             memset(&w.od, 0, sizeof w.od);
             om__lbvh_walk_list(&r->lb, &r->bvh, list, n, &w.p, visit, &w);
             finish(&w, &st->terms[(size_t)(y0 + y) * st->width + x0 + x]);
@@ -308,6 +324,14 @@ static void shade_tile(ref_job *j, om_strip *st, uint32_t x0, uint32_t y0)
         }
     const uint32_t root = 0;
     shade_block(j, st, x0, y0, 0, 0, TILE, &root, r->bvh.nnodes ? 1 : 0, 0);
+}
+
+static void job_init(ref_job *j, const ref_state *r, packet *pk)
+{
+    memset(j, 0, sizeof *j);
+    j->r = r;
+    j->pk = pk;
+    j->last_term.r = j->last_term.g = j->last_term.b = 255;   /* the term of depth 0 */
 }
 
 static void resolve_job(ref_job *j, om_strip *st)
@@ -339,7 +363,8 @@ static om_status ref_resolve(void *state, om_strip *st, om_diag *d)
 {
     (void)d;
     ref_state *r = (ref_state *)state;
-    ref_job j = {r, r->pk, 0, 0, 0};
+    ref_job j;
+    job_init(&j, r, r->pk);
     resolve_job(&j, st);
     const uint32_t counts[8] = {j.samples, j.candidates, j.blocked, 0, 0, 0, 0, 0};
     ref_merge(r, counts);
@@ -350,7 +375,8 @@ static om_status ref_resolve(void *state, om_strip *st, om_diag *d)
 static void ref_band(const void *state, om_strip *st, void *scratch, uint32_t counts[8])
 {
     const ref_state *r = (const ref_state *)state;
-    ref_job j = {r, r->pk ? (packet *)scratch : NULL, 0, 0, 0};
+    ref_job j;
+    job_init(&j, r, r->pk ? (packet *)scratch : NULL);
     resolve_job(&j, st);
     counts[0] += j.samples;
     counts[1] += j.candidates;

@@ -1,5 +1,5 @@
 /* ref_light.c — the per-frame light-grid boxes of the reference's BVH, and the walks
- * over them (ref_light.h says why they filter exactly as om__lspace_maybe does). */
+ * over them (ref_light.h says why they pass every triangle that can block). */
 #include "ref_light.h"
 
 /* As bvh.c's walk: the build splits a node only while its own stack has room, and a
@@ -48,8 +48,8 @@ static int32_t to_i32(int64_t v)
     return v < INT32_MIN ? INT32_MIN : v > INT32_MAX ? INT32_MAX : (int32_t)v;
 }
 
-/* A triangle with a vertex that needs clipping passes om__lspace_maybe whatever the
- * sample, so its box is that of what clipping leaves of it (om__lspace_tri, once a
+/* A triangle with a vertex that needs clipping has no projected vertices to bound
+ * it, so its box is that of what clipping leaves of it (om__lspace_tri, once a
  * frame): a sample it blocks is covered by one of its sub-triangles, so inside their
  * grid bounds, and is farther than that sub-triangle's nearest depth plus its bound, so
  * farther than lt.zmin (om__blocks). Nothing left inside the light's frustum: no box,
@@ -247,7 +247,7 @@ static bool gholds(const om__bvh_gbox *x, int32_t px, int32_t py, uint32_t pz)
     return px >= x->lox && px <= x->hix && py >= x->loy && py <= x->hiy && x->zmin < pz;
 }
 
-/* om__lspace_maybe in 32 bits: false when triangle t's projected vertices leave p
+/* The grid-box test (ref_light.h) in 32 bits: false when triangle t's projected vertices leave p
  * outside their grid box, or are none nearer than p; true for one that needs clipping
  * (its leaf's box has bounded it). */
 static bool tri_maybe(const om__lspace *ls, uint32_t t, int32_t px, int32_t py, uint32_t pz)
@@ -261,15 +261,13 @@ static bool tri_maybe(const om__lspace *ls, uint32_t t, int32_t px, int32_t py, 
     return a->z < pz || b->z < pz || c->z < pz;
 }
 
-void om__bvh_walk_grid(const om__bvh *b, const om__lspace *ls, const om__lpoint *p,
+void om__bvh_walk_grid(const om__bvh *b, const om__lspace *ls, const om__lpoint *p, uint32_t pz,
                        om__bvh_visit visit, void *user)
 {
     const om__bvh_node *nd = b->nodes;
     /* A point beyond 32 bits is held by no box but those that reach that far, as its
-     * clamped value is (boxes are clamped the same way). The depth is a whole number
-     * below 2^32 (om__lspace_point). */
+     * clamped value is (boxes are clamped the same way). */
     const int32_t px = to_i32(p->x), py = to_i32(p->y);
-    const uint32_t pz = (uint32_t)p->z;
     uint32_t stack[STACK];
     int sp = 0;
     if (!b->nnodes || !gholds(&nd[0].box.g, px, py, pz)) return;

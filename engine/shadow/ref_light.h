@@ -3,7 +3,8 @@
  * at the light (or runs along a directional light's axis), so on the light's image it
  * is a single grid point: a triangle can block the sample only when the grid box of its
  * projected vertices holds that point and one of those vertices is nearer the light
- * (om__lspace_maybe). Every triangle gets that box and nearest depth, and every node
+ * (the grid-box test: a blocker covers the point, and its depth there lies between
+ * its vertices' and is nearer than the sample's, occlude.h). Every triangle gets that box and nearest depth, and every node
  * the union of its triangles', so the walks skip exactly the triangles and subtrees
  * that would fail the test: the same triangles block, found with 2-D integer compares
  * instead of 3-D slab tests along a segment.
@@ -62,11 +63,11 @@ void om__lbvh_walk_list(const om__lbvh *lb, const om__bvh *b, const uint32_t *li
 /* The middle mode (the vertex projection without the memory of the boxes above):
  * every node of b gets this frame's grid box (om__bvh_gbox) in place of its 3-D one,
  * and the walk takes the nodes whose box holds p and is nearer somewhere, calling
- * visit for every triangle of their leaves that om__lspace_maybe passes; stops when
+ * visit for every triangle of their leaves that passes the grid-box test; stops when
  * visit returns true. The same triangles pass as the one-pass walk's, with no bytes
  * beyond the BVH's own. */
 void om__bvh_fit_grid(om__bvh *b, const om__lspace *ls);
-void om__bvh_walk_grid(const om__bvh *b, const om__lspace *ls, const om__lpoint *p,
+void om__bvh_walk_grid(const om__bvh *b, const om__lspace *ls, const om__lpoint *p, uint32_t z,
                        om__bvh_visit visit, void *user);
 
 #endif
