@@ -5,6 +5,7 @@
 #include "harness.h"
 #include "../engine/shadow/occlude.h"
 #include "../engine/frame/frame.h"
+#include "../engine/shadow/smlookup.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -564,6 +565,45 @@ static void light_cull_keeps_the_map(void)
     h_scene_free(&hs);
 }
 
+/* The plain map's one-tap test (om__smlook_lit) against the threshold's compare that
+ * the other lookups make, on depths around every boundary: each side of an integer,
+ * integers, 0 and -0, subnormals, 2^23, 2^24 and 2^32 (where floats are integers),
+ * infinities and NaNs, each against stored depths just below, at and above it. */
+static void smlook_lit_is_the_threshold(void)
+{
+    static const float fixed[] = {0.0f, -0.0f, 1e-45f, -1e-45f, 0.5f, 1.0f, -1.0f, 1.5f, 3.0f,
+                                  8388607.5f, 8388608.0f, 8388609.0f, 16777215.0f, 16777216.0f,
+                                  16777218.0f, 4294967040.0f, 4294967296.0f, 8589934592.0f,
+                                  -4294967296.0f, INFINITY, -INFINITY, NAN, -NAN};
+    static const uint32_t ends[] = {0u, 1u, 2u, 8388608u, 16777216u, 4294967040u, 4294967294u,
+                                    4294967295u};
+    uint32_t s = 12345, n = 0, lit = 0;
+    for (int i = 0; i < 20000; i++) {
+        float z;
+        if (i < (int)(sizeof fixed / sizeof fixed[0])) z = fixed[i];
+        else {
+            s = s * 1664525u + 1013904223u;
+            const float base = (float)(s >> 8) * (i % 3 == 0 ? 1.0f : i % 3 == 1 ? 256.0f : 1.0f / 256.0f);
+            const float step[] = {0.0f, 0.25f, -0.25f, 1.0f};
+            z = base + step[i % 4];
+            if (i % 7 == 0) z = nextafterf(z, i % 2 ? INFINITY : -INFINITY);
+        }
+        const uint64_t th = om__smlook_threshold(z);
+        uint32_t ds[11];
+        const uint32_t t = z > 0.0f && z < 4294967296.0f ? (uint32_t)z : 0u;
+        ds[0] = t; ds[1] = t - 1u; ds[2] = t + 1u;
+        for (int k = 0; k < 8; k++) ds[3 + k] = ends[k];
+        for (int k = 0; k < 11; k++) {
+            const bool want = th <= ds[k], got = om__smlook_lit(z, ds[k]);
+            CHECK_MSG(got == want, "z %.9g, stored %u: lit %d, the threshold says %d", (double)z,
+                      ds[k], got, want);
+            n++;
+            lit += got;
+        }
+    }
+    CHECK(lit > n / 8 && lit < n - n / 8);   /* both answers well represented */
+}
+
 void suite_shadow(void)
 {
     RUN(square_under_sun);
@@ -577,4 +617,5 @@ void suite_shadow(void)
     RUN(odd_lights);
     RUN(ref_small_equals_fast);
     RUN(light_cull_keeps_the_map);
+    RUN(smlook_lit_is_the_threshold);
 }

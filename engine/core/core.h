@@ -63,6 +63,14 @@ static inline int om__ctz32(uint32_t x)
 #endif
 }
 
+/* For a per-sample helper that must sit in its loop: gcc's inliner gives up on some
+ * once their caller is large, and the call then costs more than the work. */
+#if defined(__GNUC__) || defined(__clang__)
+#define OM_INLINE static inline __attribute__((always_inline))
+#else
+#define OM_INLINE static inline
+#endif
+
 /* sqrtf and fabsf as the compiler's own instructions where it has them: a firmware
  * built freestanding (-ffreestanding implies -fno-builtin) would otherwise call the
  * library for each. The same correctly rounded results either way. */

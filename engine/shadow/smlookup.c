@@ -214,10 +214,10 @@ typedef struct plain {
     float texel_dir, dz_dir;   /* a directional light's: as texel_world and locate make them */
 } plain;
 
-/* A sample's threshold and texel index; false when it is behind the light. `spot`
- * is P->spot, a constant where the callers are inlined. */
-static inline bool plain_locate(const plain *P, const bool spot, const om_sample *smp,
-                                uint64_t *zlit, uint32_t *at)
+/* A sample's biased depth (om__smlook_lit tests it) and texel index; false when it is
+ * behind the light. `spot` is P->spot, a constant where the callers are inlined. */
+OM_INLINE bool plain_locate(const plain *P, const bool spot, const om_sample *smp,
+                          float *zb, uint32_t *at)
 {
     const om_vec3 p = om__v3(smp->p[0], smp->p[1], smp->p[2]);
     float dist = 1.0f, texel = P->texel_dir, dz = P->dz_dir;
@@ -239,13 +239,15 @@ static inline bool plain_locate(const plain *P, const bool spot, const om_sample
         const float e = dist > P->half_near ? dist : P->half_near;
         dz = P->dz_num / (P->dz_den * e * e) * OM_DEPTH_ONE_F;
     }
-    *zlit = om__smlook_threshold(z - bias * dz);
+    *zb = z - bias * dz;
     return true;
 }
 
 /* A microcontroller's loads take a cycle or two: there (OM_SMLOOK_DIRECT, 1 on
  * Cortex-M cores; define it 1 elsewhere to try it) each sample is tested as soon as it
- * is located, and its term written once. The same terms either way. */
+ * is located. The same terms either way. Both this loop and plain_locate must sit in
+ * line (OM_INLINE): gcc for the M4 otherwise calls them, with `spot` a variable, and
+ * every constant of P is loaded again per sample (+0.07 M instructions a frame). */
 #ifndef OM_SMLOOK_DIRECT
 #if defined(__ARM_ARCH_PROFILE) && __ARM_ARCH_PROFILE == 'M'
 #define OM_SMLOOK_DIRECT 1
@@ -254,23 +256,21 @@ static inline bool plain_locate(const plain *P, const bool spot, const om_sample
 #endif
 #endif
 #if OM_SMLOOK_DIRECT
-static inline void plain_tests(const plain *P, const bool spot, const uint32_t *depth, om_strip *st,
-                               size_t n, uint32_t *samples, uint32_t *shadowed)
+OM_INLINE void plain_tests(const plain *P, const bool spot, const uint32_t *depth, om_strip *st,
+                          size_t n, uint32_t *samples, uint32_t *shadowed)
 {
     uint32_t nsamples = 0, nshadowed = 0;
     for (size_t i = 0; i < n; i++) {
         om_term *t = &st->terms[i];
-        uint8_t val = 255;
-        if (t->flags & OM_TERM_EXPOSED) {
-            nsamples++;
-            uint64_t zlit;
-            uint32_t at;
-            if (plain_locate(P, spot, &st->samples[i], &zlit, &at) && !(zlit <= depth[at])) {
-                val = 0;
-                nshadowed++;
-            }
+        t->r = t->g = t->b = 255;   /* constants the loop keeps in registers */
+        if (!(t->flags & OM_TERM_EXPOSED)) continue;
+        nsamples++;
+        float zb;
+        uint32_t at;
+        if (plain_locate(P, spot, &st->samples[i], &zb, &at) && !om__smlook_lit(zb, depth[at])) {
+            t->r = t->g = t->b = 0;
+            nshadowed++;
         }
-        t->r = t->g = t->b = val;
     }
     *samples += nsamples;
     *shadowed += nshadowed;
@@ -303,9 +303,9 @@ static void strip_plain(const om__smlook *L, om_strip *st, uint32_t *samples, ui
     if (P.spot) plain_tests(&P, true, depth, st, n, &nsamples, &nshadowed);
     else plain_tests(&P, false, depth, st, n, &nsamples, &nshadowed);
 #else
-    /* Blocks, as om__smlook_strip's (below), with the taps kept as their threshold
+    /* Blocks, as om__smlook_strip's (below), with the taps kept as their biased depth
      * and index alone. */
-    uint64_t zlit[SMLOOK_BLOCK];
+    float zb[SMLOOK_BLOCK];
     uint32_t at[SMLOOK_BLOCK], idx[SMLOOK_BLOCK];
     for (size_t i = 0; i < n;) {
         int got = 0;
@@ -314,7 +314,7 @@ static void strip_plain(const om__smlook *L, om_strip *st, uint32_t *samples, ui
             t->r = t->g = t->b = 255;
             if (!(t->flags & OM_TERM_EXPOSED)) continue;
             nsamples++;
-            if (plain_locate(&P, P.spot, &st->samples[i], &zlit[got], &at[got])) {
+            if (plain_locate(&P, P.spot, &st->samples[i], &zb[got], &at[got])) {
 #if defined(__GNUC__) || defined(__clang__)
                 __builtin_prefetch(&depth[at[got]]);
 #endif
@@ -322,7 +322,7 @@ static void strip_plain(const om__smlook *L, om_strip *st, uint32_t *samples, ui
             }
         }
         for (int j = 0; j < got; j++) {
-            const uint8_t val = zlit[j] <= depth[at[j]] ? 255 : 0;
+            const uint8_t val = om__smlook_lit(zb[j], depth[at[j]]) ? 255 : 0;
             om_term *t = &st->terms[idx[j]];
             t->r = t->g = t->b = val;
             nshadowed += val != 255;

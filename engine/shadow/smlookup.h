@@ -79,4 +79,18 @@ static inline uint64_t om__smlook_threshold(float z)
     return (uint64_t)t + ((float)t < z);
 }
 
+/* om__smlook_threshold(z) <= d, without the 64-bit sum and compare: within the map's
+ * range, t = trunc(z) below d or, equal to it, with z no further than t (the threshold
+ * is t there); z <= 0 is lit, NaN and z >= 2^32 never. The plain map's one tap tests
+ * with it (smlookup.c); the same answer as the threshold's compare for every z and d. */
+static inline bool om__smlook_lit(float z, uint32_t d)
+{
+    if (z > 0.0f && z < OM_DEPTH_ONE_F) {
+        const uint32_t t = (uint32_t)z;
+        if (t != d) return t < d;
+        return !((float)t < z);
+    }
+    return !(z > 0.0f) && z == z;
+}
+
 #endif
