@@ -80,19 +80,28 @@ static size_t pool_bytes_of(uint32_t samples, uint32_t leaf)
            om_arena_need((size_t)cells_bound(samples) * sizeof(uint32_t), 16);
 }
 
-/* The pool by default: tiles of at least TILE_LEAST samples, and at least TILE_PER_TRI
- * a triangle of the scene, up to the whole image. Every tile walks every triangle, so
- * with a pool of k triangles' samples the walks cost about one triangle per k samples
- * whatever the scene, while a small tile keeps its keys, nodes and cells in the
- * cache and the arena to clear at init small. On random clouds at 1024x768 (see
- * izb.md) the one pass pays off only from about 400K triangles. */
+/* The pool by default: tiles of at least TILE_LEAST samples, and at least n^2 /
+ * 2^TILE_SQ samples for a scene of n triangles, up to the whole image. Every tile walks
+ * every triangle, but one that reaches none of its samples costs it little; small
+ * tiles keep their keys, nodes and cells in the cache, leave little to clear, and give
+ * the host's threads several jobs of the like cost (a strip's tiles are cut in the
+ * screen's order, and where a cloud shadows the top half of the image, two tiles
+ * differ threefold). With many triangles, though, most reach every tile and are set up
+ * in each (clipping and projecting in double), so the pool grows faster than the
+ * triangle count: on random clouds at 1024x768 (izb.md) 32768 samples (10 tiles) at
+ * 100K triangles, 4 tiles at 300K, one pass from about 900K. */
 #define TILE_LEAST 32768u
-#define TILE_PER_TRI 2u
+#define TILE_SQ 20
+
+static uint64_t pool_of_tris(const om_scene *s)
+{
+    const uint64_t n = s->ntris, want = n * n >> TILE_SQ;
+    return want < TILE_LEAST ? TILE_LEAST : want;
+}
 
 static uint32_t auto_pool(const om_scene *s, uint32_t w, uint32_t h)
 {
-    uint64_t want = (uint64_t)s->ntris * TILE_PER_TRI, all = (uint64_t)w * h;
-    if (want < TILE_LEAST) want = TILE_LEAST;
+    uint64_t want = pool_of_tris(s), all = (uint64_t)w * h;
     if (want > all) want = all;
     return (uint32_t)(want > w ? want : w);
 }
@@ -723,8 +732,8 @@ static size_t izb_pass_scratch(const void *state, const om_scene *s)
         return pool_bytes_of(z->cap, z->leaf);
     }
     if (!s) return 0;
-    uint64_t most = (uint64_t)s->ntris * TILE_PER_TRI;   /* auto_pool without the image's bound */
-    return pool_bytes_of(most < TILE_LEAST ? TILE_LEAST : most > 0xFFFFFFFFu ? 0xFFFFFFFFu : (uint32_t)most, 64);
+    uint64_t most = pool_of_tris(s);   /* auto_pool without the image's bound */
+    return pool_bytes_of(most > 0xFFFFFFFFu ? 0xFFFFFFFFu : (uint32_t)most, 64);
 }
 
 /* Counts every row's exposed samples (rowsum) and tiles the strip. */

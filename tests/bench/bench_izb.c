@@ -3,7 +3,10 @@
  * 1024x768, with the paper's rows (BSP nodes, nodes visited, nodes culled, samples
  * tested; transform, BSP construction, rasterization and total time) and the tiles of
  * the default pool and the init that clears it, beside the BVH
- * reference's time on the same frame; then the hot-spot scene. Medians of 3 runs. */
+ * reference's time on the same frame; then the hot-spot scene. Medians of 3 runs.
+ * `slots`: the longer of the two sums of the tiles' times (transform, build, raster)
+ * that two threads would run as the frame hands tiles out (om__pass: tile k to slot
+ * k % 2), the bound that the tiles put on a frame's speed-up on two threads. */
 #include "bench.h"
 #include "../../engine/shadow/izb.h"
 
@@ -28,7 +31,7 @@ static void table_row(const bscene *b, uint32_t W, uint32_t H)
     for (size_t i = 0; i < n; i++) {
         st.terms[i].flags = st.samples[i].tri != OM_NO_TRI && om__exposed(&v, &st.samples[i]) ? OM_TERM_EXPOSED : 0;
     }
-    double ti[3], tt[3], tb[3], tr[3];
+    double ti[3], tt[3], tb[3], tr[3], ts[3];
     om__izb_stats stats;
     memset(&stats, 0, sizeof stats);
     for (int r = 0; r < 3; r++) {
@@ -41,7 +44,7 @@ static void table_row(const bscene *b, uint32_t W, uint32_t H)
         if (m->begin(state, &v, &d)) return;
         om__izb *z = (om__izb *)state;
         size_t next = 0;
-        uint64_t ns[3] = {0, 0, 0};
+        uint64_t ns[3] = {0, 0, 0}, slot[2] = {0, 0};
         uint32_t exposed = 0;
         for (size_t i = 0; i < n; i++) exposed += (st.terms[i].flags & OM_TERM_EXPOSED) != 0;
         const uint32_t tiles = om__izb_tiles(z, exposed);
@@ -57,11 +60,13 @@ static void table_row(const bscene *b, uint32_t W, uint32_t H)
             uint64_t t3 = om_clock_ns(NULL);
             ns[1] += t2 - t1;
             ns[2] += t3 - t2;
+            slot[k % 2] += t3 - t0;   /* the frame hands tile k to slot k % 2 of two */
             z->st.tiles++;
         }
         tt[r] = (double)ns[0] / 1e6;
         tb[r] = (double)ns[1] / 1e6;
         tr[r] = (double)ns[2] / 1e6;
+        ts[r] = (double)(slot[0] > slot[1] ? slot[0] : slot[1]) / 1e6;
         stats = z->st;
     }
     double i0 = bench_median(ti, 3), a = bench_median(tt, 3), bb = bench_median(tb, 3), c = bench_median(tr, 3);
@@ -72,9 +77,9 @@ static void table_row(const bscene *b, uint32_t W, uint32_t H)
         if (bench_run(b, "ref", NULL, W, H, 0, NULL, &r)) return;
         rt[k] = r.init_ms + r.resolve_ms;
     }
-    printf("%-12s %6u %8u %9u %8u %9u %6.1f %9.1f %9.1f %9.1f %9.1f %10.1f\n", b->name, stats.tiles,
+    printf("%-12s %6u %8u %9u %8u %9u %6.1f %9.1f %9.1f %9.1f %9.1f %7.1f %10.1f\n", b->name, stats.tiles,
            stats.nodes, stats.visited, stats.culled_shadowed + stats.culled_depth, stats.tested, i0, a, bb,
-           c, i0 + a + bb + c, bench_median(rt, 3));
+           c, i0 + a + bb + c, bench_median(ts, 3), bench_median(rt, 3));
     free(mem);
     free(tg.depth);
     free(tg.id);
@@ -85,8 +90,8 @@ static void table_row(const bscene *b, uint32_t W, uint32_t H)
 void bench_izb(void)
 {
     printf("irregular z-buffer at 1024x768 (Table 1 of the paper; times in ms, medians of 3)\n");
-    printf("%-12s %6s %8s %9s %8s %9s %6s %9s %9s %9s %9s %10s\n", "scene", "tiles", "nodes", "visited",
-           "culled", "tested", "init", "transform", "bsp", "raster", "total", "ref total");
+    printf("%-12s %6s %8s %9s %8s %9s %6s %9s %9s %9s %9s %7s %10s\n", "scene", "tiles", "nodes", "visited",
+           "culled", "tested", "init", "transform", "bsp", "raster", "total", "slots", "ref total");
     static const unsigned counts[] = {1000, 10000, 100000, 1000000};
     for (int k = 0; k < 4; k++) {
         bscene b;
