@@ -448,6 +448,14 @@ size_t om_frame_bytes_scene(const om_scene *s, uint32_t width, uint32_t strip_ro
  * time. A whole-frame render (one strip) also uses the bins when they fit after the
  * jobs' scratch. */
 size_t om_frame_bytes_jobs(const struct om_method *m, const om_scene *s, uint32_t threads);
+/* What the frame arena may hold beyond those so that a frame through strips keeps the
+ * triangle under every pixel of a width x height image from its first eye pass (2
+ * bytes a pixel where s has fewer than 65535 triangles, else 4). A frame that passes
+ * over the image more than once (a method that observes, such as asm and rtw, or a
+ * directional light) then rasterizes the scene once, and its later passes only
+ * resolve the samples from these ids. Without the room, each pass rasterizes again,
+ * for the same pixels. */
+size_t om_frame_bytes_ids(const om_scene *s, uint32_t width, uint32_t height);
 /* Renders one frame. The frame arena is rewound on return; the method's arena keeps
  * what the method keeps. */
 om_status om_render_frame(const om_frame_desc *fd, om_arena *frame_arena,

@@ -384,6 +384,40 @@ static void settings_by_bands(void)
     h_scene_free(&hs);
 }
 
+/* A frame through strips that passes over the image more than once (asm and rtw
+ * observe; a directional light is fitted) keeps its first pass's triangle ids where the
+ * arena has om_frame_bytes_ids beyond the rest, and its later passes resolve from them:
+ * the same frames and counters as without the room, inline and with jobs; a frame that
+ * passes once (sm under the spot light) carves none. */
+static void kept_ids(void)
+{
+    static const char *const names[] = {"asm", "rtw", "sm"};
+    for (int li = 0; li < 2; li++) {
+        h_scene hs;
+        if (!h_scene_parse(&hs, li ? directional : om_scene_default_text())) continue;
+        const size_t ids = om_frame_bytes_ids(&hs.s, 120, 90);
+        CHECK(ids >= 120 * 90 * 2);
+        for (int mi = 0; mi < 3; mi++) {
+            const om_method *m = om_method_find(names[mi]);
+            const bool twice = li || mi < 2;
+            for (uint32_t rows = 8; rows <= 40; rows += 32)
+                for (uint32_t n = 1; n <= 3; n += 2) {
+                    const size_t jb = om_frame_bytes_jobs(m, &hs.s, n);
+                    om_parallel_for_fn pf = n > 1 ? backwards : NULL;
+                    frame_out a = render(&hs.s, m, 120, 90, rows, pf, NULL, n, jb, true);
+                    frame_out b = render(&hs.s, m, 120, 90, rows, pf, NULL, n, jb + ids, true);
+                    CHECK_MSG(a.st == OM_OK && b.st == OM_OK && a.hash == b.hash,
+                              "%s light %d strips %u threads %u: kept ids change the frame", m->name, li, rows, n);
+                    CHECK_MSG(!memcmp(a.ms.counters, b.ms.counters, sizeof a.ms.counters),
+                              "%s: kept ids change the counters", m->name);
+                    CHECK_MSG(twice ? b.peak >= a.peak + 120 * 90 * 2 : b.peak == a.peak,
+                              "%s light %d: ids carved %s", m->name, li, twice ? "not" : "needlessly");
+                }
+        }
+        h_scene_free(&hs);
+    }
+}
+
 void suite_threads(void)
 {
     RUN(same_bits);
@@ -392,4 +426,5 @@ void suite_threads(void)
     RUN(asm_bands);
     RUN(izb_pass);
     RUN(settings_by_bands);
+    RUN(kept_ids);
 }

@@ -92,6 +92,11 @@ static om_status run_frame(run *r, const cli_scene *cs, const om_view *v, uint32
         if (rows == v->cam.height) *frame_bytes = om_frame_bytes_scene(&cs->scene, W, rows) +
                                                  om_frame_bytes_jobs(r->m, &cs->scene, cli_threads());
     }
+    /* Strips of a frame that passes over the image more than once: room to keep the
+     * first pass's triangle ids, so the scene is rasterized once (om_frame_bytes_ids) */
+    if (jobs && rows < v->cam.height &&
+        ((r->m->flags & OM_METHOD_OBSERVES) || v->light.kind == OM_LIGHT_DIRECTIONAL))
+        *frame_bytes += om_frame_bytes_ids(&cs->scene, W, v->cam.height);
     void *frame_mem = malloc(*frame_bytes);
     om_framebuffer fb;
     fb.format = fmt;

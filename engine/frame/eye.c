@@ -191,12 +191,9 @@ static void resolve_run(const om_view *v, const eye_tri *et, uint32_t x0, uint32
     }
 }
 
-static void eye_pass(const om_scene *s, const om_view *v, const om_target *tg, om_strip *st,
-                     const om__bins *bins, bool mark)
+/* The samples (and with `mark` the terms) of st's rows from the triangle ids in tg. */
+static void resolve_ids(const om_scene *s, const om_view *v, const om_target *tg, om_strip *st, bool mark)
 {
-    /* Culling is exact here too: the visible point of a pixel is the nearest, and the
-     * nearest surface of a closed shape the camera is outside of faces the camera. */
-    om__scene_raster(s, &v->cam_vp, tg, OM_RASTER_DEPTH_ID, true, bins);
     /* The triangles set up, by their number modulo EYE_WAYS: the rows of a strip
      * cross the same few triangles in turn, and each setup costs about as much as
      * thirty pixels. */
@@ -250,6 +247,20 @@ static void eye_pass(const om_scene *s, const om_view *v, const om_target *tg, o
             x = x1;
         }
     }
+}
+
+static void eye_pass(const om_scene *s, const om_view *v, const om_target *tg, om_strip *st,
+                     const om__bins *bins, bool mark)
+{
+    /* Culling is exact here too: the visible point of a pixel is the nearest, and the
+     * nearest surface of a closed shape the camera is outside of faces the camera. */
+    om__scene_raster(s, &v->cam_vp, tg, OM_RASTER_DEPTH_ID, true, bins);
+    resolve_ids(s, v, tg, st, mark);
+}
+
+void om__eye_resolve(const om_scene *s, const om_view *v, const om_target *tg, om_strip *st, bool mark)
+{
+    resolve_ids(s, v, tg, st, mark);
 }
 
 void om__eye_pass(const om_scene *s, const om_view *v, const om_target *tg, om_strip *st,

@@ -4,7 +4,10 @@
  * A method that observes (needs every visible sample before it builds) and a
  * directional light (fitted to the visible samples) need a first pass over the image.
  * When the frame is one strip the samples are kept and the eye pass runs once; with
- * smaller strips it runs again for each pass, so memory stays at one strip.
+ * smaller strips it runs again for each pass, so memory stays at one strip, but where
+ * the arena has room (om_frame_bytes_ids) the first pass keeps the triangle under
+ * every pixel, and the later passes only resolve the samples from them: the scene is
+ * rasterized once.
  *
  * With the host's parallel-for and more than one thread, each strip is cut into bands
  * of rows, and the eye pass, the exposure marks, shading and (for methods with
@@ -130,7 +133,47 @@ typedef struct frame_ctx {
     const om__bins *mk;        /* STAGE_BIN_*: the bins being made, through mk_vp */
     const om_mat4 *mk_vp;
     uint32_t mk_w, mk_h;
+    void *ids;                 /* the image's triangle ids from its first pass, or NULL */
+    bool ids16;                /* as uint16_t (OM_NO_TRI as 0xFFFF): under 65535 triangles */
+    bool ids_have;             /* the first pass is over: later passes resolve from ids */
 } frame_ctx;
+
+static size_t ids_bytes(const om_scene *s, uint32_t width, uint32_t height)
+{
+    return (size_t)width * height * (s && s->ntris < 0xFFFFu ? sizeof(uint16_t) : sizeof(uint32_t));
+}
+
+size_t om_frame_bytes_ids(const om_scene *s, uint32_t width, uint32_t height)
+{
+    return om_arena_need(ids_bytes(s, width, height), 8);
+}
+
+/* The eye pass of rows [st->y0, + st->rows) into tg (the same rows): with kept ids,
+ * the first pass stores its ids there and the later ones resolve from them, for the
+ * same samples and marks (om__eye_resolve). */
+static void eye_rows(const frame_ctx *c, const om_target *tg, om_strip *st, bool mark)
+{
+    const size_t n = (size_t)st->rows * st->width, at = (size_t)st->y0 * st->width;
+    if (c->ids && c->ids_have) {
+        if (c->ids16) {
+            const uint16_t *k = (const uint16_t *)c->ids + at;
+            for (size_t i = 0; i < n; i++) tg->id[i] = k[i] == 0xFFFFu ? OM_NO_TRI : k[i];
+        } else {
+            memcpy(tg->id, (const uint32_t *)c->ids + at, n * sizeof(uint32_t));
+        }
+        om__eye_resolve(c->fd->scene, c->view, tg, st, mark);
+        return;
+    }
+    if (mark) om__eye_pass_mark(c->fd->scene, c->view, tg, st, c->bins);
+    else om__eye_pass(c->fd->scene, c->view, tg, st, c->bins);
+    if (!c->ids) return;
+    if (c->ids16) {
+        uint16_t *k = (uint16_t *)c->ids + at;
+        for (size_t i = 0; i < n; i++) k[i] = tg->id[i] == OM_NO_TRI ? 0xFFFFu : (uint16_t)tg->id[i];
+    } else {
+        memcpy((uint32_t *)c->ids + at, tg->id, n * sizeof(uint32_t));
+    }
+}
 
 static void band_job(void *user, uint32_t b)
 {
@@ -180,8 +223,7 @@ static void band_job(void *user, uint32_t b)
             tg.rows = st.rows;
             tg.depth += off;
             tg.id += off;
-            if (c->mark) om__eye_pass_mark(fd->scene, c->view, &tg, &st, c->bins);
-            else om__eye_pass(fd->scene, c->view, &tg, &st, c->bins);
+            eye_rows(c, &tg, &st, c->mark);
         } else if (c->mark) {
             mark_exposed(c->view, &st);
         }
@@ -299,8 +341,7 @@ static void prepare(frame_ctx *c, bool eye, bool mark, om_frame_stats *fs)
         c->mark = mark;
         run_bands(c, STAGE_PREPARE);
     } else {
-        if (eye && mark) om__eye_pass_mark(c->fd->scene, c->view, &c->tg, &c->strip, c->bins);
-        else if (eye) om__eye_pass(c->fd->scene, c->view, &c->tg, &c->strip, c->bins);
+        if (eye) eye_rows(c, &c->tg, &c->strip, mark);
         else if (mark) mark_exposed(c->view, &c->strip);
     }
     if (eye) {
@@ -437,6 +478,12 @@ om_status om_render_frame(const om_frame_desc *fd, om_arena *fa, om_frame_stats 
     bool have_samples = false;   /* strip.samples hold the whole frame already */
     bool have_terms = false;     /* and strip.terms their exposure (mark_exposed) */
     uint64_t t0;
+    /* More than one pass over an image in strips: its ids kept where they fit, last,
+     * so they never take the room of the bins or the jobs (om_frame_bytes_ids). Not
+     * zeroed: the first pass writes them all before the next reads any. */
+    if (!single && (fit || observes) && om_arena_left(fa) >= om_frame_bytes_ids(s, W, H) &&
+        om__arena_alloc_raw(fa, ids_bytes(s, W, H), 8, &c.ids, NULL) == OM_OK)
+        c.ids16 = s->ntris < 0xFFFFu;
 
     if (fit) {
         om_vec3 lo = om__v3(0, 0, 0), hi = om__v3(0, 0, 0);
@@ -448,6 +495,7 @@ om_status om_render_frame(const om_frame_desc *fd, om_arena *fa, om_frame_stats 
         }
         if (any) om_view_fit_light(&view, s, lo, hi);
         have_samples = single;
+        c.ids_have = c.ids != NULL;
     }
     if ((st = begin(&c, &view, d)) != OM_OK) goto done;
     if (observes) {
@@ -461,6 +509,7 @@ om_status om_render_frame(const om_frame_desc *fd, om_arena *fa, om_frame_stats 
         }
         have_samples = single;
         have_terms = single;   /* observe leaves the strip as marked */
+        c.ids_have = c.ids != NULL;
     }
     t0 = now(fd);
     if (OM_WITH_JOBS && c.jobs > 1 && c.bands && c.bands->build_rows) build_map(&c);

@@ -50,6 +50,11 @@ om_vec3 om__persp_point(const om__persp_tri *c, float sx, float sy);
 void om__eye_pass_mark(const om_scene *s, const om_view *v, const om_target *tg, om_strip *st,
                        const om__bins *bins);
 
+/* The second half of the eye pass alone: the samples of st's rows (with `mark`, their
+ * exposure marks too) from the triangle ids already in tg->id (tg->depth unread), as
+ * om__eye_pass(_mark) gives them after rasterizing. */
+void om__eye_resolve(const om_scene *s, const om_view *v, const om_target *tg, om_strip *st, bool mark);
+
 /* Direction from a point towards the light (unit). */
 om_vec3 om__to_light(const om_view *v, om_vec3 p);
 
