@@ -9,6 +9,7 @@
     X(suite_scene_fuzz) \
     X(suite_raster) \
     X(suite_hiz) \
+    X(suite_scene_raster) \
     X(suite_frame) \
     X(suite_platform) \
     X(suite_shadow) \

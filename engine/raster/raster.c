@@ -7,6 +7,7 @@
 #include "../core/core.h"
 
 #include <math.h>
+#include <string.h>
 
 /* floor(a / 256), a grid position's pixel, by shifts of non-negative values (a
  * shift of a negative one is the implementation's to define, a 64-bit division a
@@ -60,12 +61,15 @@ bool om__tri2_setup(om__tri2 *t, const int64_t x[3], const int64_t y[3], bool bi
     return true;
 }
 
+typedef char om__no_tri_is_all_ones[OM_NO_TRI == 0xFFFFFFFFu ? 1 : -1];   /* target_clear's memset */
+
 void om__target_clear(const om_target *t)
 {
+    /* every byte 0xFF: depth 2^32 - 1 and OM_NO_TRI, by the C library's memset,
+     * which fills a large map several words an instruction */
     size_t n = (size_t)t->rows * t->width;
-    for (size_t i = 0; i < n; i++) t->depth[i] = 0xFFFFFFFFu;
-    if (t->id)
-        for (size_t i = 0; i < n; i++) t->id[i] = OM_NO_TRI;
+    memset(t->depth, 0xFF, n * sizeof *t->depth);
+    if (t->id) memset(t->id, 0xFF, n * sizeof *t->id);
 }
 
 /* ---- clipping */
@@ -581,6 +585,12 @@ static bool snapped(const om_raster *r, uint32_t *hiz, const int64_t x[3], const
         fill(r, &t, z, id);
     }
     return true;
+}
+
+bool om__raster_projected(const om_raster *r, uint32_t *hiz, const int64_t x[3], const int64_t y[3],
+                          const om_vec4 clip[3], uint32_t id)
+{
+    return snapped(r, hiz, x, y, NULL, clip, id);
 }
 
 bool om__raster_snapped(const om_raster *r, const int64_t x[3], const int64_t y[3], const uint32_t z[3],

@@ -143,6 +143,140 @@ void om__scene_raster(const om_scene *s, const om_mat4 *vp, const om_target *tg,
     om__scene_raster_hiz(s, vp, tg, mode, cull, bins, NULL);
 }
 
+/* ---- the walk without vertex bins, a batch of triangles at a time */
+
+/* Most triangles of a detailed scene hold no pixel centre of the target, and cost the
+ * walk their transform, plane tests, projection and box. A batch does those in loops
+ * over arrays, a lane per vertex (lane c * BATCH + k: corner c of the batch's
+ * triangle k) and then per triangle, with no branch on the data, so that a compiler
+ * may run several lanes an instruction: each lane does om__mat_apply's,
+ * om__inside_band's and om__project_xy's operations in their order, the same bits. A
+ * triangle whose box holds no pixel centre of the target is then passed over before
+ * any setup, and one with a vertex outside a plane (or not finite) goes to
+ * om__raster_tri_guarded as its clip-space vertices, as before. */
+#define BATCH 8
+
+typedef struct batch {
+    float x[3 * BATCH], y[3 * BATCH], z[3 * BATCH], w[3 * BATCH];   /* clip space */
+    int32_t gx[3 * BATCH], gy[3 * BATCH];                           /* om__project_xy's */
+    int32_t ok[3 * BATCH];   /* inside every plane, w finite and > 0, within 2^26 */
+    int32_t go[BATCH];       /* 0: passed over, 1: to be clipped, 2: projected, in the target's box */
+} batch;
+
+/* The scene's triangles t0..t0 + n (n <= BATCH) through vp: transformed, tested and
+ * projected onto a width x height image (sx, sy: om__project_xy's scales). */
+static void batch_project(batch *b, const om_scene *s, uint32_t t0, uint32_t n, const om_mat4 *vp,
+                          om__guard g, float sx, float sy)
+{
+    float px[3 * BATCH], py[3 * BATCH], pz[3 * BATCH];
+    for (uint32_t k = 0; k < BATCH; k++)
+        for (int c = 0; c < 3; c++) {
+            const om_vec3 v = k < n ? s->verts[s->idx[((size_t)t0 + k) * 3 + c]] : om__v3(0.0f, 0.0f, 0.0f);
+            px[c * BATCH + k] = v.x;
+            py[c * BATCH + k] = v.y;
+            pz[c * BATCH + k] = v.z;
+        }
+    const float *a = vp->m, lim = 67108864.0f;
+    for (int i = 0; i < 3 * BATCH; i++) {
+        const float x = a[0] * px[i] + a[1] * py[i] + a[2] * pz[i] + a[3];
+        const float y = a[4] * px[i] + a[5] * py[i] + a[6] * pz[i] + a[7];
+        const float z = a[8] * px[i] + a[9] * py[i] + a[10] * pz[i] + a[11];
+        const float w = a[12] * px[i] + a[13] * py[i] + a[14] * pz[i] + a[15];
+        /* on a lane that fails a test these may be infinite or NaN, and are not used */
+        const float iw = 1.0f / w;
+        const float X = (x * iw + 1.0f) * sx + 0.5f, Y = (1.0f - y * iw) * sy + 0.5f;
+        const int32_t ok = (z >= 0.0f) & (w - z >= 0.0f) & (x + g.x * w >= 0.0f) & (g.x * w - x >= 0.0f) &
+                           (y + g.y * w >= 0.0f) & (g.y * w - y >= 0.0f) & (w > 0.0f) & (w - w == 0.0f) &
+                           (X > -lim) & (X < lim) & (Y > -lim) & (Y < lim);
+        b->x[i] = x;
+        b->y[i] = y;
+        b->z[i] = z;
+        b->w[i] = w;
+        /* clamped, NaN included, so that every lane converts (below) */
+        const float Xc = X > -lim ? X : -lim, Yc = Y > -lim ? Y : -lim;
+        px[i] = Xc < lim ? Xc : lim;
+        py[i] = Yc < lim ? Yc : lim;
+        b->ok[i] = ok;
+    }
+    /* a loop of its own: in the one above, a compiler would convert only the lanes it
+     * knows to be in range, under a branch, and then not vectorize it */
+    for (int i = 0; i < 3 * BATCH; i++) {
+        b->gx[i] = om__floorf_i32(px[i]);
+        b->gy[i] = om__floorf_i32(py[i]);
+    }
+}
+
+/* What each triangle of the batch needs (batch.go): the pixels whose centre lies in
+ * its box, as raster.c's bounds finds them, in 32 bits (|gx|, |gy| < 2^26; the bias,
+ * a multiple of 256, makes every shifted value non-negative). */
+static void batch_boxes(batch *b, const om_target *tg, bool cons)
+{
+    const int32_t B = 1 << 27, xe = (int32_t)tg->width - 1, ya = (int32_t)tg->y0,
+                  ye = (int32_t)(tg->y0 + tg->rows) - 1;
+    for (int k = 0; k < BATCH; k++) {
+        const int32_t *gx = b->gx + k, *gy = b->gy + k;
+        int32_t x0 = gx[0], x1 = gx[0], y0 = gy[0], y1 = gy[0];
+        for (int c = 1; c < 3; c++) {
+            const int32_t x = gx[c * BATCH], y = gy[c * BATCH];
+            x0 = x < x0 ? x : x0;
+            x1 = x > x1 ? x : x1;
+            y0 = y < y0 ? y : y0;
+            y1 = y > y1 ? y : y1;
+        }
+        /* centres at 256 i + 128: the first at or after the box's low side, the last
+         * at or before its high side */
+        x0 = ((x0 + 127 + B) >> OM_SUBPIX_BITS) - (B >> OM_SUBPIX_BITS);
+        y0 = ((y0 + 127 + B) >> OM_SUBPIX_BITS) - (B >> OM_SUBPIX_BITS);
+        x1 = ((x1 - 128 + B) >> OM_SUBPIX_BITS) - (B >> OM_SUBPIX_BITS);
+        y1 = ((y1 - 128 + B) >> OM_SUBPIX_BITS) - (B >> OM_SUBPIX_BITS);
+        x0 = x0 < 0 ? 0 : x0;
+        x1 = x1 > xe ? xe : x1;
+        y0 = y0 < ya ? ya : y0;
+        y1 = y1 > ye ? ye : y1;
+        const int32_t all = b->ok[k] & b->ok[BATCH + k] & b->ok[2 * BATCH + k];
+        const int32_t in = (x0 <= x1) & (y0 <= y1);
+        /* conservative coverage reaches pixels beyond the centres: no skipping there */
+        b->go[k] = all ? 2 * (in | (int32_t)cons) : 1;
+    }
+}
+
+static void walk_batches(const om_scene *s, const om_mat4 *vp, om_raster *r, uint32_t *hiz, bool cull,
+                         const uint32_t *rows)
+{
+    const om_target *tg = r->target;
+    const uint32_t y0 = tg->y0, y1 = tg->y0 + tg->rows - 1;
+    const om__guard g = om__guard_band(tg->width, tg->height);
+    const float sx = (float)tg->width * (OM_SUBPIX / 2), sy = (float)tg->height * (OM_SUBPIX / 2);
+    om__cull cl;
+    om__cull_begin(&cl, s, vp);
+    batch b;
+    for (uint32_t t0 = 0; t0 < s->ntris; t0 += BATCH) {
+        const uint32_t n = s->ntris - t0 < BATCH ? s->ntris - t0 : BATCH;
+        batch_project(&b, s, t0, n, vp, g, sx, sy);
+        batch_boxes(&b, tg, r->mode == OM_RASTER_CONSERVATIVE);
+        for (uint32_t k = 0; k < n; k++) {
+            const uint32_t t = t0 + k;
+            if (!b.go[k] || (rows && ((rows[t] & 0xFFFFu) > y1 || rows[t] >> 16 < y0))) continue;
+            r->cull_back = cull && om__cull_next(&cl, t);
+            om_vec4 c[3];
+            for (int j = 0; j < 3; j++) {
+                const uint32_t i = (uint32_t)j * BATCH + k;
+                c[j].x = b.x[i];
+                c[j].y = b.y[i];
+                c[j].z = b.z[i];
+                c[j].w = b.w[i];
+            }
+            if (b.go[k] == 2) {
+                const int64_t x[3] = {b.gx[k], b.gx[BATCH + k], b.gx[2 * BATCH + k]};
+                const int64_t y[3] = {b.gy[k], b.gy[BATCH + k], b.gy[2 * BATCH + k]};
+                om__raster_projected(r, hiz, x, y, c, t);
+            } else {
+                om__raster_tri_guarded(r, hiz, c, t, tg->width, tg->height, g);
+            }
+        }
+    }
+}
+
 void om__scene_raster_hiz(const om_scene *s, const om_mat4 *vp, const om_target *tg,
                           om_raster_mode mode, bool cull, const om__bins *bins, uint32_t *hiz)
 {
@@ -160,19 +294,23 @@ void om__scene_raster_hiz(const om_scene *s, const om_mat4 *vp, const om_target 
     r.cull_back = false;
     r.row_mask = NULL;
     r.row_shift = 0;
-    om__cull cl;
-    om__cull_begin(&cl, s, vp);
     om__target_clear(tg);
     om__hiz_clear(hiz, tg);
     const uint32_t y0 = tg->y0, y1 = tg->y0 + tg->rows - 1;
     const uint32_t *rows = bins ? bins->rows : NULL;
     const om__vsnap *vs = bins ? bins->verts : NULL;
+    if (!vs) {
+        walk_batches(s, vp, &r, hiz, cull, rows);
+        return;
+    }
+    om__cull cl;
+    om__cull_begin(&cl, s, vp);
     const om__guard g = om__guard_band(tg->width, tg->height);
     for (uint32_t t = 0; t < s->ntris; t++) {
         if (rows && ((rows[t] & 0xFFFFu) > y1 || rows[t] >> 16 < y0)) continue;
         r.cull_back = cull && om__cull_next(&cl, t);
         const uint32_t *ix = s->idx + (size_t)t * 3;
-        if (vs && vs[ix[0]].x != INT32_MIN && vs[ix[1]].x != INT32_MIN && vs[ix[2]].x != INT32_MIN) {
+        if (vs[ix[0]].x != INT32_MIN && vs[ix[1]].x != INT32_MIN && vs[ix[2]].x != INT32_MIN) {
             const int64_t x[3] = {vs[ix[0]].x, vs[ix[1]].x, vs[ix[2]].x};
             const int64_t y[3] = {vs[ix[0]].y, vs[ix[1]].y, vs[ix[2]].y};
             const uint32_t z[3] = {vs[ix[0]].z, vs[ix[1]].z, vs[ix[2]].z};
