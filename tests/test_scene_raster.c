@@ -6,7 +6,8 @@
  * tiny (most between pixel centres), cross the near and far planes and the guard band,
  * have vertices that are NaN, infinite or huge, and whose count is no multiple of the
  * batch; into whole targets and strips, depth and depth + id, with and without the
- * culling of closed shapes and the coarse depth. */
+ * culling of closed shapes and the coarse depth. With the frame's bins (rows and
+ * vertices snapped alone), whose triangles a 32-bit box test passes over first, too. */
 #include "test.h"
 #include "../engine/raster/scene_raster.h"
 #include "../engine/raster/hiz.h"
@@ -45,16 +46,19 @@ static size_t compare_walks(const om_scene *s, const om_mat4 *vp, uint32_t W, ui
     size_t n = (size_t)W * H, drawn = 0;
     uint32_t *da = malloc(n * 4), *db = malloc(n * 4), *ia = malloc(n * 4), *ib = malloc(n * 4);
     uint32_t *ha = malloc(om__hiz_words(W, H) * 4), *hb = malloc(om__hiz_words(W, H) * 4);
-    CHECK(da && db && ia && ib && ha && hb);
-    for (int mode = 0; da && db && ia && ib && ha && hb && mode < 4; mode++) {
-        const bool id = mode & 1, cull = mode & 2;
+    om__bins bins = {malloc((size_t)s->ntris * 4), malloc((size_t)s->nverts * sizeof(om__vsnap))};
+    CHECK(da && db && ia && ib && ha && hb && bins.rows && bins.verts);
+    if (bins.rows && bins.verts) om__bins_make(s, vp, W, H, &bins);
+    for (int mode = 0; da && db && ia && ib && ha && hb && bins.rows && bins.verts && mode < 8; mode++) {
+        /* mode 4..7 with the bins (rows and snapped vertices) */
+        const bool id = mode & 1, cull = mode & 2, binned = mode & 4;
         for (uint32_t y0 = 0; y0 < H; y0 += strip) {
             const uint32_t rows = H - y0 < strip ? H - y0 : strip;
             om_target ta = {W, H, y0, rows, da + (size_t)y0 * W, id ? ia + (size_t)y0 * W : NULL};
             om_target tb = {W, H, y0, rows, db + (size_t)y0 * W, id ? ib + (size_t)y0 * W : NULL};
             const bool coarse = !id && om__hiz_fits(&ta);
             const om_raster_mode m = id ? OM_RASTER_DEPTH_ID : OM_RASTER_DEPTH;
-            om__scene_raster_hiz(s, vp, &ta, m, cull, NULL, coarse ? ha : NULL);
+            om__scene_raster_hiz(s, vp, &ta, m, cull, binned ? &bins : NULL, coarse ? ha : NULL);
             walk_one_by_one(s, vp, &tb, m, cull, coarse ? hb : NULL);
         }
         size_t diff = 0;
@@ -70,6 +74,8 @@ static size_t compare_walks(const om_scene *s, const om_mat4 *vp, uint32_t W, ui
     free(ib);
     free(ha);
     free(hb);
+    free(bins.rows);
+    free(bins.verts);
     return drawn;
 }
 

@@ -301,9 +301,13 @@ static void depth_row(const om__rtri *t, const om_target *tg, int32_t y, int32_t
     }
 }
 
+static const uint32_t *zdepths(const om_vec4 *zc, uint32_t zb[3]);
+
 /* The plain fill. The depth plane (two divisions) is set up at the first row with a
- * covered pixel: most triangles of a detailed scene cover no pixel centre at all. */
-static void fill(const om_raster *r, om__rtri *t, const uint32_t z[3], uint32_t id)
+ * covered pixel, from the depths z or, when z is NULL, those of zc (om__zdepth, three
+ * more divisions); neither when both are NULL (the plane is set): most triangles of a
+ * detailed scene that reach a pixel's row cover no pixel centre at all. */
+static void fill(const om_raster *r, om__rtri *t, const uint32_t *z, const om_vec4 *zc, uint32_t id)
 {
     const om_target *tg = r->target;
     const om__tri2 *e = &t->e;
@@ -315,9 +319,11 @@ static void fill(const om_raster *r, om__rtri *t, const uint32_t z[3], uint32_t 
         const int64_t E[3] = {om__tri2_edge(e, 0, px0, py), om__tri2_edge(e, 1, px0, py),
                               om__tri2_edge(e, 2, px0, py)};
         if (!row_span(E, step, t->maxx - t->minx, &lo, &hi)) continue;
-        if (z) {
-            om__rtri_zplane(t, z);
+        if (z || zc) {
+            uint32_t zb[3];
+            om__rtri_zplane(t, z ? z : zdepths(zc, zb));
             z = NULL;
+            zc = NULL;
         }
         uint32_t *id_row = with_id ? tg->id + (size_t)(y - (int32_t)tg->y0) * tg->width : NULL;
         depth_row(t, tg, y, t->minx + (int32_t)lo, t->minx + (int32_t)hi, id_row, id);
@@ -546,9 +552,10 @@ static bool in_range(const int64_t x[3], const int64_t y[3])
 /* A triangle on the grid (x, y) into r's target. Its depths are z, or when z is NULL
  * those of clip-space vertices zc (om__zdepth, as om__project gives them), worked out
  * only once the triangle is known to reach a pixel: most of a detailed scene's
- * triangles hold no pixel centre, and each depth is a 64-bit division. */
+ * triangles hold no pixel centre, and each depth is a 64-bit division. `ranged`: the
+ * caller's vertices are om__project's (within 2^26), so in_range need not look. */
 static bool snapped(const om_raster *r, uint32_t *hiz, const int64_t x[3], const int64_t y[3],
-                    const uint32_t *z, const om_vec4 *zc, uint32_t id)
+                    const uint32_t *z, const om_vec4 *zc, uint32_t id, bool ranged)
 {
     uint32_t zb[3];
     const bool cons = r->mode == OM_RASTER_CONSERVATIVE;
@@ -570,39 +577,41 @@ static bool snapped(const om_raster *r, uint32_t *hiz, const int64_t x[3], const
     /* the bounds first: they need no edges, and most triangles of a detailed scene
      * hold no pixel centre of a small target; the setup's range test before them, as
      * om__tri2_setup would refuse the same triangles (after the cull, which most
-     * back faces leave by; vertices from om__project_xy, zc, are always in range) */
-    if ((!zc && !in_range(x, y)) || !bounds(&t, x, y, r->target, cons) || !om__tri2_setup(&t.e, x, y, !cons))
+     * back faces leave by; om__project's vertices, `ranged`, are always in range) */
+    if ((!ranged && !in_range(x, y)) || !bounds(&t, x, y, r->target, cons) || !om__tri2_setup(&t.e, x, y, !cons))
         return false;
+    if (!cons && !(hiz && om__hiz_big(&t))) {
+        fill(r, &t, z, zc, id);   /* the depths too once a row holds a covered centre */
+        return true;
+    }
     if (!z) z = zdepths(zc, zb);
     if (cons) {
         om__rtri_zplane(&t, z);
         om__rtri_plane(&t, z);   /* the spans' callers test the plane beyond the triangle */
         fill_conservative(r, &t);
-    } else if (hiz && om__hiz_big(&t)) {
-        om__rtri_zplane(&t, z);
-        if (!om__hiz_fill(r, hiz, &t, z)) fill(r, &t, NULL, id);
     } else {
-        fill(r, &t, z, id);
+        om__rtri_zplane(&t, z);
+        if (!om__hiz_fill(r, hiz, &t, z)) fill(r, &t, NULL, NULL, id);
     }
     return true;
 }
 
 bool om__raster_projected(const om_raster *r, uint32_t *hiz, const int64_t x[3], const int64_t y[3],
-                          const om_vec4 clip[3], uint32_t id)
+                          const uint32_t *z, const om_vec4 *clip, uint32_t id)
 {
-    return snapped(r, hiz, x, y, NULL, clip, id);
+    return snapped(r, hiz, x, y, z, clip, id, true);
 }
 
 bool om__raster_snapped(const om_raster *r, const int64_t x[3], const int64_t y[3], const uint32_t z[3],
                         uint32_t id)
 {
-    return snapped(r, NULL, x, y, z, NULL, id);
+    return snapped(r, NULL, x, y, z, NULL, id, false);
 }
 
 bool om__raster_snapped_hiz(const om_raster *r, uint32_t *hiz, const int64_t x[3], const int64_t y[3],
                             const uint32_t z[3], uint32_t id)
 {
-    return snapped(r, hiz, x, y, z, NULL, id);
+    return snapped(r, hiz, x, y, z, NULL, id, false);
 }
 
 int om__raster_tri(const om_raster *r, const om_vec4 clip[3], uint32_t id)
@@ -641,7 +650,7 @@ int om__raster_tri_guarded(const om_raster *r, uint32_t *hiz, const om_vec4 clip
         if (!((clip[0].w - clip[0].w) + (clip[1].w - clip[1].w) + (clip[2].w - clip[2].w) == 0.0f)) return 0;
         for (int i = 0; i < 3; i++)
             if (!om__project_xy(&clip[i], width, height, &gx[i], &gy[i])) return 0;
-        return snapped(r, hiz, gx, gy, NULL, clip, id);
+        return snapped(r, hiz, gx, gy, NULL, clip, id, true);
     }
     /* finite: v - v is 0, and NaN for an infinity or a NaN, which the sum keeps */
     for (int i = 0; i < 3; i++)
@@ -653,7 +662,7 @@ int om__raster_tri_guarded(const om_raster *r, uint32_t *hiz, const om_vec4 clip
     for (int k = 1; k + 1 < n; k++) {
         int64_t tx[3] = {gx[0], gx[k], gx[k + 1]}, ty[3] = {gy[0], gy[k], gy[k + 1]};
         uint32_t tz[3] = {gz[0], gz[k], gz[k + 1]};
-        filled += snapped(r, hiz, tx, ty, tz, NULL, id);
+        filled += snapped(r, hiz, tx, ty, tz, NULL, id, true);
     }
     return filled;
 }

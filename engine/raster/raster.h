@@ -244,11 +244,13 @@ static inline int om__inside_band(const om_vec4 *v, om__guard g)
 int om__raster_tri_guarded(const om_raster *r, uint32_t *hiz, const om_vec4 clip[3], uint32_t id,
                            uint32_t width, uint32_t height, om__guard g);
 /* What om__raster_tri_guarded does with a triangle inside every plane, for a caller
- * that has tested and projected its vertices itself: x, y are om__project_xy of clip
- * (each inside the band, w finite and positive), whose z and w give the depths when
- * the triangle reaches a pixel. False: nothing filled. */
+ * that has tested and projected its vertices itself (each inside the band, w finite
+ * and positive): x, y are om__project_xy's, and the depths z, or when z is NULL
+ * om__zdepth of clip's z and w, worked out when the triangle reaches a pixel. The
+ * same as om__raster_snapped_hiz, without its range test (om__project's vertices are
+ * within 2^26). False: nothing filled. */
 bool om__raster_projected(const om_raster *r, uint32_t *hiz, const int64_t x[3], const int64_t y[3],
-                          const om_vec4 clip[3], uint32_t id);
+                          const uint32_t *z, const om_vec4 *clip, uint32_t id);
 
 /* Which of the six clip planes (near, far, four guard-band sides) a vertex is outside
  * of, as a bit mask; 0 means it needs no clipping. */

@@ -143,6 +143,32 @@ void om__scene_raster(const om_scene *s, const om_mat4 *vp, const om_target *tg,
     om__scene_raster_hiz(s, vp, tg, mode, cull, bins, NULL);
 }
 
+/* Whether the box of three grid points within 2^26 (om__project's) holds the centre
+ * of a pixel of tg, as raster.c's bounds finds them, in 32 bits and without a branch
+ * (the bias, a multiple of 256, makes every shifted value non-negative): 1 or 0.
+ * Centres lie at 256 i + 128; the first at or after the box's low side and the last
+ * at or before its high side, clamped to the target. */
+static inline int32_t holds_centre(int32_t xa, int32_t xb, int32_t xc, int32_t ya, int32_t yb, int32_t yc,
+                                   const om_target *tg)
+{
+    const int32_t B = 1 << 27, b = B >> OM_SUBPIX_BITS;
+    int32_t x0 = xa < xb ? xa : xb, x1 = xa < xb ? xb : xa, y0 = ya < yb ? ya : yb, y1 = ya < yb ? yb : ya;
+    x0 = xc < x0 ? xc : x0;
+    x1 = xc > x1 ? xc : x1;
+    y0 = yc < y0 ? yc : y0;
+    y1 = yc > y1 ? yc : y1;
+    x0 = ((x0 + 127 + B) >> OM_SUBPIX_BITS) - b;
+    y0 = ((y0 + 127 + B) >> OM_SUBPIX_BITS) - b;
+    x1 = ((x1 - 128 + B) >> OM_SUBPIX_BITS) - b;
+    y1 = ((y1 - 128 + B) >> OM_SUBPIX_BITS) - b;
+    const int32_t xe = (int32_t)tg->width - 1, ya0 = (int32_t)tg->y0, ye = (int32_t)(tg->y0 + tg->rows) - 1;
+    x0 = x0 < 0 ? 0 : x0;
+    x1 = x1 > xe ? xe : x1;
+    y0 = y0 < ya0 ? ya0 : y0;
+    y1 = y1 > ye ? ye : y1;
+    return (x0 <= x1) & (y0 <= y1);
+}
+
 /* ---- the walk without vertex bins, a batch of triangles at a time */
 
 /* Most triangles of a detailed scene hold no pixel centre of the target, and cost the
@@ -206,35 +232,13 @@ static void batch_project(batch *b, const om_scene *s, uint32_t t0, uint32_t n, 
     }
 }
 
-/* What each triangle of the batch needs (batch.go): the pixels whose centre lies in
- * its box, as raster.c's bounds finds them, in 32 bits (|gx|, |gy| < 2^26; the bias,
- * a multiple of 256, makes every shifted value non-negative). */
+/* What each triangle of the batch needs (batch.go). */
 static void batch_boxes(batch *b, const om_target *tg, bool cons)
 {
-    const int32_t B = 1 << 27, xe = (int32_t)tg->width - 1, ya = (int32_t)tg->y0,
-                  ye = (int32_t)(tg->y0 + tg->rows) - 1;
     for (int k = 0; k < BATCH; k++) {
         const int32_t *gx = b->gx + k, *gy = b->gy + k;
-        int32_t x0 = gx[0], x1 = gx[0], y0 = gy[0], y1 = gy[0];
-        for (int c = 1; c < 3; c++) {
-            const int32_t x = gx[c * BATCH], y = gy[c * BATCH];
-            x0 = x < x0 ? x : x0;
-            x1 = x > x1 ? x : x1;
-            y0 = y < y0 ? y : y0;
-            y1 = y > y1 ? y : y1;
-        }
-        /* centres at 256 i + 128: the first at or after the box's low side, the last
-         * at or before its high side */
-        x0 = ((x0 + 127 + B) >> OM_SUBPIX_BITS) - (B >> OM_SUBPIX_BITS);
-        y0 = ((y0 + 127 + B) >> OM_SUBPIX_BITS) - (B >> OM_SUBPIX_BITS);
-        x1 = ((x1 - 128 + B) >> OM_SUBPIX_BITS) - (B >> OM_SUBPIX_BITS);
-        y1 = ((y1 - 128 + B) >> OM_SUBPIX_BITS) - (B >> OM_SUBPIX_BITS);
-        x0 = x0 < 0 ? 0 : x0;
-        x1 = x1 > xe ? xe : x1;
-        y0 = y0 < ya ? ya : y0;
-        y1 = y1 > ye ? ye : y1;
+        const int32_t in = holds_centre(gx[0], gx[BATCH], gx[2 * BATCH], gy[0], gy[BATCH], gy[2 * BATCH], tg);
         const int32_t all = b->ok[k] & b->ok[BATCH + k] & b->ok[2 * BATCH + k];
-        const int32_t in = (x0 <= x1) & (y0 <= y1);
         /* conservative coverage reaches pixels beyond the centres: no skipping there */
         b->go[k] = all ? 2 * (in | (int32_t)cons) : 1;
     }
@@ -269,7 +273,7 @@ static void walk_batches(const om_scene *s, const om_mat4 *vp, om_raster *r, uin
             if (b.go[k] == 2) {
                 const int64_t x[3] = {b.gx[k], b.gx[BATCH + k], b.gx[2 * BATCH + k]};
                 const int64_t y[3] = {b.gy[k], b.gy[BATCH + k], b.gy[2 * BATCH + k]};
-                om__raster_projected(r, hiz, x, y, c, t);
+                om__raster_projected(r, hiz, x, y, NULL, c, t);
             } else {
                 om__raster_tri_guarded(r, hiz, c, t, tg->width, tg->height, g);
             }
@@ -306,17 +310,22 @@ void om__scene_raster_hiz(const om_scene *s, const om_mat4 *vp, const om_target 
     om__cull cl;
     om__cull_begin(&cl, s, vp);
     const om__guard g = om__guard_band(tg->width, tg->height);
+    const bool cons = mode == OM_RASTER_CONSERVATIVE;
     for (uint32_t t = 0; t < s->ntris; t++) {
         if (rows && ((rows[t] & 0xFFFFu) > y1 || rows[t] >> 16 < y0)) continue;
-        r.cull_back = cull && om__cull_next(&cl, t);
         const uint32_t *ix = s->idx + (size_t)t * 3;
-        if (vs[ix[0]].x != INT32_MIN && vs[ix[1]].x != INT32_MIN && vs[ix[2]].x != INT32_MIN) {
-            const int64_t x[3] = {vs[ix[0]].x, vs[ix[1]].x, vs[ix[2]].x};
-            const int64_t y[3] = {vs[ix[0]].y, vs[ix[1]].y, vs[ix[2]].y};
-            const uint32_t z[3] = {vs[ix[0]].z, vs[ix[1]].z, vs[ix[2]].z};
-            om__raster_snapped_hiz(&r, hiz, x, y, z, t);
+        const om__vsnap *va = &vs[ix[0]], *vb = &vs[ix[1]], *vc = &vs[ix[2]];
+        if (va->x != INT32_MIN && vb->x != INT32_MIN && vc->x != INT32_MIN) {
+            /* in 32 bits first: most triangles a strip's rows reach hold none of its
+             * pixel centres (conservative coverage reaches beyond them) */
+            if (!cons && !holds_centre(va->x, vb->x, vc->x, va->y, vb->y, vc->y, tg)) continue;
+            r.cull_back = cull && om__cull_next(&cl, t);
+            const int64_t x[3] = {va->x, vb->x, vc->x}, y[3] = {va->y, vb->y, vc->y};
+            const uint32_t z[3] = {va->z, vb->z, vc->z};
+            om__raster_projected(&r, hiz, x, y, z, NULL, t);
             continue;
         }
+        r.cull_back = cull && om__cull_next(&cl, t);
         om_vec4 c[3];
         om__clip_tri(s, vp, t, c);
         om__raster_tri_guarded(&r, hiz, c, t, tg->width, tg->height, g);
