@@ -135,14 +135,14 @@ static om_status spsm_begin(void *state, const om_view *v, om_diag *d)
     return OM_OK;
 }
 
-typedef struct sample_pt { int64_t x, y; double z; float zf; bool ok; } sample_pt;
+typedef struct sample_pt { int64_t x, y; double z; float zf; bool ok; om_vec4 q; } sample_pt;
 
 static sample_pt project(const om__spsm_state *m, om_vec3 p)
 {
     sample_pt s;
-    om_vec4 q = om__mat_apply(&m->view.light_vp, p);
+    s.q = om__mat_apply(&m->view.light_vp, p);
     uint32_t z = 0;
-    s.ok = om__project(&q, m->size, m->size, &s.x, &s.y, &z);
+    s.ok = om__project(&s.q, m->size, m->size, &s.x, &s.y, &z);
     s.z = z;
     s.zf = (float)z;
     return s;
@@ -361,48 +361,53 @@ static double consistent_min(const om__spsm_dtri *t)
     return om__spsm_clipped_min(X, Y, -H, -H, OM_SUBPIX, &p);
 }
 
-/* Light depth (raw) and grid position of a world point, in double throughout. */
-static void project_d(const om__spsm_state *m, const double w[3], double *gx, double *gy, double *gz)
-{
-    const float *M = m->view.light_vp.m;
-    double q[4];
-    for (int r = 0; r < 4; r++)
-        q[r] = (double)M[r * 4] * w[0] + (double)M[r * 4 + 1] * w[1] + (double)M[r * 4 + 2] * w[2] +
-               (double)M[r * 4 + 3];
-    double iw = 1.0 / q[3], half = (double)m->size * (OM_SUBPIX / 2);
-    *gx = (q[0] * iw + 1.0) * half;
-    *gy = (1.0 - q[1] * iw) * half;
-    *gz = q[2] * iw * OM_DEPTH_ONE;
-}
-
 /* The sample's own surface as a plane in light space: depth (raw) at grid offset
- * (dx, dy) from the sample is z + gx dx + gy dy. z/w is affine on a plane, so two
- * steps along the surface (from the geometric normal) give the slopes exactly. */
+ * (dx, dy) from the sample is z + gx dx + gy dy (z/w is affine on a plane). The slopes
+ * come from the derivatives of the projection along two directions in the surface (from
+ * the geometric normal), in float: a light-space point q = M p moves by d = M t along a
+ * direction t, and its projection by (d q.w - q d.w) / q.w^2 in each of x/w, y/w and
+ * z/w. The common factor 1 / q.w^2 cancels in the 2x2 solve, so no division is taken
+ * before it. Float, the same bits on every CPU: the slopes' relative error (about 2^-20
+ * but where the surface is nearly edge-on to the light) moves a depth carried a few
+ * texels by far less than the tolerance the tests below use (OM__SPSM_TOL0); the depth
+ * at the sample is its own projection's (the lookup's). The double values are the
+ * float ones, so both kinds of test see one plane. */
 typedef struct receiver { double z, gx, gy; float zf, gxf, gyf; bool ok; } receiver;
 
-static receiver receiver_plane(const om__spsm_state *m, const om_sample *smp)
+static receiver receiver_plane(const om__spsm_state *m, const om_sample *smp, const sample_pt *p)
 {
     receiver r;
-    double n[3] = {smp->n[0], smp->n[1], smp->n[2]}, a[3] = {0, 0, 0};
-    a[fabs(n[0]) < 0.5 ? 0 : 1] = 1.0;
-    double t1[3] = {n[1] * a[2] - n[2] * a[1], n[2] * a[0] - n[0] * a[2], n[0] * a[1] - n[1] * a[0]};
-    double t2[3] = {n[1] * t1[2] - n[2] * t1[1], n[2] * t1[0] - n[0] * t1[2], n[0] * t1[1] - n[1] * t1[0]};
-    double p0[3] = {smp->p[0], smp->p[1], smp->p[2]}, p1[3], p2[3];
-    for (int k = 0; k < 3; k++) { p1[k] = p0[k] + 0.01 * t1[k]; p2[k] = p0[k] + 0.01 * t2[k]; }
-    double x0, y0, x1, y1, z1, x2, y2, z2;
-    project_d(m, p0, &x0, &y0, &r.z);
-    project_d(m, p1, &x1, &y1, &z1);
-    project_d(m, p2, &x2, &y2, &z2);
-    double ax = x1 - x0, ay = y1 - y0, az = z1 - r.z, bx = x2 - x0, by = y2 - y0, bz = z2 - r.z;
-    double det = ax * by - ay * bx;
-    r.ok = det != 0.0 && det == det;
-    /* solve (gx, gy) . a = az, (gx, gy) . b = bz */
-    r.gx = r.ok ? (az * by - bz * ay) / det : 0.0;
-    r.gy = r.ok ? (ax * bz - bx * az) / det : 0.0;
-    r.ok = r.ok && r.gx == r.gx && r.gy == r.gy && fabs(r.gx) < 1e30 && fabs(r.gy) < 1e30;
-    r.zf = (float)r.z;
-    r.gxf = (float)r.gx;
-    r.gyf = (float)r.gy;
+    const float *M = m->view.light_vp.m;
+    const float n0 = smp->n[0], n1 = smp->n[1], n2 = smp->n[2];
+    /* t1 = n x (an axis away from n), t2 = n x t1: both in the surface, not parallel */
+    float t[2][3];
+    if (om__fabsf(n0) < 0.5f) { t[0][0] = 0.0f; t[0][1] = n2; t[0][2] = -n1; }
+    else { t[0][0] = -n2; t[0][1] = 0.0f; t[0][2] = n0; }
+    t[1][0] = n1 * t[0][2] - n2 * t[0][1];
+    t[1][1] = n2 * t[0][0] - n0 * t[0][2];
+    t[1][2] = n0 * t[0][1] - n1 * t[0][0];
+    const om_vec4 q = p->q;
+    float u[2][3];   /* (x/w, y/w, z/w) moved along t[k], times q.w^2 */
+    for (int k = 0; k < 2; k++) {
+        float d[4];
+        for (int i = 0; i < 4; i++) d[i] = M[i * 4] * t[k][0] + M[i * 4 + 1] * t[k][1] + M[i * 4 + 2] * t[k][2];
+        u[k][0] = d[0] * q.w - q.x * d[3];
+        u[k][1] = d[1] * q.w - q.y * d[3];
+        u[k][2] = d[2] * q.w - q.z * d[3];
+    }
+    /* slopes of z/w against x/w and y/w: sx u[k][0] + sy u[k][1] = u[k][2] for both k */
+    const float det = u[0][0] * u[1][1] - u[0][1] * u[1][0];
+    const float sx = (u[0][2] * u[1][1] - u[1][2] * u[0][1]) / det, sy = (u[0][0] * u[1][2] - u[1][0] * u[0][2]) / det;
+    /* to raw depth per grid unit: x/w = -1..1 is 2 half grid units, y runs down */
+    const float k = OM_DEPTH_ONE_F / ((float)m->size * (float)(OM_SUBPIX / 2));
+    r.zf = p->zf;
+    r.gxf = sx * k;
+    r.gyf = -sy * k;
+    r.ok = det != 0.0f && om__fabsf(r.gxf) < 1e30f && om__fabsf(r.gyf) < 1e30f;   /* NaN fails too */
+    if (!r.ok) r.gxf = r.gyf = 0.0f;
+    r.z = p->z;
+    r.gx = r.gxf;
+    r.gy = r.gyf;
     return r;
 }
 
@@ -479,12 +484,12 @@ static bool plain_shadow(const uint32_t *buf, int64_t side, int64_t step, const 
 /* Which of the outline's candidate centres (w->cand) hold something nearer than the
  * sample's own plane carried there: bit c for cand[c]. Sets the receiver plane. */
 static uint16_t centres_nearer(const om__spsm_state *m, const om__spsm_win *w, receiver *rp, bool *have_rp, const om_sample *smp,
-                               int64_t tx, int64_t ty, int64_t px, int64_t py)
+                               const sample_pt *p, int64_t tx, int64_t ty, int64_t px, int64_t py)
 {
     uint16_t use = 0;
     for (int c = 0; c < w->ncand; c++) {
         const int k = w->cand_k[c], dx = k % 3 - 1, dy = k / 3 - 1;
-        if (!*have_rp) { *rp = receiver_plane(m, smp); *have_rp = true; }
+        if (!*have_rp) { *rp = receiver_plane(m, smp, p); *have_rp = true; }
         if (centre_test(m, rp, tx + dx, ty + dy, px - dx * OM_SUBPIX, py - dy * OM_SUBPIX)) use |= (uint16_t)(1u << c);
     }
     return use;
@@ -653,7 +658,7 @@ OM_NOINLINE static uint8_t recover(const om__spsm_state *m, om__spsm_win *w, uin
             OM_FAST_FLOAT ? om__spsm_below_f(&t[k], px, py, p.zf, -1.0f, (float)(OM__SPSM_TOL0 + PAT_CAP)) : -1;
         if (below == 0 || (below < 0 && !(om__spsm_plane_at(&t[k], px, py) < p.z - pat_tol(&t[k], px, py))))
             continue;
-        if (!have_rp) { rp = receiver_plane(m, smp); have_rp = true; }
+        if (!have_rp) { rp = receiver_plane(m, smp, &p); have_rp = true; }
         if (t[k].ok && behind_receiver(&t[k], &rp, px, py)) continue;
         if (!t[k].have_cmin) {
             edges(t, k);
@@ -703,12 +708,12 @@ OM_NOINLINE static uint8_t recover(const om__spsm_state *m, om__spsm_win *w, uin
             for (int k = 0; k < nocc && !shadow; k++) shadow = hits(occ[k], qx, qy, q.z, q.zf);
         if (!shadow && bd->nh) shadow = om__spsm_outline_inside(bd, qx, qy);
         if (!shadow && w->ncand) {
-            if (!have_use) { use = centres_nearer(m, w, &rp, &have_rp, smp, tx, ty, px, py); have_use = true; }
+            if (!have_use) { use = centres_nearer(m, w, &rp, &have_rp, smp, &p, tx, ty, px, py); have_use = true; }
             if (use) shadow = inside_extended(w, use, qx, qy);
         }
         if (!shadow && tg->keep == 511) shadow = centre_test(m, &rp, tx, ty, px, py);   /* rp set */
         if (!shadow) {
-            if (!have_rp) { rp = receiver_plane(m, smp); have_rp = true; }
+            if (!have_rp) { rp = receiver_plane(m, smp, &p); have_rp = true; }
             shadow = m->fine ? plain_shadow(m->fdepth, 2 * (int64_t)m->size, OM_SUBPIX / 2, &rp, tx, ty, px, py, qx, qy)
                              : plain_shadow(m->cdepth, m->size, OM_SUBPIX, &rp, tx, ty, px, py, qx, qy);
         }
