@@ -1,6 +1,6 @@
 /* test_spsm.c — Sub-Pixel Shadow Maps: conservative coverage against an exact overlap
  * test, the 128-bit texel's packing, the derivative code's error profile (section 3.4),
- * the pattern table, accuracy against the reference and the conventional map (the
+ * the build's table code against it, the pattern table, accuracy against the reference and the conventional map (the
  * default scene, a dense mesh), bit-identical frames, budgets and statistics; the
  * lookup's float depth tests against the double ones. */
 #include "test.h"
@@ -201,6 +201,39 @@ static void derivative_code_profile(void)
         if (c > 0 && c < 254) bad += fabs(q.dec[c] - d) > q.err[c] * (1 + 1e-9);
     }
     CHECK_MSG(bad == 0, "%d derivatives outside their code's bound", bad);
+}
+
+/* The build's code from the table's boundaries (om__spsm_q_encode_f) is the arctangent
+ * code but within 2^-22 of a boundary, and there too within the code's error bound. */
+static void table_code_is_the_code(void)
+{
+    static om__spsm_qtable q;
+    om__spsm_qtable_build(&q);
+    int bad = 0, near = 0, checked = 0;
+    rng = 17;
+    for (int k = 0; k < 20000; k++) {
+        /* slopes of every size, half of them right at a boundary */
+        double d = k % 2 ? tan(((double)(rnd() % 200001) - 100000.0) / 100000.0 * 1.5707)
+                         : (double)q.up[rnd() % 127] * (1.0 + ((double)(rnd() % 21) - 10.0) * 0x1p-24);
+        if (rnd() % 2) d = -d;
+        const float f = (float)d;
+        const uint8_t want = om__spsm_q_encode(d), got = om__spsm_q_encode_f(&q, f);
+        checked++;
+        const double a = fabs(d);
+        bool at_bound = false;
+        for (int b = 0; b < 127; b++) at_bound |= fabs(a - (double)q.up[b]) <= a * 0x1p-22;
+        near += at_bound;
+        if (!at_bound) bad += got != want;
+        else bad += got != want && got != want + 1 && got != want - 1;
+        if (got > 0 && got < 254) bad += fabs(q.dec[got] - d) > q.err[got] * (1 + 0x1p-20) + fabs(d) * 0x1p-22;
+    }
+    CHECK_MSG(bad == 0, "%d of %d table codes differ", bad, checked);
+    CHECK(near > 1000);   /* the boundaries themselves were tried */
+    CHECK_EQ_U(om__spsm_q_encode_f(&q, 0.0f), 127);
+    CHECK_EQ_U(om__spsm_q_encode_f(&q, -0.0f), 127);
+    CHECK_EQ_U(om__spsm_q_encode_f(&q, NAN), 127);
+    CHECK_EQ_U(om__spsm_q_encode_f(&q, HUGE_VALF), 254);
+    CHECK_EQ_U(om__spsm_q_encode_f(&q, -HUGE_VALF), 0);
 }
 
 static int bitof(int dx, int dy) { return 1 << ((dy + 1) * 3 + (dx + 1)); }
@@ -655,6 +688,7 @@ void suite_spsm(void)
     RUN(o16_round_trips);
     RUN(texel_packs_and_unpacks);
     RUN(derivative_code_profile);
+    RUN(table_code_is_the_code);
     RUN(tangent_table);
     RUN(default_scene_accuracy);
     RUN(fine_plain_map);

@@ -351,14 +351,25 @@ static bool hits(const om__spsm_dtri *t, int64_t px, int64_t py, double pz, floa
 static double consistent_min(const om__spsm_dtri *t)
 {
     const int64_t H = OM_SUBPIX / 2;
+    const float h = (float)H;
     int64_t kx = t->cx + (t->gx > 0 ? -H : H), ky = t->cy + (t->gy > 0 ? -H : H);
-    if (om__tri2_covers(&t->e, kx, ky)) return om__spsm_plane_at(t, kx, ky);
-    /* in the texel's own coordinates, so that the value does not depend on where the
-     * 3x3 is centred (shift_window keeps it) */
-    const int64_t X[3] = {t->e.x[0] - t->cx, t->e.x[1] - t->cx, t->e.x[2] - t->cx},
-                  Y[3] = {t->e.y[0] - t->cy, t->e.y[1] - t->cy, t->e.y[2] - t->cy};
-    const om__spsm_zplane p = {t->z, t->gx, t->gy, 0, 0};
-    return om__spsm_clipped_min(X, Y, -H, -H, OM_SUBPIX, &p);
+    /* the plane at the corner: its least over the square */
+    if (om__tri2_covers(&t->e, kx, ky)) return t->zf - (om__fabsf(t->gxf) + om__fabsf(t->gyf)) * h;
+    /* in the texel's own coordinates (from the square's corner), so that the value does
+     * not depend on where the 3x3 is centred (shift_window keeps it); in float, the
+     * plane from the centre over offsets of at most half a texel */
+    float best = HUGE_VALF;
+    for (int i = 0; i < 3; i++) {
+        const int j = i == 2 ? 0 : i + 1;
+        const float ax = om__spsm_off_f(t->e.x[i] - t->cx + H), ay = om__spsm_off_f(t->e.y[i] - t->cy + H);
+        const float dx = om__spsm_off_f(t->e.x[j] - t->e.x[i]), dy = om__spsm_off_f(t->e.y[j] - t->e.y[i]);
+        float t0, t1;
+        if (!om__spsm_clip_f(ax, ay, dx, dy, (float)OM_SUBPIX, &t0, &t1)) continue;
+        const float u = t->gxf * dx + t->gyf * dy < 0.0f ? t1 : t0;
+        const float z = t->zf + t->gxf * (ax + u * dx - h) + t->gyf * (ay + u * dy - h);
+        if (z < best) best = z;
+    }
+    return best;
 }
 
 /* The sample's own surface as a plane in light space: depth (raw) at grid offset

@@ -50,9 +50,17 @@ static inline int64_t om__spsm_o16_decode(uint16_t c)
 typedef struct om__spsm_qtable {
     double dec[256];       /* decoded derivative, steps per texel / DSCALE */
     double err[256];       /* half the gap to the neighbouring codes: the error bound */
+    float up[128];         /* up[k]: where code 127 + k gives way to the next (the
+                              boundary decode_at(127.5 + k), rounded to float); up[127]
+                              is infinite */
 } om__spsm_qtable;
 
 uint8_t om__spsm_q_encode(double d);
+/* The same code from the table's boundaries, for the build (no arctangent): the code
+ * whose boundaries enclose d, 254 - that of -d for d < 0, 127 for NaN. It agrees with
+ * om__spsm_q_encode but within 2^-22 of a boundary, and the table's error bound holds
+ * for it to that much (tests/test_spsm.c). */
+uint8_t om__spsm_q_encode_f(const om__spsm_qtable *t, float d);
 /* Builds the table from om__tan/om__log2/om__exp2 (bit-identical everywhere). Code 254
  * (x = 1, a slope of 90 degrees) decodes to twice code 253 and 0 to its negative. */
 void om__spsm_qtable_build(om__spsm_qtable *t);

@@ -42,9 +42,15 @@ static uint32_t grow_needs(om__spsm_state *m)
 }
 typedef struct build_ctx {
     const om__spsm_state *m;     /* its buffers written at the band's rows only */
-    double zx, zy;               /* the plane whose codes are cached */
-    uint8_t qx, qy;
+    /* what the texels of one triangle share (tri_setup), for the triangle with these
+     * vertices and fixed-point plane: the spans of a triangle come one after another */
     bool have;
+    int64_t ex[3], ey[3];
+    uint64_t zq[3];
+    uint32_t zv[3], zmin;        /* its vertex depths (e's order) and their least */
+    float zf[3];                 /* the vertex depths in float (clipped_min) */
+    bool down_x, down_y;         /* whether depth falls along x, along y */
+    uint8_t qx, qy;              /* the derivative codes */
     /* the y codes of the row being filled, for the triangle with these y coordinates:
      * the fill runs along rows, so most texels written reuse them */
     int64_t ry[3];
@@ -52,6 +58,66 @@ typedef struct build_ctx {
     bool have_row;
     uint16_t vy[3];
 } build_ctx;
+
+/* What every texel of triangle t needs, worked out once: the vertex depths from the
+ * fixed-point plane (at a vertex its value is the vertex's own depth: om__rtri_zat's
+ * rule at the top of raster.h), and the derivative codes from the table's boundaries
+ * (om__spsm_q_encode_f; the slopes rounded to float first). */
+static void tri_setup(build_ctx *b, const om__rtri *t)
+{
+    const om__tri2 *e = &t->e;
+    memcpy(b->ex, e->x, sizeof b->ex);
+    memcpy(b->ey, e->y, sizeof b->ey);
+    b->zq[0] = t->zq0;
+    b->zq[1] = t->zqx;
+    b->zq[2] = t->zqy;
+    for (int i = 0; i < 3; i++) {
+        b->zv[i] = om__rtri_zat(t, e->x[i], e->y[i]);
+        b->zf[i] = (float)b->zv[i];
+    }
+    b->zmin = b->zv[0] < b->zv[1] ? b->zv[0] : b->zv[1];
+    if (b->zv[2] < b->zmin) b->zmin = b->zv[2];
+    /* derivatives in depth steps per texel, scaled (spsm.h): raw per grid unit times
+     * OM_SUBPIX / OM__SPSM_STEP / OM_SPSM_DSCALE = 2^-11, exact in float */
+    const float gx = (float)t->zx, gy = (float)t->zy, k = (float)(OM_SUBPIX / OM__SPSM_STEP / OM_SPSM_DSCALE);
+    b->qx = om__spsm_q_encode_f(&b->m->q, gx * k);
+    b->qy = om__spsm_q_encode_f(&b->m->q, gy * k);
+    b->down_x = gx > 0.0f;   /* the least depth over a square is at its left side */
+    b->down_y = gy > 0.0f;
+    b->have = true;
+}
+
+static bool same_tri(const build_ctx *b, const om__rtri *t)
+{
+    return b->have && b->zq[0] == t->zq0 && b->zq[1] == t->zqx && b->zq[2] == t->zqy &&
+           !memcmp(b->ex, t->e.x, sizeof b->ex) && !memcmp(b->ey, t->e.y, sizeof b->ey);
+}
+
+/* The least depth of the triangle inside the texel square at grid corner (x0, y0),
+ * when the square's corner its slopes point to lies outside it: the least over their
+ * overlap is then on the triangle's boundary, at an end of one of its edges clipped to
+ * the square (om__spsm_clip_f), the end its depth falls towards, interpolated between
+ * the edge's vertex depths in float (within a few hundred raw units, under 2^-7 of a
+ * 16-bit depth step, of the exact value). The triangle's least vertex depth when no
+ * edge meets the square (only the conservative bounds' rounding brings it here). */
+static uint32_t clipped_min(const build_ctx *b, const om__tri2 *e, int64_t x0, int64_t y0)
+{
+    float best = 4294967040.0f;   /* the largest float below 2^32 */
+    bool any = false;
+    for (int i = 0; i < 3; i++) {
+        const int j = i == 2 ? 0 : i + 1;
+        float t0, t1;
+        if (!om__spsm_clip_f(om__spsm_off_f(e->x[i] - x0), om__spsm_off_f(e->y[i] - y0),
+                             om__spsm_off_f(e->x[j] - e->x[i]), om__spsm_off_f(e->y[j] - e->y[i]),
+                             (float)OM_SUBPIX, &t0, &t1))
+            continue;
+        const float zi = b->zf[i], zj = b->zf[j], z = zi + (zj < zi ? t1 : t0) * (zj - zi);
+        if (z < best) best = z;
+        any = true;
+    }
+    if (!any) return b->zmin;
+    return best > 0.0f ? (uint32_t)best : 0u;
+}
 
 /* One texel x of row y touched by t: the depth test and, for the winner, its record. */
 /* Texel rows of the whole map whose squares meet a triangle's bounding box, first and
@@ -79,9 +145,7 @@ static void texel(build_ctx *b, int32_t x, int32_t y, const om__rtri *t)
 {
     const om__spsm_state *m = b->m;
     const om__tri2 *e = &t->e;
-    const double H = OM_SUBPIX / 2;
-    double cx = (double)((int64_t)x * OM_SUBPIX) + H - (double)e->x[0];
-    double cy = (double)((int64_t)y * OM_SUBPIX) + H - (double)e->y[0];
+    if (!same_tri(b, t)) tri_setup(b, t);
     /* Minimum conservative depth (section 3.2): the least depth the triangle reaches
      * inside the texel's square. That is the plane's least value over the square, at
      * the corner its slopes point to, when the triangle covers that corner; otherwise
@@ -89,18 +153,18 @@ static void texel(build_ctx *b, int32_t x, int32_t y, const om__rtri *t)
      * at the corner even there, nearer than the triangle reaches: a steep triangle
      * behind an occluder then takes its texels.) A long sliver, a fence bar's face,
      * so competes with its depth in this texel, not with its nearest end's. */
-    double z = t->z0 + t->zx * cx + t->zy * cy - (fabs(t->zx) + fabs(t->zy)) * H;
     const int64_t kx = (int64_t)x * OM_SUBPIX, ky = (int64_t)y * OM_SUBPIX;
     /* a triangle touching this texel alone lies inside it: its nearest vertex is the
      * answer (at the map's edge the bounds are clamped, and zmin stays a lower bound) */
     const bool alone = t->minx == t->maxx && t->miny == t->maxy && (!OM_WITH_JOBS || one_row(m, e));
-    if (!alone && !om__tri2_covers(e, kx + (t->zx > 0 ? 0 : OM_SUBPIX), ky + (t->zy > 0 ? 0 : OM_SUBPIX))) {
-        const om__spsm_zplane p = {t->z0, t->zx, t->zy, e->x[0], e->y[0]};
-        double zc = om__spsm_clipped_min(e->x, e->y, kx, ky, OM_SUBPIX, &p);
-        if (zc > z && zc != HUGE_VAL) z = zc;   /* (no overlap: only touching) */
+    uint32_t z = b->zmin;
+    if (!alone) {
+        const int64_t qx = kx + (b->down_x ? 0 : OM_SUBPIX), qy = ky + (b->down_y ? 0 : OM_SUBPIX);
+        /* inside the triangle the fixed-point plane is exact to a unit (raster.h) */
+        z = om__tri2_covers(e, qx, qy) ? om__rtri_zat(t, qx, qy) : clipped_min(b, e, kx, ky);
+        if (z < b->zmin) z = b->zmin;
     }
-    if (!(z >= t->zmin)) z = t->zmin;
-    uint32_t dz = (uint32_t)z & ~OM__SPSM_TIES;
+    uint32_t dz = z & ~OM__SPSM_TIES;
     size_t i = (size_t)y * m->size + (size_t)x;
     /* Near ties (within OM__SPSM_TIE_DZ, what recovery takes for one surface) are most often
      * the halves of one flat quad, the faces of one thin part (a fence bar, a pole)
@@ -117,15 +181,6 @@ static void texel(build_ctx *b, int32_t x, int32_t y, const om__rtri *t)
     } else {
         if (dz > od) return;
         m->depth[i] = dz | 1u;
-    }
-    if (!b->have || t->zx != b->zx || t->zy != b->zy) {
-        /* derivatives in depth steps per texel, scaled (spsm.h) */
-        const double k = (double)OM_SUBPIX / OM__SPSM_STEP / OM_SPSM_DSCALE;
-        b->qx = om__spsm_q_encode(t->zx * k);
-        b->qy = om__spsm_q_encode(t->zy * k);
-        b->zx = t->zx;
-        b->zy = t->zy;
-        b->have = true;
     }
     if (!b->have_row || y != b->row || memcmp(b->ry, e->y, sizeof b->ry)) {
         om__spsm_row_codes(b->vy, t, y);

@@ -87,39 +87,38 @@ typedef struct om__spsm_state {
     om__spsm_win win;            /* the lookup's, a strip at a time */
 } om__spsm_state;
 
-/* A depth plane: z at grid point (ox, oy), slopes gx, gy per grid unit. */
-typedef struct om__spsm_zplane { double z, gx, gy; int64_t ox, oy; } om__spsm_zplane;
-
-/* The least depth of plane p over the triangle (X, Y) clipped to the square
- * [x0, x0 + side] x [y0, y0 + side], for a square whose corner the slopes point to
- * (the plane's least value over the square) lies outside the triangle: the least
- * value over the two's overlap is then on the triangle's boundary, at an end of one
- * of its edges clipped to the square (Liang-Barsky), whichever the slope along the
- * edge points to. HUGE_VAL when no edge crosses the square. */
-static inline double om__spsm_clipped_min(const int64_t X[3], const int64_t Y[3], int64_t x0, int64_t y0, int64_t side,
-                                 const om__spsm_zplane *p)
+/* The part of the segment (ax, ay) + t (dx, dy), t in [0, 1], that lies in the closed
+ * square [0, side] x [0, side] (coordinates relative to its corner): its ends t0 <= t1
+ * (Liang-Barsky), false when it misses. In float: the callers take the least depth of a
+ * triangle inside a texel's square at such an end (spsm_build.c's clipped_min and
+ * spsm.c's consistent_min), where an end off by 2^-22 of the edge moves that depth by
+ * as little of the edge's depth range, far below a 16-bit depth step. */
+static inline bool om__spsm_clip_f(float ax, float ay, float dx, float dy, float side, float *t0, float *t1)
 {
-    const double lo[2] = {(double)x0, (double)y0}, hi[2] = {(double)(x0 + side), (double)(y0 + side)};
-    double best = HUGE_VAL;
-    for (int i = 0; i < 3; i++) {
-        const int j = i == 2 ? 0 : i + 1;
-        const double a[2] = {(double)X[i], (double)Y[i]}, d[2] = {(double)(X[j] - X[i]), (double)(Y[j] - Y[i])};
-        double t0 = 0.0, t1 = 1.0;
-        bool in = true;
-        for (int k = 0; k < 2 && in; k++) {
-            if (d[k] == 0.0) { in = a[k] >= lo[k] && a[k] <= hi[k]; continue; }
-            double inv = 1.0 / d[k], ta = (lo[k] - a[k]) * inv, tb = (hi[k] - a[k]) * inv;
-            if (ta > tb) { double s = ta; ta = tb; tb = s; }
-            if (ta > t0) t0 = ta;
-            if (tb < t1) t1 = tb;
-            in = t0 <= t1;
+    const float a[2] = {ax, ay}, d[2] = {dx, dy};
+    float lo = 0.0f, hi = 1.0f;
+    for (int k = 0; k < 2; k++) {
+        if (d[k] == 0.0f) {
+            if (!(a[k] >= 0.0f && a[k] <= side)) return false;
+            continue;
         }
-        if (!in) continue;
-        double t = p->gx * d[0] + p->gy * d[1] < 0.0 ? t1 : t0;
-        double z = p->z + p->gx * (a[0] + t * d[0] - (double)p->ox) + p->gy * (a[1] + t * d[1] - (double)p->oy);
-        if (z < best) best = z;
+        const float inv = 1.0f / d[k];
+        float ta = -a[k] * inv, tb = (side - a[k]) * inv;
+        if (ta > tb) { const float s = ta; ta = tb; tb = s; }
+        if (ta > lo) lo = ta;
+        if (tb < hi) hi = tb;
+        if (!(lo <= hi)) return false;
     }
-    return best;
+    *t0 = lo;
+    *t1 = hi;
+    return true;
+}
+
+/* A grid offset as a float: offsets inside the rasterizer's range (om__tri2's, below
+ * 2^30) fit 32 bits, whose conversion a single-precision FPU does in one instruction. */
+static inline float om__spsm_off_f(int64_t v)
+{
+    return (float)(int32_t)v;
 }
 
 /* The build (spsm_build.c): the records the lookup will read, from the marks; by bands

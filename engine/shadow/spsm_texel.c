@@ -91,6 +91,19 @@ void om__spsm_qtable_build(om__spsm_qtable *t)
         t->err[q] = t->err[254 - q];
     }
     t->dec[255] = t->err[255] = 0.0;
+    for (int k = 0; k < 127; k++) t->up[k] = (float)decode_at(127.5 + k);
+    t->up[127] = HUGE_VALF;
+}
+
+uint8_t om__spsm_q_encode_f(const om__spsm_qtable *t, float d)
+{
+    if (d != d) return 127;
+    const float a = om__fabsf(d);
+    /* the number of boundaries at or below a (up[] rises): a bisection of 7 steps */
+    unsigned lo = 0;
+    for (unsigned half = 64; half; half >>= 1)
+        if (t->up[lo + half - 1] <= a) lo += half;
+    return (uint8_t)(d < 0.0f ? 127 - lo : 127 + lo);
 }
 
 /* ---- tangent table (section 4.2) */
