@@ -271,8 +271,6 @@ static void move_entry(om__spsm_dtri *to, const om__spsm_dtri *from)
     to->cminf = from->cminf;
     to->have_vz = from->have_vz;
     if (from->have_vz) {
-        memcpy(to->vz, from->vz, sizeof to->vz);
-        memcpy(to->vtol, from->vtol, sizeof to->vtol);
         memcpy(to->vzf, from->vzf, sizeof to->vzf);
         memcpy(to->vtolf, from->vtolf, sizeof to->vtolf);
     }
@@ -381,9 +379,9 @@ static double consistent_min(const om__spsm_dtri *t)
  * before it. Float, the same bits on every CPU: the slopes' relative error (about 2^-20
  * but where the surface is nearly edge-on to the light) moves a depth carried a few
  * texels by far less than the tolerance the tests below use (OM__SPSM_TOL0); the depth
- * at the sample is its own projection's (the lookup's). The double values are the
- * float ones, so both kinds of test see one plane. */
-typedef struct receiver { double z, gx, gy; float zf, gxf, gyf; bool ok; } receiver;
+ * at the sample is its own projection's (the lookup's). Every test that carries it
+ * (behind_receiver, centre_test, plain_shadow) is in float too. */
+typedef struct receiver { float zf, gxf, gyf; bool ok; } receiver;
 
 static receiver receiver_plane(const om__spsm_state *m, const om_sample *smp, const sample_pt *p)
 {
@@ -416,9 +414,6 @@ static receiver receiver_plane(const om__spsm_state *m, const om_sample *smp, co
     r.gyf = -sy * k;
     r.ok = det != 0.0f && om__fabsf(r.gxf) < 1e30f && om__fabsf(r.gyf) < 1e30f;   /* NaN fails too */
     if (!r.ok) r.gxf = r.gyf = 0.0f;
-    r.z = p->z;
-    r.gx = r.gxf;
-    r.gy = r.gyf;
     return r;
 }
 
@@ -429,25 +424,18 @@ static bool behind_receiver(om__spsm_dtri *t, const receiver *r, int64_t px, int
 {
     if (!r->ok) return false;
     if (!t->have_vz) {   /* the texel's own part, the same for every sample */
+        const float cap = (float)(OM__SPSM_TOL0 + PAT_CAP);
         for (int i = 0; i < 3; i++) {
-            t->vz[i] = om__spsm_plane_at(t, t->rx[i], t->ry[i]);
-            t->vtol[i] = pat_tol(t, t->rx[i], t->ry[i]);
-            t->vzf[i] = (float)t->vz[i];
-            t->vtolf[i] = (float)t->vtol[i];
+            const float tol = om__spsm_tol_at_f(t, t->rx[i], t->ry[i]);
+            t->vzf[i] = om__spsm_plane_at_f(t, t->rx[i], t->ry[i]);
+            t->vtolf[i] = tol < cap ? tol : cap;   /* pat_tol's */
         }
         t->have_vz = true;
     }
+    /* in float (the receiver's plane is: receiver_plane) */
     for (int i = 0; i < 3; i++) {
-        const int64_t dx = t->rx[i] - px, dy = t->ry[i] - py;
-        /* offsets of a few texels: exact in float */
-        int below = -1;
-        if (OM_FAST_FLOAT && dx > -(1 << 20) && dx < (1 << 20) && dy > -(1 << 20) && dy < (1 << 20))
-            below = om__spsm_less_f(t->vzf[i], r->zf, r->gxf, (float)dx, r->gyf, (float)dy, t->vtolf[i]);
-        if (below < 0) {
-            const double zr = r->z + r->gx * (double)dx + r->gy * (double)dy;
-            below = t->vz[i] < zr - t->vtol[i];
-        }
-        if (below) return false;
+        const float zr = r->zf + r->gxf * om__spsm_off_f(t->rx[i] - px) + r->gyf * om__spsm_off_f(t->ry[i] - py);
+        if (t->vzf[i] < zr - t->vtolf[i]) return false;
     }
     return true;
 }
@@ -460,8 +448,8 @@ static bool centre_test(const om__spsm_state *m, const receiver *r, int64_t tx, 
 {
     uint32_t c = m->cdepth[(size_t)ty * m->size + (size_t)tx];
     if (c == 0xFFFFFFFFu) return false;
-    double z = r->ok ? r->z - r->gx * (double)px - r->gy * (double)py : r->z;
-    return (double)c < z - OM__SPSM_TOL0;
+    const float z = r->ok ? r->zf - r->gxf * om__spsm_off_f(px) - r->gyf * om__spsm_off_f(py) : r->zf;
+    return (float)c < z - (float)OM__SPSM_TOL0;   /* in float, as the plane is */
 }
 
 /* The plain map around a point of the pixel at grid offset (qx, qy) from the centre of
@@ -485,9 +473,9 @@ static bool plain_shadow(const uint32_t *buf, int64_t side, int64_t step, const 
             if (i < 0 || j < 0 || i >= side || j >= side) return false;
             const uint32_t c = buf[(size_t)j * (size_t)side + (size_t)i];
             if (c == 0xFFFFFFFFu) return false;
-            const double dx = (double)(i * step + h - ox - px), dy = (double)(j * step + h - oy - py);
-            const double z = r->ok ? r->z + r->gx * dx + r->gy * dy : r->z;
-            if (!((double)c < z - OM__SPSM_TOL0)) return false;
+            const float dx = om__spsm_off_f(i * step + h - ox - px), dy = om__spsm_off_f(j * step + h - oy - py);
+            const float z = r->ok ? r->zf + r->gxf * dx + r->gyf * dy : r->zf;
+            if (!((float)c < z - (float)OM__SPSM_TOL0)) return false;   /* in float, as the plane is */
         }
     return true;
 }
@@ -545,9 +533,8 @@ static void occluders_of(const om__spsm_state *m, om__spsm_win *w, om__spsm_dtri
         if (x < 0 || y < 0 || x >= (int64_t)m->size || y >= (int64_t)m->size) continue;
         const uint32_t c = m->cdepth[(size_t)y * m->size + (size_t)x];
         if (c == 0xFFFFFFFFu || om__tri2_covers(&t[k].e, t[k].cx, t[k].cy)) continue;
-        if (fabs(om__spsm_plane_at(&t[k], t[k].cx, t[k].cy) - (double)c) >
-            om__spsm_tol_at(&t[k], t[k].cx, t[k].cy) + OM__SPSM_LINK_DZ)
-            continue;
+        /* at its own centre the plane is z and the tolerance OM__SPSM_TOL0 */
+        if (om__fabsf(t[k].zf - (float)c) > (float)(OM__SPSM_TOL0 + OM__SPSM_LINK_DZ)) continue;
         w->cand[w->ncand].x = t[k].cx;
         w->cand[w->ncand].y = t[k].cy;
         w->cand[w->ncand].owner = j;
@@ -660,7 +647,7 @@ OM_NOINLINE static uint8_t recover(const om__spsm_state *m, om__spsm_win *w, uin
      * neighbours, near its terminator) cannot block the way to the light. */
     n[N_UNCERTAIN]++;
     unsigned pat = 0;
-    receiver rp = {0.0, 0.0, 0.0, 0.0f, 0.0f, 0.0f, false};
+    receiver rp = {0.0f, 0.0f, 0.0f, false};
     bool have_rp = false;
     for (int k = 0; k < 9; k++) {
         /* cheapest test first; the receiver's plane only when a texel needs it */

@@ -26,8 +26,9 @@ typedef struct om__spsm_dtri {
     float zf, gxf, gyf, exf, eyf;   /* the same rounded to float (om__spsm_below_f) */
     double cmin;                 /* consistent_min, once computed (have_cmin) */
     bool have_cmin;
-    double vz[3], vtol[3];       /* plane and pat_tol at the vertices rx, ry (have_vz) */
-    float cminf, vzf[3], vtolf[3];   /* the same rounded to float (om__spsm_less_f) */
+    float cminf;                 /* cmin rounded to float (om__spsm_less_f) */
+    float vzf[3], vtolf[3];      /* plane and pattern slack at the vertices rx, ry, in
+                                    float (have_vz; spsm.c's behind_receiver) */
     bool have_vz;
 } om__spsm_dtri;   /* a new field is moved in spsm.c's move_entry too */
 
@@ -54,6 +55,27 @@ static inline double om__spsm_plane_at(const om__spsm_dtri *t, int64_t px, int64
 static inline double om__spsm_tol_at(const om__spsm_dtri *t, int64_t px, int64_t py)
 {
     return OM__SPSM_TOL0 + t->ex * fabs((double)(px - t->cx)) + t->ey * fabs((double)(py - t->cy));
+}
+
+/* A grid offset as a float: offsets inside the rasterizer's range (om__tri2's, below
+ * 2^30) fit 32 bits, whose conversion a single-precision FPU does in one instruction. */
+static inline float om__spsm_off_f(int64_t v)
+{
+    return (float)(int32_t)v;
+}
+
+/* The same two in float, for the tests whose slack is wide (outline links, the
+ * receiver's plane at a record's vertices, the plain map): every CPU rounds them
+ * alike, and their error (2^-22 of the terms) is far inside those slacks. */
+static inline float om__spsm_plane_at_f(const om__spsm_dtri *t, int64_t px, int64_t py)
+{
+    return t->zf + t->gxf * om__spsm_off_f(px - t->cx) + t->gyf * om__spsm_off_f(py - t->cy);
+}
+
+static inline float om__spsm_tol_at_f(const om__spsm_dtri *t, int64_t px, int64_t py)
+{
+    return (float)OM__SPSM_TOL0 + t->exf * om__fabsf(om__spsm_off_f(px - t->cx)) +
+           t->eyf * om__fabsf(om__spsm_off_f(py - t->cy));
 }
 
 /* Their float paths run where OM_FAST_FLOAT is 1 (core.h). */

@@ -114,13 +114,6 @@ static inline bool om__spsm_clip_f(float ax, float ay, float dx, float dy, float
     return true;
 }
 
-/* A grid offset as a float: offsets inside the rasterizer's range (om__tri2's, below
- * 2^30) fit 32 bits, whose conversion a single-precision FPU does in one instruction. */
-static inline float om__spsm_off_f(int64_t v)
-{
-    return (float)(int32_t)v;
-}
-
 /* The build (spsm_build.c): the records the lookup will read, from the marks; by bands
  * of the map's rows (om__bands: map_of on the calling thread, then build_rows for
  * each band), or all at once. */

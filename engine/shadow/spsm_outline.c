@@ -109,8 +109,8 @@ void om__spsm_outline_build(om__spsm_boundary *b, const om__spsm_dtri *const occ
              * (a smooth mesh bends little over a texel; a cloud of separate triangles
              * does not line up) */
             const om__spsm_dtri *a = occ[owner[i]], *c = occ[owner[j]];
-            double za = om__spsm_plane_at(a, b->x[j], b->y[j]), zc = om__spsm_plane_at(c, b->x[j], b->y[j]);
-            if (fabs(za - zc) > om__spsm_tol_at(a, b->x[j], b->y[j]) + OM__SPSM_LINK_DZ) continue;
+            const float za = om__spsm_plane_at_f(a, b->x[j], b->y[j]), zc = om__spsm_plane_at_f(c, b->x[j], b->y[j]);
+            if (om__fabsf(za - zc) > om__spsm_tol_at_f(a, b->x[j], b->y[j]) + (float)OM__SPSM_LINK_DZ) continue;
             sets -= unite(up, owner[i], owner[j]);
         }
     /* A piece is labelled by its first vertex. */
