@@ -111,7 +111,8 @@ static void grow_light_box(const om_view *v, const om_strip *st, om_vec3 *lo, om
 
 /* The bands of the strip: band b is job b of the host's parallel-for, with slot b and
  * rows of its own. */
-typedef enum { STAGE_PREPARE, STAGE_RESOLVE, STAGE_SHADE, STAGE_BUILD, STAGE_PASS, STAGE_PASS_SETUP, STAGE_BIN_VERTS, STAGE_BIN_ROWS } stage;
+typedef enum { STAGE_PREPARE, STAGE_RESOLVE, STAGE_SHADE, STAGE_BUILD, STAGE_PASS, STAGE_PASS_SETUP, STAGE_LEND,
+               STAGE_BIN_VERTS, STAGE_BIN_ROWS } stage;
 
 typedef struct frame_ctx {
     const om_frame_desc *fd;
@@ -124,8 +125,10 @@ typedef struct frame_ctx {
     uint32_t jobs, band_rows;
     job_slot *slots;           /* BANDS_PER_JOB * jobs of them */
     job_slot *pass_slots;      /* the pass's, pass_max of them */
-    uint32_t pass_max, pass_jobs, pass_slots_now;   /* STAGE_PASS: K jobs on P slots */
+    uint32_t pass_max, pass_jobs, pass_slots_now;   /* STAGE_PASS, STAGE_LEND: K jobs on P slots */
     uint32_t setup_items;      /* STAGE_PASS_SETUP: the pass's per-frame items */
+    void (*lend_fn)(void *user, uint32_t k, void *scratch);   /* STAGE_LEND (om__lend) */
+    void *lend_user;
     stage stage;
     bool eye, mark;            /* STAGE_PREPARE: run the eye pass, mark exposure */
     om__bins map_bins;         /* the light map's (rows NULL: none) */
@@ -179,14 +182,15 @@ static void band_job(void *user, uint32_t b)
 {
     const frame_ctx *c = (const frame_ctx *)user;
     const om_frame_desc *fd = c->fd;
-    if (c->stage == STAGE_PASS) {   /* slot b: jobs b, b + P, ... (om__pass) */
+    if (c->stage == STAGE_PASS || c->stage == STAGE_LEND) {   /* slot b: jobs b, b + P, ... (om__pass) */
         job_slot *sl = &c->pass_slots[b];
         if (sl->dirty) {   /* zeroed here, on the slot's thread, not all on the caller's */
             memset(sl->scratch, 0, sl->dirty);
             sl->dirty = 0;
         }
         for (uint32_t k = b; k < c->pass_jobs; k += c->pass_slots_now)
-            c->pass->job(fd->method_state, &c->strip, k, sl->scratch, sl->counts);
+            if (c->stage == STAGE_PASS) c->pass->job(fd->method_state, &c->strip, k, sl->scratch, sl->counts);
+            else c->lend_fn(c->lend_user, k, sl->scratch);   /* a method's own stage (om__lend) */
         return;
     }
     if (c->stage == STAGE_PASS_SETUP) {   /* part b of BANDS_PER_JOB * jobs */
@@ -313,6 +317,19 @@ static om_status begin(frame_ctx *c, const om_view *v, om_diag *d)
     om_status st = c->pass->begin(state, v, &c->setup_items, d);
     if (st == OM_OK && c->setup_items) run_stage(c, STAGE_PASS_SETUP, BANDS_PER_JOB * c->jobs);
     return st;
+}
+
+/* om__lend.run: a method's own jobs on the pass's slots, from its begin, observe or
+ * build on the calling thread (no stage of the frame's is running then). */
+static void lend_run(const om__lend *l, void (*fn)(void *user, uint32_t k, void *scratch), void *user, uint32_t n)
+{
+    frame_ctx *c = (frame_ctx *)l->frame;
+    if (n == 0) return;
+    c->lend_fn = fn;
+    c->lend_user = user;
+    c->pass_jobs = n;
+    c->pass_slots_now = n < c->pass_max ? n : c->pass_max;
+    run_stage(c, STAGE_LEND, c->pass_slots_now);
 }
 
 /* Bins' memory: the rows, and the vertices when they fit too. False: no room. Not
@@ -473,6 +490,8 @@ om_status om_render_frame(const om_frame_desc *fd, om_arena *fa, om_frame_stats 
     }
     if (OM_WITH_JOBS && c.jobs > 1 && c.bands && c.bands->build_rows) carve_bins(fa, s, &c.map_bins);
     fs->jobs = c.jobs;
+    om__lend lend = {lend_run, &c, c.pass_max};
+    if (OM_WITH_JOBS && c.pass && c.pass->lend) c.pass->lend(fd->method_state, &lend);
     const bool observes = (m->flags & OM_METHOD_OBSERVES) && (!m->observes || m->observes(fd->method_state));
     const bool fit = view.light.kind == OM_LIGHT_DIRECTIONAL;
     bool have_samples = false;   /* strip.samples hold the whole frame already */
@@ -545,6 +564,7 @@ om_status om_render_frame(const om_frame_desc *fd, om_arena *fa, om_frame_stats 
         if (fd->on_strip && (st = fd->on_strip(fd->user, &c.strip, fd->fb)) != OM_OK) goto done;
     }
 done:
+    if (OM_WITH_JOBS && c.pass && c.pass->lend) c.pass->lend(fd->method_state, NULL);
     fs->frame_peak = fa->peak;
     om_arena_rewind(fa, mark);
     return st;

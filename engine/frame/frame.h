@@ -141,6 +141,18 @@ const om__bands *om__method_bands(const om_method *m);
  *   two slots' scratch beside the bands' (at most one slot a job); otherwise the
  *   method's bands are not used either and its resolve runs a strip at a time, which
  *   must give the same terms and counts. */
+/* The pass's slots lent to the method's own stages (asm: its analysis and tile renders
+ * in observe and build): run(l, fn, user, n), called on the calling thread, calls
+ * fn(user, k, scratch) for every k in [0, n) on min(n, slots) of the pass's slots at
+ * once (slot p: k = p, p + P, ..., with its scratch) and returns when all have
+ * returned. What fn writes must not depend on the slot that ran it. */
+typedef struct om__lend {
+    void (*run)(const struct om__lend *l, void (*fn)(void *user, uint32_t k, void *scratch), void *user,
+                uint32_t n);
+    void *frame;
+    uint32_t slots;
+} om__lend;
+
 typedef struct om__pass {
     size_t (*scratch)(const void *state, const om_scene *s);
     uint32_t (*plan)(void *state, om_strip *strip);
@@ -153,6 +165,10 @@ typedef struct om__pass {
      * of the scene's vertices). */
     om_status (*begin)(void *state, const om_view *v, uint32_t *items, om_diag *d);
     void (*setup)(const void *state, uint32_t first, uint32_t end);
+    /* May be NULL. Where the frame uses the pass, it hands lend the slots before begin,
+     * and NULL when the frame ends (the method must not keep the pointer beyond). A
+     * pass for lend alone has plan return 0, and job and merge NULL. */
+    void (*lend)(void *state, const om__lend *l);
 } om__pass;
 
 /* Method m's pass; NULL for none (registry.c). */

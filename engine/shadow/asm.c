@@ -327,6 +327,9 @@ static om_status asm_observe(void *state, const om_strip *st, om_diag *d)
     const uint32_t stride = m->cfg.asm_stride ? m->cfg.asm_stride : 1;
     const double ncell = (double)l->cp * l->cp;
     om__asm_prepare(m);
+#if OM_WITH_JOBS
+    if (m->lend && om__asm_observe_jobs(m, st)) return OM_OK;   /* the same, by bands */
+#endif
     for (uint32_t y = 0; y < st->rows; y++) {
         const uint32_t gy = st->y0 + y;
         /* one sample in `stride`, on diagonals so no column or row is favoured */
@@ -383,12 +386,97 @@ static om_status asm_observe(void *state, const om_strip *st, om_diag *d)
     return OM_OK;
 }
 
+#if OM_WITH_JOBS
+/* asm_observe's analysis for a band of rows on the host's threads (asm_jobs.c runs the
+ * bands): the same descent and tests, with what it adds to the tree kept in `a`. */
+static inline void acc_node(const om__asm_acc *a, uint32_t index)
+{
+    if (index < a->hdr[2]) a->hdr[2] = index;
+    if (index >= a->hdr[3]) a->hdr[3] = index + 1;
+}
+
+void om__asm_observe_rows(const om__asm_state *m, const om_strip *st, uint32_t y0, uint32_t rows,
+                          const om__asm_acc *a, bool again)
+{
+    om__asm_tree *t = (om__asm_tree *)&m->tree;   /* om__asm_tile_of: read here, not written */
+    const om__asm_layout *l = &t->lay;
+    const uint32_t stride = m->cfg.asm_stride ? m->cfg.asm_stride : 1;
+    const uint32_t c2 = l->cells * l->cells;
+    const double ncell = (double)l->cp * l->cp;
+    for (uint32_t y = y0; y < y0 + rows; y++) {
+        const uint32_t gy = st->y0 + y;
+        for (uint32_t x = (uint32_t)((stride - (3u * gy) % stride) % stride); x < st->width; x += stride) {
+            const size_t i = (size_t)y * st->width + x;
+            om_term *tm = &st->terms[i];
+            if (!(tm->flags & OM_TERM_EXPOSED)) continue;
+            if (again) {
+                if (tm->g != 254) continue;
+                tm->g = 255;
+            }
+            asm_smp o;
+            if (!smp_begin(m, &st->samples[i], true, &o)) continue;
+            if (!again) a->hdr[0]++;
+            uint32_t index = OM__ASM_ROOT, level = 0;
+            for (;;) {
+                om__asm_tile tl;
+                uint32_t tx, ty;
+                bool want = false;
+                om__asm_tile_of(t, index, &tl);
+                smp_texel(m, &o, &tl, &tx, &ty);
+                const uint32_t bit = index == OM__ASM_ROOT ? l->count : index;
+                a->stamp[bit >> 5] |= 1u << (bit & 31);
+                uint32_t c = (ty / tl.cp) * tl.cells + tx / tl.cp;
+                uint32_t child = tl.child[c];
+                if (level == 0) {
+                    if (child == OM__ASM_NONE) {   /* the root tile is made after the bands */
+                        if (!again && (!a->first[c] || a->first[c] > i + 1)) a->first[c] = (uint32_t)i + 1;
+                        tm->g = again ? 255 : 254;
+                        break;
+                    }
+                    a->benefit[child]++;
+                    acc_node(a, child);
+                } else {
+                    want = smp_finer(m, &o, level) && straddles(m, &o, &tl, tx, ty);
+                    if (child != OM__ASM_NONE && want) {
+                        a->benefit[child]++;
+                        acc_node(a, child);
+                    }
+                }
+                if (child != OM__ASM_NONE) {
+                    index = child;
+                    level++;
+                    continue;
+                }
+                if (want && level < l->max_level) {
+                    const double r = smp_exact(m, &o, true)->ratio0 * m->inv_scale[level];
+                    const float nreq = (float)(ncell * r * r);
+                    const size_t k = (size_t)index * c2 + c;
+                    a->ben[k]++;
+                    if (nreq > a->need[k]) a->need[k] = nreq;
+                    acc_node(a, index);
+                    a->hdr[1]++;
+                }
+                break;
+            }
+        }
+    }
+}
+#endif
+
 static om_status asm_build(void *state, om_diag *d)
 {
     (void)d;
     om__asm_state *m = (om__asm_state *)state;
     om__asm_tree *t = &m->tree;
     om__asm_prepare(m);
+    /* With the host's threads the new tiles are rendered after the tree is made, each
+     * by a job: which nodes are made reads no tile. */
+#if OM_WITH_JOBS
+    const uint32_t serial0 = t->serial;
+    const bool later = m->lend != NULL;
+#else
+    const bool later = false;
+#endif
     /* Root tiles first, wherever samples fell, most samples first: the root level is
      * what a conventional map at asm.root would give, and every refinement hangs off it. */
     uint32_t n = om__asm_candidates(t, true, 0.0f, 0.0f, m->cand, m->ncand_max);
@@ -397,7 +485,7 @@ static om_status asm_build(void *state, om_diag *d)
         n = om__asm_cand_pop(m->cand, n, &c);
         uint32_t k = om__asm_make(t, OM__ASM_ROOT, c.cell, c.benefit);
         if (k == OM__ASM_NONE) break;   /* no room: the rest have fewer samples still */
-        om__asm_render_node(m, k);
+        if (!later) om__asm_render_node(m, k);
     }
     n = om__asm_candidates(t, false, m->cfg.asm_cost_a, m->cfg.asm_cost_b, m->cand, m->ncand_max);
     m->candidates = n;
@@ -414,9 +502,19 @@ static om_status asm_build(void *state, om_diag *d)
             refused = c.benefit;
             continue;
         }
-        om__asm_render_node(m, k);
+        if (!later) om__asm_render_node(m, k);
         spent += (double)c.cost;
     }
+#if OM_WITH_JOBS
+    if (later) {   /* the nodes made here and still in the tree (gen: made after serial0) */
+        uint32_t *list = (uint32_t *)(void *)m->cand, nl = 0;   /* the heap is done with */
+        for (uint32_t i = 0; i < t->lay.count; i++) {
+            const om__asm_node *nd = om__asm_node_at(t, i);
+            if (nd->alive && nd->gen > serial0) list[nl++] = i;
+        }
+        (void)om__asm_render_list(m, list, nl);
+    }
+#endif
     m->cache = OM__ASM_NONE;
     return OM_OK;
 }
@@ -522,10 +620,12 @@ static om_status asm_resolve(void *state, om_strip *st, om_diag *d)
 /* By bands on the host's threads (frame.h, om__bands): each band looks up its own
  * samples with a cache of its own and writes nothing of the state. The use stamps are
  * the one thing a lookup leaves in the tree: a band marks each sample whose lookup
- * descended (its term's blue one off its red), and finish, on the calling thread,
- * finds those samples' leaves again and stamps their paths. The stamped nodes are the
- * paths to every leaf found, whatever the bands: the stamps, the terms and the counts
- * (added up by merge) are a strip at a time's. */
+ * descended with the leaf it found (1 + its index, 0xFFFF the base, in its term's green
+ * and blue, each xor its red), and finish, on the calling thread, stamps their paths
+ * and puts the terms back. A tree of 0xFFFF nodes or more has no room there: its
+ * samples are marked by blue one off red, and finish finds their leaves again. The
+ * stamped nodes are the paths to every leaf found, whatever the bands: the stamps, the
+ * terms and the counts (added up by merge) are a strip at a time's. */
 static void asm_band(const void *state, om_strip *st, void *scratch, uint32_t counts[8])
 {
     const om__asm_state *m = (const om__asm_state *)state;
@@ -542,7 +642,13 @@ static void asm_band(const void *state, om_strip *st, void *scratch, uint32_t co
             t->r = t->g = t->b = 0;
             counts[1]++;
         }
-        if (moved) t->b ^= 1u;
+        if (moved && m->tree.lay.count < 0xFFFFu) {
+            const uint32_t v = c->index == OM__ASM_ROOT ? 0xFFFFu : c->index + 1;
+            t->g = (uint8_t)(t->r ^ (v >> 8));
+            t->b = (uint8_t)(t->r ^ (v & 255u));
+        } else if (moved) {
+            t->b ^= 1u;
+        }
     }
 }
 
@@ -557,9 +663,16 @@ static void asm_finish(void *state, om_strip *st)
 {
     om__asm_state *m = (om__asm_state *)state;
     const size_t n = (size_t)st->rows * st->width;
+    const bool direct = m->tree.lay.count < 0xFFFFu;
     for (size_t i = 0; i < n; i++) {
         om_term *t = &st->terms[i];
-        if (t->b == t->r) continue;
+        if (t->b == t->r && t->g == t->r) continue;
+        if (direct) {
+            const uint32_t v = (uint32_t)(t->g ^ t->r) << 8 | (uint32_t)(t->b ^ t->r);
+            t->g = t->b = t->r;
+            stamp_path(&m->tree, v == 0xFFFFu ? OM__ASM_ROOT : v - 1);
+            continue;
+        }
         t->b = t->r;
         asm_smp o;
         asm_cache c = {OM__ASM_NONE, m->cache_tile};

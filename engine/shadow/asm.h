@@ -278,11 +278,55 @@ typedef struct om__asm_state {
     uint32_t cache;        /* the last leaf found by resolve, or OM__ASM_NONE */
     om__asm_tile cache_tile;
     uint32_t samples, shadowed, analysed, straddling, candidates, rebuilds;
+#if OM_WITH_JOBS
+    /* The host's threads for this frame (om__lend, asm_jobs.c), NULL without; the
+     * slots' scratch, slot[j] for j < nslot (one a job: render and analysis scratch). */
+    const om__lend *lend;
+    void *const *slot;
+    uint32_t nslot;
+#endif
 } om__asm_state;
 
+/* A tile render's scratch: one tile's depth and ids for the rasterizer, and (not lean)
+ * a cull list of ntris and a bit a triangle, all clear between renders. */
+typedef struct om__asm_rs {
+    uint32_t *sdepth, *sid, *cull, *gbits;
+} om__asm_rs;
+
 /* asm_render.c: this frame's projections, bounds and triangle grid (once a frame;
- * a rebuild renders the base tile), and the tile of node `index` rendered. */
+ * a rebuild renders the base tile), and the tile of node `index` rendered (with the
+ * state's scratch, or with `rs`). */
 void om__asm_prepare(om__asm_state *m);
 void om__asm_render_node(om__asm_state *m, uint32_t index);
+void om__asm_render_with(om__asm_state *m, uint32_t index, const om__asm_rs *rs);
+
+#if OM_WITH_JOBS
+/* asm_jobs.c: on the host's threads. The tiles of `list` (n nodes, each rendered by
+ * one job); false where there are no threads (nothing done). */
+bool om__asm_render_list(om__asm_state *m, const uint32_t *list, uint32_t n);
+/* observe's analysis of a strip by bands; false where it cannot run so (no threads,
+ * or root tiles to make that would need to replace others): nothing done but the
+ * strip's terms as they were. */
+bool om__asm_observe_jobs(om__asm_state *m, const om_strip *st);
+
+/* What a band's analysis adds to the tree, in a job's scratch, put on the tree after
+ * the bands on the calling thread: sums, maxima and marks, the same in any order. */
+typedef struct om__asm_acc {
+    uint32_t *hdr;         /* analysed, straddling; nodes touched: lowest, highest + 1 */
+    uint32_t *stamp;       /* a bit a node used (stamped), bit `count` the base's */
+    uint32_t *benefit;     /* count: added to each node's benefit */
+    uint32_t *ben;         /* count * cells^2: added to each cell's benefit */
+    float *need;           /* count * cells^2: each cell's largest N_required */
+    uint32_t *first;       /* the base's cells: 1 + the first sample (strip index) that
+                              fell in the cell while it held no root tile, else 0 */
+} om__asm_acc;
+
+/* asm.c: observe's analysis of rows [y0, y0 + rows) of the strip into `a`, reading
+ * the tree only. A sample whose base cell holds no root tile goes no further: its
+ * term's g is set to 254 and the cell's first sample noted. With `again`, only those
+ * samples (g put back to 255), once the root tiles are made. */
+void om__asm_observe_rows(const om__asm_state *m, const om_strip *st, uint32_t y0, uint32_t rows,
+                          const om__asm_acc *a, bool again);
+#endif
 
 #endif

@@ -92,22 +92,22 @@ static void render_tri(om_raster *r, const om__asm_dvec q[3], double s_, double 
 
 /* The triangles whose bounds meet the region and hold a texel centre, in index order,
  * into m->cull: every triangle's bounds tested (most miss a deep node's region). */
-static uint32_t gather_all(om__asm_state *m, float u0, float v0, float u1, float v1, double sc,
-                           const uint32_t *centre)
+static uint32_t gather_all(const om__asm_state *m, const om__asm_rs *rs, float u0, float v0, float u1,
+                           float v1, double sc, const uint32_t *centre)
 {
     uint32_t n = 0;
     if (centre) {   /* a word of bits at a time: in a big scene most are clear */
         for (uint32_t w = 0; w < (m->scene->ntris + 31) / 32; w++)
             for (uint32_t bits = centre[w]; bits; bits &= bits - 1) {
                 const uint32_t k = w * 32 + om__ctz32(bits);
-                m->cull[n] = k;
+                rs->cull[n] = k;
                 n += box_meets(&m->tbox[(size_t)k * 4], u0, v0, u1, v1);
             }
         return n;
     }
     for (uint32_t k = 0; k < m->scene->ntris; k++) {
         const float *b = &m->tbox[(size_t)k * 4];
-        m->cull[n] = k;
+        rs->cull[n] = k;
         n += box_meets(b, u0, v0, u1, v1) && box_holds_centre(b, sc);
     }
     return n;
@@ -153,8 +153,8 @@ static void grid_make(om__asm_state *m)
 /* gather_all's result from the cells the region meets: their triangles marked in a
  * bit set (a triangle in several cells once; with `centre`, only those it has),
  * collected in index order and tested as gather_all tests them. */
-static uint32_t gather_cells(om__asm_state *m, float u0, float v0, float u1, float v1, double sc,
-                             const uint32_t *centre)
+static uint32_t gather_cells(const om__asm_state *m, const om__asm_rs *rs, float u0, float v0, float u1,
+                             float v1, double sc, const uint32_t *centre)
 {
     const uint32_t G = m->gside;
     uint32_t lo = UINT32_MAX, hi = 0, n = 0;
@@ -162,18 +162,18 @@ static uint32_t gather_cells(om__asm_state *m, float u0, float v0, float u1, flo
         for (uint32_t cx = cell_of(m, u0); cx <= cell_of(m, u1); cx++)
             for (uint32_t i = m->gstart[cy * G + cx]; i < m->gstart[cy * G + cx + 1]; i++) {
                 uint32_t k = m->glist[i];
-                m->gbits[k >> 5] |= (centre ? centre[k >> 5] : ~0u) & 1u << (k & 31);
+                rs->gbits[k >> 5] |= (centre ? centre[k >> 5] : ~0u) & 1u << (k & 31);
                 if (k < lo) lo = k;
                 if (k > hi) hi = k;
             }
     for (uint32_t w = lo == UINT32_MAX ? 1 : lo >> 5; w <= (hi >> 5) && lo != UINT32_MAX; w++) {
-        uint32_t bits = m->gbits[w];
-        m->gbits[w] = 0;
+        uint32_t bits = rs->gbits[w];
+        rs->gbits[w] = 0;
         while (bits) {
             uint32_t k = w * 32 + om__ctz32(bits);
             bits &= bits - 1;
             const float *b = &m->tbox[(size_t)k * 4];
-            m->cull[n] = k;
+            rs->cull[n] = k;
             n += box_meets(b, u0, v0, u1, v1) && (centre || box_holds_centre(b, sc));
         }
     }
@@ -184,8 +184,8 @@ static uint32_t gather_cells(om__asm_state *m, float u0, float v0, float u1, flo
  * tile's depth and ids, from the triangles whose light bounds meet the region. The light's clip space is composed with the window that maps the
  * region's tile to [-1, 1] (x' = s x + k w), so the engine's rasterizer, clipping and
  * fill rule apply unchanged at any depth of the tree. */
-static void render(om__asm_state *m, uint32_t level, uint32_t ox, uint32_t oy, uint32_t *depth,
-                   uint16_t *id16, uint32_t *id32)
+static void render(const om__asm_state *m, const om__asm_rs *rs, uint32_t level, uint32_t ox, uint32_t oy,
+                   uint32_t *depth, uint16_t *id16, uint32_t *id32)
 {
     const om__asm_layout *l = &m->tree.lay;
     const om_scene *s = m->scene;
@@ -197,7 +197,7 @@ static void render(om__asm_state *m, uint32_t level, uint32_t ox, uint32_t oy, u
     const double ic = m->inv_scale[level];
     const float u0 = (float)(((double)ox - 1.0) * ic), u1 = (float)(((double)ox + T + 1.0) * ic);
     const float v0 = (float)(((double)oy - 1.0) * ic), v1 = (float)(((double)oy + T + 1.0) * ic);
-    om_target tg = {T, T, 0, T, m->sdepth, m->sid};
+    om_target tg = {T, T, 0, T, rs->sdepth, rs->sid};
     om__target_clear(&tg);
     om_raster r = {&tg, OM_RASTER_DEPTH_ID, NULL, NULL, NULL, NULL, 0, false, NULL, NULL, NULL, NULL, 0, 0, NULL, 0};
     /* back faces of closed shapes skipped, as in every light map (om__cull); the
@@ -221,19 +221,19 @@ static void render(om__asm_state *m, uint32_t level, uint32_t ox, uint32_t oy, u
         const double sc = l->scale[level];
         const uint32_t *centre = level < 2 ? m->centre[level] : NULL;
         /* the base covers every cell: its centre bits alone are the shorter walk */
-        uint32_t n = m->gready && level > 0 ? gather_cells(m, u0, v0, u1, v1, sc, centre)
-                                            : gather_all(m, u0, v0, u1, v1, sc, centre);
+        uint32_t n = m->gready && level > 0 ? gather_cells(m, rs, u0, v0, u1, v1, sc, centre)
+                                            : gather_all(m, rs, u0, v0, u1, v1, sc, centre);
         for (uint32_t k = 0; k < n; k++) {
-            const uint32_t t = m->cull[k];
+            const uint32_t t = rs->cull[k];
             const uint32_t *ix = s->idx + (size_t)t * 3;
 #if defined(__GNUC__) || defined(__clang__)
             /* a big scene's triangles in a tile lie far apart in memory: ask for the
              * next ones' vertices early (a hint: no effect on what is computed) */
             if (k + 4 < n) {
-                const uint32_t *nx = s->idx + (size_t)m->cull[k + 4] * 3;
+                const uint32_t *nx = s->idx + (size_t)rs->cull[k + 4] * 3;
                 for (int i = 0; i < 3; i++) __builtin_prefetch(&s->verts[nx[i]]);
             }
-            if (k + 8 < n) __builtin_prefetch(s->idx + (size_t)m->cull[k + 8] * 3);
+            if (k + 8 < n) __builtin_prefetch(s->idx + (size_t)rs->cull[k + 8] * 3);
 #endif
             om__asm_dvec q[3];
             for (int i = 0; i < 3; i++) q[i] = dapply(&m->view.light_vp, s->verts[ix[i]]);
@@ -242,19 +242,59 @@ static void render(om__asm_state *m, uint32_t level, uint32_t ox, uint32_t oy, u
         }
     }
     const size_t t2 = (size_t)T * T;
-    memcpy(depth, m->sdepth, t2 * sizeof *depth);
+    memcpy(depth, rs->sdepth, t2 * sizeof *depth);
     if (id16)
-        for (size_t i = 0; i < t2; i++) id16[i] = m->sid[i] == OM_NO_TRI ? (uint16_t)0xFFFFu : (uint16_t)m->sid[i];
+        for (size_t i = 0; i < t2; i++) id16[i] = rs->sid[i] == OM_NO_TRI ? (uint16_t)0xFFFFu : (uint16_t)rs->sid[i];
     else
-        memcpy(id32, m->sid, t2 * sizeof *id32);
+        memcpy(id32, rs->sid, t2 * sizeof *id32);
+}
+
+/* A node's tile depends on nothing but its place and the frame's light and bounds, so
+ * tiles render in any order, each written by its own job (om__asm_render_list). */
+void om__asm_render_with(om__asm_state *m, uint32_t index, const om__asm_rs *rs)
+{
+    om__asm_tile tl;
+    om__asm_tile_of(&m->tree, index, &tl);
+    render(m, rs, tl.node->level, tl.node->ox, tl.node->oy, tl.depth, tl.id16, tl.id32);
 }
 
 void om__asm_render_node(om__asm_state *m, uint32_t index)
 {
-    om__asm_tile tl;
-    om__asm_tile_of(&m->tree, index, &tl);
-    render(m, tl.node->level, tl.node->ox, tl.node->oy, tl.depth, tl.id16, tl.id32);
+    const om__asm_rs rs = {m->sdepth, m->sid, m->cull, m->gbits};
+    om__asm_render_with(m, index, &rs);
 }
+
+/* Triangles [k0, k1)'s bounds and their centre bits, into words cleared or their own. */
+static void bounds(om__asm_state *m, uint32_t k0, uint32_t k1)
+{
+    const om_scene *s = m->scene;
+    for (uint32_t k = k0; k < k1; k++) {
+        const uint32_t *ix = s->idx + (size_t)k * 3;
+        om__asm_dvec q[3];
+        for (int i = 0; i < 3; i++) q[i] = dapply(&m->view.light_vp, s->verts[ix[i]]);
+        float *b = &m->tbox[(size_t)k * 4];
+        tri_box(q, m->tree.lay.tile, b);
+        for (int i = 0; i < 2; i++)
+            m->centre[i][k >> 5] |= (uint32_t)box_holds_centre(b, m->tree.lay.scale[i]) << (k & 31);
+    }
+}
+
+#if OM_WITH_JOBS
+/* Part p of the bounds as a job (om__lend): whole words of centre bits, so no word is
+ * shared with another part. */
+static void bounds_part(void *user, uint32_t p, void *scratch)
+{
+    om__asm_state *m = (om__asm_state *)user;
+    (void)scratch;
+    const uint32_t words = (m->scene->ntris + 31) / 32;
+    const uint32_t n = words < 4 * m->lend->slots ? words : 4 * m->lend->slots;
+    const uint32_t w0 = (uint32_t)((uint64_t)words * p / n), w1 = (uint32_t)((uint64_t)words * (p + 1) / n);
+    const uint32_t k1 = w1 * 32 < m->scene->ntris ? w1 * 32 : m->scene->ntris;
+    memset(m->centre[0] + w0, 0, (w1 - w0) * sizeof(uint32_t));
+    memset(m->centre[1] + w0, 0, (w1 - w0) * sizeof(uint32_t));
+    bounds(m, w0 * 32, k1);
+}
+#endif
 
 /* This frame's projections (once, from the first observe or build), and the rebuild
  * when the light has moved. */
@@ -266,17 +306,17 @@ void om__asm_prepare(om__asm_state *m)
     if (!m->lean) {
         /* Projections per triangle, kept only as bounds: a tile projects again the few
          * it renders (the same bits), which costs less than keeping every vertex's. */
-        const size_t words = ((size_t)s->ntris + 31) / 32;
-        memset(m->centre[0], 0, words * sizeof(uint32_t));
-        memset(m->centre[1], 0, words * sizeof(uint32_t));
-        for (uint32_t k = 0; k < s->ntris; k++) {
-            const uint32_t *ix = s->idx + (size_t)k * 3;
-            om__asm_dvec q[3];
-            for (int i = 0; i < 3; i++) q[i] = dapply(&m->view.light_vp, s->verts[ix[i]]);
-            float *b = &m->tbox[(size_t)k * 4];
-            tri_box(q, m->tree.lay.tile, b);
-            for (int i = 0; i < 2; i++)
-                m->centre[i][k >> 5] |= (uint32_t)box_holds_centre(b, m->tree.lay.scale[i]) << (k & 31);
+        const uint32_t words = (s->ntris + 31) / 32;
+#if OM_WITH_JOBS
+        if (m->lend) {   /* by parts of whole words, each its own triangles' */
+            const uint32_t n = words < 4 * m->lend->slots ? words : 4 * m->lend->slots;
+            m->lend->run(m->lend, bounds_part, m, n);
+        } else
+#endif
+        {
+            memset(m->centre[0], 0, words * sizeof(uint32_t));
+            memset(m->centre[1], 0, words * sizeof(uint32_t));
+            bounds(m, 0, s->ntris);
         }
         grid_make(m);
     }

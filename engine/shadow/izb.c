@@ -831,7 +831,7 @@ static void izb_pass_setup(const void *state, uint32_t first, uint32_t end)
 }
 
 const om__pass om__pass_izb = {izb_pass_scratch, izb_pass_plan, izb_pass_job, izb_pass_merge,
-                               izb_pass_begin, izb_pass_setup};
+                               izb_pass_begin, izb_pass_setup, NULL};
 
 static om_status izb_resolve(void *state, om_strip *st, om_diag *d)
 {

@@ -433,7 +433,7 @@ static void ref_pass_setup(const void *state, uint32_t first, uint32_t end)
 }
 
 const om__pass om__pass_ref = {ref_pass_scratch, ref_pass_plan, ref_pass_job, ref_pass_merge,
-                               ref_pass_begin, ref_pass_setup};
+                               ref_pass_begin, ref_pass_setup, NULL};
 
 static void ref_stats(const void *state, om_method_stats *out)
 {

@@ -83,9 +83,10 @@ const om__bands *om__method_bands(const om_method *m_)
     return NULL;
 }
 
-/* The methods with a pass of jobs of their own (frame.h, om__pass): izb's tiles, and
- * ref's per-frame vertex projection (its begin; its bands resolve). */
-#define PASSED(X) X(izb, OM_WITH_IZB) X(ref, OM_WITH_REF)
+/* The methods with a pass of jobs of their own (frame.h, om__pass): izb's tiles, ref's
+ * per-frame vertex projection (its begin; its bands resolve), and asm, which lends the
+ * threads to its analysis and tile renders (asm_jobs.c). */
+#define PASSED(X) X(izb, OM_WITH_IZB) X(ref, OM_WITH_REF) X(asm, OM_WITH_ASM)
 
 #define DECLARE_PASS(m, on) extern const om__pass om__pass_##m;
 PASSED(DECLARE_PASS)
