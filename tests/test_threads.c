@@ -380,47 +380,59 @@ static void asm_jobs_tree(void)
 }
 
 /* ---- hybrid: its bands look the map up and mark the samples they leave uncertain;
- * the irregular pass over those runs after the bands (om__bands.finish). The same
- * terms, pixels and counters for any number of jobs and their order, whole frames and
- * strips, one tile of uncertain samples or tiles of a few (izb.pool). */
+ * its pass (om__pass) then runs the tiles of those as jobs, each with a tile's memory
+ * of its own from the frame arena. The same terms, pixels and counters for any number
+ * of jobs and their order, whole frames and strips, one tile of uncertain samples a
+ * strip or tiles of a few (izb.pool); a frame arena without room for two tiles runs
+ * inline (the bands unused), the same again. */
 static frame_out hybrid_frame(const om_scene *s, uint32_t pool, uint32_t rows, om_parallel_for_fn pf,
-                              void *host, uint32_t threads)
+                              void *host, uint32_t threads, bool lean)
 {
     const om_method *m = om_method_find("hybrid");
     char set[32];
     snprintf(set, sizeof set, "izb.pool=%u", pool);
-    return render_set(s, m, set, 160, 120, rows, pf, host, threads, om_frame_bytes_jobs(m, s, threads), true);
+    return render_set(s, m, set, 160, 120, rows, pf, host, threads, om_frame_bytes_jobs(m, lean ? NULL : s, threads),
+                      true);
 }
 
 static void hybrid_bands(void)
 {
-    static const uint32_t threads[] = {2, 3, 7};
-    om_jobs *pools[3];
-    for (int k = 0; k < 3; k++) CHECK_OK(om_jobs_start(&pools[k], threads[k], NULL));
+    static const uint32_t threads[] = {2, 3, 7, 16};
+    om_jobs *pools[4];
+    for (int k = 0; k < 4; k++) CHECK_OK(om_jobs_start(&pools[k], threads[k], NULL));
     for (int li = 0; li < 2; li++) {
         h_scene hs;
         if (!h_scene_parse(&hs, li ? directional : om_scene_default_text())) continue;
         for (int pi = 0; pi < 2; pi++)
             for (uint32_t rows = 0; rows <= 24; rows += 24) {
                 uint32_t pool = pi ? 97 : 0;
-                frame_out one = hybrid_frame(&hs.s, pool, rows, NULL, NULL, 1);
+                frame_out one = hybrid_frame(&hs.s, pool, rows, NULL, NULL, 1, false);
                 CHECK_MSG(one.st == OM_OK && one.jobs == 1, "hybrid: inline frame");
                 /* a pool of 97 leaves several tiles a strip; the counters say how many */
                 CHECK_MSG(one.ms.counters[2] > 0 && (pool == 0 || one.ms.counters[5] > one.ms.counters[2] / 97),
                           "hybrid: %u uncertain in %u tiles", one.ms.counters[2], one.ms.counters[5]);
-                for (int k = 0; k < 4; k++) {
-                    uint32_t n = k < 3 ? threads[k] : 5;
-                    frame_out o = k < 3 ? hybrid_frame(&hs.s, pool, rows, om_jobs_for, pools[k], n)
-                                        : hybrid_frame(&hs.s, pool, rows, backwards, NULL, n);
+                size_t last_peak = 0;
+                for (int k = 0; k < 6; k++) {
+                    uint32_t n = k < 4 ? threads[k] : 5;
+                    bool lean = k == 5;   /* room for the bands' slots only: inline */
+                    frame_out o = hybrid_frame(&hs.s, pool, rows, k < 4 ? om_jobs_for : backwards, k < 4 ? pools[k] : NULL,
+                                               n, lean);
                     CHECK_MSG(o.st == OM_OK && o.jobs == n, "hybrid: %u jobs ran %u", n, o.jobs);
                     CHECK_MSG(o.hash == one.hash && !memcmp(o.ms.counters, one.ms.counters, sizeof o.ms.counters),
                               "hybrid light %d pool %u strips %u: %u threads%s change the frame", li, pool, rows,
-                              n, k < 3 ? "" : " backwards");
+                              n, k < 4 ? "" : lean ? " inline tiles" : " backwards");
+                    /* the tiles of two jobs at least (two keys of 20 bytes a sample); the
+                     * lean frame (5 jobs, as the one before it) without them */
+                    size_t tile = pool ? pool : 160 * 120;   /* below hybrid's most, 32768 */
+                    if (!lean) CHECK_MSG(o.peak > one.peak + 2 * 40 * tile, "hybrid %u jobs: no tiles (%zu vs %zu)",
+                                         n, o.peak, one.peak);
+                    else CHECK_MSG(o.peak + 2 * 40 * tile < last_peak, "hybrid lean: %zu vs %zu", o.peak, last_peak);
+                    last_peak = o.peak;
                 }
             }
         h_scene_free(&hs);
     }
-    for (int k = 0; k < 3; k++) om_jobs_stop(pools[k]);
+    for (int k = 0; k < 4; k++) om_jobs_stop(pools[k]);
 }
 
 /* ---- izb: its tiles of exposed samples as jobs (om__pass), each with a pool of its

@@ -111,8 +111,7 @@ typedef struct om__bands {
     void (*build_rows)(const void *state, const om__bins *bins, uint32_t y0, uint32_t rows,
                        uint32_t counts[8]);
     /* May be NULL. Runs on the calling thread after merge, over the whole strip: what
-     * the bands left to the method (hybrid's irregular pass over the samples its
-     * bands found uncertain). */
+     * the bands left to the method (asm's use stamps on the leaves its bands read). */
     void (*finish)(void *state, om_strip *strip);
 } om__bands;
 

@@ -78,11 +78,31 @@ typedef struct hybrid_state {
     int tshift;            /* log2(T) when T is a power of two (the default sides), else -1 */
     om__hscene h;          /* what the irregular pass reads */
     om__htile tile;        /* its tile of uncertain samples, cap of them */
-    uint32_t cap;          /* samples the pool holds */
+    uint32_t cap;          /* samples the pool holds: a tile's */
+    /* The pass (OM_WITH_JOBS): where each of the current strip's tiles begins in it,
+     * ntiles + 1 of them (the last: the strip's end), and room for most_tiles. */
+    uint32_t *starts, ntiles, most_tiles;
     uint32_t lit, shadowed, uncertain, tiles;   /* with the tile's setups and tested */
 } hybrid_state;
 
 #define GRID_SIDE ((int64_t)OM_LIGHT_GRID * OM_SUBPIX)   /* 2^21 grid units */
+
+/* Most uncertain samples a tile takes, whatever izb.pool says (tile_most): the tiles
+ * are the jobs of the pass on the host's threads (om__pass, below), each with a
+ * tile's memory of its own from the frame arena, which om_frame_bytes_jobs sizes from
+ * the scene alone; and a strip's uncertain samples make several tiles to share out.
+ * But every tile walks every triangle: twice the scene's triangles, at least
+ * TILE_LEAST and at most TILE_CAP, keeps that walk small beside a tile's own work
+ * (callgrind, one thread, 1024x768: tiles of 32768 cost random-100K 15% more frame
+ * than one tile, the default scene 3% less). */
+#define TILE_LEAST 32768u
+#define TILE_CAP 262144u
+
+static uint32_t tile_most(const om_scene *s)
+{
+    const uint64_t t = 2 * (uint64_t)s->ntris;
+    return t < TILE_LEAST ? TILE_LEAST : t > TILE_CAP ? TILE_CAP : (uint32_t)t;
+}
 #define FAR_OUT ((int64_t)1 << 27)   /* beyond every grid point a triangle can admit */
 
 /* The map's side: as set, or by default the largest power of two at most half the
@@ -112,14 +132,36 @@ static size_t fixed_bytes(uint32_t side, const om_scene *s, bool cache)
 /* A pool of n uncertain samples: a tile's memory (hybrid_tile.c). */
 static size_t pool_bytes(uint32_t n) { return om_arena_need(om__htile_bytes(n), 16); }
 
+/* The pool's least and largest sizes: as set, or from one row up to the frame; never
+ * above tile_most. */
+static void pool_range(const hybrid_cfg *c, const om_scene *s, uint32_t w, uint32_t h, uint32_t *least,
+                       uint32_t *most)
+{
+    const uint32_t lo = c->izb_pool ? c->izb_pool : w, hi = c->izb_pool ? c->izb_pool : w * h, t = tile_most(s);
+    *least = lo < t ? lo : t;
+    *most = hi < t ? hi : t;
+}
+
+/* Most tiles a strip makes with pools of `least` samples, for the pass's starts. */
+static uint32_t most_tiles(uint32_t w, uint32_t h, uint32_t least)
+{
+    return OM_WITH_JOBS ? (uint32_t)(((uint64_t)w * h + least - 1) / least) : 0;
+}
+
+static size_t starts_bytes(uint32_t tiles)
+{
+    return OM_WITH_JOBS ? om_arena_need(((size_t)tiles + 1) * sizeof(uint32_t), 4) : 0;
+}
+
 static om_status need(const hybrid_cfg *c, const om_scene *s, uint32_t w, uint32_t h,
                       size_t *min, size_t *full)
 {
     if (c->hybrid_map > OM_LIGHT_GRID) return OM_E_INVALID;
-    uint32_t one_pass = w * h, smallest = w, side = map_side(c, w, h);
-    if (c->izb_pool) one_pass = smallest = c->izb_pool;
-    *min = fixed_bytes(side, s, false) + pool_bytes(smallest);
-    *full = fixed_bytes(side, s, true) + pool_bytes(one_pass);
+    uint32_t smallest, one_pass, side = map_side(c, w, h);
+    pool_range(c, s, w, h, &smallest, &one_pass);
+    const size_t starts = starts_bytes(most_tiles(w, h, smallest));
+    *min = fixed_bytes(side, s, false) + starts + pool_bytes(smallest);
+    *full = fixed_bytes(side, s, true) + starts + pool_bytes(one_pass);
     return OM_OK;
 }
 
@@ -160,10 +202,16 @@ static om_status hybrid_init(void **state, om_arena *a, const om_method_cfg *mc,
         if (((int64_t)1 << b) == m->T) m->tshift = b;
     if ((st = carve(a, (size_t)m->side * m->side, sizeof(htexel), &p, d))) return st;
     m->map = (htexel *)p;
-    /* The vertex projection only when a one-pass pool fits beside it (it speeds up
+    /* The vertex projection only when the least pool fits beside it (it speeds up
      * triangle setup, it changes no result); then the pool, as set or as large as
-     * the arena allows, from one row up to the frame. */
-    uint32_t want = c.izb_pool ? c.izb_pool : w * h, least = c.izb_pool ? c.izb_pool : w;
+     * the arena allows, from one row up to the frame, at most tile_most. */
+    uint32_t want, least;
+    pool_range(&c, s, w, h, &least, &want);
+    m->most_tiles = most_tiles(w, h, least);
+    if (OM_WITH_JOBS) {
+        if ((st = om_arena_alloc(a, ((size_t)m->most_tiles + 1) * sizeof(uint32_t), 4, &p, d))) return st;
+        m->starts = (uint32_t *)p;
+    }
     if (om_arena_left(a) >= om__lspace_bytes(s) + mats_bytes(s) + pool_bytes(least)) {
         if ((st = om__lspace_init(&m->ls, a, s, d))) return st;
     } else {
@@ -470,17 +518,24 @@ int om__hybrid_decide(void *state, const om__lpoint *p, om_term *t)
 
 const om__lspace *om__hybrid_lspace(const void *state) { return &((const hybrid_state *)state)->ls; }
 
-/* The term a band leaves on a sample its map could not decide (no certain answer is
- * ever anything but 0 or 255 in every channel); the pass after the bands overwrites
- * every one. */
-static bool marked(const om_term *t) { return t->r == 0 && t->g == 0 && t->b == 1; }
-
-/* The irregular pass over a strip's uncertain samples, a tile at a time. With `banded`
- * the bands have classified and counted every sample already (hybrid_band) and the
- * marked ones are projected again; otherwise each exposed sample is projected, looked
- * up and counted here. The same samples, in the same order, either way. */
-static void uncertain_pass(hybrid_state *m, om_strip *st, bool banded)
+/* A tile's key for a sample: its grid point, depth and triangle, and its place i in
+ * the strip. */
+static void put_key(om__hkey *q, const om__lpoint *p, size_t i)
 {
+    q->x = (int32_t)p->x;
+    q->y = (int32_t)p->y;
+    q->z = (uint32_t)p->z;
+    q->tri = p->tri;
+    q->idx = (uint32_t)i;
+}
+
+/* The strip's resolve on one thread: each exposed sample is projected, looked up and
+ * counted, and the uncertain ones go through the irregular pass a tile (cap samples)
+ * at a time, in the strip's order. */
+static om_status hybrid_resolve(void *state, om_strip *st, om_diag *d)
+{
+    (void)d;
+    hybrid_state *m = (hybrid_state *)state;
     size_t n = (size_t)st->rows * st->width, i = 0;
     while (i < n) {
         uint32_t k = 0;
@@ -488,42 +543,33 @@ static void uncertain_pass(hybrid_state *m, om_strip *st, bool banded)
             om_term *t = &st->terms[i];
             om__lpoint p;
             int64_t tex;
-            if (banded) {
-                if (!(t->flags & OM_TERM_EXPOSED) || !marked(t) || !om__lspace_point(&m->ls, &st->samples[i], &p))
-                    continue;
-            } else {
-                t->r = t->g = t->b = 255;
-                if (!(t->flags & OM_TERM_EXPOSED) || !om__lspace_point(&m->ls, &st->samples[i], &p)) continue;
-                int c = classify(m, &p, t, &tex);
-                if (c == 1) m->lit++;
-                else if (c == 2) m->shadowed++;
-                if (c) continue;
-                m->uncertain++;
-            }
-            om__hkey *q = &m->tile.raw[k++];
-            q->x = (int32_t)p.x;
-            q->y = (int32_t)p.y;
-            q->z = (uint32_t)p.z;
-            q->tri = p.tri;
-            q->idx = (uint32_t)i;
+            t->r = t->g = t->b = 255;
+            if (!(t->flags & OM_TERM_EXPOSED) || !om__lspace_point(&m->ls, &st->samples[i], &p)) continue;
+            int c = classify(m, &p, t, &tex);
+            if (c == 1) m->lit++;
+            else if (c == 2) m->shadowed++;
+            if (c) continue;
+            m->uncertain++;
+            put_key(&m->tile.raw[k++], &p, i);
         }
         if (k) {
             om__htile_run(&m->h, &m->tile, k, st);
             m->tiles++;
         }
     }
-}
-
-static om_status hybrid_resolve(void *state, om_strip *st, om_diag *d)
-{
-    (void)d;
-    uncertain_pass((hybrid_state *)state, st, false);
     return OM_OK;
 }
 
-/* By bands on the host's threads (om__bands): each band projects and looks up its own
- * samples, reading the map only, and marks the uncertain ones; merge adds up the
- * counts, and the irregular pass runs over the whole strip after the bands. */
+/* ---- on the host's threads: by bands (om__bands), each band projects and looks up
+ * its own samples, reading the map only, and marks the uncertain ones; merge adds up
+ * the counts. Then the pass (om__pass) takes the marked samples in the tiles
+ * hybrid_resolve makes (cap of them, in the strip's order), a job a tile with a tile's
+ * memory of its own: the same terms and counts whatever the number of jobs. */
+
+/* The term a band leaves on a sample its map could not decide (no certain answer is
+ * ever anything but 0 or 255 in every channel); the pass overwrites every one. */
+static bool marked(const om_term *t) { return t->r == 0 && t->g == 0 && t->b == 1; }
+
 static void hybrid_band(const void *state, om_strip *st, void *scratch, uint32_t counts[8])
 {
     (void)scratch;
@@ -552,15 +598,68 @@ static void hybrid_merge(void *state, const uint32_t counts[8])
     m->uncertain += counts[2];
 }
 
-static void hybrid_finish(void *state, om_strip *st) { uncertain_pass((hybrid_state *)state, st, true); }
+const om__bands om__bands_hybrid = {hybrid_band, hybrid_merge, 0, NULL, NULL, NULL};
 
-const om__bands om__bands_hybrid = {hybrid_band, hybrid_merge, 0, NULL, NULL, hybrid_finish};
+static size_t hybrid_pass_scratch(const void *state, const om_scene *s)
+{
+    if (state) return om__htile_bytes(((const hybrid_state *)state)->cap);
+    return s ? om__htile_bytes(tile_most(s)) : 0;
+}
+
+/* Where each tile of marked samples begins: at every cap-th of them. */
+static uint32_t hybrid_pass_plan(void *state, om_strip *st)
+{
+    hybrid_state *m = (hybrid_state *)state;
+    const size_t n = (size_t)st->rows * st->width;
+    uint32_t k = 0, left = 0;
+    for (size_t i = 0; i < n; i++) {
+        const om_term *t = &st->terms[i];
+        if (!(t->flags & OM_TERM_EXPOSED) || !marked(t)) continue;
+        if (left == 0) {
+            m->starts[k++] = (uint32_t)i;
+            left = m->cap;
+        }
+        left--;
+    }
+    m->starts[k] = (uint32_t)n;
+    return m->ntiles = k;
+}
+
+static void hybrid_pass_job(const void *state, const om_strip *st, uint32_t k, void *scratch, uint32_t counts[8])
+{
+    const hybrid_state *m = (const hybrid_state *)state;
+    om__htile t;
+    om__htile_carve(&t, scratch, m->cap);
+    uint32_t n = 0;
+    for (size_t i = m->starts[k]; i < m->starts[k + 1] && n < m->cap; i++) {
+        const om_term *term = &st->terms[i];
+        om__lpoint p;
+        if ((term->flags & OM_TERM_EXPOSED) && marked(term) && om__lspace_point(&m->ls, &st->samples[i], &p))
+            put_key(&t.raw[n++], &p, i);
+    }
+    om__htile_run(&m->h, &t, n, st);
+    counts[0] += t.setups;
+    counts[1] += t.tested;
+    counts[2]++;
+}
+
+static void hybrid_pass_merge(void *state, const uint32_t counts[8])
+{
+    hybrid_state *m = (hybrid_state *)state;
+    m->tile.setups += counts[0];
+    m->tile.tested += counts[1];
+    m->tiles += counts[2];
+}
+
+const om__pass om__pass_hybrid = {hybrid_pass_scratch, hybrid_pass_plan, hybrid_pass_job, hybrid_pass_merge,
+                                  NULL, NULL, NULL};
 
 static void hybrid_stats(const void *state, om_method_stats *out)
 {
     const hybrid_state *m = (const hybrid_state *)state;
     memset(out, 0, sizeof *out);
-    out->bytes_used = fixed_bytes(m->side, m->scene, m->ls.verts != NULL) + pool_bytes(m->cap);
+    out->bytes_used = fixed_bytes(m->side, m->scene, m->ls.verts != NULL) + starts_bytes(m->most_tiles) +
+                      pool_bytes(m->cap);
     static const char *const names[] = {"certain lit", "certain shadowed", "uncertain", "triangles set up",
                                         "samples tested", "tiles", "pool samples"};
     uint32_t v[7] = {m->lit, m->shadowed, m->uncertain, m->tile.setups, m->tile.tested, m->tiles, m->cap};

@@ -66,6 +66,6 @@ void om__htile_carve(om__htile *t, void *mem, uint32_t cap);
 /* Runs the tile's n samples (t->raw[0..n)) through every triangle of the scene and
  * writes their terms into st; adds to t->setups and t->tested. The same terms and
  * counts whatever the tile's memory held before. */
-void om__htile_run(const om__hscene *h, om__htile *t, uint32_t n, om_strip *st);
+void om__htile_run(const om__hscene *h, om__htile *t, uint32_t n, const om_strip *st);
 
 #endif

@@ -240,7 +240,7 @@ static uint32_t cast(const om__hscene *h, om__htile *t, uint32_t tri)
     return closed;
 }
 
-void om__htile_run(const om__hscene *h, om__htile *t, uint32_t n, om_strip *st)
+void om__htile_run(const om__hscene *h, om__htile *t, uint32_t n, const om_strip *st)
 {
     sort_tile(t, n);
     uint32_t open = n;

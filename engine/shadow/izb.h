@@ -64,7 +64,7 @@ typedef struct om__izb {
 typedef struct om__izb_cfg {
     uint32_t izb_leaf;     /* most samples in a BSP leaf */
     uint32_t izb_pool;     /* samples the pool holds; 0: izb picks by the scene (izb.c,
-                              auto_pool), hybrid takes the whole frame */
+                              auto_pool), hybrid the frame, at most 2 a triangle */
 } om__izb_cfg;
 
 /* Their entries in the settings of a method whose struct T holds them at `f` (a field
@@ -73,7 +73,7 @@ typedef struct om__izb_cfg {
     OM__SETTING(T, f, "izb.leaf", OM_SETTING_U32, 1, 65536, 64, "most samples in a BSP leaf (the paper: 64)")
 #define OM__SET_IZB_POOL(T, f) \
     OM__SETTING(T, f, "izb.pool", OM_SETTING_U32, 0, 1e9, 0, \
-                "samples the pool holds, 0 = izb: n^2/2^20 for n triangles, 32768 to the frame; hybrid: the frame")
+                "samples the pool holds, 0 = izb: n^2/2^20 for n triangles, 32768 to the frame; hybrid: the frame, at most 2 a triangle (32768..262144)")
 
 /* A strip's tiles: its E exposed samples in om__izb_tiles(z, E) = ceil(E / pool)
  * tiles, tile k holding the exposed samples numbered [om__izb_tile_first(z, E, k),
