@@ -154,6 +154,10 @@ static void resolve_run(const om_view *v, const eye_tri *et, uint32_t x0, uint32
     const om_vec3 o = c->v[0], d1 = c->d1, d2 = c->d2, n = c->n;
     const uint32_t tri = c->tri;
     const bool sure = et->sure;
+    /* the light's and the turned normal's values in locals too: the samples' stores
+     * may alias them, and the compiler would load them again per pixel */
+    const bool dir = v->light.kind == OM_LIGHT_DIRECTIONAL;
+    const om_vec3 lpos = v->light.pos, ldir = om__scale(v->light_axis, -1.0f), nf = et->nf;
     /* (float)x + 0.5f, stepped by one: exact below 2^22, and images are narrower */
     float xc = (float)x0 + 0.5f;
     for (uint32_t x = x0; x < x1; x++, xc += 1.0f) {
@@ -177,7 +181,7 @@ static void resolve_run(const om_view *v, const eye_tri *et, uint32_t x0, uint32
         if (terms) {
             bool exposed;
             if (sure && w1 >= -EYE_SLACK && w2 >= -EYE_SLACK && w1 + w2 <= 1.0f + EYE_SLACK) {
-                const float cs = om__dot(et->nf, om__to_light_in(v, p));
+                const float cs = om__dot(nf, dir ? ldir : om__to_point(lpos, p));
                 exposed = cs > 0.0f;
                 out->nl = exposed ? cs : 0.0f;
             } else {

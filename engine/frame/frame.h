@@ -58,15 +58,21 @@ void om__eye_resolve(const om_scene *s, const om_view *v, const om_target *tg, o
 /* Direction from a point towards the light (unit). */
 om_vec3 om__to_light(const om_view *v, om_vec3 p);
 
-/* om__to_light in line (the exposure marks run it for every covered pixel): the
- * operations of om__normalize, in its order, so the same bits. */
-static inline om_vec3 om__to_light_in(const om_view *v, om_vec3 p)
+/* The unit direction from p towards a point light at `pos`: the operations of
+ * om__normalize, in its order, so the same bits. */
+static inline om_vec3 om__to_point(om_vec3 pos, om_vec3 p)
 {
-    if (v->light.kind == OM_LIGHT_DIRECTIONAL) return om__scale(v->light_axis, -1.0f);
-    const om_vec3 a = om__sub(v->light.pos, p);
+    const om_vec3 a = om__sub(pos, p);
     const float l2 = om__dot(a, a);
     if (!(l2 > 0.0f)) return om__v3(0, 0, 0);
     return om__scale(a, 1.0f / om__sqrtf(l2));
+}
+
+/* om__to_light in line (the exposure marks run it for every covered pixel). */
+static inline om_vec3 om__to_light_in(const om_view *v, om_vec3 p)
+{
+    if (v->light.kind == OM_LIGHT_DIRECTIONAL) return om__scale(v->light_axis, -1.0f);
+    return om__to_point(v->light.pos, p);
 }
 
 /* The parts of the lit rule that no occluder decides, the same for every method:
