@@ -31,6 +31,24 @@ void h_scene_free(h_scene *hs)
     hs->mem = NULL;
 }
 
+om_status h_view(om_view *v, const om_scene *s, float t, uint32_t w, uint32_t h, om_diag *d)
+{
+    om_camera cam;
+    om_light light;
+    om_scene_at(s, t, &cam, &light);
+    if (w) { cam.width = w; cam.height = h; }
+    return om_view_init(v, &cam, &light, s, d);
+}
+
+void h_frame_desc(om_frame_desc *fd, om_shade_cfg *shade, const om_scene *s, const om_view *v,
+                  const om_method *m, void *state, om_framebuffer *fb, uint32_t strip_rows)
+{
+    om_shade_cfg_default(shade);
+    memset(fd, 0, sizeof *fd);
+    fd->scene = s; fd->view = v; fd->method = m; fd->method_state = state; fd->shade = shade;
+    fd->strip_rows = strip_rows; fd->fb = fb;
+}
+
 typedef struct grab { uint8_t *mask; om_term *terms; om_sample *samples; } grab;
 
 static om_status on_strip(void *user, const om_strip *st, const om_framebuffer *fb)
@@ -81,38 +99,33 @@ om_status h_render_in(const om_scene *s, const char *name, const om_method_cfg *
                       uint32_t h, float t, uint32_t strip_rows, size_t method_bytes, uint8_t *mask,
                       om_term *terms, om_sample *samples)
 {
-    om_camera cam;
-    om_light light;
     om_view v;
     om_diag d;
-    om_scene_at(s, t, &cam, &light);
-    if (w) { cam.width = w; cam.height = h; }
-    om_status st = om_view_init(&v, &cam, &light, s, &d);
+    om_status st = h_view(&v, s, t, w, h, &d);
     if (st) return st;
     const om_method *m = om_method_find(name);
     if (!m) return OM_E_NOTFOUND;
     om_method_cfg c;
     om_method_cfg_from(&c, m, cfg);
     size_t mn, full;
-    if ((st = m->bytes(&c, s, cam.width, cam.height, &mn, &full))) return st;
+    const uint32_t W = v.cam.width, H = v.cam.height;
+    if ((st = m->bytes(&c, s, W, H, &mn, &full))) return st;
     if (method_bytes) full = method_bytes;
-    uint32_t rows = strip_rows ? strip_rows : cam.height;
-    size_t fbytes = om_frame_bytes_scene(s, cam.width, rows);
-    void *mm = malloc(full), *fm = malloc(fbytes), *px = malloc((size_t)cam.width * rows * 3);
+    uint32_t rows = strip_rows ? strip_rows : H;
+    size_t fbytes = om_frame_bytes_scene(s, W, rows);
+    void *mm = malloc(full), *fm = malloc(fbytes), *px = malloc((size_t)W * rows * 3);
     om_arena ma, fa;
     om_arena_init(&ma, mm, full, "method");
     om_arena_init(&fa, fm, fbytes, "frame");
     void *state;
-    st = m->init(&state, &ma, &c, s, cam.width, cam.height, &d);
+    st = m->init(&state, &ma, &c, s, W, H, &d);
     if (st == OM_OK) {
-        om_framebuffer fb = {OM_RGB888, cam.width, rows, (size_t)cam.width * 3, (uint8_t *)px};
+        om_framebuffer fb = {OM_RGB888, W, rows, (size_t)W * 3, (uint8_t *)px};
         om_shade_cfg shade;
-        om_shade_cfg_default(&shade);
-        grab g = {mask, terms, samples};
         om_frame_desc fd;
-        memset(&fd, 0, sizeof fd);
-        fd.scene = s; fd.view = &v; fd.method = m; fd.method_state = state; fd.shade = &shade;
-        fd.strip_rows = strip_rows; fd.fb = &fb; fd.on_strip = on_strip; fd.user = &g;
+        grab g = {mask, terms, samples};
+        h_frame_desc(&fd, &shade, s, &v, m, state, &fb, strip_rows);
+        fd.on_strip = on_strip; fd.user = &g;
         st = om_render_frame(&fd, &fa, NULL, &d);
     }
     if (st) fprintf(stderr, "  (h_render %s: %s)\n", name, d.msg);

@@ -1,5 +1,6 @@
-/* harness.h — helpers the suites share: parse scene text into a heap arena, and render
- * one method's frame into a whole-frame mask (and the terms) through the public API. */
+/* harness.h — helpers the suites share: parse scene text into a heap arena, set up the
+ * scene's view and a frame description, and render one method's frame into a
+ * whole-frame mask (and the terms) through the public API. */
 #ifndef OM_HARNESS_H
 #define OM_HARNESS_H
 
@@ -20,6 +21,17 @@ void h_scene_free(h_scene *hs);
  * that it takes, so that one list serves a test that loops over the methods. A value
  * out of its range fails the check. */
 om_method_cfg h_cfg(const char *method, const char *list);
+
+/* The view from scene s's camera and light at time t, the camera at w x h when w is
+ * non-zero (else the scene's size); v->cam and v->light hold them. Returns
+ * om_view_init's status (details in d, which may be NULL). */
+om_status h_view(om_view *v, const om_scene *s, float t, uint32_t w, uint32_t h, om_diag *d);
+
+/* *fd zeroed, then scene s, view v, method m with its state, default shading (written
+ * to *shade, which must outlive the frame), strips of strip_rows rows (0: the whole
+ * frame) into fb. The caller sets the rest: strip callback, clock, parallel-for. */
+void h_frame_desc(om_frame_desc *fd, om_shade_cfg *shade, const om_scene *s, const om_view *v,
+                  const om_method *m, void *state, om_framebuffer *fb, uint32_t strip_rows);
 
 /* Renders with method `name` and configuration `cfg` (NULL: defaults; one made for
  * another method: the settings they share, om_method_cfg_from) at the scene's

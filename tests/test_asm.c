@@ -103,12 +103,10 @@ static om_status arun_frame(arun *r, float t, float tl, uint32_t strip, uint8_t 
     om_arena_init(&fa, r->fmem, om_frame_bytes(r->W, rows), "frame");
     om_framebuffer fb = {OM_RGB888, r->W, rows, (size_t)r->W * 3, (uint8_t *)r->px};
     om_shade_cfg shade;
-    om_shade_cfg_default(&shade);
     agrab g = {mask, terms};
     om_frame_desc fd;
-    memset(&fd, 0, sizeof fd);
-    fd.scene = r->s; fd.view = &v; fd.method = r->m; fd.method_state = r->state; fd.shade = &shade;
-    fd.strip_rows = strip; fd.fb = &fb; fd.on_strip = agrab_strip; fd.user = &g;
+    h_frame_desc(&fd, &shade, r->s, &v, r->m, r->state, &fb, strip);
+    fd.on_strip = agrab_strip; fd.user = &g;
     st = om_render_frame(&fd, &fa, NULL, &d);
     if (st) fprintf(stderr, "  (asm frame: %s)\n", d.msg);
     if (ms) r->m->stats(r->state, ms);
@@ -527,11 +525,8 @@ static void float_bounds_hold(void)
     for (int k = 0; k < 2; k++) {
         h_scene hs;
         if (!h_scene_parse(&hs, scenes[k])) return;
-        om_camera cam;
-        om_light light;
         om_view v;
-        om_scene_at(&hs.s, 0.0f, &cam, &light);
-        CHECK_OK(om_view_init(&v, &cam, &light, &hs.s, NULL));
+        CHECK_OK(h_view(&v, &hs.s, 0, 0, 0, NULL));
         om__asm_cfg c;
         memset(&c, 0, sizeof c);
         c.asm_cap = 16u << 20;

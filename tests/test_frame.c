@@ -3,6 +3,7 @@
  * budgets, and the method registry. Scenes are built by hand so this suite does not
  * depend on the parser. */
 #include "test.h"
+#include "harness.h"
 #include "../engine/frame/frame.h"
 
 #include <math.h>
@@ -78,11 +79,9 @@ static om_status render(const om_scene *s, const om_light *light, uint32_t strip
     om_framebuffer fb = {f, v.cam.width, strip ? strip : v.cam.height,
                          (size_t)v.cam.width * om_format_bpp(f), strip_pix};
     om_shade_cfg shade;
-    om_shade_cfg_default(&shade);
     om_frame_desc fd;
-    memset(&fd, 0, sizeof fd);
-    fd.scene = s; fd.view = &v; fd.method = m; fd.method_state = state; fd.shade = &shade;
-    fd.strip_rows = strip; fd.fb = &fb; fd.on_strip = grab; fd.user = cap;
+    h_frame_desc(&fd, &shade, s, &v, m, state, &fb, strip);
+    fd.on_strip = grab; fd.user = cap;
     cap->bpp = om_format_bpp(f);
     st = om_render_frame(&fd, &fa, NULL, &d);
     frame_carves = fa.carves;
@@ -228,11 +227,8 @@ static void frame_budget(void)
     static unsigned char pix[80 * 3 * 4];
     om_framebuffer fb = {OM_RGB888, 80, 4, 240, pix};
     om_shade_cfg shade;
-    om_shade_cfg_default(&shade);
     om_frame_desc fd;
-    memset(&fd, 0, sizeof fd);
-    fd.scene = &s; fd.view = &v; fd.method = m; fd.method_state = state; fd.shade = &shade;
-    fd.strip_rows = 4; fd.fb = &fb;
+    h_frame_desc(&fd, &shade, &s, &v, m, state, &fb, 4);
     size_t need = om_frame_bytes(80, 4);
     /* The query covers any alignment of the host's buffer; the four arrays' padding is
      * at most 4 * 7 bytes, so 29 bytes fewer can never be enough. Guard bytes around

@@ -28,14 +28,9 @@ static int term_diff(void)
 static uint32_t certain_agree(const om_scene *s, const om_method_cfg *c, const char *what)
 {
     const om_method *m = om_method_find("hybrid");
-    om_camera cam;
-    om_light light;
     om_view v;
     om_diag d;
-    om_scene_at(s, 0, &cam, &light);
-    cam.width = W;
-    cam.height = H;
-    CHECK_OK(om_view_init(&v, &cam, &light, s, &d));
+    CHECK_OK(h_view(&v, s, 0, W, H, &d));
     size_t mn, full;
     CHECK_OK(m->bytes(c, s, W, H, &mn, &full));
     void *mem = malloc(full), *state;

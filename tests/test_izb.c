@@ -117,13 +117,8 @@ static void budgets(void)
     free(buf);
     /* between minimum and one pass: tiles, and the same terms as the reference */
     CHECK_OK(h_render(&hs.s, "ref", NULL, W, H, 0, 0, NULL, ref_t, NULL));
-    om_camera cam;
-    om_light light;
     om_view v;
-    om_scene_at(&hs.s, 0, &cam, &light);
-    cam.width = W;
-    cam.height = H;
-    CHECK_OK(om_view_init(&v, &cam, &light, &hs.s, NULL));
+    CHECK_OK(h_view(&v, &hs.s, 0, W, H, NULL));
     size_t sizes[3] = {mn, (mn + full) / 2, full};
     for (int k = 0; k < 3; k++) {
         unsigned char *mem = malloc(sizes[k]), *fmem = malloc(om_frame_bytes(W, H));
@@ -135,11 +130,8 @@ static void budgets(void)
         CHECK(ma.peak <= sizes[k]);
         om_framebuffer fb = {OM_RGB888, W, H, W * 3, px};
         om_shade_cfg shade;
-        om_shade_cfg_default(&shade);
         om_frame_desc fd;
-        memset(&fd, 0, sizeof fd);
-        fd.scene = &hs.s; fd.view = &v; fd.method = m; fd.method_state = state; fd.shade = &shade;
-        fd.fb = &fb;
+        h_frame_desc(&fd, &shade, &hs.s, &v, m, state, &fb, 0);
         /* capture terms through the strip callback of the harness' kind */
         CHECK_OK(om_render_frame(&fd, &fa, NULL, &d));
         om_method_stats ms;
@@ -191,23 +183,15 @@ static void default_pool(void)
         om_arena ma, fa;
         om_arena_init(&ma, mem, bytes, "method");
         om_arena_init(&fa, fmem, om_frame_bytes(W2, H2), "frame");
-        om_camera cam;
-        om_light light;
         om_view v;
         om_diag d;
         void *state;
-        om_scene_at(&hs.s, 0, &cam, &light);
-        cam.width = W2;
-        cam.height = H2;
-        CHECK_OK(om_view_init(&v, &cam, &light, &hs.s, NULL));
+        CHECK_OK(h_view(&v, &hs.s, 0, W2, H2, NULL));
         CHECK_OK(m->init(&state, &ma, ck, &hs.s, W2, H2, &d));
         om_framebuffer fb = {OM_RGB888, W2, H2, W2 * 3, px};
         om_shade_cfg shade;
-        om_shade_cfg_default(&shade);
         om_frame_desc fd;
-        memset(&fd, 0, sizeof fd);
-        fd.scene = &hs.s; fd.view = &v; fd.method = m; fd.method_state = state; fd.shade = &shade;
-        fd.fb = &fb;
+        h_frame_desc(&fd, &shade, &hs.s, &v, m, state, &fb, 0);
         CHECK_OK(om_render_frame(&fd, &fa, NULL, &d));
         om_method_stats ms;
         m->stats(state, &ms);

@@ -121,21 +121,16 @@ static int cell(const oracle *o, double v, int axis)
 
 static void oracle_init(oracle *o, const om_scene *s, uint32_t w, uint32_t h)
 {
-    om_camera cam;
-    om_light light;
     om_diag d;
     memset(o, 0, sizeof *o);
     o->s = s;
-    om_scene_at(s, 0, &cam, &light);
-    cam.width = w;
-    cam.height = h;
-    CHECK_OK(om_view_init(&o->v, &cam, &light, s, &d));
-    o->spot = light.kind == OM_LIGHT_SPOT;
+    CHECK_OK(h_view(&o->v, s, 0, w, h, &d));
+    o->spot = o->v.light.kind == OM_LIGHT_SPOT;
     o->az = dnorm(fv(o->v.light_axis));
     dv up = fabs(o->az.y) < 0.9 ? (dv){0, 1, 0} : (dv){1, 0, 0};
     o->ax = dnorm(dcross(o->az, up));
     o->ay = dcross(o->ax, o->az);
-    o->light = fv(light.pos);
+    o->light = fv(o->v.light.pos);
     o->toward = dscale(o->az, -1.0);
     dv ext = dsub(fv(s->hi), fv(s->lo));
     o->reach = 2.0 * (fabs(ext.x) + fabs(ext.y) + fabs(ext.z)) + 1.0;

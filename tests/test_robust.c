@@ -44,12 +44,10 @@ static om_status frame(frame_ctx *f, void *state, om_arena *fa, uint8_t *mask)
 {
     static uint8_t px[W * H * 3];
     om_shade_cfg shade;
-    om_shade_cfg_default(&shade);
     om_framebuffer fb = {OM_RGB888, W, 9, W * 3, px};
     om_frame_desc fd;
-    memset(&fd, 0, sizeof fd);
-    fd.scene = f->s; fd.view = &f->v; fd.method = f->m; fd.method_state = state;
-    fd.shade = &shade; fd.strip_rows = 9; fd.fb = &fb; fd.on_strip = grab; fd.user = mask;
+    h_frame_desc(&fd, &shade, f->s, &f->v, f->m, state, &fb, 9);
+    fd.on_strip = grab; fd.user = mask;
     return om_render_frame(&fd, fa, NULL, NULL);
 }
 
@@ -62,10 +60,7 @@ static void failure_injection(void)
     if (!h_scene_parse(&hs, small_scene)) return;
     frame_ctx f;
     f.s = &hs.s;
-    om_camera cam;
-    om_light light;
-    om_scene_at(&hs.s, 0, &cam, &light);
-    CHECK_OK(om_view_init(&f.v, &cam, &light, &hs.s, NULL));
+    CHECK_OK(h_view(&f.v, &hs.s, 0, 0, 0, NULL));
     static unsigned char fmem[W * 9 * 52];   /* 44 bytes a pixel, and room for the bins */
     for (size_t k = 0; k < om_method_count(); k++) {
         f.m = om_method_at(k);
@@ -257,12 +252,9 @@ static void largest_image(void)
         void *state;
         CHECK_OK(m->init(&state, &ma, &c, &s, 8192, 8192, NULL));
         om_shade_cfg shade;
-        om_shade_cfg_default(&shade);
         om_framebuffer fb = {OM_RGB565, 8192, 64, 8192 * 2, px};
         om_frame_desc fd;
-        memset(&fd, 0, sizeof fd);
-        fd.scene = &s; fd.view = &v; fd.method = m; fd.method_state = state; fd.shade = &shade;
-        fd.strip_rows = 64; fd.fb = &fb;
+        h_frame_desc(&fd, &shade, &s, &v, m, state, &fb, 64);
         om_frame_stats fs;
         CHECK_OK(om_render_frame(&fd, &fa, &fs, NULL));
         CHECK_EQ_U(fs.strips, 128);

@@ -165,13 +165,8 @@ static om_status on_strip(void *user, const om_strip *st, const om_framebuffer *
 static om_status run_rtw(const om_scene *s, const om_method_cfg *c, uint32_t w, uint32_t h,
                          uint32_t strip, om_term *terms, inspect_fn fn, void *user)
 {
-    om_camera cam;
-    om_light light;
     om_view v;
-    om_scene_at(s, 0, &cam, &light);
-    cam.width = w;
-    cam.height = h;
-    om_status st = om_view_init(&v, &cam, &light, s, NULL);
+    om_status st = h_view(&v, s, 0, w, h, NULL);
     if (st) return st;
     const om_method *m = om_method_find("rtw");
     size_t mn, full;
@@ -188,11 +183,9 @@ static om_status run_rtw(const om_scene *s, const om_method_cfg *c, uint32_t w, 
     if (st == OM_OK) {
         om_framebuffer fb = {OM_RGB888, w, rows, (size_t)w * 3, (uint8_t *)px};
         om_shade_cfg shade;
-        om_shade_cfg_default(&shade);
         om_frame_desc fd;
-        memset(&fd, 0, sizeof fd);
-        fd.scene = s; fd.view = &v; fd.method = m; fd.method_state = state; fd.shade = &shade;
-        fd.strip_rows = strip; fd.fb = &fb; fd.on_strip = on_strip; fd.user = terms;
+        h_frame_desc(&fd, &shade, s, &v, m, state, &fb, strip);
+        fd.on_strip = on_strip; fd.user = terms;
         st = om_render_frame(&fd, &fa, NULL, &d);
         if (st == OM_OK && fn) fn((const om__rtw *)state, user);
         CHECK(ma.peak <= full);   /* with the coarse depth, beyond the minimum */

@@ -113,11 +113,8 @@ static void bvh_equals_brute_force(void)
         h_scene hs;
         if (!h_scene_parse(&hs, scenes[k])) return;
         CHECK_OK(h_render(&hs.s, "ref", NULL, 0, 0, 0, 0, NULL, terms, samples));
-        om_camera cam;
-        om_light light;
         om_view v;
-        om_scene_at(&hs.s, 0, &cam, &light);
-        CHECK_OK(om_view_init(&v, &cam, &light, &hs.s, NULL));
+        CHECK_OK(h_view(&v, &hs.s, 0, 0, 0, NULL));
         static unsigned char mem[1 << 20];
         om_arena a;
         om_arena_init(&a, mem, sizeof mem, "t");
@@ -179,11 +176,8 @@ static void float_predicate_is_the_double_one(void)
     for (int k = 0; k < 2; k++) {
         h_scene hs;
         if (!h_scene_parse(&hs, scenes[k])) return;
-        om_camera cam;
-        om_light light;
         om_view v;
-        om_scene_at(&hs.s, 0, &cam, &light);
-        CHECK_OK(om_view_init(&v, &cam, &light, &hs.s, NULL));
+        CHECK_OK(h_view(&v, &hs.s, 0, 0, 0, NULL));
         static unsigned char mem[1 << 16];
         om_arena a;
         om_arena_init(&a, mem, sizeof mem, "t");
@@ -407,13 +401,8 @@ static void ref_small_equals_fast(void)
     size_t mn, full;
     CHECK_OK(m->bytes(&c, &hs.s, W, H, &mn, &full));
     CHECK(mn < full / 4);
-    om_camera cam;
-    om_light light;
     om_view v;
-    om_scene_at(&hs.s, 0, &cam, &light);
-    cam.width = W;
-    cam.height = H;
-    CHECK_OK(om_view_init(&v, &cam, &light, &hs.s, NULL));
+    CHECK_OK(h_view(&v, &hs.s, 0, W, H, NULL));
     for (int k = 0; k < 2; k++) {
         const size_t size = k ? full - 1 : mn;
         unsigned char *mem = malloc(size), *fmem = malloc(om_frame_bytes(W, H)), *px = malloc(W * H * 3);
@@ -424,11 +413,8 @@ static void ref_small_equals_fast(void)
         CHECK_OK(m->init(&state, &ma, &c, &hs.s, W, H, NULL));
         om_framebuffer fb = {OM_RGB888, W, H, W * 3, px};
         om_shade_cfg shade;
-        om_shade_cfg_default(&shade);
         om_frame_desc fd;
-        memset(&fd, 0, sizeof fd);
-        fd.scene = &hs.s; fd.view = &v; fd.method = m; fd.method_state = state; fd.shade = &shade;
-        fd.fb = &fb;
+        h_frame_desc(&fd, &shade, &hs.s, &v, m, state, &fb, 0);
         /* terms out through a strip callback */
         struct cap { om_term *t; } cp = {small};
         fd.user = &cp;

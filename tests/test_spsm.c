@@ -405,19 +405,12 @@ static void spsm_frames(const om_scene *s, void *state, uint32_t strip, int fram
     static uint8_t px[160 * 120 * 3];
     om_arena fa;
     om_arena_init(&fa, fm, sizeof fm, "frame");
-    om_camera cam;
-    om_light light;
     om_view v;
-    om_scene_at(s, 0, &cam, &light);
-    cam.width = 160; cam.height = 120;
-    CHECK_OK(om_view_init(&v, &cam, &light, s, NULL));
+    CHECK_OK(h_view(&v, s, 0, 160, 120, NULL));
     om_framebuffer fb = {OM_RGB888, 160, strip ? strip : 120, 160 * 3, px};
     om_shade_cfg shade;
-    om_shade_cfg_default(&shade);
     om_frame_desc fd;
-    memset(&fd, 0, sizeof fd);
-    fd.scene = s; fd.view = &v; fd.method = om_method_find("spsm"); fd.method_state = state;
-    fd.shade = &shade; fd.fb = &fb; fd.strip_rows = strip;
+    h_frame_desc(&fd, &shade, s, &v, om_method_find("spsm"), state, &fb, strip);
     om_diag d;
     for (int f = 0; f < frames; f++) CHECK_OK(om_render_frame(&fd, &fa, fs, &d));
 }

@@ -44,14 +44,9 @@ static frame_out render_set(const om_scene *s, const om_method *m, const char *s
 {
     frame_out o;
     memset(&o, 0, sizeof o);
-    om_camera cam;
-    om_light light;
     om_view v;
     om_diag d;
-    om_scene_at(s, 0.0f, &cam, &light);
-    cam.width = W;
-    cam.height = H;
-    if ((o.st = om_view_init(&v, &cam, &light, s, &d))) return o;
+    if ((o.st = h_view(&v, s, 0, W, H, &d))) return o;
     om_method_cfg c = h_cfg(m->name, set);
     size_t mn, full;
     if ((o.st = m->bytes(&c, s, W, H, &mn, &full))) return o;
@@ -69,11 +64,9 @@ static frame_out render_set(const om_scene *s, const om_method *m, const char *s
     if ((o.st = m->init(&state, &ma, &c, s, W, H, &d)) == OM_OK) {
         om_framebuffer fb = {OM_RGB888, W, r, (size_t)W * 3, (uint8_t *)px};
         om_shade_cfg shade;
-        om_shade_cfg_default(&shade);
         om_frame_desc fd;
-        memset(&fd, 0, sizeof fd);
-        fd.scene = s; fd.view = &v; fd.method = m; fd.method_state = state; fd.shade = &shade;
-        fd.strip_rows = rows; fd.fb = &fb; fd.on_strip = on_strip; fd.user = &o.hash;
+        h_frame_desc(&fd, &shade, s, &v, m, state, &fb, rows);
+        fd.on_strip = on_strip; fd.user = &o.hash;
         fd.parallel_for = pf; fd.parallel_user = host; fd.threads = threads;
         o.hash = OM_HASH_INIT;
         om_frame_stats fs;
@@ -201,11 +194,9 @@ static void asm_frames(const om_scene *s, uint32_t rows, om_parallel_for_fn pf, 
         om_arena_init(&fa, fm, fbytes, "frame");
         om_framebuffer fb = {OM_RGB888, W, r, (size_t)W * 3, (uint8_t *)px};
         om_shade_cfg shade;
-        om_shade_cfg_default(&shade);
         om_frame_desc fd;
-        memset(&fd, 0, sizeof fd);
-        fd.scene = s; fd.view = &v; fd.method = m; fd.method_state = state; fd.shade = &shade;
-        fd.strip_rows = rows; fd.fb = &fb; fd.on_strip = on_strip; fd.user = &hash[f];
+        h_frame_desc(&fd, &shade, s, &v, m, state, &fb, rows);
+        fd.on_strip = on_strip; fd.user = &hash[f];
         fd.parallel_for = pf; fd.parallel_user = host; fd.threads = threads;
         hash[f] = OM_HASH_INIT;
         om_frame_stats fs;
