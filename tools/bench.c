@@ -90,17 +90,6 @@ om_status cli_load_named(const char *name, cli_scene *cs, om_diag *d)
     return om_scene_parse(r, len, NULL, &cs->arena, &cs->scene, d);
 }
 
-typedef struct mask_out { uint8_t *mask, *rgb; } mask_out;
-
-static om_status grab(void *user, const om_strip *st, const om_framebuffer *fb)
-{
-    mask_out *o = (mask_out *)user;
-    for (uint32_t i = 0; i < st->rows * st->width; i++)
-        o->mask[(size_t)st->y0 * st->width + i] = om_mask_of(&st->samples[i], &st->terms[i]);
-    if (o->rgb) memcpy(o->rgb + (size_t)st->y0 * st->width * 3, fb->pixels, (size_t)st->rows * fb->stride);
-    return OM_OK;
-}
-
 static int cmp_d(const void *a, const void *b)
 {
     double x = *(const double *)a, y = *(const double *)b;
@@ -156,11 +145,11 @@ om_status cli_measure_strips(const om_method *m, const om_method_cfg *cfg, const
         om_shade_cfg shade;
         om_shade_cfg_default(&shade);
         om_framebuffer fb = {OM_RGB888, W, H, (size_t)W * 3, (uint8_t *)px};
-        mask_out mo = {mask, rgb};
+        cli_masks mo = {mask, rgb};
         om_frame_desc fd;
         memset(&fd, 0, sizeof fd);
         fd.scene = &cs->scene; fd.view = v; fd.method = m; fd.method_state = state;
-        fd.shade = &shade; fd.fb = &fb; fd.on_strip = grab; fd.user = &mo; fd.clock = om_clock_ns;
+        fd.shade = &shade; fd.fb = &fb; fd.on_strip = cli_grab_mask; fd.user = &mo; fd.clock = om_clock_ns;
         fd.strip_rows = rows;
         cli_frame_jobs(&fd);
         om_frame_stats fs;
@@ -359,12 +348,6 @@ static bool chart(om_out *o, const svg_chart *c, const cli_point *pts, int n, co
     return svg_write(o->f, c, s, ns);
 }
 
-static const char *base_name(const char *path)
-{
-    const char *b = strrchr(path, '/');
-    return b ? b + 1 : path;
-}
-
 /* Splits a comma-separated list in place; returns the count (empty items kept). */
 static size_t split(char *list, char **items, size_t max)
 {
@@ -390,9 +373,9 @@ static int check_names(const char *cmd, char **names, size_t n, const char *meth
             return cli_usage_error(cmd, "unknown scene '%s': not default, random-1K, random-10K, "
                                    "random-100K, random-1M or a scene file", names[i]);
         for (size_t j = 0; j < i; j++)
-            if (!strcmp(base_name(names[i]), base_name(names[j])))
+            if (!strcmp(cli_base_name(names[i]), cli_base_name(names[j])))
                 return cli_usage_error(cmd, "two scenes named '%s' would write the same charts",
-                                       base_name(names[i]));
+                                       cli_base_name(names[i]));
     }
     for (const char *p = methods; p && *p;) {
         char name[32];
@@ -455,8 +438,8 @@ static int write_outputs(const char *dir, char **names, size_t nn, const cli_poi
             if (!strcmp(pts[j].scene, names[i])) { W = pts[j].w; H = pts[j].h; break; }
         for (int c = 0; c < 3 && st == OM_OK; c++) {
             char file[300], title[300];
-            snprintf(file, sizeof file, "%s-%s.svg", base_name(names[i]), suffix[c]);
-            snprintf(title, sizeof title, "%s at %ux%u: %s", base_name(names[i]), W, H, what[c]);
+            snprintf(file, sizeof file, "%s-%s.svg", cli_base_name(names[i]), suffix[c]);
+            snprintf(title, sizeof title, "%s at %ux%u: %s", cli_base_name(names[i]), W, H, what[c]);
             svg_chart ch = {title, xlabel[c], "samples wrong against ref", true, true, true, false,
                             xunit[c], SVG_SHARE};
             if (!(paths[k] = cli_path(dir, file))) st = cli_oom(&d);
@@ -527,7 +510,7 @@ static int scaling(const char *cmd, char **names, size_t nn, const uint32_t *sw,
             if ((cli_sweep(m) && !cli_sweep(m)[0]) || !in_list(methods, m->name)) continue;
             om_method_cfg cfg;
             om_method_cfg_default(&cfg, m);
-            printf("%-12s %-6s", base_name(names[si]), m->name);
+            printf("%-12s %-6s", cli_base_name(names[si]), m->name);
             double one = 0.0;
             for (int c = 0; c < nc && st == OM_OK; c++) {
                 char arg[16];
@@ -550,7 +533,7 @@ static int scaling(const char *cmd, char **names, size_t nn, const uint32_t *sw,
             have_eye = true;
         }
         if (have_eye && st == OM_OK && !rc) {
-            printf("%-12s %-6s", base_name(names[si]), "eye");
+            printf("%-12s %-6s", cli_base_name(names[si]), "eye");
             for (int c = 0; c < nc; c++) {
                 printf(" %10.2f", eye[c]);
                 if (c) printf(" %6.2fx%c", eye[c] > 0.0 ? eye[0] / eye[c] : 0.0, eye_jobs[c] == counts[c] ? ' ' : '*');

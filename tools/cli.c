@@ -1,4 +1,7 @@
-/* cli.c — helpers shared by the subcommands. */
+/* cli.c — what the subcommands share (cli.h): one-line errors and usage messages,
+ * parsing of sizes, byte counts and numbers, loading a scene into an arena sized by
+ * its bytes query, --set settings, the thread pool frames run on, paths, and the strip
+ * callback that collects a frame's mask. */
 #include "cli.h"
 
 #include <errno.h>
@@ -205,6 +208,21 @@ char *cli_path(const char *dir, const char *file)
         memcpy(p + a + 1, file, b + 1);
     }
     return p;
+}
+
+const char *cli_base_name(const char *path)
+{
+    const char *b = strrchr(path, '/');
+    return b ? b + 1 : path;
+}
+
+om_status cli_grab_mask(void *user, const om_strip *st, const om_framebuffer *fb)
+{
+    cli_masks *o = (cli_masks *)user;
+    for (uint32_t i = 0; i < st->rows * st->width; i++)
+        o->mask[(size_t)st->y0 * st->width + i] = om_mask_of(&st->samples[i], &st->terms[i]);
+    if (o->rgb) memcpy(o->rgb + (size_t)st->y0 * st->width * 3, fb->pixels, (size_t)st->rows * fb->stride);
+    return OM_OK;
 }
 
 om_status cli_scene_view(const cli_scene *cs, uint32_t w, uint32_t h, om_view *v, om_diag *d)

@@ -109,6 +109,14 @@ void cli_short_setting(const char *setting, char *out, size_t n);
 
 /* "dir/file", malloc'd (NULL when out of memory): paths are never cut short. */
 char *cli_path(const char *dir, const char *file);
+/* What follows the path's last '/' (the whole path without one). */
+const char *cli_base_name(const char *path);
+
+/* A frame's strip callback (om_strip_fn) with a cli_masks as its user: each strip's
+ * mask into mask (the whole image's, row-major) and, where rgb is given, its RGB888
+ * pixels into rgb. */
+typedef struct cli_masks { uint8_t *mask, *rgb; } cli_masks;
+om_status cli_grab_mask(void *user, const om_strip *st, const om_framebuffer *fb);
 /* Cuts a trailing "@WxH" (the size to measure that scene at) off a --scenes entry
  * into w, h (0 when there is none); false when what follows the @ is not a size. */
 bool cli_scene_size(char *entry, uint32_t *w, uint32_t *h);

@@ -184,11 +184,6 @@ static void inline_file(FILE *f, const char *dir, const char *file, void (*put)(
     free(path);
 }
 
-static const char *base_name(const char *path)
-{
-    return strrchr(path, '/') ? strrchr(path, '/') + 1 : path;
-}
-
 /* What a scene is, in a sentence: the built-in ones described, a file by the comment
  * lines that open it (a stability case says there what it provokes). */
 static void scene_about(FILE *f, const char *name)
@@ -258,7 +253,7 @@ static const rcol stability_cols[] = {
 static int scene_part(FILE *f, const char *dir, const char *name, uint32_t w, uint32_t h,
                       const rcsv *bench, const char *runs)
 {
-    const char *base = base_name(name);
+    const char *base = cli_base_name(name);
     uint32_t W = w, H = h;
     for (size_t r = 0; r < bench->rows; r++)
         if (same_scene(bench, r, name)) {
@@ -380,9 +375,9 @@ int cmd_report(int argc, char **argv)
         uint32_t sw, sh;
         cli_scene_size(name, &sw, &sh);
         fprintf(f, " <a href=\"#scene-");
-        svg_escape(f, base_name(name));
+        svg_escape(f, cli_base_name(name));
         fprintf(f, "\">");
-        svg_escape(f, base_name(name));
+        svg_escape(f, cli_base_name(name));
         fprintf(f, "</a>");
     }
     fprintf(f, ".</p>\n");

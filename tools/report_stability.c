@@ -74,17 +74,6 @@ static void cell(FILE *f, const char *method, const double *v, int n, int flick)
     fprintf(f, "</svg>\n");
 }
 
-typedef struct grab_ctx { uint8_t *mask, *rgb; } grab_ctx;
-
-static om_status grab(void *user, const om_strip *st, const om_framebuffer *fb)
-{
-    grab_ctx *g = (grab_ctx *)user;
-    for (uint32_t i = 0; i < st->rows * st->width; i++)
-        g->mask[(size_t)st->y0 * st->width + i] = om_mask_of(&st->samples[i], &st->terms[i]);
-    if (g->rgb) memcpy(g->rgb + (size_t)st->y0 * st->width * 3, fb->pixels, (size_t)st->rows * fb->stride);
-    return OM_OK;
-}
-
 /* Frames 0..last of the case's path with one state of m (progressive methods refine,
  * as under make stability); the masks of frames last - 1 and last come out, and the
  * last frame's pixels when rgb is given. */
@@ -115,11 +104,11 @@ static om_status path(const om_scene *s, const om_method *m, const om_method_cfg
         om_shade_cfg shade;
         om_shade_cfg_default(&shade);
         om_framebuffer fb = {OM_RGB888, SW, SH, (size_t)SW * 3, (uint8_t *)px};
-        grab_ctx g = {fr == last ? cur : prev, fr == last ? rgb : NULL};
+        cli_masks g = {fr == last ? cur : prev, fr == last ? rgb : NULL};
         om_frame_desc fd;
         memset(&fd, 0, sizeof fd);
         fd.scene = s; fd.view = &v; fd.method = m; fd.method_state = state;
-        fd.shade = &shade; fd.fb = &fb; fd.on_strip = grab; fd.user = &g; fd.clock = om_clock_ns;
+        fd.shade = &shade; fd.fb = &fb; fd.on_strip = cli_grab_mask; fd.user = &g; fd.clock = om_clock_ns;
         om_frame_stats fs;
         st = om_render_frame(&fd, &fa, &fs, d);
     }
