@@ -327,6 +327,10 @@ cmp -s "$dir/bench/bench.csv" "$dir/bench-old.csv" && ok || bad "a failed bench 
 has "$dir/bench/bench.csv" "^scene,method,setting,width,height,time_ms,init_ms," "bench.csv has an init column"
 has "$dir/bench/bench.csv" ",stats$" "bench.csv ends with the methods' counters"
 has "$dir/bench/bench.csv" ",threads,stats$" "bench.csv records the threads"
+# frame_wall_ms times the whole frame call, time_ms sums its stages: never less (each to 0.001 ms)
+if awk -F, 'NR == 1 {for (i = 1; i <= NF; i++) {if ($i == "time_ms") t = i; if ($i == "frame_wall_ms") w = i}
+            if (!t || !w) exit 1; next} $w + 0.0015 < $t {exit 1}' "$dir/bench/bench.csv"; then ok
+else bad "bench.csv's frame_wall_ms is missing or below the stage sum time_ms"; fi
 has "$dir/bench/bench.csv" "bsp nodes=" "bench.csv carries izb's counters"
 if awk -F, 'NR > 1 && ($4 != 64 || $5 != 48) {exit 1}' "$dir/bench/bench.csv"; then ok; else bad "bench ignored the scene's 64x48"; fi
 if [ -s "$dir/bench/ok.scene-first.svg" ]; then ok; else bad "no first-frame (init + frame) chart"; fi

@@ -109,6 +109,18 @@ om_status cli_measure(const om_method *m, const om_method_cfg *cfg, const cli_sc
                               rgb, p, d);
 }
 
+/* The mask grab, timed: the frame's wall time leaves the host's callbacks out. */
+typedef struct timed_masks { cli_masks out; uint64_t ns; } timed_masks;
+
+static om_status grab_timed(void *user, const om_strip *st, const om_framebuffer *fb)
+{
+    timed_masks *g = (timed_masks *)user;
+    uint64_t t0 = om_clock_ns(NULL);
+    om_status s = cli_grab_mask(&g->out, st, fb);
+    g->ns += om_clock_ns(NULL) - t0;
+    return s;
+}
+
 /* Init once, render `runs` frames (progressive methods refine meanwhile); times are
  * medians over the frames, the mask is the last frame's. */
 om_status cli_measure_strips(const om_method *m, const om_method_cfg *cfg, const cli_scene *cs,
@@ -133,7 +145,7 @@ om_status cli_measure_strips(const om_method *m, const om_method_cfg *cfg, const
     om_arena_init(&ma, mem, full, "method");
     om_arena_init(&fa, fmem, fbytes, "frame");
     void *state;
-    double t[5][16];
+    double t[5][16], wall[16];
     if (runs > 16) runs = 16;
     /* init is a stage of its own: a user pays it whenever the scene changes */
     uint64_t t0 = om_clock_ns(NULL);
@@ -145,15 +157,17 @@ om_status cli_measure_strips(const om_method *m, const om_method_cfg *cfg, const
         om_shade_cfg shade;
         om_shade_cfg_default(&shade);
         om_framebuffer fb = {OM_RGB888, W, H, (size_t)W * 3, (uint8_t *)px};
-        cli_masks mo = {mask, rgb};
+        timed_masks mo = {{mask, rgb}, 0};
         om_frame_desc fd;
         memset(&fd, 0, sizeof fd);
         fd.scene = &cs->scene; fd.view = v; fd.method = m; fd.method_state = state;
-        fd.shade = &shade; fd.fb = &fb; fd.on_strip = cli_grab_mask; fd.user = &mo; fd.clock = om_clock_ns;
+        fd.shade = &shade; fd.fb = &fb; fd.on_strip = grab_timed; fd.user = &mo; fd.clock = om_clock_ns;
         fd.strip_rows = rows;
         cli_frame_jobs(&fd);
         om_frame_stats fs;
+        const uint64_t w0 = om_clock_ns(NULL);
         st = om_render_frame(&fd, &fa, &fs, d);
+        wall[r] = (double)(om_clock_ns(NULL) - w0 - mo.ns) / 1e6;
         p->threads = fs.jobs;
         t[0][r] = (double)fs.ns_eye / 1e6;
         t[1][r] = (double)fs.ns_observe / 1e6;
@@ -167,6 +181,7 @@ om_status cli_measure_strips(const om_method *m, const om_method_cfg *cfg, const
         p->total = median(tot, runs);   /* sorts tot */
         p->tmin = tot[0];
         p->tmax = tot[runs - 1];
+        p->wall = median(wall, runs);
         p->eye = median(t[0], runs);
         p->observe = median(t[1], runs);
         p->build = median(t[2], runs);
@@ -409,18 +424,19 @@ static int write_outputs(const char *dir, char **names, size_t nn, const cli_poi
         FILE *f = outs[k].f;
         fprintf(f, "scene,method,setting,width,height,time_ms,init_ms,eye_ms,observe_ms,build_ms,"
                    "resolve_ms,shade_ms,bytes,samples,false_lit,false_shadowed,mismatch_share,"
-                   "edge_samples,edge_mismatch_share,time_min_ms,time_max_ms,threads,stats\n");
+                   "edge_samples,edge_mismatch_share,time_min_ms,time_max_ms,frame_wall_ms,threads,stats\n");
         for (int i = 0; i < np; i++) {
             const cli_point *p = &pts[i];
             double share = 1.0 - om_metrics_match(&p->m);
             double edge = p->m.edge_samples ? (double)(p->m.edge_false_lit + p->m.edge_false_shadowed) /
                                                   (double)p->m.edge_samples : 0.0;
-            fprintf(f, "%s,%s,%s,%u,%u,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%zu,%llu,%llu,%llu,%.6f,%llu,%.6f,%.3f,%.3f,%u,%s\n",
+            fprintf(f, "%s,%s,%s,%u,%u,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%zu,%llu,%llu,%llu,%.6f,%llu,%.6f,%.3f,%.3f,%.3f,%u,%s\n",
                     p->scene, p->method, p->setting, p->w, p->h, p->total, p->init, p->eye,
                     p->observe, p->build, p->resolve, p->shade, p->bytes,
                     (unsigned long long)p->m.samples, (unsigned long long)p->m.false_lit,
                     (unsigned long long)p->m.false_shadowed, share,
-                    (unsigned long long)p->m.edge_samples, edge, p->tmin, p->tmax, p->threads, p->stats);
+                    (unsigned long long)p->m.edge_samples, edge, p->tmin, p->tmax, p->wall, p->threads,
+                    p->stats);
         }
         k++;
     }
@@ -708,15 +724,15 @@ int cmd_bench(int argc, char **argv)
     }
     if (tri_sweep && isatty(2)) fprintf(stderr, "\n");
     if (!rc) {
-        printf("%-12s %-5s %-28s %9s %9s %9s %11s %9s %9s\n", "scene", "meth", "setting", "time ms",
-               "init", "resolve", "bytes", "mismatch", "edge");
+        printf("%-12s %-5s %-28s %9s %9s %9s %11s %9s %9s %9s\n", "scene", "meth", "setting", "time ms",
+               "init", "resolve", "bytes", "mismatch", "edge", "wall ms");
         for (int i = 0; i < np; i++) {
             const cli_point *p = &pts[i];
             double share = 1.0 - om_metrics_match(&p->m);
             double edge = p->m.edge_samples ? (double)(p->m.edge_false_lit + p->m.edge_false_shadowed) /
                                                   (double)p->m.edge_samples : 0.0;
-            printf("%-12s %-5s %-28s %9.2f %9.2f %9.2f %11zu %8.4f%% %8.3f%%\n", p->scene, p->method,
-                   p->setting, p->total, p->init, p->resolve, p->bytes, 100 * share, 100 * edge);
+            printf("%-12s %-5s %-28s %9.2f %9.2f %9.2f %11zu %8.4f%% %8.3f%% %9.2f\n", p->scene, p->method,
+                   p->setting, p->total, p->init, p->resolve, p->bytes, 100 * share, 100 * edge, p->wall);
         }
         if (scale) rc = scaling(argv[0], names, nn, sw, sh, w, h, methods, (int)runs, threads);
         if (!rc)

@@ -81,6 +81,9 @@ typedef struct cli_point {
     uint32_t w, h;         /* the image size it was measured at */
     double init;           /* the method's init, ms (once per point; ref builds its BVH) */
     double total, eye, observe, build, resolve, shade;   /* per frame, ms (medians) */
+    double wall;           /* the whole frame call, ms (median; the strip callbacks left
+                              out): total is its stages' sum, which misses what runs
+                              between them on the calling thread */
     double tmin, tmax;     /* the fastest and slowest of the frames (total, ms): the spread */
     size_t bytes;
     om_metrics m;
