@@ -405,6 +405,12 @@ static int check_names(const char *cmd, char **names, size_t n, const char *meth
     return 0;
 }
 
+/* The share of the samples near a reference shadow edge that are wrong (0 for none). */
+static double edge_share(const om_metrics *m)
+{
+    return m->edge_samples ? (double)(m->edge_false_lit + m->edge_false_shadowed) / (double)m->edge_samples : 0.0;
+}
+
 /* The CSV and the charts, all replaced together once every one is written whole. */
 static int write_outputs(const char *dir, char **names, size_t nn, const cli_point *pts, int np,
                          const double *tri_x, const double (*tri_y)[4], const size_t *tri_n,
@@ -427,9 +433,7 @@ static int write_outputs(const char *dir, char **names, size_t nn, const cli_poi
                    "edge_samples,edge_mismatch_share,time_min_ms,time_max_ms,frame_wall_ms,threads,stats\n");
         for (int i = 0; i < np; i++) {
             const cli_point *p = &pts[i];
-            double share = 1.0 - om_metrics_match(&p->m);
-            double edge = p->m.edge_samples ? (double)(p->m.edge_false_lit + p->m.edge_false_shadowed) /
-                                                  (double)p->m.edge_samples : 0.0;
+            double share = 1.0 - om_metrics_match(&p->m), edge = edge_share(&p->m);
             fprintf(f, "%s,%s,%s,%u,%u,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%zu,%llu,%llu,%llu,%.6f,%llu,%.6f,%.3f,%.3f,%.3f,%u,%s\n",
                     p->scene, p->method, p->setting, p->w, p->h, p->total, p->init, p->eye,
                     p->observe, p->build, p->resolve, p->shade, p->bytes,
@@ -728,9 +732,7 @@ int cmd_bench(int argc, char **argv)
                "init", "resolve", "bytes", "mismatch", "edge", "wall ms");
         for (int i = 0; i < np; i++) {
             const cli_point *p = &pts[i];
-            double share = 1.0 - om_metrics_match(&p->m);
-            double edge = p->m.edge_samples ? (double)(p->m.edge_false_lit + p->m.edge_false_shadowed) /
-                                                  (double)p->m.edge_samples : 0.0;
+            double share = 1.0 - om_metrics_match(&p->m), edge = edge_share(&p->m);
             printf("%-12s %-5s %-28s %9.2f %9.2f %9.2f %11zu %8.4f%% %8.3f%% %9.2f\n", p->scene, p->method,
                    p->setting, p->total, p->init, p->resolve, p->bytes, 100 * share, 100 * edge, p->wall);
         }
