@@ -318,93 +318,56 @@ static bool straddles(const om__asm_state *m, asm_smp *o, const om__asm_tile *tl
     return false;
 }
 
-static om_status asm_observe(void *state, const om_strip *st, om_diag *d)
-{
-    (void)d;
-    om__asm_state *m = (om__asm_state *)state;
-    om__asm_tree *t = &m->tree;
-    const om__asm_layout *l = &t->lay;
-    const uint32_t stride = m->cfg.asm_stride ? m->cfg.asm_stride : 1;
-    const double ncell = (double)l->cp * l->cp;
-    om__asm_prepare(m);
-#if OM_WITH_JOBS
-    if (m->lend && om__asm_observe_jobs(m, st)) return OM_OK;   /* the same, by bands */
-#endif
-    for (uint32_t y = 0; y < st->rows; y++) {
-        const uint32_t gy = st->y0 + y;
-        /* one sample in `stride`, on diagonals so no column or row is favoured */
-        for (uint32_t x = (uint32_t)((stride - (3u * gy) % stride) % stride); x < st->width; x += stride) {
-            size_t i = (size_t)y * st->width + x;
-            if (!(st->terms[i].flags & OM_TERM_EXPOSED)) continue;
-            asm_smp o;
-            if (!smp_begin(m, &st->samples[i], true, &o)) continue;
-            m->analysed++;
-            uint32_t index = OM__ASM_ROOT, level = 0;
-            for (;;) {
-                om__asm_tile tl;
-                uint32_t tx, ty;
-                bool want = false;
-                om__asm_tile_of(t, index, &tl);
-                smp_texel(m, &o, &tl, &tx, &ty);
-                tl.node->stamp = t->frame;
-                uint32_t c = (ty / tl.cp) * tl.cells + tx / tl.cp;
-                uint32_t child = tl.child[c];
-                if (level == 0) {   /* the base: into the root tile, made on first touch */
-                    if (child == OM__ASM_NONE) {
-                        /* Only from free or unused memory here (benefit 0 replaces
-                         * nothing): the counts that rule replacement are not complete
-                         * until every strip is seen. Build retries the rest. */
-                        child = om__asm_make(t, OM__ASM_ROOT, c, 0);
-                        if (child == OM__ASM_NONE) {
-                            tl.ben[c]++;
-                            break;
-                        }
-                        om__asm_render_node(m, child);
-                    }
-                    om__asm_node_at(t, child)->benefit++;
-                } else {
-                    want = smp_finer(m, &o, level) && straddles(m, &o, &tl, tx, ty);
-                    if (child != OM__ASM_NONE && want) om__asm_node_at(t, child)->benefit++;
-                }
-                if (child != OM__ASM_NONE) {
-                    index = child;
-                    level++;
-                    continue;
-                }
-                if (want && level < l->max_level) {
-                    /* Section 3.1: N_required = N_current * (texel area / pixel area). */
-                    const double r = smp_exact(m, &o, true)->ratio0 * m->inv_scale[level];
-                    const float nreq = (float)(ncell * r * r);
-                    tl.ben[c]++;
-                    if (nreq > tl.need[c]) tl.need[c] = nreq;
-                    m->straddling++;
-                }
-                break;
-            }
-        }
-    }
-    return OM_OK;
-}
-
-#if OM_WITH_JOBS
-/* asm_observe's analysis for a band of rows on the host's threads (asm_jobs.c runs the
- * bands): the same descent and tests, with what it adds to the tree kept in `a`. */
+/* Where an analysed sample's findings go: with `a` NULL onto the tree itself (a strip
+ * at a time), else into a band's accumulators (asm_jobs.c puts them on the tree after
+ * the bands). A node touched is noted so the merge reads only the range. */
 static inline void acc_node(const om__asm_acc *a, uint32_t index)
 {
     if (index < a->hdr[2]) a->hdr[2] = index;
     if (index >= a->hdr[3]) a->hdr[3] = index + 1;
 }
 
-void om__asm_observe_rows(const om__asm_state *m, const om_strip *st, uint32_t y0, uint32_t rows,
-                          const om__asm_acc *a, bool again)
+/* One more sample inside node `index` that needs it (its benefit, om__asm_make). */
+static inline void add_benefit(om__asm_tree *t, const om__asm_acc *a, uint32_t index)
 {
-    om__asm_tree *t = (om__asm_tree *)&m->tree;   /* om__asm_tile_of: read here, not written */
+    if (!a) {
+        om__asm_node_at(t, index)->benefit++;
+        return;
+    }
+    a->benefit[index]++;
+    acc_node(a, index);
+}
+
+/* A root tile made where a sample first falls in an empty cell of the base, from
+ * free or unused memory only (benefit 0 replaces nothing): the counts that rule
+ * replacement are not complete until every strip is seen, and build retries the rest.
+ * Where none is made the cell counts the sample. */
+static uint32_t root_tile(om__asm_state *m, const om__asm_tile *base, uint32_t c)
+{
+    const uint32_t k = om__asm_make(&m->tree, OM__ASM_ROOT, c, 0);
+    if (k == OM__ASM_NONE) base->ben[c]++;
+    else om__asm_render_node(m, k);
+    return k;
+}
+
+/* observe's analysis of rows [y0, y0 + rows) of the strip: one walk for one thread and
+ * for the bands, so both decide alike. With `a` NULL it writes the tree, and a sample
+ * whose base cell holds no root tile makes it (root_tile). With `a` it reads the tree
+ * only and writes nothing of `m`: such a sample goes no further, its term's g set to
+ * 254 and the cell's first sample noted; with `again` only those samples (g back to
+ * 255), once the root tiles are made. OM_INLINE: each caller gets its own copy with `a`
+ * known, so one thread's walk costs what it did before the bands shared it. */
+OM_INLINE void observe_rows(om__asm_state *m, const om_strip *st, uint32_t y0, uint32_t rows,
+                            const om__asm_acc *a, bool again)
+{
+    om__asm_tree *t = &m->tree;
     const om__asm_layout *l = &t->lay;
     const uint32_t stride = m->cfg.asm_stride ? m->cfg.asm_stride : 1;
     const uint32_t c2 = l->cells * l->cells;
     const double ncell = (double)l->cp * l->cp;
     for (uint32_t y = y0; y < y0 + rows; y++) {
         const uint32_t gy = st->y0 + y;
+        /* one sample in `stride`, on diagonals so no column or row is favoured */
         for (uint32_t x = (uint32_t)((stride - (3u * gy) % stride) % stride); x < st->width; x += stride) {
             const size_t i = (size_t)y * st->width + x;
             om_term *tm = &st->terms[i];
@@ -415,7 +378,8 @@ void om__asm_observe_rows(const om__asm_state *m, const om_strip *st, uint32_t y
             }
             asm_smp o;
             if (!smp_begin(m, &st->samples[i], true, &o)) continue;
-            if (!again) a->hdr[0]++;
+            if (!a) m->analysed++;
+            else if (!again) a->hdr[0]++;
             uint32_t index = OM__ASM_ROOT, level = 0;
             for (;;) {
                 om__asm_tile tl;
@@ -423,24 +387,25 @@ void om__asm_observe_rows(const om__asm_state *m, const om_strip *st, uint32_t y
                 bool want = false;
                 om__asm_tile_of(t, index, &tl);
                 smp_texel(m, &o, &tl, &tx, &ty);
-                const uint32_t bit = index == OM__ASM_ROOT ? l->count : index;
-                a->stamp[bit >> 5] |= 1u << (bit & 31);
-                uint32_t c = (ty / tl.cp) * tl.cells + tx / tl.cp;
+                if (a) {
+                    const uint32_t bit = index == OM__ASM_ROOT ? l->count : index;
+                    a->stamp[bit >> 5] |= 1u << (bit & 31);
+                } else {
+                    tl.node->stamp = t->frame;
+                }
+                const uint32_t c = (ty / tl.cp) * tl.cells + tx / tl.cp;
                 uint32_t child = tl.child[c];
-                if (level == 0) {
-                    if (child == OM__ASM_NONE) {   /* the root tile is made after the bands */
+                if (level == 0) {   /* the base: into the root tile */
+                    if (child == OM__ASM_NONE && a) {   /* made after the bands */
                         if (!again && (!a->first[c] || a->first[c] > i + 1)) a->first[c] = (uint32_t)i + 1;
                         tm->g = again ? 255 : 254;
                         break;
                     }
-                    a->benefit[child]++;
-                    acc_node(a, child);
+                    if (child == OM__ASM_NONE && (child = root_tile(m, &tl, c)) == OM__ASM_NONE) break;
+                    add_benefit(t, a, child);
                 } else {
                     want = smp_finer(m, &o, level) && straddles(m, &o, &tl, tx, ty);
-                    if (child != OM__ASM_NONE && want) {
-                        a->benefit[child]++;
-                        acc_node(a, child);
-                    }
+                    if (child != OM__ASM_NONE && want) add_benefit(t, a, child);
                 }
                 if (child != OM__ASM_NONE) {
                     index = child;
@@ -448,18 +413,45 @@ void om__asm_observe_rows(const om__asm_state *m, const om_strip *st, uint32_t y
                     continue;
                 }
                 if (want && level < l->max_level) {
+                    /* Section 3.1: N_required = N_current * (texel area / pixel area). */
                     const double r = smp_exact(m, &o, true)->ratio0 * m->inv_scale[level];
                     const float nreq = (float)(ncell * r * r);
-                    const size_t k = (size_t)index * c2 + c;
-                    a->ben[k]++;
-                    if (nreq > a->need[k]) a->need[k] = nreq;
-                    acc_node(a, index);
-                    a->hdr[1]++;
+                    uint32_t *ben = a ? a->ben + (size_t)index * c2 : tl.ben;
+                    float *need = a ? a->need + (size_t)index * c2 : tl.need;
+                    ben[c]++;
+                    if (nreq > need[c]) need[c] = nreq;
+                    if (a) {
+                        acc_node(a, index);
+                        a->hdr[1]++;
+                    } else {
+                        m->straddling++;
+                    }
                 }
                 break;
             }
         }
     }
+}
+
+static om_status asm_observe(void *state, const om_strip *st, om_diag *d)
+{
+    (void)d;
+    om__asm_state *m = (om__asm_state *)state;
+    om__asm_prepare(m);
+#if OM_WITH_JOBS
+    if (m->lend && om__asm_observe_jobs(m, st)) return OM_OK;   /* the same, by bands */
+#endif
+    observe_rows(m, st, 0, st->rows, NULL, false);
+    return OM_OK;
+}
+
+#if OM_WITH_JOBS
+/* The bands' walk (asm_jobs.c runs them): with accumulators it writes nothing of the
+ * state, so the bands may share it. */
+void om__asm_observe_rows(const om__asm_state *m, const om_strip *st, uint32_t y0, uint32_t rows,
+                          const om__asm_acc *a, bool again)
+{
+    observe_rows((om__asm_state *)m, st, y0, rows, a, again);
 }
 #endif
 

@@ -300,17 +300,10 @@ void om__asm_prepare(om__asm_state *m);
 void om__asm_render_node(om__asm_state *m, uint32_t index);
 void om__asm_render_with(om__asm_state *m, uint32_t index, const om__asm_rs *rs);
 
-#if OM_WITH_JOBS
-/* asm_jobs.c: on the host's threads. The tiles of `list` (n nodes, each rendered by
- * one job); false where there are no threads (nothing done). */
-bool om__asm_render_list(om__asm_state *m, const uint32_t *list, uint32_t n);
-/* observe's analysis of a strip by bands; false where it cannot run so (no threads,
- * or root tiles to make that would need to replace others): nothing done but the
- * strip's terms as they were. */
-bool om__asm_observe_jobs(om__asm_state *m, const om_strip *st);
-
 /* What a band's analysis adds to the tree, in a job's scratch, put on the tree after
- * the bands on the calling thread: sums, maxima and marks, the same in any order. */
+ * the bands on the calling thread (asm_jobs.c): sums, maxima and marks, the same in any
+ * order. Declared without the jobs too: asm.c's one analysis walk takes it, NULL for
+ * the tree itself. */
 typedef struct om__asm_acc {
     uint32_t *hdr;         /* analysed, straddling; nodes touched: lowest, highest + 1 */
     uint32_t *stamp;       /* a bit a node used (stamped), bit `count` the base's */
@@ -320,6 +313,15 @@ typedef struct om__asm_acc {
     uint32_t *first;       /* the base's cells: 1 + the first sample (strip index) that
                               fell in the cell while it held no root tile, else 0 */
 } om__asm_acc;
+
+#if OM_WITH_JOBS
+/* asm_jobs.c: on the host's threads. The tiles of `list` (n nodes, each rendered by
+ * one job); false where there are no threads (nothing done). */
+bool om__asm_render_list(om__asm_state *m, const uint32_t *list, uint32_t n);
+/* observe's analysis of a strip by bands; false where it cannot run so (no threads,
+ * or root tiles to make that would need to replace others): nothing done but the
+ * strip's terms as they were. */
+bool om__asm_observe_jobs(om__asm_state *m, const om_strip *st);
 
 /* asm.c: observe's analysis of rows [y0, y0 + rows) of the strip into `a`, reading
  * the tree only. A sample whose base cell holds no root tile goes no further: its
