@@ -6,6 +6,7 @@
 #include "../engine/shadow/occlude.h"
 #include "../engine/frame/frame.h"
 #include "../engine/shadow/smlookup.h"
+#include "../engine/shadow/ref_light.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -142,6 +143,96 @@ static void bvh_equals_brute_force(void)
         }
         CHECK_MSG(diff == 0, "scene %d: %d samples differ from brute force", k, diff);
         CHECK_MSG(partial > 50 && blocked > 500, "scene %d: %d partial, %d blocked", k, partial, blocked);
+        h_scene_free(&hs);
+    }
+}
+
+/* The reference's one-pass fit in parts (ref_light.h, om__lbvh_plan): the parts and the
+ * nodes above them hold every node once and the parts every triangle once, and fitted
+ * part by part (last first, as threads may take them) and then the top, every node
+ * and triangle box is the same bits as the fit of the whole tree in one pass from the
+ * last node back. A cloud of 20K triangles (many parts), one with a floor the light's
+ * near plane clips, the default scene, and three triangles (the root a leaf). */
+static void lbvh_fit_in_parts(void)
+{
+    static const char *scenes[] = {
+        "camera eye 0 6 14 target 0 1 0 fov 50\n"
+        "light spot pos 8 20 6 target 0 0 0 fov 60 near 5 far 60\n"
+        "triangles count 20000 seed 7 area 20 in -5 0.5 -5 5 3 5\n",
+        "camera eye 0 6 14 target 0 1 0 fov 50\n"
+        "light spot pos 0 3 0 target 0 0 0 fov 120 near 1 far 60\n"
+        "plane size 40 40 divisions 8\n"
+        "triangles count 3000 seed 2 area 20 in -5 -1 -5 5 5 5\n",
+        NULL,
+        "camera eye 0 2 5 target 0 0 0\n"
+        "light spot pos 1 5 1 target 0 0 0\n"
+        "triangles count 3 seed 1 area 2 in -1 0 -1 1 1 1\n",
+    };
+    static unsigned char mem[12 << 20];
+    for (int k = 0; k < 4; k++) {
+        h_scene hs;
+        if (!h_scene_parse(&hs, scenes[k] ? scenes[k] : om_scene_default_text())) return;
+        const om_scene *s = &hs.s;
+        om_view v;
+        CHECK_OK(h_view(&v, s, 0, 0, 0, NULL));
+        om_arena a;
+        om_arena_init(&a, mem, sizeof mem, "t");
+        om__lspace ls;
+        om__bvh b;
+        om__lbvh parts, whole;
+        CHECK_OK(om__lspace_init(&ls, &a, s, NULL));
+        CHECK_OK(om__lbvh_init(&parts, &a, s, 4, NULL));
+        CHECK_OK(om__lbvh_init(&whole, &a, s, 4, NULL));
+        CHECK_OK(om__bvh_build(&b, &a, s, 4, NULL));
+        unsigned char *seen = (unsigned char *)calloc(b.nnodes + s->ntris, 1);
+        if (!seen) return;
+        om__lbvh_plan(&parts, &b);
+        if (k == 0) CHECK_MSG(parts.nparts >= 8, "%u parts", parts.nparts);
+        if (k == 3) CHECK(parts.nparts == 1 && parts.ntop == 0);
+        CHECK(parts.nparts >= 1 && parts.nparts <= OM__LBVH_PARTS && parts.ntop == parts.nparts - 1);
+        for (uint32_t i = 0; i < parts.ntop; i++) {
+            CHECK(parts.top[i] < b.nnodes && b.nodes[parts.top[i]].count == 0);
+            seen[parts.top[i]]++;
+        }
+        for (uint32_t p = 0; p < parts.nparts; p++) {
+            const om__lbvh_part *q = &parts.parts[p];
+            CHECK(q->node < b.nnodes && q->lo <= q->hi && q->hi <= b.nnodes && q->thi <= s->ntris);
+            seen[q->node]++;
+            for (uint32_t i = q->lo; i < q->hi && i < b.nnodes; i++) seen[i]++;
+            for (uint32_t t = q->tlo; t < q->thi && t < s->ntris; t++) seen[b.nnodes + t]++;
+        }
+        uint32_t once = 0;
+        for (uint32_t i = 0; i < b.nnodes + s->ntris; i++) once += seen[i] == 1;
+        CHECK_EQ_U(once, b.nnodes + s->ntris);
+        free(seen);
+        /* the whole tree as one part: the fit in one pass from the last node back */
+        whole.nparts = 1;
+        whole.ntop = 0;
+        whole.parts[0].node = 0;
+        whole.parts[0].lo = b.nnodes > 1 ? 1 : 0;
+        whole.parts[0].hi = b.nnodes > 1 ? b.nnodes : 0;
+        whole.parts[0].tlo = 0;
+        whole.parts[0].thi = s->ntris;
+        om__lspace_begin(&ls, &v);
+        const size_t nb = b.nnodes * sizeof(om__lnode), tb = s->ntris * sizeof(om__lbox);
+        memset(parts.nodes, 0xA5, nb);   /* what a fit leaves unwritten shows */
+        memset(parts.tris, 0xA5, tb);
+        memset(whole.nodes, 0x5A, nb);
+        memset(whole.tris, 0x5A, tb);
+        for (uint32_t p = parts.nparts; p-- > 0;) om__lbvh_fit_part(&parts, &b, &ls, p);
+        om__lbvh_fit_top(&parts, &b, &ls);
+        om__lbvh_fit(&whole, &b, &ls);
+        CHECK_MSG(!memcmp(parts.nodes, whole.nodes, nb) && !memcmp(parts.tris, whole.tris, tb),
+                  "scene %d: the fit in %u parts differs from the whole tree's", k, parts.nparts);
+        /* and that one bounds what it should: the root's box holds every vertex */
+        uint32_t out = 0;
+        for (uint32_t i = 0; i < s->nverts; i++) {
+            const om__lvert *vx = &ls.verts[i];
+            const om__lbox *r = &whole.nodes[0].box;
+            if (vx->x != INT32_MIN)
+                out += vx->x < r->lox || vx->x > r->hix || vx->y < r->loy || vx->y > r->hiy || vx->z < r->zmin;
+        }
+        CHECK_EQ_U(out, 0);
         h_scene_free(&hs);
     }
 }
@@ -595,6 +686,7 @@ void suite_shadow(void)
     RUN(square_under_sun);
     RUN(sphere_under_spot);
     RUN(bvh_equals_brute_force);
+    RUN(lbvh_fit_in_parts);
     RUN(float_predicate_is_the_double_one);
     RUN(transmittance_composes);
     RUN(sm_improves_with_resolution);

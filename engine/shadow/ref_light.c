@@ -10,7 +10,9 @@
 size_t om__lbvh_bytes(const om_scene *s, uint32_t leaf)
 {
     return om_arena_need(om__bvh_nodes_max(s, leaf) * sizeof(om__lnode), 16) +
-           om_arena_need((size_t)(s->ntris ? s->ntris : 1) * sizeof(om__lbox), 16);
+           om_arena_need((size_t)(s->ntris ? s->ntris : 1) * sizeof(om__lbox), 16) +
+           om_arena_need(OM__LBVH_PARTS * sizeof(om__lbvh_part), 4) +
+           om_arena_need(OM__LBVH_PARTS * sizeof(uint32_t), 4);
 }
 
 om_status om__lbvh_init(om__lbvh *lb, om_arena *a, const om_scene *s, uint32_t leaf,
@@ -24,7 +26,81 @@ om_status om__lbvh_init(om__lbvh *lb, om_arena *a, const om_scene *s, uint32_t l
     if ((st = om_arena_alloc(a, (size_t)(s->ntris ? s->ntris : 1) * sizeof(om__lbox), 16, &p, d)))
         return st;
     lb->tris = (om__lbox *)p;
+    if ((st = om_arena_alloc(a, OM__LBVH_PARTS * sizeof(om__lbvh_part), 4, &p, d))) return st;
+    lb->parts = (om__lbvh_part *)p;
+    if ((st = om_arena_alloc(a, OM__LBVH_PARTS * sizeof(uint32_t), 4, &p, d))) return st;
+    lb->top = (uint32_t *)p;
+    lb->nparts = lb->ntop = 0;
     return OM_OK;
+}
+
+/* A part smaller than this many nodes is not split further: a job of fewer costs
+ * more to hand out than it saves. */
+#define PART_LEAST 512
+
+/* The part of node `at`: its descendants' indices (sz nodes under it, the greatest
+ * index `last`) and its triangles' positions (the first leaf down its first children
+ * to the last down its second: the build partitions a node's range between them). */
+static bool part_of(const om__bvh *b, uint32_t at, uint32_t sz, uint32_t last, om__lbvh_part *p)
+{
+    p->node = at;
+    p->lo = p->hi = 0;
+    if (!b->nodes[at].count) {
+        p->lo = b->nodes[at].first;
+        p->hi = last + 1;
+    }
+    uint32_t i = at;
+    while (!b->nodes[i].count) i = b->nodes[i].first;
+    p->tlo = b->nodes[i].first;
+    for (i = at; !b->nodes[i].count;) i = b->nodes[i].first + 1;
+    p->thi = b->nodes[i].first + b->nodes[i].count;
+    return p->hi - p->lo == sz - 1;   /* in the build's order, the descendants are these */
+}
+
+void om__lbvh_plan(om__lbvh *lb, const om__bvh *b)
+{
+    uint32_t size[OM__LBVH_PARTS];
+    om__lnode *sc = lb->nodes;
+    lb->nparts = lb->ntop = 0;
+    if (!b->nnodes || (!b->nodes[0].count && !b->nodes[0].first))
+        return;   /* an empty scene's lone root: om__lbvh_fit_top's */
+    /* The nodes as scratch until the first fit: how many nodes each has under it
+     * (itself included) in count, the greatest index among them in first. */
+    for (uint32_t i = b->nnodes; i-- > 0;) {
+        const om__bvh_node *n = &b->nodes[i];
+        sc[i].count = 1;
+        sc[i].first = i;
+        if (n->count) continue;
+        const om__lnode *c0 = &sc[n->first], *c1 = &sc[n->first + 1];
+        sc[i].count += c0->count + c1->count;
+        sc[i].first = c0->first > c1->first ? c0->first : c1->first;
+    }
+    if (!part_of(b, 0, sc[0].count, sc[0].first, &lb->parts[0])) return;
+    size[0] = sc[0].count;
+    lb->nparts = 1;
+    /* The largest part splits into its children while there is room: the node above
+     * them joins the top. */
+    while (lb->nparts < OM__LBVH_PARTS) {
+        uint32_t k = 0;
+        for (uint32_t i = 1; i < lb->nparts; i++)
+            if (size[i] > size[k]) k = i;
+        const uint32_t at = lb->parts[k].node, c = b->nodes[at].first;
+        om__lbvh_part p[2];
+        if (size[k] < 2 * PART_LEAST || b->nodes[at].count ||
+            !part_of(b, c, sc[c].count, sc[c].first, &p[0]) ||
+            !part_of(b, c + 1, sc[c + 1].count, sc[c + 1].first, &p[1]))
+            break;
+        for (uint32_t i = lb->nparts; i > k + 1; i--) {   /* the second child beside the first */
+            lb->parts[i] = lb->parts[i - 1];
+            size[i] = size[i - 1];
+        }
+        lb->parts[k] = p[0];
+        size[k] = sc[c].count;
+        lb->parts[k + 1] = p[1];
+        size[k + 1] = sc[c + 1].count;
+        lb->nparts++;
+        lb->top[lb->ntop++] = at;
+    }
 }
 
 static void box_none(om__lbox *x)
@@ -82,17 +158,12 @@ static void tri_box(om__lbox *x, const om__lspace *ls, uint32_t t)
     }
 }
 
-void om__lbvh_fit(om__lbvh *lb, const om__bvh *b, const om__lspace *ls)
+/* Nodes [lo, hi) from the last back (a node's children come after it: the build
+ * appends them, so both are fitted before the node), from their children's boxes or
+ * their triangles'. */
+static void fit_nodes(om__lbvh *lb, const om__bvh *b, uint32_t lo, uint32_t hi)
 {
-    for (uint32_t i = 0; i < ls->scene->ntris; i++) tri_box(&lb->tris[i], ls, b->tris[i]);
-    if (!ls->scene->ntris) {   /* the build's lone root has no children to read */
-        box_none(&lb->nodes[0].box);
-        lb->nodes[0].first = lb->nodes[0].count = 0;
-        return;
-    }
-    /* A node's children come after it (the build appends them), so one pass from the
-     * last node back sees both children of a node before the node. */
-    for (uint32_t i = b->nnodes; i-- > 0;) {
+    for (uint32_t i = hi; i-- > lo;) {
         om__lnode *n = &lb->nodes[i];
         n->first = b->nodes[i].first;
         n->count = b->nodes[i].count;
@@ -104,6 +175,30 @@ void om__lbvh_fit(om__lbvh *lb, const om__bvh *b, const om__lspace *ls)
             box_union(&n->box, &lb->nodes[n->first + 1].box);
         }
     }
+}
+
+void om__lbvh_fit_part(om__lbvh *lb, const om__bvh *b, const om__lspace *ls, uint32_t k)
+{
+    const om__lbvh_part *p = &lb->parts[k];
+    for (uint32_t t = p->tlo; t < p->thi; t++) tri_box(&lb->tris[t], ls, b->tris[t]);
+    fit_nodes(lb, b, p->lo, p->hi);
+    fit_nodes(lb, b, p->node, p->node + 1);
+}
+
+void om__lbvh_fit_top(om__lbvh *lb, const om__bvh *b, const om__lspace *ls)
+{
+    if (!ls->scene->ntris) {   /* the build's lone root has no children to read */
+        box_none(&lb->nodes[0].box);
+        lb->nodes[0].first = lb->nodes[0].count = 0;
+        return;
+    }
+    for (uint32_t i = lb->ntop; i-- > 0;) fit_nodes(lb, b, lb->top[i], lb->top[i] + 1);
+}
+
+void om__lbvh_fit(om__lbvh *lb, const om__bvh *b, const om__lspace *ls)
+{
+    for (uint32_t k = 0; k < lb->nparts; k++) om__lbvh_fit_part(lb, b, ls, k);
+    om__lbvh_fit_top(lb, b, ls);
 }
 
 /* & rather than &&: one branch on the whole test, whose parts are as hard to predict

@@ -32,18 +32,36 @@ typedef struct om__lnode {
     uint32_t first, count;   /* as the BVH node's: count 0 is inner */
 } om__lnode;
 
+/* The fit in parts (om__lbvh_plan), fixed once the BVH is built: subtrees of about
+ * equal size, each fitted whole by one job (its nodes are `node` and [lo, hi): the
+ * build appends a node's descendants after its children, all before it returns to the
+ * rest of the tree), and the nodes above them (`top`, parents before children), fitted
+ * after them on the calling thread. Every node is fitted from its children by the same
+ * code whoever fits it, so the boxes are the same bits for any number of jobs. A
+ * part's triangles are [tlo, thi) of the BVH's list (its leaves' ranges). */
+#define OM__LBVH_PARTS 64
+typedef struct om__lbvh_part { uint32_t node, lo, hi, tlo, thi; } om__lbvh_part;
+
 typedef struct om__lbvh {
     om__lnode *nodes;
     om__lbox *tris;          /* parallel to the BVH's tris */
+    om__lbvh_part *parts;    /* OM__LBVH_PARTS of them */
+    uint32_t *top;           /* as many */
+    uint32_t nparts, ntop;
 } om__lbvh;
 
 /* Bytes for a BVH over s with leaves of `leaf`; the arrays from the arena. */
 size_t om__lbvh_bytes(const om_scene *s, uint32_t leaf);
 om_status om__lbvh_init(om__lbvh *lb, om_arena *a, const om_scene *s, uint32_t leaf,
                         om_diag *d);
+/* The parts of the fit for b (once, after b is built). */
+void om__lbvh_plan(om__lbvh *lb, const om__bvh *b);
 /* Bounds every triangle and node of b for this frame from ls's projected vertices (ls
- * must have them, begun for the frame). */
+ * must have them, begun for the frame): every part (om__lbvh_fit_part, k in [0,
+ * nparts), in any order or at once), then the top (om__lbvh_fit_top). */
 void om__lbvh_fit(om__lbvh *lb, const om__bvh *b, const om__lspace *ls);
+void om__lbvh_fit_part(om__lbvh *lb, const om__bvh *b, const om__lspace *ls, uint32_t k);
+void om__lbvh_fit_top(om__lbvh *lb, const om__bvh *b, const om__lspace *ls);
 
 /* A packet's grid rectangle and farthest depth. */
 typedef struct om__lrect { int64_t lox, loy, hix, hiy; double zmax; } om__lrect;
