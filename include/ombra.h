@@ -390,7 +390,9 @@ typedef om_status (*om_strip_fn)(void *user, const om_strip *st,
                                  const om_framebuffer *fb);
 
 typedef struct om_frame_stats {
-    uint64_t ns_eye, ns_observe, ns_build, ns_resolve, ns_shade;  /* 0 without a clock */
+    /* 0 without a clock. ns_build: the method's per-frame set-up (begin) and its map
+     * build; the eye pass of every strip counts in ns_eye. */
+    uint64_t ns_eye, ns_observe, ns_build, ns_resolve, ns_shade;
     uint32_t strips, eye_passes;
     size_t frame_peak;
     uint32_t jobs;         /* jobs run at once: 1 inline, up to om_frame_desc.threads */

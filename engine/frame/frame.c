@@ -516,7 +516,12 @@ om_status om_render_frame(const om_frame_desc *fd, om_arena *fa, om_frame_stats 
         have_samples = single;
         c.ids_have = c.ids != NULL;
     }
-    if ((st = begin(&c, &view, d)) != OM_OK) goto done;
+    /* The method's per-frame set-up (izb's and ref's vertex projection) counts as
+     * build time, so the stage times add up to the frame (om_frame_stats). */
+    t0 = now(fd);
+    st = begin(&c, &view, d);
+    fs->ns_build += now(fd) - t0;
+    if (st != OM_OK) goto done;
     if (observes) {
         for (uint32_t y = 0; y < H; y += rows) {
             strip_at(&c, y, rows);
