@@ -3,9 +3,12 @@
  * (a floor at a grazing light angle), under a directional light, and at every tiling
  * from one pass down to tiles of a few rows, through strips too. Budgets below the
  * minimum fail naming it; budgets between minimum and one pass tile; the default pool
- * takes tiles where the scene has few triangles for the image. */
+ * takes tiles where the scene has few triangles for the image. The triangles binned on
+ * the light's image (lgrid.c) list each triangle where its box lies, made in parts or
+ * at once, and a tile that walks only its own gives the same terms and counts. */
 #include "test.h"
 #include "harness.h"
+#include "../engine/shadow/izb.h"
 
 #include <stdlib.h>
 
@@ -206,6 +209,208 @@ static void default_pool(void)
     h_scene_free(&hs);
 }
 
+/* ---- the grid (lgrid.h) */
+
+/* Triangle t's cells on g as lgrid.c's box says, worked out here again: false for one
+ * in the wide list. */
+static bool tri_cells(const om__lgrid *g, uint32_t t, uint32_t *x0, uint32_t *y0, uint32_t *x1, uint32_t *y1)
+{
+    const om__lvert *v = g->ls->verts;
+    const uint32_t *ix = g->ls->scene->idx + (size_t)t * 3;
+    int64_t lo[2] = {INT64_MAX, INT64_MAX}, hi[2] = {INT64_MIN, INT64_MIN};
+    for (int k = 0; k < 3; k++) {
+        const om__lvert *p = &v[ix[k]];
+        if (p->x == INT32_MIN) return false;
+        const int64_t c[2] = {p->x, p->y};
+        for (int a = 0; a < 2; a++) {
+            if (c[a] < lo[a]) lo[a] = c[a];
+            if (c[a] > hi[a]) hi[a] = c[a];
+        }
+    }
+    const int64_t top = (1 << 21) - 1, cell = ((int64_t)1 << 21) / g->side;
+    uint32_t r[4];
+    const int64_t e[4] = {lo[0], lo[1], hi[0], hi[1]};
+    for (int k = 0; k < 4; k++) r[k] = (uint32_t)((e[k] < 0 ? 0 : e[k] > top ? top : e[k]) / cell);
+    *x0 = r[0]; *y0 = r[1]; *x1 = r[2]; *y1 = r[3];
+    return (uint64_t)(r[2] - r[0] + 1) * (r[3] - r[1] + 1) <= LGRID_MOST;
+}
+
+/* Every triangle is listed once in each cell of its vertices' box (clamped to the
+ * grid), or once in the wide list where a vertex needs clipping or the box covers more
+ * than LGRID_MOST cells; every list ascends; steps made in parts, in any order, give
+ * the same lists as one pass; and a tile's selection is the triangles of its cells. */
+static void grid_lists(void)
+{
+    h_scene hs;
+    if (!h_scene_parse(&hs, "camera eye 0 5 8 target 0 0.5 0 fov 55\n"
+                            "light spot pos -1 9 2 target 0 0 0 fov 75 near 1 far 40\n"
+                            "plane size 30 30 divisions 6\n"
+                            "triangles count 3000 seed 3 area 40 in -4 0.3 -4 4 3 4\n"
+                            "sphere radius 0.7 segments 24 rings 12 translate 1 1 1\n"))
+        return;
+    om_camera cam;
+    om_light light;
+    om_view v;
+    om_scene_at(&hs.s, 0, &cam, &light);
+    CHECK_OK(om_view_init(&v, &cam, &light, &hs.s, NULL));
+    const size_t bytes = om__lspace_bytes(&hs.s) + 2 * om__lgrid_bytes(&hs.s);
+    unsigned char *mem = malloc(bytes);
+    om_arena a;
+    om_arena_init(&a, mem, bytes, "grid");
+    om__lspace ls;
+    om__lgrid g, p;
+    CHECK_OK(om__lspace_init(&ls, &a, &hs.s, NULL));
+    CHECK_OK(om__lgrid_init(&g, &a, &ls, NULL));
+    CHECK_OK(om__lgrid_init(&p, &a, &ls, NULL));
+    CHECK_MSG(a.peak <= bytes, "grid: %zu bytes of %zu", a.peak, bytes);
+    om__lspace_begin(&ls, &v);
+    om__lgrid_make(&g);
+    CHECK_EQ_U(g.ready, 1);
+    /* the steps in parts, last part first */
+    const uint32_t n = hs.s.ntris, rows = om__lgrid_rows(&p);
+    for (uint32_t k = 3; k-- > 0;) om__lgrid_boxes(&p, n * k / 3, n * (k + 1) / 3);
+    for (uint32_t k = 5; k-- > 0;) om__lgrid_count(&p, rows * k / 5, rows * (k + 1) / 5);
+    om__lgrid_sum(&p);
+    for (uint32_t k = 7; k-- > 0;) om__lgrid_fill(&p, rows * k / 7, rows * (k + 1) / 7);
+    CHECK(p.ready == 1 && !memcmp(p.start, g.start, ((size_t)g.lists + 1) * sizeof *g.start) &&
+          !memcmp(p.tris, g.tris, (size_t)g.start[g.lists] * sizeof *g.tris));
+    /* each triangle where its box lies; each list ascending */
+    uint32_t *seen = calloc(n, sizeof *seen);
+    uint32_t wide = 0, bad = 0, order = 0;
+    for (uint32_t c = 0; c < g.lists; c++)
+        for (uint32_t e = g.start[c]; e < g.start[c + 1]; e++) {
+            const uint32_t t = g.tris[e];
+            uint32_t x0, y0, x1, y1, cx = c % g.side, cy = c / g.side;
+            const bool cells = tri_cells(&g, t, &x0, &y0, &x1, &y1);
+            order += e > g.start[c] && g.tris[e - 1] >= t;
+            seen[t]++;
+            if (c == g.lists - 1) wide++, bad += cells;
+            else bad += !cells || cx < x0 || cx > x1 || cy < y0 || cy > y1;
+        }
+    uint32_t missing = 0;
+    for (uint32_t t = 0; t < n; t++) {
+        uint32_t x0, y0, x1, y1;
+        missing += seen[t] != (tri_cells(&g, t, &x0, &y0, &x1, &y1) ? (x1 - x0 + 1) * (y1 - y0 + 1) : 1);
+    }
+    CHECK_MSG(!bad && !order && !missing, "grid: %u misplaced, %u out of order, %u miscounted", bad, order, missing);
+    CHECK_MSG(wide > 2 && wide < n / 4, "grid: %u wide of %u (the floor's triangles need clipping)", wide, n);
+    /* a tile of samples at two points: the triangles of their cells and the wide ones */
+    uint32_t *sel = calloc(om__lgrid_sel_bytes(&hs.s), 1);
+    const int64_t pts[2][2] = {{1 << 20, 1 << 20}, {(1 << 20) + (1 << 18), (1 << 20) - (1 << 17)}};
+    om__lgrid_clear(&g, sel);
+    for (int k = 0; k < 2; k++) om__lgrid_mark(&g, sel, pts[k][0], pts[k][1]);
+    om__lgrid_select(&g, sel);
+    const uint32_t *tm = om__lgrid_tris(&g, sel);
+    uint32_t wrong = 0, picked = 0;
+    for (uint32_t t = 0; t < n; t++) {
+        uint32_t x0, y0, x1, y1;
+        bool want = !tri_cells(&g, t, &x0, &y0, &x1, &y1);
+        for (int k = 0; k < 2; k++) {
+            const uint32_t cx = (uint32_t)(pts[k][0] >> g.shift), cy = (uint32_t)(pts[k][1] >> g.shift);
+            want |= cx >= x0 && cx <= x1 && cy >= y0 && cy <= y1;
+        }
+        const bool got = (tm[t >> 5] >> (t & 31)) & 1;
+        wrong += want != got;
+        picked += got;
+    }
+    CHECK_MSG(!wrong && picked > wide, "selection: %u wrong, %u picked", wrong, picked);
+    free(sel);
+    free(seen);
+    free(mem);
+    h_scene_free(&hs);
+}
+
+/* A frame of izb in a method arena of `bytes`: the frame's hash, its counters, and how
+ * its grid went (2: none, else lgrid's ready). */
+typedef struct izb_run { uint64_t hash; uint32_t counters[8]; int grid; } izb_run;
+
+static om_status hash_strip(void *user, const om_strip *st, const om_framebuffer *fb)
+{
+    *(uint64_t *)user = om_hash(*(uint64_t *)user, fb->pixels, (size_t)st->rows * fb->stride);
+    return OM_OK;
+}
+
+static izb_run izb_frame(const om_scene *s, const char *pool, size_t bytes, uint32_t rows)
+{
+    izb_run r;
+    memset(&r, 0, sizeof r);
+    r.hash = OM_HASH_INIT;
+    const om_method *m = om_method_find("izb");
+    om_method_cfg c = h_cfg("izb", pool);
+    om_camera cam;
+    om_light light;
+    om_view v;
+    om_diag d;
+    void *state;
+    om_scene_at(s, 0, &cam, &light);
+    cam.width = W;
+    cam.height = H;
+    CHECK_OK(om_view_init(&v, &cam, &light, s, NULL));
+    const size_t fbytes = om_frame_bytes(W, rows ? rows : H);
+    unsigned char *mem = malloc(bytes), *fmem = malloc(fbytes), *px = malloc(W * H * 3);
+    om_arena ma, fa;
+    om_arena_init(&ma, mem, bytes, "method");
+    om_arena_init(&fa, fmem, fbytes, "frame");
+    CHECK_OK(m->init(&state, &ma, &c, s, W, H, &d));
+    om_framebuffer fb = {OM_RGB888, W, H, W * 3, px};
+    om_shade_cfg shade;
+    om_shade_cfg_default(&shade);
+    om_frame_desc fd;
+    memset(&fd, 0, sizeof fd);
+    fd.scene = s; fd.view = &v; fd.method = m; fd.method_state = state; fd.shade = &shade;
+    fd.fb = &fb; fd.strip_rows = rows; fd.on_strip = hash_strip; fd.user = &r.hash;
+    CHECK_OK(om_render_frame(&fd, &fa, NULL, &d));
+    om_method_stats ms;
+    m->stats(state, &ms);
+    for (uint32_t k = 0; k < ms.ncounters && k < 8; k++) r.counters[k] = (uint32_t)ms.counters[k];
+    const om__izb *z = (const om__izb *)state;
+    r.grid = z->grid ? z->grid->ready : 2;
+    free(mem);
+    free(fmem);
+    free(px);
+    return r;
+}
+
+/* With the grid, each tile walks only the triangles whose box meets its samples' cells
+ * (and the wide ones); the same frame and counters as an arena short of it,
+ * where every tile walks every triangle: whole frames and strips, one tile and many;
+ * and on a scene of triangles too large for its lists, the grid left unused. */
+static void grid_same_walk(void)
+{
+    static const char *const scenes[2] = {
+        "camera eye 0 5 8 target 0 0.5 0 fov 55\n"
+        "light spot pos 1 9 2 target 0 0 0 fov 75 near 1 far 40\n"
+        "plane size 14 14 divisions 3\n"
+        "triangles count 4000 seed 4 area 25 in -3 0.3 -3 3 3 3\n"
+        "triangles count 500 seed 9 area 20 in -3 0.3 -3 3 3 3 albedo 1 0.6 0.2 opacity 0.5\n",
+        /* triangles of a few cells each: more entries than the lists hold */
+        "camera eye 0 5 8 target 0 0.5 0 fov 55\n"
+        "light spot pos 1 9 2 target 0 0 0 fov 75 near 1 far 40\n"
+        "plane size 14 14 divisions 3\n"
+        "triangles count 1200 seed 4 area 300 in -3 0.3 -3 3 3 3\n"};
+    for (int si = 0; si < 2; si++) {
+        h_scene hs;
+        if (!h_scene_parse(&hs, scenes[si])) continue;
+        const om_method *m = om_method_find("izb");
+        for (int pi = 0; pi < 2; pi++) {
+            const char *pool = pi ? "izb.pool=1500" : "izb.pool=0";
+            om_method_cfg c = h_cfg("izb", pool);
+            size_t mn, full;
+            CHECK_OK(m->bytes(&c, &hs.s, W, H, &mn, &full));
+            for (uint32_t rows = 0; rows <= 16; rows += 16) {
+                izb_run a = izb_frame(&hs.s, pool, full, rows),
+                        b = izb_frame(&hs.s, pool, full - om__lgrid_bytes(&hs.s) / 2, rows);
+                CHECK_MSG(a.grid == (si ? -1 : 1) && b.grid == 2, "scene %d %s strips %u: grid %d, %d", si, pool,
+                          rows, a.grid, b.grid);
+                CHECK_MSG(a.hash == b.hash && !memcmp(a.counters, b.counters, sizeof a.counters),
+                          "scene %d %s strips %u: the grid changes the frame", si, pool, rows);
+                CHECK_MSG(pi == 0 || a.counters[5] > 4, "%s: %u tiles", pool, a.counters[5]);
+            }
+        }
+        h_scene_free(&hs);
+    }
+}
+
 void suite_izb(void)
 {
     RUN(izb_default_scene);
@@ -214,4 +419,6 @@ void suite_izb(void)
     RUN(directional);
     RUN(budgets);
     RUN(default_pool);
+    RUN(grid_lists);
+    RUN(grid_same_walk);
 }

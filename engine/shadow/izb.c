@@ -6,12 +6,10 @@
  * their Z order rather than at medians), leaves of at most izb.leaf samples; each
  * node keeps the bounds of its samples and their largest light depth. A grid of
  * cells, each one node of the tree, lets small triangles skip the descent.
- * Sections 3-5: every triangle is rasterized through the BSP: a node is entered only
- * when the triangle's footprint can touch its bounds (bounding boxes, then the exact
- * integer edge functions at the box's corners), when it still holds a sample not yet
- * opaquely shadowed, and when the triangle is nearer the light somewhere than the
- * node's farthest sample; in a leaf each sample gets the shared occlusion predicate.
- * Section 4: semi-transparent casters add their optical depth per sample.
+ * Sections 3-5: every triangle is rasterized through the BSP (izb_raster.c), where
+ * the frame's grid of triangles on the light's image (lgrid.h) does not rule it out
+ * for the tile. Section 4: semi-transparent casters add their optical depth per
+ * sample.
  *
  * Bounded pools: samples and nodes live in pools carved once from the method's arena.
  * When a strip holds more exposed samples than the pool, it is processed in tiles of
@@ -32,12 +30,16 @@ typedef struct izb_state {
      * OM_WITH_JOBS), and their tiling. */
     uint32_t *rowsum;
     uint32_t exposed, ntiles;
+    /* The triangles binned on the light's image (z.grid points here when it has room),
+     * and the pass's slots that make it, a frame at a time (om__pass.lend). */
+    om__lgrid grid;
+    const om__lend *lend;
 } izb_state;
 
 /* Least samples a split leaves in a leaf: a node splits only above `leaf` samples. */
 static uint32_t min_leaf(uint32_t leaf) { return (leaf + 1) / 2 ? (leaf + 1) / 2 : 1; }
 
-/* The Z order of the BSP's keys has ZBITS bits an axis (see zcode): 4M cells over a
+/* The Z order of the BSP's keys has ZBITS bits an axis (om__izb_zcode): 4M cells over a
  * tile, far finer than its leaves (keys of one code are split in the middle), and a
  * sort of two passes. */
 #define ZBITS 11
@@ -47,7 +49,6 @@ static uint32_t min_leaf(uint32_t leaf) { return (leaf + 1) / 2 ? (leaf + 1) / 2
  * triangle reach its samples without descending the tree; coarser ones cost a large
  * triangle fewer cell checks. */
 #define CELL_FILL 4u
-#define DIRECT 16   /* most cells a triangle's bounds may cover to be sent to them directly */
 
 static uint32_t cells_bound(uint32_t samples)
 {
@@ -81,9 +82,9 @@ static size_t pool_bytes_of(uint32_t samples, uint32_t leaf)
 }
 
 /* The pool by default: tiles of at least TILE_LEAST samples, and at least n^2 /
- * 2^TILE_SQ samples for a scene of n triangles, up to the whole image. Every tile walks
- * every triangle, but one that reaches none of its samples costs it little; small
- * tiles keep their keys, nodes and cells in the cache, leave little to clear, and give
+ * 2^TILE_SQ samples for a scene of n triangles, up to the whole image. Each tile walks
+ * the triangles the frame's grid lists near its samples (every triangle without the
+ * grid, where one that reaches none of its samples costs it little); small tiles keep their keys, nodes and cells in the cache, leave little to clear, and give
  * the host's threads several jobs of the like cost (a strip's tiles are cut in the
  * screen's order, and where a cloud shadows the top half of the image, two tiles
  * differ threefold). With many triangles, though, most reach every tile and are set up
@@ -106,6 +107,10 @@ static uint32_t auto_pool(const om_scene *s, uint32_t w, uint32_t h)
     return (uint32_t)(want > w ? want : w);
 }
 
+/* The triangles binned on the light's image and a tile's selection of them (lgrid.h):
+ * kept where the arena holds them beside the vertex projection and the whole pool. */
+static size_t grid_bytes(const om_scene *s) { return om__lgrid_bytes(s) + om_arena_need(om__lgrid_sel_bytes(s), 16); }
+
 /* The state, its row sums for the pass, and setup's parts. */
 static size_t fixed_bytes(const om_scene *s, uint32_t h, bool cache)
 {
@@ -120,7 +125,7 @@ static om_status pool_bytes(const om__izb_cfg *c, const om_scene *s, uint32_t w,
     uint32_t one_pass = auto_pool(s, w, h), smallest = w;   /* the smallest tile: one row */
     if (c->izb_pool) one_pass = smallest = c->izb_pool;
     *min = fixed_bytes(s, h, false) + pool_bytes_of(smallest, c->izb_leaf);
-    *full = fixed_bytes(s, h, true) + pool_bytes_of(one_pass, c->izb_leaf);
+    *full = fixed_bytes(s, h, true) + pool_bytes_of(one_pass, c->izb_leaf) + grid_bytes(s);
     return OM_OK;
 }
 
@@ -149,7 +154,7 @@ static uint32_t pool_fit(size_t bytes, uint32_t least, uint32_t want, uint32_t l
 /* Carves z's parts from `a`: the vertex projection when the arena holds it and a pool
  * at least half as large as without it, then the pool: c->izb_pool samples when set, else the
  * largest from `least` up to `want` that fits. The caller has checked the minimum. */
-static om_status setup(om__izb *z, om_arena *a, const om__izb_cfg *c, const om_scene *s,
+static om_status setup(om__izb *z, om__lgrid *g, om_arena *a, const om__izb_cfg *c, const om_scene *s,
                        uint32_t want, uint32_t least, om_diag *d)
 {
     om_status st;
@@ -174,6 +179,16 @@ static om_status setup(om__izb *z, om_arena *a, const om__izb_cfg *c, const om_s
         return st;
     z->mat_od = (om__odepth *)p;
     for (uint32_t i = 0; i < s->nmats; i++) z->mat_od[i] = om__material_odepth(&s->mats[i]);
+    /* The grid when the whole pool still fits beside it: the pool matters more. */
+    z->grid = NULL;
+    z->sel = NULL;
+    if (z->ls.verts && om_arena_left(a) >= grid_bytes(s) &&
+        pool_fit(om_arena_left(a) - grid_bytes(s), least, want, z->leaf) == want) {
+        if ((st = om__lgrid_init(g, a, &z->ls, d))) return st;
+        if ((st = om_arena_alloc(a, om__lgrid_sel_bytes(s), 16, &p, d))) return st;
+        z->grid = g;
+        z->sel = (uint32_t *)p;
+    }
     /* The pool: as configured, or as many samples as the arena holds, up to one pass. */
     uint32_t cap = pool_fit(om_arena_left(a), least, want, z->leaf);
     if (!cap) cap = least;   /* (the caller checked the minimum: the carve below fails) */
@@ -214,7 +229,7 @@ static om_status izb_init(void **state, om_arena *a, const om_method_cfg *mc, co
         if ((st = om_arena_alloc(a, ((size_t)h + 1) * sizeof(uint32_t), 4, &p, d))) return st;
         m->rowsum = (uint32_t *)p;
     }
-    if ((st = setup(&m->z, a, c, s, auto_pool(s, w, h), w, d))) return st;
+    if ((st = setup(&m->z, &m->grid, a, c, s, auto_pool(s, w, h), w, d))) return st;
     *state = m;
     return OM_OK;
 }
@@ -224,6 +239,7 @@ static om_status izb_init(void **state, om_arena *a, const om_method_cfg *mc, co
 static uint32_t begin_view(izb_state *m, const om_view *v)
 {
     om__lspace_view(&m->z.ls, v);
+    m->grid.ready = 0;
     memset(&m->z.st, 0, sizeof m->z.st);
     return m->z.ls.verts ? m->z.scene->nverts : 0;
 }
@@ -280,24 +296,6 @@ uint32_t om__izb_transform(om__izb *z, const om_strip *st, size_t *next, size_t 
 
 /* ---- stage 2: the 2-D BSP */
 
-/* The Z-order (Morton) code of a key: x and y relative to the tile's corner, shifted
- * to ZBITS bits each, bits interleaved. Both are spread at once, one in each half of
- * a 64-bit word. */
-static uint32_t zcode_xy(uint32_t x, uint32_t y)
-{
-    uint64_t v = (uint64_t)x | (uint64_t)y << 32;
-    v = (v | (v << 8)) & 0x00FF00FF00FF00FFull;
-    v = (v | (v << 4)) & 0x0F0F0F0F0F0F0F0Full;
-    v = (v | (v << 2)) & 0x3333333333333333ull;
-    v = (v | (v << 1)) & 0x5555555555555555ull;
-    return (uint32_t)v | (uint32_t)(v >> 32) << 1;
-}
-
-static uint32_t zcode(const om__izb_key *k, int32_t x0, int32_t y0, int shift)
-{
-    return zcode_xy((uint32_t)(k->x - x0) >> shift, (uint32_t)(k->y - y0) >> shift);
-}
-
 /* Gives every key its code, then sorts z->keys into Z order (a stable
  * least-significant-digit radix sort through z->sorted, two passes of 11 bits; keys
  * of equal code keep the screen's order), so
@@ -315,7 +313,7 @@ static int zsort(om__izb *z)
     uint32_t count[2][2049];
     memset(count, 0, sizeof count);
     for (uint32_t i = 0; i < n; i++) {
-        uint32_t c = z->keys[i].code = zcode(&z->keys[i], x0, y0, shift);
+        uint32_t c = z->keys[i].code = om__izb_zcode(&z->keys[i], x0, y0, shift);
         count[0][(c & 2047u) + 1]++;
         count[1][(c >> 11) + 1]++;
     }
@@ -458,237 +456,6 @@ void om__izb_build(om__izb *z)
     z->st.nodes += z->nnodes;
 }
 
-/* ---- stage 3: rasterize the triangles through the BSP */
-
-/* Could any sub-triangle of lt cover a point of the box? Exact: the box is outside a
- * sub-triangle when it lies wholly outside one of its (biased) edges. */
-static bool box_touches(const om__ltri *lt, const om__izb_node *nd)
-{
-    if (lt->hix < nd->x0 || lt->lox > nd->x1 || lt->hiy < nd->y0 || lt->loy > nd->y1) return false;
-    for (int k = 0; k < lt->n; k++) {
-        const om__tri2 *e = &lt->sub[k].e;
-        bool out = false;
-        for (int i = 0; i < 3 && !out; i++) {
-            int64_t mx = e->a[i] > 0 ? e->a[i] * nd->x1 : e->a[i] * nd->x0;
-            int64_t my = e->b[i] > 0 ? e->b[i] * nd->y1 : e->b[i] * nd->y0;
-            out = mx + my + e->c[i] < 0;
-        }
-        if (!out) return true;
-    }
-    return false;
-}
-
-/* One triangle on its way through the tree: its setup, its optical depth, and the
- * range of Z-order codes of its bounds (clamped to the tile's): a key inside the
- * bounds has a code in [clo, chi], as the code grows with x and with y. */
-typedef struct tjob {
-    const om__ltri *lt;
-    const om__odepth *od;
-    uint32_t clo, chi;
-} tjob;
-
-/* Returns how many samples of the subtree became opaque-shadowed. */
-static uint32_t visit(om__izb *z, uint32_t ni, const tjob *j)
-{
-    om__izb_node *nd = &z->nodes[ni];
-    const om__ltri *lt = j->lt;
-    z->st.visited++;
-    if (nd->open == 0) { z->st.culled_shadowed++; return 0; }
-    if (lt->zmin >= (double)nd->zmax) { z->st.culled_depth++; return 0; }
-    uint32_t first = nd->first, end = first + nd->count;
-    if (z->keys[first].code > j->chi || z->keys[end - 1].code < j->clo || !box_touches(lt, nd)) return 0;
-    uint32_t closed = 0;
-    if (nd->child) {
-        closed = visit(z, nd->child, j) + visit(z, nd->child + 1, j);
-    } else {
-        while (end - first > 1) {   /* the first key whose code can be in the bounds */
-            uint32_t mid = first + (end - first) / 2;
-            if (z->keys[mid - 1].code < j->clo) first = mid;
-            else end = mid;
-        }
-        for (uint32_t i = first; i < nd->first + nd->count && z->keys[i].code <= j->chi; i++) {
-            om__izb_key *k = &z->keys[i];
-            if ((k->s & OM_IZB_DONE) || k->x < lt->lox || k->x > lt->hix || k->y < lt->loy ||
-                k->y > lt->hiy)
-                continue;
-            const om__lpoint p = {k->x, k->y, (double)k->z, k->tri};
-            z->st.tested++;
-            if (!om__blocks(lt, &p)) continue;
-            z->st.blocked++;
-            om__odepth_add(&z->od[i], j->od);
-            if (om__odepth_opaque(&z->od[i])) {
-                k->s |= OM_IZB_DONE;
-                closed++;
-            }
-        }
-    }
-    nd->open -= closed;
-    return closed;
-}
-
-/* Visits a cell's node and takes the samples it closed off the counts above it. */
-static void visit_cell(om__izb *z, uint32_t ni, const tjob *j)
-{
-    uint32_t closed = visit(z, ni, j);
-    if (closed)
-        for (uint32_t p = z->nodes[ni].parent; p != OM_IZB_NONE; p = z->nodes[p].parent)
-            z->nodes[p].open -= closed;
-}
-
-/* The grid cells that the grid bounds [lox, hix] x [loy, hiy] can reach; false when
- * they miss the tile's keys. */
-typedef struct crange { uint32_t x0, y0, x1, y1; } crange;
-
-static bool cell_range(const om__izb *z, int64_t lox, int64_t loy, int64_t hix, int64_t hiy, crange *c)
-{
-    if (hix < z->kx0 || lox > z->kx1 || hiy < z->ky0 || loy > z->ky1) return false;
-    if (lox < z->kx0) lox = z->kx0;
-    if (loy < z->ky0) loy = z->ky0;
-    if (hix > z->kx1) hix = z->kx1;
-    if (hiy > z->ky1) hiy = z->ky1;
-    c->x0 = (uint32_t)((lox - z->kx0) >> z->gshift);
-    c->x1 = (uint32_t)((hix - z->kx0) >> z->gshift);
-    c->y0 = (uint32_t)((loy - z->ky0) >> z->gshift);
-    c->y1 = (uint32_t)((hiy - z->ky0) >> z->gshift);
-    return true;
-}
-
-/* The codes of a triangle's bounds; false when the bounds miss the tile's keys. */
-static bool codes_of(const om__izb *z, const om__ltri *lt, tjob *j)
-{
-    if (lt->hix < z->kx0 || lt->lox > z->kx1 || lt->hiy < z->ky0 || lt->loy > z->ky1) return false;
-    om__izb_key lo, hi;
-    lo.x = (int32_t)(lt->lox > z->kx0 ? lt->lox : z->kx0);
-    lo.y = (int32_t)(lt->loy > z->ky0 ? lt->loy : z->ky0);
-    hi.x = (int32_t)(lt->hix < z->kx1 ? lt->hix : z->kx1);
-    hi.y = (int32_t)(lt->hiy < z->ky1 ? lt->hiy : z->ky1);
-    j->clo = zcode(&lo, z->kx0, z->ky0, z->zshift);
-    j->chi = zcode(&hi, z->kx0, z->ky0, z->zshift);
-    return true;
-}
-
-static uint32_t cell_at(const om__izb *z, uint32_t cx, uint32_t cy)
-{
-    return z->cells[zcode_xy(cx, cy)];
-}
-
-/* Could a triangle whose projected vertices have bounds [lox, hix] x [loy, hiy] and
- * nearest depth zlo block a sample of node ni's subtree? Only an open sample inside
- * those bounds and farther than zlo: the culls visit() and the predicate make, before
- * any setup (which, clipping and projecting in double, costs a Cortex-M4 far more). */
-typedef struct vbox { int32_t lox, loy, hix, hiy; uint32_t zlo, clo, chi; } vbox;
-
-static bool reaches(const om__izb *z, uint32_t ni, const vbox *b)
-{
-    const om__izb_node *nd = &z->nodes[ni];
-    if (!nd->open || b->zlo >= nd->zmax || b->lox > nd->x1 || b->hix < nd->x0 || b->loy > nd->y1 ||
-        b->hiy < nd->y0)
-        return false;
-    if (nd->child) return reaches(z, nd->child, b) || reaches(z, nd->child + 1, b);
-    uint32_t first = nd->first, end = first + nd->count;
-    if (z->keys[first].code > b->chi || z->keys[end - 1].code < b->clo) return false;
-    while (end - first > 1) {   /* the first key whose code can be in the bounds (as visit) */
-        uint32_t mid = first + (end - first) / 2;
-        if (z->keys[mid - 1].code < b->clo) first = mid;
-        else end = mid;
-    }
-    for (const om__izb_key *k = &z->keys[first], *e = &z->keys[nd->first + nd->count]; k < e && k->code <= b->chi; k++)
-        if (!(k->s & OM_IZB_DONE) && b->zlo < k->z && k->x >= b->lox && k->x <= b->hix && k->y >= b->loy &&
-            k->y <= b->hiy)
-            return true;
-    return false;
-}
-
-/* The box's codes (its corners clamped to the tile's keys, which it meets). */
-static void vbox_codes(const om__izb *z, vbox *b)
-{
-    om__izb_key lo, hi;
-    lo.x = b->lox > z->kx0 ? b->lox : z->kx0;
-    lo.y = b->loy > z->ky0 ? b->loy : z->ky0;
-    hi.x = b->hix < z->kx1 ? b->hix : z->kx1;
-    hi.y = b->hiy < z->ky1 ? b->hiy : z->ky1;
-    b->clo = zcode(&lo, z->kx0, z->ky0, z->zshift);
-    b->chi = zcode(&hi, z->kx0, z->ky0, z->zshift);
-}
-
-/* A triangle whose bounds cover at most DIRECT cells goes straight to their nodes;
- * with its projected vertices at hand (no clipping), the nodes are first checked
- * against the vertices' bounds and nearest depth, so that a triangle over no open,
- * farther sample costs no setup. Any other triangle descends the tree from its root.
- * Both reach every sample inside the triangle's bounds once: the cells part the
- * tile's keys. */
-void om__izb_raster(om__izb *z)
-{
-    if (z->nnodes == 0) return;
-    const om_scene *sc = z->scene;
-    const om__izb_node *root = &z->nodes[0];
-    for (uint32_t t = 0; t < sc->ntris && root->open; t++) {
-        const uint32_t *ix = sc->idx + (size_t)t * 3;
-        const om__lvert *a = z->ls.verts ? &z->ls.verts[ix[0]] : NULL;
-        const om__lvert *b = a ? &z->ls.verts[ix[1]] : NULL, *c = a ? &z->ls.verts[ix[2]] : NULL;
-        const om__odepth *od = &z->mat_od[sc->tri_mat[t]];
-        crange cr;
-        uint32_t hit[DIRECT];
-        int nhit = -1;   /* -1: not sorted out before setup */
-        if (a && a->x != INT32_MIN && b->x != INT32_MIN && c->x != INT32_MIN) {
-            /* The plane's depth lies within its vertices', and the triangle's bounds are
-             * its vertices': the same culls visit() makes, before any setup. */
-            int32_t lox = a->x, hix = a->x, loy = a->y, hiy = a->y;
-            uint32_t zlo = a->z;
-            if (b->x < lox) lox = b->x;
-            if (b->x > hix) hix = b->x;
-            if (c->x < lox) lox = c->x;
-            if (c->x > hix) hix = c->x;
-            if (b->y < loy) loy = b->y;
-            if (b->y > hiy) hiy = b->y;
-            if (c->y < loy) loy = c->y;
-            if (c->y > hiy) hiy = c->y;
-            if (b->z < zlo) zlo = b->z;
-            if (c->z < zlo) zlo = c->z;
-            if (zlo >= root->zmax || !cell_range(z, lox, loy, hix, hiy, &cr)) continue;
-            vbox vb = {lox, loy, hix, hiy, zlo, 0, 0};
-            if ((uint64_t)(cr.x1 - cr.x0 + 1) * (cr.y1 - cr.y0 + 1) <= DIRECT) {
-                nhit = 0;
-                for (uint32_t cy = cr.y0; cy <= cr.y1; cy++)
-                    for (uint32_t cx = cr.x0; cx <= cr.x1; cx++) {
-                        uint32_t ni = cell_at(z, cx, cy);
-                        if (ni == OM_IZB_NONE) continue;
-                        const om__izb_node *nd = &z->nodes[ni];
-                        if (nd->open && zlo < nd->zmax && lox <= nd->x1 && hix >= nd->x0 &&
-                            loy <= nd->y1 && hiy >= nd->y0)
-                            hit[nhit++] = ni;
-                    }
-                if (nhit == 0) continue;
-                /* and then by their samples */
-                vbox_codes(z, &vb);
-                int i = 0;
-                while (i < nhit && !reaches(z, hit[i], &vb)) i++;
-                if (i == nhit) continue;
-            } else {
-                vbox_codes(z, &vb);
-                if (!reaches(z, 0, &vb)) continue;
-            }
-        }
-        om__ltri lt;
-        tjob j = {&lt, od, 0, 0};
-        if (!om__lspace_tri(&z->ls, t, &lt) || !codes_of(z, &lt, &j)) continue;
-        if (nhit < 0 && cell_range(z, lt.lox, lt.loy, lt.hix, lt.hiy, &cr) &&
-            (uint64_t)(cr.x1 - cr.x0 + 1) * (cr.y1 - cr.y0 + 1) <= DIRECT) {
-            nhit = 0;
-            for (uint32_t cy = cr.y0; cy <= cr.y1; cy++)
-                for (uint32_t cx = cr.x0; cx <= cr.x1; cx++) {
-                    uint32_t ni = cell_at(z, cx, cy);
-                    if (ni != OM_IZB_NONE) hit[nhit++] = ni;
-                }
-        }
-        if (nhit < 0) {
-            visit(z, 0, &j);
-        } else {
-            for (int i = 0; i < nhit; i++) visit_cell(z, hit[i], &j);
-        }
-    }
-}
-
 void om__izb_write(const om__izb *z, const om_strip *st)
 {
     for (uint32_t i = 0; i < z->n; i++) om__odepth_term(&z->od[i], &st->terms[z->keys[i].s & ~OM_IZB_DONE]);
@@ -705,8 +472,14 @@ uint32_t om__izb_tile_first(const om__izb *z, uint32_t exposed, uint32_t k)
     return o < exposed ? (uint32_t)o : exposed;
 }
 
+void om__izb_grid(om__izb *z)
+{
+    if (z->grid && z->grid->ready == 0) om__lgrid_make(z->grid);
+}
+
 void om__izb_resolve(om__izb *z, om_strip *st)
 {
+    om__izb_grid(z);
     size_t n = (size_t)st->rows * st->width, next = 0;
     for (size_t i = 0; i < n; i++) st->terms[i].r = st->terms[i].g = st->terms[i].b = 255;
     for (;;) {   /* pool after pool of exposed samples: om__izb_tiles' tiles */
@@ -729,17 +502,52 @@ static size_t izb_pass_scratch(const void *state, const om_scene *s)
 {
     if (state) {
         const om__izb *z = &((const izb_state *)state)->z;
-        return pool_bytes_of(z->cap, z->leaf);
+        return pool_bytes_of(z->cap, z->leaf) + (z->grid ? up16(om__lgrid_sel_bytes(z->scene)) : 0);
     }
     if (!s) return 0;
     uint64_t most = pool_of_tris(s);   /* auto_pool without the image's bound */
-    return pool_bytes_of(most > 0xFFFFFFFFu ? 0xFFFFFFFFu : (uint32_t)most, 64);
+    return pool_bytes_of(most > 0xFFFFFFFFu ? 0xFFFFFFFFu : (uint32_t)most, 64) + up16(om__lgrid_sel_bytes(s));
+}
+
+/* The grid's steps as jobs of the pass's slots (om__lend): each of `parts` jobs takes
+ * its share of the triangles, then of the rows of lists. */
+typedef struct grid_job { om__lgrid *g; uint32_t parts, step; } grid_job;
+
+static void grid_part(void *user, uint32_t k, void *scratch)
+{
+    (void)scratch;
+    const grid_job *j = (const grid_job *)user;
+    const uint32_t n = j->step ? om__lgrid_rows(j->g) : j->g->ntris;
+    const uint32_t first = (uint32_t)((uint64_t)n * k / j->parts), end = (uint32_t)((uint64_t)n * (k + 1) / j->parts);
+    if (j->step == 0) om__lgrid_boxes(j->g, first, end);
+    else if (j->step == 1) om__lgrid_count(j->g, first, end);
+    else om__lgrid_fill(j->g, first, end);
+}
+
+/* The frame's grid, once, before its first strip's tiles: by jobs where the frame
+ * lends its slots, else on this thread (the same lists). */
+static void make_grid(izb_state *m)
+{
+    if (!m->z.grid || m->grid.ready) return;
+    if (!m->lend) {
+        om__izb_grid(&m->z);
+        return;
+    }
+    grid_job j = {&m->grid, m->lend->slots, 0};
+    for (j.step = 0; j.step < 3; j.step++) {
+        if (j.step == 2) {
+            om__lgrid_sum(&m->grid);
+            if (m->grid.ready != 1) return;
+        }
+        m->lend->run(m->lend, grid_part, &j, j.parts);
+    }
 }
 
 /* Counts every row's exposed samples (rowsum) and tiles the strip. */
 static uint32_t izb_pass_plan(void *state, om_strip *st)
 {
     izb_state *m = (izb_state *)state;
+    make_grid(m);
     m->rowsum[0] = 0;
     for (uint32_t r = 0; r < st->rows; r++) {
         const om_term *t = st->terms + (size_t)r * st->width;
@@ -790,6 +598,7 @@ static void izb_pass_job(const void *state, const om_strip *st, uint32_t k, void
     z.nodes = (om__izb_node *)p;
     p += up16((size_t)z.node_cap * sizeof(om__izb_node));
     z.cells = (uint32_t *)p;
+    if (z.grid) z.sel = (uint32_t *)(p + up16((size_t)z.cells_cap * sizeof(uint32_t)));
     memset(&z.st, 0, sizeof z.st);
     size_t next = tile_start(m, st, k), end = tile_start(m, st, k + 1);
     for (size_t i = next; i < end; i++) st->terms[i].r = st->terms[i].g = st->terms[i].b = 255;
@@ -830,8 +639,14 @@ static void izb_pass_setup(const void *state, uint32_t first, uint32_t end)
     om__lspace_project(&((const izb_state *)state)->z.ls, first, end);
 }
 
+/* The slots to make the grid with, this frame (NULL at its end or with fewer than two). */
+static void izb_pass_lend(void *state, const om__lend *l)
+{
+    if (state) ((izb_state *)state)->lend = l && l->slots > 1 ? l : NULL;
+}
+
 const om__pass om__pass_izb = {izb_pass_scratch, izb_pass_plan, izb_pass_job, izb_pass_merge,
-                               izb_pass_begin, izb_pass_setup, NULL};
+                               izb_pass_begin, izb_pass_setup, izb_pass_lend};
 
 static om_status izb_resolve(void *state, om_strip *st, om_diag *d)
 {
@@ -845,7 +660,8 @@ static void izb_stats(const void *state, om_method_stats *out)
     const izb_state *m = (const izb_state *)state;
     const om__izb *z = &m->z;
     memset(out, 0, sizeof *out);
-    out->bytes_used = fixed_bytes(z->scene, m->height, z->ls.verts != NULL) + pool_bytes_of(z->cap, z->leaf);
+    out->bytes_used = fixed_bytes(z->scene, m->height, z->ls.verts != NULL) + pool_bytes_of(z->cap, z->leaf) +
+                      (z->grid ? grid_bytes(z->scene) : 0);
     static const char *const names[] = {"bsp nodes", "nodes visited", "nodes culled (shadowed)",
                                         "nodes culled (depth)", "samples tested", "tiles",
                                         "pool samples"};

@@ -8,7 +8,7 @@
 #ifndef OM_IZB_H
 #define OM_IZB_H
 
-#include "occlude.h"
+#include "lgrid.h"
 
 /* What the BSP orders and the leaves test: a sample's grid position and light depth
  * (exact: the projection gives integers), its own triangle, where the sample is in its
@@ -55,6 +55,11 @@ typedef struct om__izb {
     uint32_t n, nnodes;    /* samples and nodes of the current tile */
     uint32_t taken;        /* exposed samples its transform took (n of them kept) */
     int32_t kx0, ky0, kx1, ky1;   /* the bounds of the tile's keys */
+    /* The scene's triangles binned on the light's image once a frame (lgrid.h), and
+     * the tile's selection of them (om__lgrid_sel_bytes, beside the pool); NULL
+     * without room: every tile then walks every triangle, for the same counts. */
+    om__lgrid *grid;
+    uint32_t *sel;
     om__izb_stats st;
 } om__izb;
 
@@ -75,6 +80,25 @@ typedef struct om__izb_cfg {
     OM__SETTING(T, f, "izb.pool", OM_SETTING_U32, 0, 1e9, 0, \
                 "samples the pool holds, 0 = izb: n^2/2^20 for n triangles, 32768 to the frame; hybrid: the frame, at most 2 a triangle (32768..262144)")
 
+/* The Z-order (Morton) code of a key: x and y relative to the tile's corner, shifted
+ * to izb.c's ZBITS bits each, bits interleaved (the build sorts and splits by it, the
+ * raster bounds a triangle's keys by it). Both are spread at once, one in each half
+ * of a 64-bit word. */
+static inline uint32_t om__izb_zcode_xy(uint32_t x, uint32_t y)
+{
+    uint64_t v = (uint64_t)x | (uint64_t)y << 32;
+    v = (v | (v << 8)) & 0x00FF00FF00FF00FFull;
+    v = (v | (v << 4)) & 0x0F0F0F0F0F0F0F0Full;
+    v = (v | (v << 2)) & 0x3333333333333333ull;
+    v = (v | (v << 1)) & 0x5555555555555555ull;
+    return (uint32_t)v | (uint32_t)(v >> 32) << 1;
+}
+
+static inline uint32_t om__izb_zcode(const om__izb_key *k, int32_t x0, int32_t y0, int shift)
+{
+    return om__izb_zcode_xy((uint32_t)(k->x - x0) >> shift, (uint32_t)(k->y - y0) >> shift);
+}
+
 /* A strip's tiles: its E exposed samples in om__izb_tiles(z, E) = ceil(E / pool)
  * tiles, tile k holding the exposed samples numbered [om__izb_tile_first(z, E, k),
  * om__izb_tile_first(z, E, k + 1)) in the strip's order: full pools, the rest last.
@@ -90,12 +114,16 @@ uint32_t om__izb_tile_first(const om__izb *z, uint32_t exposed, uint32_t k);
  * took). */
 uint32_t om__izb_transform(om__izb *z, const om_strip *st, size_t *next, size_t end, uint32_t take);
 void om__izb_build(om__izb *z);
-/* Rasterizes every triangle of the scene through the BSP. */
+/* Bins the scene's triangles on the light's image for this frame (once, after begin;
+ * nothing without the grid): om__izb_raster then walks only a tile's own. */
+void om__izb_grid(om__izb *z);
+/* Rasterizes every triangle of the scene through the BSP (with the grid, those that
+ * can reach the tile's samples, for the same terms and counts). */
 void om__izb_raster(om__izb *z);
 /* Writes the tile's terms into the strip. */
 void om__izb_write(const om__izb *z, const om_strip *st);
-/* A strip's terms: 255 everywhere, then tile after tile of the exposed samples through
- * transform, build, raster, write (on one thread; izb.c's pass runs the same tiles as
+/* A strip's terms: 255 everywhere, then (after om__izb_grid) tile after tile of the
+ * exposed samples through transform, build, raster, write (on one thread; izb.c's pass runs the same tiles as
  * jobs). */
 void om__izb_resolve(om__izb *z, om_strip *st);
 
