@@ -7,7 +7,8 @@
  * have vertices that are NaN, infinite or huge, and whose count is no multiple of the
  * batch; into whole targets and strips, depth and depth + id, with and without the
  * culling of closed shapes and the coarse depth. With the frame's bins (rows and
- * vertices snapped alone), whose triangles a 32-bit box test passes over first, too. */
+ * vertices snapped alone), whose triangles a 32-bit box test passes over first, too;
+ * and the bins themselves, made in parts, against each vertex projected alone. */
 #include "test.h"
 #include "../engine/raster/scene_raster.h"
 #include "../engine/raster/hiz.h"
@@ -79,6 +80,49 @@ static size_t compare_walks(const om_scene *s, const om_mat4 *vp, uint32_t W, ui
     return drawn;
 }
 
+/* The bins of scene s through vp onto a W x H image, made in one go and in parts cut
+ * anywhere (mid-batch, one vertex, empty): each vertex exactly what om__project gives
+ * it alone when om__raster_tri would send it unclipped (finite, inside every plane),
+ * x = INT32_MIN when not; the rows the same however cut. Returns how many were alone. */
+static size_t check_bins(const om_scene *s, const om_mat4 *vp, uint32_t W, uint32_t H)
+{
+    om__bins a = {malloc((size_t)s->ntris * 4), malloc((size_t)s->nverts * sizeof(om__vsnap))};
+    om__bins b = {malloc((size_t)s->ntris * 4), malloc((size_t)s->nverts * sizeof(om__vsnap))};
+    size_t alone = 0;
+    CHECK(a.rows && a.verts && b.rows && b.verts);
+    if (!(a.rows && a.verts && b.rows && b.verts)) goto out;
+    memset(b.verts, 0x5A, (size_t)s->nverts * sizeof(om__vsnap));   /* not zeroed, as the frame's */
+    memset(b.rows, 0x5A, (size_t)s->ntris * 4);
+    om__bins_make(s, vp, W, H, &a);
+    const uint32_t cuts[] = {0, 1, 5, 29, 30, 77, s->nverts / 2, s->nverts - 1, s->nverts};
+    for (int k = 0; k + 1 < 9; k++)
+        if (cuts[k] <= cuts[k + 1]) om__bins_make_verts(s, vp, W, H, &b, cuts[k], cuts[k + 1]);
+    om__bins_make_rows(s, vp, W, H, &b, 0, s->ntris / 3);
+    om__bins_make_rows(s, vp, W, H, &b, s->ntris / 3, s->ntris + 9);
+    size_t wrong = 0;
+    const om__guard g = om__guard_band(W, H);
+    for (uint32_t v = 0; v < s->nverts; v++) {
+        const om_vec4 c = om__mat_apply(vp, s->verts[v]);
+        int64_t x, y;
+        uint32_t z;
+        const bool in = om__finite(c.x) && om__finite(c.y) && om__finite(c.z) && om__finite(c.w) &&
+                        om__inside_band(&c, g) && om__project(&c, W, H, &x, &y, &z);
+        const om__vsnap *p = &a.verts[v], *q = &b.verts[v];
+        alone += in;
+        wrong += in ? p->x != x || p->y != y || p->z != z : p->x != INT32_MIN;
+        wrong += p->x != q->x || p->y != q->y || p->z != q->z;
+    }
+    for (uint32_t t = 0; t < s->ntris; t++) wrong += a.rows[t] != b.rows[t];
+    CHECK_MSG(wrong == 0, "%ux%u: %zu vertices or rows differ", W, H, wrong);
+    CHECK_MSG(alone > s->nverts / 4, "%ux%u: %zu of %u vertices alone", W, H, alone, s->nverts);
+out:
+    free(a.rows);
+    free(a.verts);
+    free(b.rows);
+    free(b.verts);
+    return alone;
+}
+
 /* Tiny triangles around a camera inside the cloud (the near plane cuts some, the
  * guard band others), closed shapes in front of it and behind, 4,003 triangles (not a
  * multiple of any batch); then the same with some vertices made NaN, infinite, huge or
@@ -114,6 +158,8 @@ static void scene_walk_same_as_one_by_one(void)
             CHECK_MSG(false, "view: %s", d.msg);
             break;
         }
+        CHECK(check_bins(s, &v.cam_vp, 96, 64) < s->nverts);   /* some need clipping */
+        check_bins(s, &v.light_vp, 256, 256);
         const size_t eye = compare_walks(s, &v.cam_vp, 96, 64, 64);
         compare_walks(s, &v.cam_vp, 96, 64, 7);
         compare_walks(s, &v.cam_vp, 37, 23, 5);

@@ -52,21 +52,6 @@ size_t om__bins_verts_bytes(const om_scene *s)
     return om_arena_need((size_t)s->nverts * sizeof(om__vsnap), 8);
 }
 
-/* Vertex c snapped alone, when it needs no clipping: the test om__raster_tri makes
- * first (finite, inside every plane), then its projection. */
-static bool snap_alone(const om_vec4 *c, uint32_t width, uint32_t height, om__guard g, om__vsnap *out)
-{
-    int64_t x, y;
-    uint32_t z;
-    if (!om__finite(c->x) || !om__finite(c->y) || !om__finite(c->z) || !om__finite(c->w) ||
-        !om__inside_band(c, g) || !om__project(c, width, height, &x, &y, &z))
-        return false;
-    out->x = (int32_t)x;   /* |x|, |y| < 2^26 after om__project */
-    out->y = (int32_t)y;
-    out->z = z;
-    return true;
-}
-
 /* Row r's pixel centres lie at r * 256 + 128: the rows between grid rows lo and hi, a
  * row either side to spare. */
 static uint32_t rows_between(int64_t lo, int64_t hi, uint32_t height)
@@ -77,25 +62,21 @@ static uint32_t rows_between(int64_t lo, int64_t hi, uint32_t height)
     return r0 > r1 ? 0x0000FFFFu : (uint32_t)r0 | (uint32_t)r1 << 16;
 }
 
+/* rows_between for grid rows of om__project's (within 2^26), in 32 bits: the floor
+ * where rows_between truncates gives a row less only below row 0, which both clamp
+ * away, and the spare row either side keeps every row a pixel of it can lie in. */
+static inline uint32_t rows_between32(int32_t lo, int32_t hi, int32_t height)
+{
+    int32_t r0 = ((lo - OM_SUBPIX / 2) >> OM_SUBPIX_BITS) - 1, r1 = ((hi - OM_SUBPIX / 2) >> OM_SUBPIX_BITS) + 1;
+    r0 = r0 < 0 ? 0 : r0;
+    r1 = r1 > height - 1 ? height - 1 : r1;
+    return r0 > r1 ? 0x0000FFFFu : (uint32_t)r0 | (uint32_t)r1 << 16;
+}
+
 void om__bins_make(const om_scene *s, const om_mat4 *vp, uint32_t width, uint32_t height, const om__bins *b)
 {
     om__bins_make_verts(s, vp, width, height, b, 0, s->nverts);
     om__bins_make_rows(s, vp, width, height, b, 0, s->ntris);
-}
-
-void om__bins_make_verts(const om_scene *s, const om_mat4 *vp, uint32_t width, uint32_t height, const om__bins *b,
-                         uint32_t v0, uint32_t v1)
-{
-    om__vsnap *vs = b->verts;
-    const om__guard g = om__guard_band(width, height);
-    for (uint32_t v = v0; vs && v < v1 && v < s->nverts; v++) {
-        const om_vec4 c = om__mat_apply(vp, s->verts[v]);
-        if (!snap_alone(&c, width, height, g, &vs[v])) {
-            vs[v].x = INT32_MIN;   /* all of it: the frame's bins are not zeroed first */
-            vs[v].y = 0;
-            vs[v].z = 0;
-        }
-    }
 }
 
 void om__bins_make_rows(const om_scene *s, const om_mat4 *vp, uint32_t width, uint32_t height, const om__bins *b,
@@ -105,14 +86,15 @@ void om__bins_make_rows(const om_scene *s, const om_mat4 *vp, uint32_t width, ui
     const om__vsnap *vs = b->verts;
     for (uint32_t t = t0; b->rows && t < t1 && t < s->ntris; t++) {
         const uint32_t *ix = s->idx + (size_t)t * 3;
-        if (vs && vs[ix[0]].x != INT32_MIN && vs[ix[1]].x != INT32_MIN && vs[ix[2]].x != INT32_MIN) {
-            int64_t lo = vs[ix[0]].y, hi = lo;
-            for (int k = 1; k < 3; k++) {
-                if (vs[ix[k]].y < lo) lo = vs[ix[k]].y;
-                if (vs[ix[k]].y > hi) hi = vs[ix[k]].y;
+        if (vs) {
+            const om__vsnap *va = &vs[ix[0]], *vb = &vs[ix[1]], *vc = &vs[ix[2]];
+            if (va->x != INT32_MIN && vb->x != INT32_MIN && vc->x != INT32_MIN) {
+                int32_t lo = va->y < vb->y ? va->y : vb->y, hi = va->y < vb->y ? vb->y : va->y;
+                lo = vc->y < lo ? vc->y : lo;
+                hi = vc->y > hi ? vc->y : hi;
+                b->rows[t] = rows_between32(lo, hi, (int32_t)height);
+                continue;
             }
-            b->rows[t] = rows_between(lo, hi, height);
-            continue;
         }
         om_vec4 c[3];
         om__clip_tri(s, vp, t, c);
@@ -169,41 +151,31 @@ static inline int32_t holds_centre(int32_t xa, int32_t xb, int32_t xc, int32_t y
     return (x0 <= x1) & (y0 <= y1);
 }
 
-/* ---- the walk without vertex bins, a batch of triangles at a time */
-
-/* Most triangles of a detailed scene hold no pixel centre of the target, and cost the
- * walk their transform, plane tests, projection and box. A batch does those in loops
- * over arrays, a lane per vertex (lane c * BATCH + k: corner c of the batch's
- * triangle k) and then per triangle, with no branch on the data, so that a compiler
- * may run several lanes an instruction: each lane does om__mat_apply's,
- * om__inside_band's and om__project_xy's operations in their order, the same bits. A
- * triangle whose box holds no pixel centre of the target is then passed over before
- * any setup, and one with a vertex outside a plane (or not finite) goes to
- * om__raster_tri_guarded as its clip-space vertices, as before. */
+/* ---- vertices a batch at a time
+ *
+ * Most triangles of a detailed scene hold no pixel centre of the target, and cost the
+ * walk (and the bins) their vertices' transform, plane tests and projection. Those run
+ * in loops over arrays, LANES vertices at a time, with no branch on the data, so that
+ * a compiler may run several lanes an instruction (four on SSE2): each lane does
+ * om__mat_apply's, om__inside_band's and om__project_xy's operations in their order,
+ * the same bits. They give no depth (a 64-bit division): the walk works a triangle's
+ * out once it covers a pixel centre, the bins one per vertex for all its triangles. */
 #define BATCH 8
+#define LANES (3 * BATCH)
 
-typedef struct batch {
-    float x[3 * BATCH], y[3 * BATCH], z[3 * BATCH], w[3 * BATCH];   /* clip space */
-    int32_t gx[3 * BATCH], gy[3 * BATCH];                           /* om__project_xy's */
-    int32_t ok[3 * BATCH];   /* inside every plane, w finite and > 0, within 2^26 */
-    int32_t go[BATCH];       /* 0: passed over, 1: to be clipped, 2: projected, in the target's box */
-} batch;
+typedef struct lanes {
+    float x[LANES], y[LANES], z[LANES], w[LANES];   /* clip space */
+    int32_t gx[LANES], gy[LANES];                   /* om__project_xy's */
+    int32_t ok[LANES];   /* inside every plane, w finite and > 0, within 2^26 */
+} lanes;
 
-/* The scene's triangles t0..t0 + n (n <= BATCH) through vp: transformed, tested and
- * projected onto a width x height image (sx, sy: om__project_xy's scales). */
-static void batch_project(batch *b, const om_scene *s, uint32_t t0, uint32_t n, const om_mat4 *vp,
-                          om__guard g, float sx, float sy)
+/* The points (px, py, pz) through vp, tested and projected onto a width x height image
+ * (sx, sy: om__project_xy's scales); px and py are used up. */
+static inline void lanes_project(lanes *restrict b, float *restrict px, float *restrict py, const float *restrict pz,
+                                 const om_mat4 *vp, om__guard g, float sx, float sy)
 {
-    float px[3 * BATCH], py[3 * BATCH], pz[3 * BATCH];
-    for (uint32_t k = 0; k < BATCH; k++)
-        for (int c = 0; c < 3; c++) {
-            const om_vec3 v = k < n ? s->verts[s->idx[((size_t)t0 + k) * 3 + c]] : om__v3(0.0f, 0.0f, 0.0f);
-            px[c * BATCH + k] = v.x;
-            py[c * BATCH + k] = v.y;
-            pz[c * BATCH + k] = v.z;
-        }
     const float *a = vp->m, lim = 67108864.0f;
-    for (int i = 0; i < 3 * BATCH; i++) {
+    for (int i = 0; i < LANES; i++) {
         const float x = a[0] * px[i] + a[1] * py[i] + a[2] * pz[i] + a[3];
         const float y = a[4] * px[i] + a[5] * py[i] + a[6] * pz[i] + a[7];
         const float z = a[8] * px[i] + a[9] * py[i] + a[10] * pz[i] + a[11];
@@ -211,6 +183,7 @@ static void batch_project(batch *b, const om_scene *s, uint32_t t0, uint32_t n, 
         /* on a lane that fails a test these may be infinite or NaN, and are not used */
         const float iw = 1.0f / w;
         const float X = (x * iw + 1.0f) * sx + 0.5f, Y = (1.0f - y * iw) * sy + 0.5f;
+        /* an infinite or NaN x, y or z fails a plane test, an infinite w its w - w */
         const int32_t ok = (z >= 0.0f) & (w - z >= 0.0f) & (x + g.x * w >= 0.0f) & (g.x * w - x >= 0.0f) &
                            (y + g.y * w >= 0.0f) & (g.y * w - y >= 0.0f) & (w > 0.0f) & (w - w == 0.0f) &
                            (X > -lim) & (X < lim) & (Y > -lim) & (Y < lim);
@@ -226,19 +199,114 @@ static void batch_project(batch *b, const om_scene *s, uint32_t t0, uint32_t n, 
     }
     /* a loop of its own: in the one above, a compiler would convert only the lanes it
      * knows to be in range, under a branch, and then not vectorize it */
-    for (int i = 0; i < 3 * BATCH; i++) {
+    for (int i = 0; i < LANES; i++) {
         b->gx[i] = om__floorf_i32(px[i]);
         b->gy[i] = om__floorf_i32(py[i]);
     }
+}
+
+/* Whether the CPU runs several float lanes an instruction (SSE2, NEON): there the
+ * bins' vertices go LANES at a time, which costs a quarter of one at a time; on a CPU
+ * without lanes (a Cortex-M) the batch would only add its loads and stores, and each
+ * vertex goes alone. The same bits either way: lanes_project's tests and projection
+ * are om__inside_band's and om__project's. */
+#if defined(__SSE2__) || defined(__ARM_NEON)
+#define VERT_LANES 1
+#else
+#define VERT_LANES 0
+#endif
+
+/* The bins' vertices [v0, v1): each snapped alone as om__raster_tri would snap it when
+ * it needs no clipping, its depth with it (a triangle's strips and bands share it),
+ * x = INT32_MIN when it needs clipping. Every entry is written: the frame's bins are
+ * not zeroed first. */
+void om__bins_make_verts(const om_scene *s, const om_mat4 *vp, uint32_t width, uint32_t height, const om__bins *b,
+                         uint32_t v0, uint32_t v1)
+{
+    om__vsnap *vs = b->verts;
+    const om__guard g = om__guard_band(width, height);
+    if (!vs) return;
+    if (v1 > s->nverts) v1 = s->nverts;
+#if VERT_LANES
+    const float sx = (float)width * (OM_SUBPIX / 2), sy = (float)height * (OM_SUBPIX / 2);
+    lanes l;
+    float px[LANES], py[LANES], pz[LANES];
+    for (uint32_t v = v0; v < v1; v += LANES) {
+        const uint32_t n = v1 - v < LANES ? v1 - v : LANES;
+        const om_vec3 *p = s->verts + v;
+        for (uint32_t i = 0; i < LANES; i++) {   /* a short last batch repeats its first vertex */
+            const uint32_t k = i < n ? i : 0;
+            px[i] = p[k].x;
+            py[i] = p[k].y;
+            pz[i] = p[k].z;
+        }
+        lanes_project(&l, px, py, pz, vp, g, sx, sy);
+        for (uint32_t i = 0; i < n; i++) {
+            om__vsnap *o = &vs[v + i];
+            if (l.ok[i]) {
+                o->x = l.gx[i];
+                o->y = l.gy[i];
+                o->z = om__zdepth(l.z[i], l.w[i]);
+            } else {
+                o->x = INT32_MIN;
+                o->y = 0;
+                o->z = 0;
+            }
+        }
+    }
+#else
+    for (uint32_t v = v0; v < v1; v++) {
+        const om_vec4 c = om__mat_apply(vp, s->verts[v]);
+        int64_t x, y;
+        uint32_t z;
+        om__vsnap *o = &vs[v];
+        /* om__raster_tri's first test (finite, inside every plane), then its projection */
+        if (om__finite(c.x) && om__finite(c.y) && om__finite(c.z) && om__finite(c.w) && om__inside_band(&c, g) &&
+            om__project(&c, width, height, &x, &y, &z)) {
+            o->x = (int32_t)x;   /* |x|, |y| < 2^26 after om__project */
+            o->y = (int32_t)y;
+            o->z = z;
+        } else {
+            o->x = INT32_MIN;
+            o->y = 0;
+            o->z = 0;
+        }
+    }
+#endif
+}
+
+/* ---- the walk without vertex bins, a batch of triangles at a time: lane c * BATCH + k
+ * is corner c of the batch's triangle k. A triangle whose box holds no pixel centre of
+ * the target is then passed over before any setup, and one with a vertex outside a
+ * plane (or not finite) goes to om__raster_tri_guarded as its clip-space vertices, as
+ * before. */
+typedef struct batch {
+    lanes v;
+    int32_t go[BATCH];       /* 0: passed over, 1: to be clipped, 2: projected, in the target's box */
+} batch;
+
+/* The scene's triangles t0..t0 + n (n <= BATCH) through vp onto a width x height image. */
+static void batch_project(batch *b, const om_scene *s, uint32_t t0, uint32_t n, const om_mat4 *vp,
+                          om__guard g, float sx, float sy)
+{
+    float px[LANES], py[LANES], pz[LANES];
+    for (uint32_t k = 0; k < BATCH; k++)
+        for (int c = 0; c < 3; c++) {
+            const om_vec3 v = k < n ? s->verts[s->idx[((size_t)t0 + k) * 3 + c]] : om__v3(0.0f, 0.0f, 0.0f);
+            px[c * BATCH + k] = v.x;
+            py[c * BATCH + k] = v.y;
+            pz[c * BATCH + k] = v.z;
+        }
+    lanes_project(&b->v, px, py, pz, vp, g, sx, sy);
 }
 
 /* What each triangle of the batch needs (batch.go). */
 static void batch_boxes(batch *b, const om_target *tg, bool cons)
 {
     for (int k = 0; k < BATCH; k++) {
-        const int32_t *gx = b->gx + k, *gy = b->gy + k;
+        const int32_t *gx = b->v.gx + k, *gy = b->v.gy + k, *ok = b->v.ok + k;
         const int32_t in = holds_centre(gx[0], gx[BATCH], gx[2 * BATCH], gy[0], gy[BATCH], gy[2 * BATCH], tg);
-        const int32_t all = b->ok[k] & b->ok[BATCH + k] & b->ok[2 * BATCH + k];
+        const int32_t all = ok[0] & ok[BATCH] & ok[2 * BATCH];
         /* conservative coverage reaches pixels beyond the centres: no skipping there */
         b->go[k] = all ? 2 * (in | (int32_t)cons) : 1;
     }
@@ -265,14 +333,14 @@ static void walk_batches(const om_scene *s, const om_mat4 *vp, om_raster *r, uin
             om_vec4 c[3];
             for (int j = 0; j < 3; j++) {
                 const uint32_t i = (uint32_t)j * BATCH + k;
-                c[j].x = b.x[i];
-                c[j].y = b.y[i];
-                c[j].z = b.z[i];
-                c[j].w = b.w[i];
+                c[j].x = b.v.x[i];
+                c[j].y = b.v.y[i];
+                c[j].z = b.v.z[i];
+                c[j].w = b.v.w[i];
             }
             if (b.go[k] == 2) {
-                const int64_t x[3] = {b.gx[k], b.gx[BATCH + k], b.gx[2 * BATCH + k]};
-                const int64_t y[3] = {b.gy[k], b.gy[BATCH + k], b.gy[2 * BATCH + k]};
+                const int64_t x[3] = {b.v.gx[k], b.v.gx[BATCH + k], b.v.gx[2 * BATCH + k]};
+                const int64_t y[3] = {b.v.gy[k], b.v.gy[BATCH + k], b.v.gy[2 * BATCH + k]};
                 om__raster_projected(r, hiz, x, y, NULL, c, t);
             } else {
                 om__raster_tri_guarded(r, hiz, c, t, tg->width, tg->height, g);
