@@ -2,7 +2,8 @@
  * test, the 128-bit texel's packing, the derivative code's error profile (section 3.4),
  * the build's table code against it, the pattern table, accuracy against the reference and the conventional map (the
  * default scene, a dense mesh), bit-identical frames, budgets and statistics; the
- * lookup's float depth tests against the double ones. */
+ * lookup's float depth tests against the double ones and its integer shortcuts against
+ * the shared routines. */
 #include "test.h"
 #include "harness.h"
 #include "../engine/shadow/spsm.h"
@@ -675,6 +676,55 @@ static void float_less_is_the_double_one(void)
     CHECK_MSG(far_answered * 10 > far * 8, "%llu of %llu answered away from equality", far_answered, far);
 }
 
+/* The lookup's integer shortcuts give the very integers of the shared routines:
+ * om__spsm_zdepth against om__zdepth (random floats of every exponent, near 0 and near
+ * w, subnormals, z >= w, NaN), om__spsm_covers against om__tri2_covers (records at the
+ * o16 code's extremes, points out to the projection's limit). */
+static void lookup_integers_are_the_shared_ones(void)
+{
+    uint32_t s = 23;
+    unsigned long long bad = 0;
+    for (int it = 0; it < 400000; it++) {
+        union { float f; uint32_t u; } a, b;
+        a.u = next_rand(&s) << 8 ^ next_rand(&s);
+        b.u = next_rand(&s) << 8 ^ next_rand(&s);
+        a.u &= 0x7FFFFFFFu;
+        b.u &= 0x7FFFFFFFu;
+        switch (it % 5) {   /* w near z: the largest quotients, and a few ulps apart */
+        case 1: b.u = a.u + next_rand(&s) % 64; break;
+        case 2: b.u = a.u + (next_rand(&s) % 40u << 23); break;
+        case 3: a.u %= 0x1000000u; break;   /* subnormal or tiny z */
+        case 4: b.u %= 0x1000000u; break;
+        default: break;
+        }
+        bad += om__spsm_zdepth(a.f, b.f) != om__zdepth(a.f, b.f);
+    }
+    const float odd[] = {0.0f, -0.0f, 1.0f, -1.0f, 0x1p-149f, 0x1p-126f, 0x1.fffffep127f, HUGE_VALF, NAN};
+    for (int i = 0; i < 9; i++)
+        for (int j = 0; j < 9; j++) bad += om__spsm_zdepth(odd[i], odd[j]) != om__zdepth(odd[i], odd[j]);
+    CHECK_EQ_U(bad, 0);
+    const int64_t far = (int64_t)4095 << 14;   /* the o16 code's largest offset */
+    for (int it = 0; it < 200000; it++) {
+        int64_t X[3], Y[3];
+        for (int i = 0; i < 3; i++) {
+            const uint32_t r = next_rand(&s) % 4;
+            const int64_t reach = r == 0 ? far : r == 1 ? 4096 : 600;
+            X[i] = (int64_t)(next_rand(&s) % 3) * 256 - 256 + (int64_t)(next_rand(&s) % (uint32_t)(2 * reach + 1)) - reach;
+            Y[i] = (int64_t)(next_rand(&s) % 3) * 256 - 256 + (int64_t)(next_rand(&s) % (uint32_t)(2 * reach + 1)) - reach;
+            if (next_rand(&s) % 8 == 0) X[i] = next_rand(&s) % 2 ? far + 256 : -far - 256;
+        }
+        om__tri2 e;
+        om__tri2_setup(&e, X, Y, false);
+        const int64_t lim = ((int64_t)1 << 26) + ((int64_t)1 << 22);
+        const uint32_t r = next_rand(&s) % 3;
+        const int64_t px = r == 0 ? (int64_t)(next_rand(&s) % 769) - 384 : r == 1 ? X[0] : (next_rand(&s) % 2 ? lim : -lim);
+        const int64_t py = r == 0 ? (int64_t)(next_rand(&s) % 769) - 384 : r == 1 ? Y[0] + (int64_t)(next_rand(&s) % 3) - 1 : -lim;
+        bad += om__spsm_covers(&e, px, py) != om__tri2_covers(&e, px, py);
+        for (int i = 0; i < 3; i++) bad += om__spsm_edge(&e, i, px, py) != om__tri2_edge(&e, i, px, py);
+    }
+    CHECK_EQ_U(bad, 0);
+}
+
 void suite_spsm(void)
 {
     RUN(conservative_is_exact_overlap);
@@ -694,4 +744,5 @@ void suite_spsm(void)
     RUN(odd_inputs);
     RUN(float_tests_are_the_double_ones);
     RUN(float_less_is_the_double_one);
+    RUN(lookup_integers_are_the_shared_ones);
 }

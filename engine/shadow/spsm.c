@@ -135,16 +135,19 @@ static om_status spsm_begin(void *state, const om_view *v, om_diag *d)
     return OM_OK;
 }
 
-typedef struct sample_pt { int64_t x, y; double z; float zf; bool ok; om_vec4 q; } sample_pt;
+/* A sample on the map: grid position, depth (zi; zf rounded to float for the float
+ * tests, the double tests convert zi when they run), clip-space point q. */
+typedef struct sample_pt { int64_t x, y; uint32_t zi; float zf; bool ok; om_vec4 q; } sample_pt;
 
+/* om__project's position and depth (the depth by om__spsm_zdepth where a 64-bit
+ * division is a library routine: the same integer). */
 static sample_pt project(const om__spsm_state *m, om_vec3 p)
 {
     sample_pt s;
     s.q = om__mat_apply(&m->view.light_vp, p);
-    uint32_t z = 0;
-    s.ok = om__project(&s.q, m->size, m->size, &s.x, &s.y, &z);
-    s.z = z;
-    s.zf = (float)z;
+    s.ok = om__project_xy(&s.q, m->size, m->size, &s.x, &s.y);
+    s.zi = !s.ok ? 0u : OM_FAST_FLOAT ? om__spsm_zdepth(s.q.z, s.q.w) : om__zdepth(s.q.z, s.q.w);
+    s.zf = (float)s.zi;
     return s;
 }
 
@@ -334,11 +337,11 @@ static double pat_tol(const om__spsm_dtri *t, int64_t px, int64_t py)
 
 /* Algorithm 1: the stored triangle covers the point in 2-D and is nearer there (its
  * edges set up: edges). */
-static bool hits(const om__spsm_dtri *t, int64_t px, int64_t py, double pz, float pzf)
+static bool hits(const om__spsm_dtri *t, int64_t px, int64_t py, uint32_t pz, float pzf)
 {
-    if (!t->ok || !om__tri2_covers(&t->e, px, py)) return false;
+    if (!t->ok || !om__spsm_covers(&t->e, px, py)) return false;
     const int below = OM_FAST_FLOAT ? om__spsm_below_f(t, px, py, pzf, -1.0f, 0.0f) : -1;
-    return below >= 0 ? below == 1 : om__spsm_plane_at(t, px, py) < pz - om__spsm_tol_at(t, px, py);
+    return below >= 0 ? below == 1 : om__spsm_plane_at(t, px, py) < (double)pz - om__spsm_tol_at(t, px, py);
 }
 
 /* Figure 9: the least depth the triangle reaches inside its texel's square, found where
@@ -352,7 +355,7 @@ static double consistent_min(const om__spsm_dtri *t)
     const float h = (float)H;
     int64_t kx = t->cx + (t->gx > 0 ? -H : H), ky = t->cy + (t->gy > 0 ? -H : H);
     /* the plane at the corner: its least over the square */
-    if (om__tri2_covers(&t->e, kx, ky)) return t->zf - (om__fabsf(t->gxf) + om__fabsf(t->gyf)) * h;
+    if (om__spsm_covers(&t->e, kx, ky)) return t->zf - (om__fabsf(t->gxf) + om__fabsf(t->gyf)) * h;
     /* in the texel's own coordinates (from the square's corner), so that the value does
      * not depend on where the 3x3 is centred (shift_window keeps it); in float, the
      * plane from the centre over offsets of at most half a texel */
@@ -532,7 +535,7 @@ static void occluders_of(const om__spsm_state *m, om__spsm_win *w, om__spsm_dtri
         const int64_t x = tx + k % 3 - 1, y = ty + k / 3 - 1;
         if (x < 0 || y < 0 || x >= (int64_t)m->size || y >= (int64_t)m->size) continue;
         const uint32_t c = m->cdepth[(size_t)y * m->size + (size_t)x];
-        if (c == 0xFFFFFFFFu || om__tri2_covers(&t[k].e, t[k].cx, t[k].cy)) continue;
+        if (c == 0xFFFFFFFFu || om__spsm_covers(&t[k].e, t[k].cx, t[k].cy)) continue;
         /* at its own centre the plane is z and the tolerance OM__SPSM_TOL0 */
         if (om__fabsf(t[k].zf - (float)c) > (float)(OM__SPSM_TOL0 + OM__SPSM_LINK_DZ)) continue;
         w->cand[w->ncand].x = t[k].cx;
@@ -605,12 +608,13 @@ static uint8_t lookup(const om__spsm_state *m, om__spsm_win *w, uint32_t n[8], c
         if (on == 1) close = om__spsm_tol_within_f(&t[4], px, py, (float)(OM__SPSM_TOL0 + LIT_CAP));
         if (below < 0 || on < 0 || close < 0) {
             const double z = om__spsm_plane_at(&t[4], px, py), tol = om__spsm_tol_at(&t[4], px, py);
-            below = z < p.z - tol;
-            on = z <= p.z + tol;
+            const double pz = p.zi;
+            below = z < pz - tol;
+            on = z <= pz + tol;
             close = tol <= OM__SPSM_TOL0 + LIT_CAP;
         }
         if (below) {
-            if (om__tri2_covers(edges(t, 4), px, py)) { n[N_SHADOWED]++; return 0; }
+            if (om__spsm_covers(edges(t, 4), px, py)) { n[N_SHADOWED]++; return 0; }
         } else if (on && close) {
             n[N_LIT]++;
             return 255;
@@ -621,7 +625,7 @@ static uint8_t lookup(const om__spsm_state *m, om__spsm_win *w, uint32_t n[8], c
         if (k == 4) continue;
         if (!((w->t_have >> k) & 1u)) { decode(m, tx, ty, t, k); w->t_have |= 1u << k; }
         if (t[k].ok) edges(t, k);
-        if (hits(&t[k], px, py, p.z, p.zf)) { n[N_SHADOWED]++; return 0; }
+        if (hits(&t[k], px, py, p.zi, p.zf)) { n[N_SHADOWED]++; return 0; }
     }
     return recover(m, w, n, st, i, &p, tx, ty);
 }
@@ -654,7 +658,7 @@ OM_NOINLINE static uint8_t recover(const om__spsm_state *m, om__spsm_win *w, uin
         if (t[k].empty) continue;
         const int below =
             OM_FAST_FLOAT ? om__spsm_below_f(&t[k], px, py, p.zf, -1.0f, (float)(OM__SPSM_TOL0 + PAT_CAP)) : -1;
-        if (below == 0 || (below < 0 && !(om__spsm_plane_at(&t[k], px, py) < p.z - pat_tol(&t[k], px, py))))
+        if (below == 0 || (below < 0 && !(om__spsm_plane_at(&t[k], px, py) < (double)p.zi - pat_tol(&t[k], px, py))))
             continue;
         if (!have_rp) { rp = receiver_plane(m, smp, &p); have_rp = true; }
         if (t[k].ok && behind_receiver(&t[k], &rp, px, py)) continue;
@@ -667,7 +671,7 @@ OM_NOINLINE static uint8_t recover(const om__spsm_state *m, om__spsm_win *w, uin
         /* pat_tol at the texel's centre is OM__SPSM_TOL0: its offsets are 0 and its
          * error bounds finite */
         int in = OM_FAST_FLOAT ? om__spsm_less_f(t[k].cminf, p.zf, 0.0f, 0.0f, 0.0f, 0.0f, (float)OM__SPSM_TOL0) : -1;
-        if (in < 0) in = t[k].cmin < p.z - pat_tol(&t[k], t[k].cx, t[k].cy);
+        if (in < 0) in = t[k].cmin < (double)p.zi - pat_tol(&t[k], t[k].cx, t[k].cy);
         if (in) pat |= 1u << k;
     }
     const om__spsm_tangent *tg = &m->lut[pat];
@@ -703,7 +707,7 @@ OM_NOINLINE static uint8_t recover(const om__spsm_state *m, om__spsm_win *w, uin
         bool shadow = false;
         /* at the sample itself the lookup found no hit in the whole 3x3 */
         if (K > 1)
-            for (int k = 0; k < nocc && !shadow; k++) shadow = hits(occ[k], qx, qy, q.z, q.zf);
+            for (int k = 0; k < nocc && !shadow; k++) shadow = hits(occ[k], qx, qy, q.zi, q.zf);
         if (!shadow && bd->nh) shadow = om__spsm_outline_inside(bd, qx, qy);
         if (!shadow && w->ncand) {
             if (!have_use) { use = centres_nearer(m, w, &rp, &have_rp, smp, &p, tx, ty, px, py); have_use = true; }
