@@ -584,9 +584,23 @@ static size_t tile_start(const izb_state *m, const om_strip *st, uint32_t k)
     return (size_t)lo * st->width + x;
 }
 
+/* The tile job k runs. The frame hands slot p the jobs p, p + P, ... (om__pass), and a
+ * strip's tiles mostly cost less the lower they lie on the screen (the top's samples
+ * lie far, under more of the scene: on random 100K at 1024x768 the first of ten took
+ * 11.1 ms of thread time, the last 1.2), so each round of P jobs takes its P tiles in the other
+ * direction from the round before: slot 0 gets tiles 0, 2P - 1, 2P, ..., the last slot
+ * P - 1, P, 3P - 1, ... Which slot runs a tile changes no term or count. */
+static uint32_t tile_of(const izb_state *m, uint32_t k)
+{
+    const uint32_t slots = m->lend ? m->lend->slots : 1, p = m->ntiles < slots ? m->ntiles : slots;
+    const uint32_t r = k / p, first = r * p, n = m->ntiles - first < p ? m->ntiles - first : p;
+    return r & 1 ? first + n - 1 - (k - first) : k;
+}
+
 static void izb_pass_job(const void *state, const om_strip *st, uint32_t k, void *scratch, uint32_t counts[8])
 {
     const izb_state *m = (const izb_state *)state;
+    k = tile_of(m, k);
     om__izb z = m->z;   /* the scene, projection and pool's sizes; the pool is the scratch */
     unsigned char *p = (unsigned char *)scratch;
     z.od = (om__odepth *)p;
