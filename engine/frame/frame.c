@@ -319,8 +319,8 @@ static om_status begin(frame_ctx *c, const om_view *v, om_diag *d)
     return st;
 }
 
-/* om__lend.run: a method's own jobs on the pass's slots, from its begin, observe or
- * build on the calling thread (no stage of the frame's is running then). */
+/* om__lend.run: a method's own jobs on the pass's slots, from its begin, observe, build
+ * or bands' finish on the calling thread (no stage of the frame's is running then). */
 static void lend_run(const om__lend *l, void (*fn)(void *user, uint32_t k, void *scratch), void *user, uint32_t n)
 {
     frame_ctx *c = (frame_ctx *)l->frame;

@@ -147,7 +147,8 @@ const om__bands *om__method_bands(const om_method *m);
  *   method's bands are not used either and its resolve runs a strip at a time, which
  *   must give the same terms and counts. */
 /* The pass's slots lent to the method's own stages (asm: its analysis and tile renders
- * in observe and build): run(l, fn, user, n), called on the calling thread, calls
+ * in observe and build, its bands' finish): run(l, fn, user, n), called on the calling
+ * thread while no stage of the frame's runs, calls
  * fn(user, k, scratch) for every k in [0, n) on min(n, slots) of the pass's slots at
  * once (slot p: k = p, p + P, ..., with its scratch) and returns when all have
  * returned. What fn writes must not depend on the slot that ran it. */

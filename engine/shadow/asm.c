@@ -613,11 +613,12 @@ static om_status asm_resolve(void *state, om_strip *st, om_diag *d)
  * samples with a cache of its own and writes nothing of the state. The use stamps are
  * the one thing a lookup leaves in the tree: a band marks each sample whose lookup
  * descended with the leaf it found (1 + its index, 0xFFFF the base, in its term's green
- * and blue, each xor its red), and finish, on the calling thread, stamps their paths
- * and puts the terms back. A tree of 0xFFFF nodes or more has no room there: its
- * samples are marked by blue one off red, and finish finds their leaves again. The
- * stamped nodes are the paths to every leaf found, whatever the bands: the stamps, the
- * terms and the counts (added up by merge) are a strip at a time's. */
+ * and blue, each xor its red), and finish puts the terms back and stamps the paths of
+ * the leaves they name (the scan by parts on the host's threads, asm_jobs.c). A tree
+ * of 0xFFFF nodes or more has no room there: its samples are marked by blue one off
+ * red, and finish finds their leaves again. The stamped nodes are the paths to every
+ * leaf found, whatever the bands: the stamps, the terms and the counts (added up by
+ * merge) are a strip at a time's. */
 static void asm_band(const void *state, om_strip *st, void *scratch, uint32_t counts[8])
 {
     const om__asm_state *m = (const om__asm_state *)state;
@@ -651,31 +652,71 @@ static void asm_merge(void *state, const uint32_t counts[8])
     m->shadowed += counts[1];
 }
 
-static void asm_finish(void *state, om_strip *st)
+/* finish's scan of terms [i0, i1) of the strip: each marked term put back, and the leaf
+ * its lookup found stamped with its path (`bits` NULL) or its bit set in `bits` (a bit a
+ * node, bit `count` the base's: the tree is only read then, and asm_jobs.c stamps the
+ * paths of the bits the parts set). */
+static void leaves(om__asm_state *m, om_strip *st, size_t i0, size_t i1, uint32_t *bits)
 {
-    om__asm_state *m = (om__asm_state *)state;
-    const size_t n = (size_t)st->rows * st->width;
-    const bool direct = m->tree.lay.count < 0xFFFFu;
-    for (size_t i = 0; i < n; i++) {
+    const uint32_t count = m->tree.lay.count;
+    const bool direct = count < 0xFFFFu;
+    for (size_t i = i0; i < i1; i++) {
         om_term *t = &st->terms[i];
         if (t->b == t->r && t->g == t->r) continue;
+        uint32_t leaf;
         if (direct) {
             const uint32_t v = (uint32_t)(t->g ^ t->r) << 8 | (uint32_t)(t->b ^ t->r);
             t->g = t->b = t->r;
-            stamp_path(&m->tree, v == 0xFFFFu ? OM__ASM_ROOT : v - 1);
+            leaf = v == 0xFFFFu ? OM__ASM_ROOT : v - 1;
+        } else {
+            t->b = t->r;
+            asm_smp o;
+            asm_cache c = {OM__ASM_NONE, m->cache_tile};
+            om__asm_tile tl;
+            uint32_t tx, ty;
+            bool moved = false;
+            if (!smp_begin(m, &st->samples[i], false, &o)) continue;   /* (it was looked up) */
+            smp_find(m, &o, &c, &tl, &tx, &ty, &moved);
+            leaf = c.index;
+        }
+        if (!bits) {
+            stamp_path(&m->tree, leaf);
             continue;
         }
-        t->b = t->r;
-        asm_smp o;
-        asm_cache c = {OM__ASM_NONE, m->cache_tile};
-        om__asm_tile tl;
-        uint32_t tx, ty;
-        bool moved = false;
-        if (!smp_begin(m, &st->samples[i], false, &o)) continue;   /* (it was looked up) */
-        smp_find(m, &o, &c, &tl, &tx, &ty, &moved);
-        stamp_path(&m->tree, c.index);
+        const uint32_t bit = leaf == OM__ASM_ROOT ? count : leaf;
+        bits[bit >> 5] |= 1u << (bit & 31);
     }
 }
+
+static void asm_finish(void *state, om_strip *st)
+{
+    om__asm_state *m = (om__asm_state *)state;
+#if OM_WITH_JOBS
+    if (m->lend && om__asm_finish_jobs(m, st)) return;   /* the same, by parts */
+#endif
+    leaves(m, st, 0, (size_t)st->rows * st->width, NULL);
+}
+
+#if OM_WITH_JOBS
+/* A part of finish's scan on the host's threads (asm_jobs.c): with `bits` it writes
+ * nothing of the state. */
+void om__asm_leaves(const om__asm_state *m, om_strip *st, size_t i0, size_t i1, uint32_t *bits)
+{
+    leaves((om__asm_state *)m, st, i0, i1, bits);
+}
+
+void om__asm_stamp_leaves(om__asm_tree *t, uint32_t *bits)
+{
+    const uint32_t count = t->lay.count;
+    for (uint32_t w = 0; w < (count + 1 + 31) / 32; w++) {
+        for (uint32_t b = bits[w]; b; b &= b - 1) {
+            const uint32_t i = w * 32 + om__ctz32(b);
+            stamp_path(t, i == count ? OM__ASM_ROOT : i);
+        }
+        bits[w] = 0;
+    }
+}
+#endif
 
 const om__bands om__bands_asm = {asm_band, asm_merge, sizeof(asm_cache), NULL, NULL, asm_finish};
 

@@ -260,7 +260,8 @@ typedef struct om__asm_state {
      * rebuild renders whole, so their gathers read no bounds of triangles that would
      * write nothing (not lean). */
     uint32_t *centre[2];
-    uint32_t *cull;        /* triangles that meet the region being rendered (not lean) */
+    uint32_t *cull;        /* triangles that meet the region being rendered (not lean);
+                              from the bounds to the grid, each triangle's cells */
     /* A grid of cells over the base texels, each listing the triangles whose bounds
      * meet it, made once per frame, so that a tile gathers from its cells instead of
      * testing every triangle's bounds; a bit per triangle puts them back in index
@@ -329,6 +330,14 @@ bool om__asm_observe_jobs(om__asm_state *m, const om_strip *st);
  * samples (g put back to 255), once the root tiles are made. */
 void om__asm_observe_rows(const om__asm_state *m, const om_strip *st, uint32_t y0, uint32_t rows,
                           const om__asm_acc *a, bool again);
+/* resolve's finish, by parts of the strip; false where there are no threads. */
+bool om__asm_finish_jobs(om__asm_state *m, om_strip *st);
+/* asm.c: finish's scan of terms [i0, i1): each marked term put back and its leaf's bit
+ * set in `bits` (a bit a node, bit `count` the base's), reading the tree only. */
+void om__asm_leaves(const om__asm_state *m, om_strip *st, size_t i0, size_t i1, uint32_t *bits);
+/* asm.c: stamps the path of every leaf set in `bits` (as om__asm_leaves sets them) as
+ * used this frame, and clears them. */
+void om__asm_stamp_leaves(om__asm_tree *t, uint32_t *bits);
 #endif
 
 #endif

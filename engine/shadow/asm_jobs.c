@@ -1,8 +1,9 @@
-/* asm_jobs.c — Adaptive Shadow Maps on the host's threads: the tile renders and the
- * view analysis of observe as jobs (frame.h's om__lend, through asm's om__pass), with
- * the tree the same bits as on one thread. asm.c decides what is made and analysed;
- * this file cuts the work into jobs, gives each job its scratch and puts what the jobs
- * found on the tree afterwards, on the calling thread.
+/* asm_jobs.c — Adaptive Shadow Maps on the host's threads: the tile renders, the view
+ * analysis of observe and the scan behind resolve's use stamps as jobs (frame.h's
+ * om__lend, through asm's om__pass), with the tree the same bits as on one thread.
+ * asm.c decides what is made and analysed; this file cuts the work into jobs, gives
+ * each job its scratch and puts what the jobs found on the tree afterwards, on the
+ * calling thread.
  *
  * Tiles: a node's tile depends on its place, the light and the frame's bounds only, so
  * the tiles a build (or an observe) makes are rendered after the nodes are made, one
@@ -289,6 +290,46 @@ bool om__asm_observe_jobs(om__asm_state *m, const om_strip *st)
     j.again = true;
     m->lend->run(m->lend, obs_fn, &j, nb);
     merge(m, &j.sl, true);
+    return true;
+}
+
+/* ---- resolve's use stamps: the terms the bands marked, scanned by parts, each part
+ * setting the bits of the leaves it finds in its slot's use bits; after the parts, the
+ * calling thread stamps the paths of every leaf set in any slot (the same stamps, in
+ * any order, as a strip at a time leaves). */
+
+typedef struct fin_job {
+    const om__asm_state *m;
+    om_strip *st;
+    uint32_t parts;
+    slot_layout sl;
+} fin_job;
+
+static void fin_fn(void *user, uint32_t k, void *scratch)
+{
+    const fin_job *j = (const fin_job *)user;
+    const uint64_t n = (uint64_t)j->st->rows * j->st->width;
+    om__asm_leaves(j->m, j->st, (size_t)(n * k / j->parts), (size_t)(n * (k + 1) / j->parts),
+                   (uint32_t *)scratch + j->sl.stamp);
+}
+
+bool om__asm_finish_jobs(om__asm_state *m, om_strip *st)
+{
+    if (!m->lend) return false;
+    /* about four parts a slot, never more jobs than registered slots run at once */
+    fin_job j = {m, st, m->nslot < m->lend->slots ? m->nslot : 4 * m->nslot, {0}};
+    slot_layout_m(m, &j.sl);
+    m->lend->run(m->lend, fin_fn, &j, j.parts);
+    const uint32_t words = (m->tree.lay.count + 1 + 31) / 32;
+    uint32_t *all = (uint32_t *)m->slot[0] + j.sl.stamp;
+    for (uint32_t s = 1; s < m->nslot; s++) {   /* into slot 0's, cleared for the next use */
+        uint32_t *bits = (uint32_t *)m->slot[s] + j.sl.stamp;
+        for (uint32_t w = 0; w < words; w++) {
+            all[w] |= bits[w];
+            bits[w] = 0;
+        }
+    }
+    om__asm_stamp_leaves(&m->tree, all);
     return true;
 }
 

@@ -121,8 +121,16 @@ static uint32_t cell_of(const om__asm_state *m, float u)
     return !(f > 0.0f) ? 0 : f >= (float)(m->gside - 1) ? m->gside - 1 : (uint32_t)f;
 }
 
-/* This frame's cell lists (a counting sort of triangles by cell); gready stays false
- * when they would not fit. */
+/* A triangle's cells, a byte each (gside is at most 256): cx0, cy0, cx1, cy1 from the
+ * low byte up. Made with its bounds (on the host's threads where there are some) and
+ * kept in m->cull, which no tile uses before the grid is made. */
+static uint32_t cells_of(const om__asm_state *m, const float *b)
+{
+    return cell_of(m, b[0]) | cell_of(m, b[1]) << 8 | cell_of(m, b[2]) << 16 | cell_of(m, b[3]) << 24;
+}
+
+/* This frame's cell lists (a counting sort of triangles by cell, from their cells in
+ * m->cull); gready stays false when they would not fit. */
 static void grid_make(om__asm_state *m)
 {
     const om_scene *s = m->scene;
@@ -131,8 +139,7 @@ static void grid_make(om__asm_state *m)
     memset(m->gstart, 0, ((size_t)G * G + 1) * sizeof(uint32_t));
     uint64_t total = 0;
     for (uint32_t k = 0; k < s->ntris; k++) {
-        const float *b = &m->tbox[(size_t)k * 4];
-        uint32_t cx0 = cell_of(m, b[0]), cy0 = cell_of(m, b[1]), cx1 = cell_of(m, b[2]), cy1 = cell_of(m, b[3]);
+        const uint32_t p = m->cull[k], cx0 = p & 255u, cy0 = p >> 8 & 255u, cx1 = p >> 16 & 255u, cy1 = p >> 24;
         total += (uint64_t)(cx1 - cx0 + 1) * (cy1 - cy0 + 1);
         if (total > m->gcap) return;
         for (uint32_t cy = cy0; cy <= cy1; cy++)
@@ -140,8 +147,7 @@ static void grid_make(om__asm_state *m)
     }
     for (uint32_t c = 0; c < G * G; c++) m->gstart[c + 1] += m->gstart[c];
     for (uint32_t k = 0; k < s->ntris; k++) {   /* each cell's list in index order */
-        const float *b = &m->tbox[(size_t)k * 4];
-        uint32_t cx0 = cell_of(m, b[0]), cy0 = cell_of(m, b[1]), cx1 = cell_of(m, b[2]), cy1 = cell_of(m, b[3]);
+        const uint32_t p = m->cull[k], cx0 = p & 255u, cy0 = p >> 8 & 255u, cx1 = p >> 16 & 255u, cy1 = p >> 24;
         for (uint32_t cy = cy0; cy <= cy1; cy++)
             for (uint32_t cx = cx0; cx <= cx1; cx++) m->glist[m->gstart[cy * G + cx]++] = k;
     }
@@ -264,7 +270,8 @@ void om__asm_render_node(om__asm_state *m, uint32_t index)
     om__asm_render_with(m, index, &rs);
 }
 
-/* Triangles [k0, k1)'s bounds and their centre bits, into words cleared or their own. */
+/* Triangles [k0, k1)'s bounds, their centre bits (into words cleared or their own) and
+ * their grid cells (cells_of). */
 static void bounds(om__asm_state *m, uint32_t k0, uint32_t k1)
 {
     const om_scene *s = m->scene;
@@ -274,6 +281,7 @@ static void bounds(om__asm_state *m, uint32_t k0, uint32_t k1)
         for (int i = 0; i < 3; i++) q[i] = dapply(&m->view.light_vp, s->verts[ix[i]]);
         float *b = &m->tbox[(size_t)k * 4];
         tri_box(q, m->tree.lay.tile, b);
+        m->cull[k] = cells_of(m, b);
         for (int i = 0; i < 2; i++)
             m->centre[i][k >> 5] |= (uint32_t)box_holds_centre(b, m->tree.lay.scale[i]) << (k & 31);
     }
