@@ -253,7 +253,8 @@ static void asm_bands(void)
 
 /* ---- asm: observe's analysis and the tile renders as jobs (asm_jobs.c). The method
  * driven directly, its tree hashed after observe and after build (use marks, benefits,
- * every cell's benefit and need, every tile), with the jobs lent to it run backwards
+ * every cell's benefit and need, every tile, the triangle grid), on method memory
+ * filled with different garbage, with the jobs lent to it run backwards
  * on 3 slots against none lent: views jumping between two places (so that nodes were
  * last used two frames before), caps that leave the free list short (observe then runs
  * a strip at a time) or not, strips of 8 rows or one. */
@@ -273,7 +274,12 @@ static void lent_run(const om__lend *l, void (*fn)(void *user, uint32_t k, void 
 static uint64_t asm_tree_hash(const void *state)
 {
     om__asm_tree *t = (om__asm_tree *)om__asm_tree_of(state);
+    const om__asm_state *m = (const om__asm_state *)state;
     uint64_t h = OM_HASH_INIT;
+    if (m->gready) {   /* the frame's triangle grid: its starts and lists */
+        const size_t g2 = (size_t)m->gside * m->gside;
+        h = om_hash(om_hash(h, m->gstart, (g2 + 1) * sizeof *m->gstart), m->glist, m->gstart[g2] * sizeof *m->glist);
+    }
     for (uint32_t i = 0; i <= t->lay.count; i++) {
         const uint32_t idx = i == t->lay.count ? OM__ASM_ROOT : i;
         om__asm_tile tl;
@@ -299,6 +305,7 @@ static void asm_jobs_case(const om_scene *s, const char *set, uint32_t rows, flo
     om_diag d;
     CHECK_OK(m->bytes(&c, s, W, H, &mn, &full));
     void *mm = malloc(full), *state = NULL;
+    memset(mm, lend ? 0x5A : 0xA5, full);   /* what init leaves unwritten differs between the two */
     uint32_t *depth = calloc((size_t)W * H, sizeof *depth), *id = calloc((size_t)W * H, sizeof *id);
     om_sample *smp = calloc((size_t)W * H, sizeof *smp);
     om_term *terms = calloc((size_t)W * H, sizeof *terms), *kept = calloc((size_t)W * H, sizeof *terms);

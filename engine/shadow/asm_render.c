@@ -129,27 +129,81 @@ static uint32_t cells_of(const om__asm_state *m, const float *b)
     return cell_of(m, b[0]) | cell_of(m, b[1]) << 8 | cell_of(m, b[2]) << 16 | cell_of(m, b[3]) << 24;
 }
 
+/* Rows [r0, r1) of the triangle grid: with `place` false, each cell's count of the
+ * triangles that meet it into gstart[cell + 1] (zeroed first), stopping once the rows
+ * hold more than gcap entries; with `place`, each triangle appended to the lists of its
+ * cells there (gstart[cell]: where the cell's next goes), in index order. Every
+ * triangle's cells are read (m->cull), only these rows' counts and lists written, so
+ * bands of rows may run at once and give what one band of all rows gives. Returns the
+ * entries the rows hold (counting). */
+static uint64_t grid_rows(const om__asm_state *m, uint32_t r0, uint32_t r1, bool place)
+{
+    const uint32_t G = m->gside, *cells = m->cull;
+    uint32_t *start = m->gstart;
+    uint64_t total = 0;
+    if (!place) memset(start + (size_t)r0 * G + 1, 0, (size_t)(r1 - r0) * G * sizeof(uint32_t));
+    for (uint32_t k = 0; k < m->scene->ntris; k++) {
+        const uint32_t p = cells[k], cy0 = p >> 8 & 255u, cy1 = p >> 24;
+        if (cy1 < r0 || cy0 >= r1) continue;
+        const uint32_t cx0 = p & 255u, cx1 = p >> 16 & 255u, y0 = cy0 > r0 ? cy0 : r0, y1 = cy1 < r1 ? cy1 : r1 - 1;
+        if (place) {
+            for (uint32_t cy = y0; cy <= y1; cy++)
+                for (uint32_t cx = cx0; cx <= cx1; cx++) m->glist[start[cy * G + cx]++] = k;
+            continue;
+        }
+        total += (uint64_t)(cx1 - cx0 + 1) * (y1 - y0 + 1);
+        if (total > m->gcap) return total;
+        for (uint32_t cy = y0; cy <= y1; cy++)
+            for (uint32_t cx = cx0; cx <= cx1; cx++) start[cy * G + cx + 1]++;
+    }
+    return total;
+}
+
+#if OM_WITH_JOBS
+/* grid_rows by bands of rows as jobs (om__lend): the same lists. */
+typedef struct grid_job {
+    const om__asm_state *m;
+    uint32_t bands;
+    bool place;
+    uint64_t total[256];   /* each band's entries (gside, so bands, is at most 256) */
+} grid_job;
+
+static void grid_band(void *user, uint32_t b, void *scratch)
+{
+    grid_job *j = (grid_job *)user;
+    const uint32_t G = j->m->gside;
+    (void)scratch;
+    j->total[b] = grid_rows(j->m, G * b / j->bands, G * (b + 1) / j->bands, j->place);
+}
+#endif
+
 /* This frame's cell lists (a counting sort of triangles by cell, from their cells in
  * m->cull); gready stays false when they would not fit. */
 static void grid_make(om__asm_state *m)
 {
-    const om_scene *s = m->scene;
     const uint32_t G = m->gside;
     m->gready = false;
-    memset(m->gstart, 0, ((size_t)G * G + 1) * sizeof(uint32_t));
-    uint64_t total = 0;
-    for (uint32_t k = 0; k < s->ntris; k++) {
-        const uint32_t p = m->cull[k], cx0 = p & 255u, cy0 = p >> 8 & 255u, cx1 = p >> 16 & 255u, cy1 = p >> 24;
-        total += (uint64_t)(cx1 - cx0 + 1) * (cy1 - cy0 + 1);
+    m->gstart[0] = 0;
+#if OM_WITH_JOBS
+    if (m->lend) {
+        /* two bands a slot: every band reads every triangle's cells, so few */
+        grid_job j;
+        j.m = m;
+        j.bands = 2 * m->lend->slots < G ? 2 * m->lend->slots : G;
+        j.place = false;
+        m->lend->run(m->lend, grid_band, &j, j.bands);
+        uint64_t total = 0;
+        for (uint32_t b = 0; b < j.bands; b++) total += j.total[b];
         if (total > m->gcap) return;
-        for (uint32_t cy = cy0; cy <= cy1; cy++)
-            for (uint32_t cx = cx0; cx <= cx1; cx++) m->gstart[cy * G + cx + 1]++;
-    }
-    for (uint32_t c = 0; c < G * G; c++) m->gstart[c + 1] += m->gstart[c];
-    for (uint32_t k = 0; k < s->ntris; k++) {   /* each cell's list in index order */
-        const uint32_t p = m->cull[k], cx0 = p & 255u, cy0 = p >> 8 & 255u, cx1 = p >> 16 & 255u, cy1 = p >> 24;
-        for (uint32_t cy = cy0; cy <= cy1; cy++)
-            for (uint32_t cx = cx0; cx <= cx1; cx++) m->glist[m->gstart[cy * G + cx]++] = k;
+        for (uint32_t c = 0; c < G * G; c++) m->gstart[c + 1] += m->gstart[c];
+        j.place = true;
+        m->lend->run(m->lend, grid_band, &j, j.bands);
+    } else
+#endif
+    {
+        if (grid_rows(m, 0, G, false) > m->gcap) return;
+        for (uint32_t c = 0; c < G * G; c++) m->gstart[c + 1] += m->gstart[c];
+        (void)grid_rows(m, 0, G, true);
     }
     for (uint32_t c = G * G; c > 0; c--) m->gstart[c] = m->gstart[c - 1];   /* back to starts */
     m->gstart[0] = 0;
