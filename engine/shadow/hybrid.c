@@ -538,6 +538,63 @@ static void put_key(om__hkey *q, const om__lpoint *p, size_t i)
     q->idx = (uint32_t)i;
 }
 
+/* Samples go onto the light's grid LANES exposed ones at a time: first the light's
+ * matrix times each one's point, in one loop over the lanes that a compiler can run on
+ * vector registers (om__mat_apply, the same float operations in the same order as
+ * om__lspace_point's: the same bits), then each lane's snap and lookup. The products
+ * no longer wait in line behind the branches of the lookup before them. One lane
+ * where a double is a software routine (OM_FAST_FLOAT): no vector unit there. */
+#if OM_FAST_FLOAT
+#define LANES 1
+#else
+#define LANES 16
+#endif
+
+/* The next batch of the strip's samples from *i on: every term set to 255 on the way,
+ * up to LANES exposed samples projected and looked up, counts[0], [1], [2] counting
+ * those certainly lit, certainly shadowed and uncertain. The uncertain ones' keys go
+ * to q, in the strip's order; returns how many. */
+static uint32_t look_up(const hybrid_state *m, om_strip *st, size_t *i, size_t n, uint32_t counts[3],
+                        om__hkey q[LANES])
+{
+    float px[LANES], py[LANES], pz[LANES], cx[LANES], cy[LANES], cz[LANES], cw[LANES];
+    uint32_t at[LANES], k = 0, u = 0;
+    for (; *i < n && k < LANES; ++*i) {
+        om_term *t = &st->terms[*i];
+        t->r = t->g = t->b = 255;
+        if (!(t->flags & OM_TERM_EXPOSED)) continue;
+        const om_sample *s = &st->samples[*i];
+        px[k] = s->p[0];
+        py[k] = s->p[1];
+        pz[k] = s->p[2];
+        at[k++] = (uint32_t)*i;
+    }
+    for (uint32_t j = k; j < LANES; j++) {   /* lanes left over */
+        px[j] = py[j] = pz[j] = 0.0f;
+        at[j] = 0;
+    }
+    for (uint32_t j = 0; j < LANES; j++) {
+        const om_vec4 c = om__mat_apply(&m->ls.vp, om__v3(px[j], py[j], pz[j]));
+        cx[j] = c.x;
+        cy[j] = c.y;
+        cz[j] = c.z;
+        cw[j] = c.w;
+    }
+    for (uint32_t j = 0; j < k; j++) {
+        const om_vec4 c = {cx[j], cy[j], cz[j], cw[j]};
+        om__lpoint p;
+        uint32_t z = 0;
+        int64_t tex;
+        if (!om__project(&c, OM_LIGHT_GRID, OM_LIGHT_GRID, &p.x, &p.y, &z)) continue;
+        p.z = z;
+        p.tri = st->samples[at[j]].tri;
+        const int a = classify(m, &p, &st->terms[at[j]], &tex);
+        counts[a == 1 ? 0 : a == 2 ? 1 : 2]++;
+        if (a == 0) put_key(&q[u++], &p, at[j]);
+    }
+    return u;
+}
+
 /* The strip's resolve on one thread: each exposed sample is projected, looked up and
  * counted, and the uncertain ones go through the irregular pass a tile (cap samples)
  * at a time, in the strip's order. */
@@ -545,27 +602,28 @@ static om_status hybrid_resolve(void *state, om_strip *st, om_diag *d)
 {
     (void)d;
     hybrid_state *m = (hybrid_state *)state;
-    size_t n = (size_t)st->rows * st->width, i = 0;
+    const size_t n = (size_t)st->rows * st->width;
+    size_t i = 0;
+    uint32_t counts[3] = {0, 0, 0}, k = 0;
+    om__hkey q[LANES];
     while (i < n) {
-        uint32_t k = 0;
-        for (; i < n && k < m->cap; i++) {
-            om_term *t = &st->terms[i];
-            om__lpoint p;
-            int64_t tex;
-            t->r = t->g = t->b = 255;
-            if (!(t->flags & OM_TERM_EXPOSED) || !om__lspace_point(&m->ls, &st->samples[i], &p)) continue;
-            int c = classify(m, &p, t, &tex);
-            if (c == 1) m->lit++;
-            else if (c == 2) m->shadowed++;
-            if (c) continue;
-            m->uncertain++;
-            put_key(&m->tile.raw[k++], &p, i);
-        }
-        if (k) {
-            om__htile_run(&m->h, &m->tile, k, st);
-            m->tiles++;
+        const uint32_t u = look_up(m, st, &i, n, counts, q);
+        for (uint32_t j = 0; j < u; j++) {
+            m->tile.raw[k++] = q[j];
+            if (k == m->cap) {   /* a tile is full: its samples' terms, before the next */
+                om__htile_run(&m->h, &m->tile, k, st);
+                m->tiles++;
+                k = 0;
+            }
         }
     }
+    if (k) {
+        om__htile_run(&m->h, &m->tile, k, st);
+        m->tiles++;
+    }
+    m->lit += counts[0];
+    m->shadowed += counts[1];
+    m->uncertain += counts[2];
     return OM_OK;
 }
 
@@ -583,16 +641,13 @@ static void hybrid_band(const void *state, om_strip *st, void *scratch, uint32_t
 {
     (void)scratch;
     const hybrid_state *m = (const hybrid_state *)state;
-    size_t n = (size_t)st->rows * st->width;
-    for (size_t i = 0; i < n; i++) {
-        om_term *t = &st->terms[i];
-        om__lpoint p;
-        int64_t tex;
-        t->r = t->g = t->b = 255;
-        if (!(t->flags & OM_TERM_EXPOSED) || !om__lspace_point(&m->ls, &st->samples[i], &p)) continue;
-        int c = classify(m, &p, t, &tex);
-        counts[c == 1 ? 0 : c == 2 ? 1 : 2]++;
-        if (c == 0) {
+    const size_t n = (size_t)st->rows * st->width;
+    size_t i = 0;
+    om__hkey q[LANES];
+    while (i < n) {
+        const uint32_t u = look_up(m, st, &i, n, counts, q);
+        for (uint32_t j = 0; j < u; j++) {
+            om_term *t = &st->terms[q[j].idx];
             t->r = t->g = 0;
             t->b = 1;
         }

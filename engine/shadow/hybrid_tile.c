@@ -119,7 +119,7 @@ static void sort_tile(om__htile *t, uint32_t n)
  * bounds first, so the shifts are of 32 bits. */
 typedef struct crange { uint32_t x0, y0, x1, y1; } crange;
 
-static crange cells_in(const om__htile *t, int64_t lox, int64_t loy, int64_t hix, int64_t hiy)
+static inline crange cells_in(const om__htile *t, int64_t lox, int64_t loy, int64_t hix, int64_t hiy)
 {
     const om__hbox *x = &t->box;
     crange r;
