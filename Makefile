@@ -115,8 +115,10 @@ $(O)/embed-only-sm: tests/embed/render_once.c engine/shadow/registry.c $(O)/libo
                     include/ombra.h $(wildcard engine/*/*.h)
 	$(Q)$(CC) $(CFLAGS_ALL) $(ONLY_SM) -o $@ $(filter %.c %.a,$^) $(LDLIBS)
 
+# The benchmark, stress and stability programs are built (not run), so a change that
+# breaks one fails here and not at the next `make bench`.
 check: $(O)/run-tests $(O)/ombra $(FUZZ_TARGETS:%=$(O)/fuzz-replay-%) $(O)/embed-render-once \
-       $(O)/embed-render-sized $(O)/embed-only-sm
+       $(O)/embed-render-sized $(O)/embed-only-sm $(O)/bench $(O)/stress $(O)/stability
 	@echo "== $(O)"
 	$(O)/run-tests
 	sh tests/cli.sh $(O)/ombra
