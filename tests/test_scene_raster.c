@@ -172,7 +172,48 @@ static void scene_walk_same_as_one_by_one(void)
     h_scene_free(&hs);
 }
 
+/* The bins' vertex depths at om__zdepth's edges: a matrix that takes vertex (w, 0, z)
+ * to clip space (0, 0, z, w), so that each vertex tests one pair: z of 0 and -0,
+ * subnormal, one unit and just below, equal to w and an ulp either side, w subnormal
+ * or near 2^127, and z/w below 2^-24, through every position of a batch. */
+static void bins_depths_at_the_edges(void)
+{
+    const float zs[] = {0.0f, -0.0f, 1e-45f, 1e-40f, 1.1754942e-38f, 1.17549435e-38f, 2.3283064e-10f,
+                        2.3283063e-10f, 5.9604645e-08f, 0.25f, 0.5f, 0.99999994f, 1.0f, 1.0000001f,
+                        3e38f, 1e-30f, 7.0f, 0.3333333f};
+    const float ws[] = {1.0f, 1e-39f, 1.17549435e-38f, 3.4e38f, 0.5f, 1e10f, 7.0f, 2.0f};
+    enum { NZ = sizeof zs / sizeof zs[0], NW = sizeof ws / sizeof ws[0], N = NZ * NW };
+    om_vec3 verts[N];
+    for (int i = 0; i < N; i++) verts[i] = om__v3(ws[i % NW], 0.0f, zs[i / NW]);
+    om_scene sc;
+    memset(&sc, 0, sizeof sc);
+    sc.nverts = N;
+    sc.verts = verts;
+    om_mat4 vp;
+    memset(&vp, 0, sizeof vp);
+    vp.m[10] = 1.0f;   /* z' = z */
+    vp.m[12] = 1.0f;   /* w' = x */
+    om__vsnap vs[N];
+    om__bins b = {NULL, vs};
+    size_t wrong = 0, inside = 0;
+    for (uint32_t v0 = 0; v0 < 24; v0 += 7) {   /* batches starting anywhere */
+        memset(vs, 0x5A, sizeof vs);
+        om__bins_make_verts(&sc, &vp, 64, 64, &b, v0, N);
+        for (uint32_t v = v0; v < N; v++) {
+            const om_vec4 c = om__mat_apply(&vp, verts[v]);
+            int64_t x, y;
+            uint32_t z;
+            const bool in = om__inside_band(&c, om__guard_band(64, 64)) && om__project(&c, 64, 64, &x, &y, &z);
+            inside += in;
+            wrong += in ? vs[v].x == INT32_MIN || vs[v].z != z : vs[v].x != INT32_MIN;
+        }
+    }
+    CHECK_MSG(wrong == 0, "%zu vertex depths differ from om__zdepth", wrong);
+    CHECK(inside > N);   /* most pairs are inside the near and far planes */
+}
+
 void suite_scene_raster(void)
 {
     RUN(scene_walk_same_as_one_by_one);
+    RUN(bins_depths_at_the_edges);
 }

@@ -216,6 +216,32 @@ static inline void lanes_project(lanes *restrict b, float *restrict px, float *r
 #define VERT_LANES 0
 #endif
 
+/* om__zdepth of the lanes' z and w up to its division, a loop over the lanes on the
+ * floats' bits (copied out whole: a union a lane would stop a compiler's lanes), with
+ * its tests and steps in its order: kind 0 for depth 0 (z <= 0, NaN, or below one
+ * unit), 2 for 2^32 - 1 (z >= w), 1 for mz * 2^e / mw (a shift left or right, then
+ * one integer division), the same bits. Only lanes of w > 0 are used. */
+typedef struct depths {
+    uint32_t mz[LANES], mw[LANES];
+    int32_t e[LANES], kind[LANES];
+} depths;
+
+static inline void lanes_depth(depths *restrict d, const lanes *restrict l)
+{
+    uint32_t bz[LANES], bw[LANES];
+    memcpy(bz, l->z, sizeof bz);
+    memcpy(bw, l->w, sizeof bw);
+    for (int i = 0; i < LANES; i++) {
+        const int32_t ez = (int32_t)(bz[i] >> 23), ew = (int32_t)(bw[i] >> 23);   /* z > 0, w > 0: no sign */
+        d->mz[i] = (bz[i] & 0x7FFFFFu) | (ez ? 0x800000u : 0u);
+        d->mw[i] = (bw[i] & 0x7FFFFFu) | (ew ? 0x800000u : 0u);
+        const int32_t e = (ez + !ez) - (ew + !ew) + 32;   /* a subnormal's exponent is the least normal one's */
+        const int32_t pos = l->z[i] > 0.0f, below = l->z[i] < l->w[i];
+        d->e[i] = e;
+        d->kind[i] = pos & below ? (int32_t)(e >= -24) : 2 * pos;
+    }
+}
+
 /* The bins' vertices [v0, v1): each snapped alone as om__raster_tri would snap it when
  * it needs no clipping, its depth with it (a triangle's strips and bands share it),
  * x = INT32_MIN when it needs clipping. Every entry is written: the frame's bins are
@@ -230,6 +256,7 @@ void om__bins_make_verts(const om_scene *s, const om_mat4 *vp, uint32_t width, u
 #if VERT_LANES
     const float sx = (float)width * (OM_SUBPIX / 2), sy = (float)height * (OM_SUBPIX / 2);
     lanes l;
+    depths d;
     float px[LANES], py[LANES], pz[LANES];
     for (uint32_t v = v0; v < v1; v += LANES) {
         const uint32_t n = v1 - v < LANES ? v1 - v : LANES;
@@ -241,12 +268,16 @@ void om__bins_make_verts(const om_scene *s, const om_mat4 *vp, uint32_t width, u
             pz[i] = p[k].z;
         }
         lanes_project(&l, px, py, pz, vp, g, sx, sy);
+        lanes_depth(&d, &l);
         for (uint32_t i = 0; i < n; i++) {
             om__vsnap *o = &vs[v + i];
             if (l.ok[i]) {
+                const uint32_t mz = d.mz[i], mw = d.mw[i];
+                const int32_t e = d.e[i];
                 o->x = l.gx[i];
                 o->y = l.gy[i];
-                o->z = om__zdepth(l.z[i], l.w[i]);
+                o->z = d.kind[i] == 1 ? (uint32_t)(e >= 0 ? ((uint64_t)mz << e) / mw : mz / ((uint64_t)mw << -e))
+                                      : d.kind[i] == 2 ? 0xFFFFFFFFu : 0u;
             } else {
                 o->x = INT32_MIN;
                 o->y = 0;
