@@ -357,6 +357,42 @@ static void float_predicate_is_the_double_one(void)
     CHECK_MSG(far_answered * 10 > far * 8, "%llu of %llu answered away from it", far_answered, far);
 }
 
+/* om__zdepth by 32-bit words (raster.h, the Cortex-M4's way) gives the 64-bit
+ * division's quotient: every shift, significands at both ends of their range, next to
+ * each other and random, wherever the quotient fits 32 bits (z < w). */
+static void zdepth_by_words(void)
+{
+    uint32_t seed = 0x2545F491u, bad = 0, n = 0;
+    for (int s = -24; s <= 32; s++)
+        for (int i = 0; i < 4000; i++) {
+            uint32_t mz, mw;
+            switch (i % 8) {
+            case 0: mz = rnd32(&seed) % 0xFFFFFFu + 1; mw = 0xFFFFFFu; break;
+            case 1: mw = (rnd32(&seed) & 0x7FFFFFu) | 0x800000u; mz = mw - 1 - rnd32(&seed) % 4; break;
+            case 2: mz = (rnd32(&seed) & 0x7FFFFFu) | 0x800000u; mw = 0x800000u; break;
+            case 3: mz = rnd32(&seed) % 64 + 1; mw = rnd32(&seed) % 64 + 1; break;   /* subnormal-like */
+            default: mz = rnd32(&seed) % 0xFFFFFFu + 1; mw = rnd32(&seed) % 0xFFFFFFu + 1; break;
+            }
+            const uint64_t z = mz, w = mw;
+            /* the quotient must fit 32 bits, as it does for z < w */
+            if (s > 0 && (z << s) / w > 0xFFFFFFFFu) continue;
+            const uint64_t want = s >= 0 ? (z << s) / w : z / (w << -s);
+            bad += om__zdepth_words(mz, mw, s) != want;
+            n++;
+        }
+    CHECK_MSG(bad == 0 && n > 150000, "%u of %u quotients differ", bad, n);
+    /* and through om__zdepth, whichever way it divides: depths of floats */
+    const float zs[] = {1e-40f, 1e-30f, 0.25f, 0.5f, 0.999f, 1.0f, 3.0f, 1e20f};
+    for (int a = 0; a < 8; a++)
+        for (int b = 0; b < 8; b++) {
+            const float z = zs[a], w = zs[b];
+            const double q = (double)z / (double)w * 4294967296.0;   /* exact enough to floor here */
+            const uint32_t want = !(z > 0.0f) ? 0 : !(z < w) ? 0xFFFFFFFFu : (uint32_t)floor(q);
+            CHECK_MSG(om__zdepth(z, w) == want || (q - floor(q)) * (q - floor(q)) < 1e-12,
+                      "zdepth(%g, %g) = %u, not %u", (double)z, (double)w, om__zdepth(z, w), want);
+        }
+}
+
 static void transmittance_composes(void)
 {
     om_material glass = {1.0f, 0.5f, 0.0f, 0.5f};
@@ -688,6 +724,7 @@ void suite_shadow(void)
     RUN(bvh_equals_brute_force);
     RUN(lbvh_fit_in_parts);
     RUN(float_predicate_is_the_double_one);
+    RUN(zdepth_by_words);
     RUN(transmittance_composes);
     RUN(sm_improves_with_resolution);
     RUN(methods_agree_on_samples);

@@ -302,9 +302,39 @@ static inline bool om__project_xy(const om_vec4 *v, uint32_t width, uint32_t hei
     return true;
 }
 
+/* Where the CPU divides 32-bit words but a 64-bit division is a library call (32-bit
+ * ARM with a divide instruction: the Cortex-M3, M4, M7), om__zdepth divides by words
+ * (om__zdepth_words); elsewhere (64-bit CPUs, the Cortex-M0, which divides no word
+ * either) by one 64-bit division. The same quotient either way. */
+#if defined(__ARM_FEATURE_IDIV) && UINTPTR_MAX <= 0xFFFFFFFFu
+#define OM_ZDEPTH_WORDS 1
+#else
+#define OM_ZDEPTH_WORDS 0
+#endif
+
+/* mz * 2^s / mw, truncated, for mz, mw in [1, 2^24) and s in [-24, 32] where the
+ * quotient is below 2^32, with 32-bit divisions alone: for s > 0, as in long division,
+ * the quotient's first 1 to 8 bits, then eight at a time (each remainder is below mw,
+ * so shifted by 8 it still fits a word); for s <= 0, mz / mw shifted down (truncating
+ * twice truncates once: floor(floor(a / b) / c) = floor(a / (b c)) for whole a, b,
+ * c > 0). */
+static inline uint32_t om__zdepth_words(uint32_t mz, uint32_t mw, int s)
+{
+    if (s <= 0) return (mz / mw) >> -s;
+    const int steps = (s - 1) >> 3;   /* after the first: 0 to 3 of 8 bits */
+    const uint32_t n = mz << (s - 8 * steps);
+    uint32_t q = n / mw, r = n - q * mw;
+    for (int i = 0; i < steps; i++) {
+        const uint32_t m = r << 8, d = m / mw;   /* d < 2^8, as r < mw */
+        q = (q << 8) + d;
+        r = m - d * mw;
+    }
+    return q;
+}
+
 /* z/w * 2^32, truncated: exact, from the floats' significands divided as integers (a
- * 64-by-32-bit integer division, far cheaper than an emulated double one); 0 for
- * z <= 0 (or NaN), 2^32 - 1 for z >= w. */
+ * 64-by-32-bit integer division, or words, far cheaper than an emulated double one);
+ * 0 for z <= 0 (or NaN), 2^32 - 1 for z >= w. */
 static inline uint32_t om__zdepth(float z, float w)
 {
     if (!(z > 0.0f)) return 0;
@@ -321,6 +351,7 @@ static inline uint32_t om__zdepth(float z, float w)
     ew += !ew;
     const int s = ez - ew + 32;   /* z/w * 2^32 = mz / mw * 2^s, s <= 32 as z < w */
     if (s < -24) return 0;        /* mz / mw < 2^24: below one unit */
+    if (OM_ZDEPTH_WORDS) return om__zdepth_words((uint32_t)mz, (uint32_t)mw, s);
     return (uint32_t)(s >= 0 ? (mz << s) / mw : mz / (mw << -s));
 }
 
