@@ -33,7 +33,7 @@ typedef struct ref_state {
  *         a frame has many samples a packet can share;
  * CACHE   the vertex projection and leaves of 4, the BVH's own nodes re-bounded on the
  *         light's grid every frame in place of their 3-D boxes, walked per sample:
- *         about half the bytes (on the small scene at 160x120, 107 KB of 206 KB), for
+ *         about half the bytes (on the small scene at 160x120, 107 KB of 207 KB), for
  *         a 256 KiB machine;
  * LEAST   no projection cache, leaves of 32: a fraction of the nodes, for the smallest
  *         machines, walked along the segment in 3-D. */
