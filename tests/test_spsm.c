@@ -725,6 +725,121 @@ static void lookup_integers_are_the_shared_ones(void)
     CHECK_EQ_U(bad, 0);
 }
 
+/* The build's plane without double (om__spsm_fplane) gives the double plane's codes,
+ * directions and centre depths wherever it answers: random triangles near and far
+ * (slivers among them), slopes a few units from a code boundary, and centre depths a few
+ * units from a 16-bit step's half; it answers for most triangles and nearly every
+ * texel. */
+static void build_plane_is_the_double_one(void)
+{
+    static om__spsm_qtable q;
+    om__spsm_qtable_build(&q);
+    uint32_t s = 29;
+    unsigned long long wrong = 0, tris = 0, sure = 0, texels = 0, answered = 0, near = 0, near_answered = 0;
+    unsigned long long near_tris = 0, near_sure = 0;
+    const float k = 0x1p-11f;
+    for (int it = 0; it < 60000; it++) {
+        int64_t X[3], Y[3];
+        uint32_t Z[3];
+        const int kind = it % 4;
+        const int64_t bx = (int64_t)(next_rand(&s) % 1024) * 256, by = (int64_t)(next_rand(&s) % 1024) * 256;
+        if (kind == 3) {
+            /* a right triangle whose slope along x (or y) sits a few units from a code
+             * boundary: zx = dz / L */
+            const int64_t L = 3000 + (int64_t)(next_rand(&s) % 2000);   /* rounded in float */
+            const int b = (int)(next_rand(&s) % 127);
+            const double U = (double)q.up[b] * 2048.0;
+            if (U * (double)L > 2e9) continue;
+            const int64_t off = ((int64_t)(next_rand(&s) % 7) - 3) * (next_rand(&s) % 2 ? 1 : 97);
+            const int64_t dz = (int64_t)floor(U * (double)L + 0.5) + off;
+            const uint32_t z0 = 1000000000u + next_rand(&s) % 1000000u;
+            const bool along_y = next_rand(&s) % 2;
+            const bool neg = next_rand(&s) % 2;
+            X[0] = bx; Y[0] = by; X[1] = bx + L; Y[1] = by; X[2] = bx; Y[2] = by + L;
+            Z[0] = z0;
+            Z[1] = along_y ? z0 : (uint32_t)(neg ? (int64_t)z0 - dz : (int64_t)z0 + dz);
+            Z[2] = along_y ? (uint32_t)(neg ? (int64_t)z0 - dz : (int64_t)z0 + dz) : z0;
+        } else {
+            /* small, middling and large triangles, depths spread over 2^20 to all of 2^32 */
+            const int64_t reach = kind == 0 ? 600 : kind == 1 ? 20000 : 300000;
+            const uint32_t span = it % 3 == 0 ? 1u << 20 : it % 3 == 1 ? 1u << 28 : 0xFFFFFFFFu;
+            const uint32_t base = span == 0xFFFFFFFFu ? 0u : ((next_rand(&s) << 8) ^ next_rand(&s)) % (0xFFFFFFFFu - span);
+            for (int i = 0; i < 3; i++) {
+                X[i] = bx + (int64_t)(next_rand(&s) % (uint32_t)(2 * reach)) - reach;
+                Y[i] = by + (int64_t)(next_rand(&s) % (uint32_t)(2 * reach)) - reach;
+                Z[i] = base + ((next_rand(&s) << 8) ^ next_rand(&s)) % span;
+            }
+            if (it % 16 == 5) { X[2] = X[0] + (X[1] - X[0]) * 3 + 1; Y[2] = Y[0] + (Y[1] - Y[0]) * 3; }   /* sliver */
+            if (it % 16 == 9) Z[1] = Z[2] = Z[0];   /* flat */
+        }
+        om__rtri t;
+        om__tri2_setup(&t.e, X, Y, false);
+        om__rtri_zplane(&t, Z);
+        om__rtri_plane(&t, Z);
+        uint32_t zv[3];
+        for (int i = 0; i < 3; i++) zv[i] = Z[t.e.perm[i]];
+        om__spsm_fplane f;
+        om__spsm_fplane_setup(&f, &q, &t, zv);
+        tris += kind != 3;
+        near_tris += kind == 3;
+        if (f.sure) {
+            sure += kind != 3;
+            near_sure += kind == 3;
+            const float gx = (float)t.zx, gy = (float)t.zy;
+            wrong += f.qx != om__spsm_q_encode_f(&q, gx * k) || f.qy != om__spsm_q_encode_f(&q, gy * k) ||
+                     f.down_x != (gx > 0.0f) || f.down_y != (gy > 0.0f);
+        }
+        /* texels the triangle touches, and centre depths moved next to a step's half */
+        int64_t lx = X[0], hx = X[0], ly = Y[0], hy = Y[0];
+        for (int i = 1; i < 3; i++) {
+            lx = X[i] < lx ? X[i] : lx; hx = X[i] > hx ? X[i] : hx;
+            ly = Y[i] < ly ? Y[i] : ly; hy = Y[i] > hy ? Y[i] : hy;
+        }
+        for (int j = 0; j < 6; j++) {
+            const int tx = (int)((lx >> 8) - 1 + (int64_t)(next_rand(&s) % (uint32_t)((hx >> 8) - (lx >> 8) + 3)));
+            const int ty = (int)((ly >> 8) - 1 + (int64_t)(next_rand(&s) % (uint32_t)((hy >> 8) - (ly >> 8) + 3)));
+            if (!overlaps(X, Y, tx, ty)) continue;
+            om__rtri u = t;
+            om__spsm_fplane g = f;
+            bool moved = false;
+            if (j % 2) {
+                const double zc = u.z0 + u.zx * (double)((int64_t)tx * 256 + 128 - u.e.x[0]) +
+                                  u.zy * (double)((int64_t)ty * 256 + 128 - u.e.y[0]);
+                const double half = floor(zc / 65536.0) * 65536.0 + 32768.0;
+                const int64_t d = (int64_t)floor(half - zc + 0.5) + (int64_t)(next_rand(&s) % 9) - 4;
+                uint32_t Zs[3];
+                bool fits = true;
+                for (int i = 0; i < 3; i++) {
+                    const int64_t v = (int64_t)Z[i] + d;
+                    fits &= v >= 0 && v <= 0xFFFFFFFFll;
+                    Zs[i] = (uint32_t)v;
+                }
+                if (!fits) continue;
+                om__rtri_zplane(&u, Zs);
+                om__rtri_plane(&u, Zs);
+                for (int i = 0; i < 3; i++) zv[i] = Zs[u.e.perm[i]];
+                om__spsm_fplane_setup(&g, &q, &u, zv);
+                moved = true;
+            }
+            const int32_t got = om__spsm_centre_zf(&g, &u, tx, ty);
+            texels += !moved;
+            near += moved;
+            if (got >= 0) {
+                answered += !moved;
+                near_answered += moved;
+                wrong += got != (int32_t)om__spsm_centre_z(&u, tx, ty);
+            }
+        }
+    }
+    CHECK_EQ_U(wrong, 0);
+    CHECK_MSG(sure * 20 > tris * 19, "%llu of %llu triangles sure", sure, tris);
+    /* (a third of the triangles have depths over all of 2^32, so steep that the
+     * depths of some of their texel centres may wrap: those texels ask the double) */
+    CHECK_MSG(answered * 10 > texels * 9, "%llu of %llu centre depths answered", answered, texels);
+    CHECK(near_answered > 0 && near_answered < near);
+    CHECK(near_sure > 0 && near_sure < near_tris);
+}
+
 void suite_spsm(void)
 {
     RUN(conservative_is_exact_overlap);
@@ -745,4 +860,5 @@ void suite_spsm(void)
     RUN(float_tests_are_the_double_ones);
     RUN(float_less_is_the_double_one);
     RUN(lookup_integers_are_the_shared_ones);
+    RUN(build_plane_is_the_double_one);
 }

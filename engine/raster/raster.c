@@ -586,8 +586,8 @@ static bool snapped(const om_raster *r, uint32_t *hiz, const int64_t x[3], const
     }
     if (!z) z = zdepths(zc, zb);
     if (cons) {
-        om__rtri_zplane(&t, z);
-        om__rtri_plane(&t, z);   /* the spans' callers test the plane beyond the triangle */
+        om__rtri_zplane(&t, z);   /* the fixed-point plane alone (spsm_build.c asks for the
+                                     double one, om__rtri_plane, where it needs it) */
         fill_conservative(r, &t);
     } else {
         om__rtri_zplane(&t, z);

@@ -101,9 +101,10 @@ void om__target_clear(const om_target *t);
 typedef struct om__rtri {
     om__tri2 e;
     uint64_t zq0, zqx, zqy; /* the fixed-point plane the fills use (the rule above) */
-    /* The plane in double, for the occlusion predicate and the callers of conservative
-     * mode, which test it at points outside the triangle too (om__rtri_plane): depth
-     * (0..2^32) at stored vertex 0, per sub-pixel unit, and the vertex depth range. */
+    /* The plane in double, for the occlusion predicate, which tests it at points
+     * outside the triangle too (om__rtri_plane; no fill sets it, and conservative mode's
+     * spans get the fixed-point plane alone): depth (0..2^32) at stored vertex 0, per
+     * sub-pixel unit, and the vertex depth range. */
     double z0, zx, zy;
     double zmin, zmax;
     int32_t minx, maxx, miny, maxy;   /* pixel bounds (inclusive), clamped to the image */

@@ -82,16 +82,50 @@ typedef struct om__spsm_tangent {
 
 void om__spsm_tangent_build(om__spsm_tangent lut[512]);
 
-/* Packs the snapped triangle `t` (as the rasterizer hands it to a fragment) into the
- * texel at (x, y); qx, qy are its derivative codes (the same for every texel of it). */
+/* Packs the snapped triangle `t` (as the rasterizer hands it to a fragment, with its
+ * double plane, om__rtri_plane) into the texel at (x, y); qx, qy are its derivative
+ * codes (the same for every texel of it). The centre depth is om__spsm_centre_z's. */
 void om__spsm_pack(om__spsm_texel *out, const om__rtri *t, int32_t x, int32_t y, uint8_t qx,
                    uint8_t qy);
+/* The record's depth: the double plane at the centre of texel (x, y), not clamped to
+ * the triangle's depth range (the lookup extrapolates from there), rounded to 16 bits
+ * and clamped to them. */
+uint16_t om__spsm_centre_z(const om__rtri *t, int32_t x, int32_t y);
 
 /* The same in two parts, for the build: the vertices' y codes depend only on the
  * triangle and the texel row, so a run of texels along a row encodes them once
- * (om__spsm_row_codes) and packs each texel with them (om__spsm_pack_row). */
+ * (om__spsm_row_codes) and packs each texel x of the row with them and its centre
+ * depth z (om__spsm_pack_row). */
 void om__spsm_row_codes(uint16_t vy[3], const om__rtri *t, int32_t y);
-void om__spsm_pack_row(om__spsm_texel *out, const om__rtri *t, int32_t x, int32_t y, uint8_t qx,
-                       uint8_t qy, const uint16_t vy[3]);
+void om__spsm_pack_row(om__spsm_texel *out, const om__rtri *t, int32_t x, uint8_t qx, uint8_t qy,
+                       const uint16_t vy[3], uint16_t z);
+
+/* What the build takes from a triangle's double plane (om__rtri_plane: the slopes'
+ * codes, the direction depth falls in, the centre depths om__spsm_centre_z), found
+ * without double where that is sure: the slopes' exact numerators in float with an
+ * error bound, and the centre depth from the fixed-point plane (om__rtri_zat), which
+ * is within a unit of the exact plane where the double one is within far less.
+ * Where the bounds leave a doubt the build asks the double plane itself. */
+typedef struct om__spsm_fplane {
+    float zx, zy;            /* the slopes, raw depth per grid unit */
+    bool sure;               /* qx, qy, down_x, down_y are the double plane's */
+    uint8_t qx, qy;          /* om__spsm_q_encode_f of the slopes (float) / 2^11 */
+    bool down_x, down_y;     /* whether the slopes (float) are > 0 */
+    uint32_t reach;          /* centre depths: the doubt around a code boundary (raw
+                                units); 0: none decided here */
+} om__spsm_fplane;
+
+/* Sets f for triangle t (the fixed-point plane set, om__rtri_zplane) whose vertex
+ * depths, in the order of t->e, are z. */
+void om__spsm_fplane_setup(om__spsm_fplane *f, const om__spsm_qtable *q, const om__rtri *t, const uint32_t z[3]);
+/* om__spsm_centre_z(t, x, y) for a texel (x, y) whose square the triangle touches, or
+ * -1 where f cannot be sure of it. */
+static inline int32_t om__spsm_centre_zf(const om__spsm_fplane *f, const om__rtri *t, int32_t x, int32_t y)
+{
+    if (!f->reach) return -1;
+    const uint32_t k = om__rtri_zat(t, (int64_t)x * OM_SUBPIX + OM_SUBPIX / 2, (int64_t)y * OM_SUBPIX + OM_SUBPIX / 2) +
+                       32768u, r = k & 0xFFFFu;
+    return r >= f->reach && r + f->reach < 65536u ? (int32_t)(k >> 16) : -1;
+}
 
 #endif

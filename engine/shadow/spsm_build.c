@@ -51,6 +51,9 @@ typedef struct build_ctx {
     float zf[3];                 /* the vertex depths in float (clipped_min) */
     bool down_x, down_y;         /* whether depth falls along x, along y */
     uint8_t qx, qy;              /* the derivative codes */
+    om__spsm_fplane fp;          /* the double plane's answers without it (spsm.h) */
+    om__rtri dt;                 /* the triangle with its double plane, where fp is */
+    bool have_dt;                /* not sure (made on demand) */
     /* the y codes of the row being filled, for the triangle with these y coordinates:
      * the fill runs along rows, so most texels written reuse them */
     int64_t ry[3];
@@ -59,10 +62,25 @@ typedef struct build_ctx {
     uint16_t vy[3];
 } build_ctx;
 
+/* The triangle's double plane (om__rtri_plane, which conservative mode does not set),
+ * for the answers om__spsm_fplane is not sure of. */
+static const om__rtri *double_plane(build_ctx *b, const om__rtri *t)
+{
+    if (!b->have_dt) {
+        uint32_t z[3];   /* om__rtri_plane takes them in the input order */
+        for (int i = 0; i < 3; i++) z[t->e.perm[i]] = b->zv[i];
+        b->dt = *t;
+        om__rtri_plane(&b->dt, z);
+        b->have_dt = true;
+    }
+    return &b->dt;
+}
+
 /* What every texel of triangle t needs, worked out once: the vertex depths from the
  * fixed-point plane (at a vertex its value is the vertex's own depth: om__rtri_zat's
- * rule at the top of raster.h), and the derivative codes from the table's boundaries
- * (om__spsm_q_encode_f; the slopes rounded to float first). */
+ * rule at the top of raster.h), and the derivative codes of the double plane's slopes
+ * from the table's boundaries (om__spsm_q_encode_f; the slopes rounded to float
+ * first), where om__spsm_fplane is not sure of them from the plane itself. */
 static void tri_setup(build_ctx *b, const om__rtri *t)
 {
     const om__tri2 *e = &t->e;
@@ -77,13 +95,23 @@ static void tri_setup(build_ctx *b, const om__rtri *t)
     }
     b->zmin = b->zv[0] < b->zv[1] ? b->zv[0] : b->zv[1];
     if (b->zv[2] < b->zmin) b->zmin = b->zv[2];
-    /* derivatives in depth steps per texel, scaled (spsm.h): raw per grid unit times
-     * OM_SUBPIX / OM__SPSM_STEP / OM_SPSM_DSCALE = 2^-11, exact in float */
-    const float gx = (float)t->zx, gy = (float)t->zy, k = (float)(OM_SUBPIX / OM__SPSM_STEP / OM_SPSM_DSCALE);
-    b->qx = om__spsm_q_encode_f(&b->m->q, gx * k);
-    b->qy = om__spsm_q_encode_f(&b->m->q, gy * k);
-    b->down_x = gx > 0.0f;   /* the least depth over a square is at its left side */
-    b->down_y = gy > 0.0f;
+    b->have_dt = false;
+    om__spsm_fplane_setup(&b->fp, &b->m->q, t, b->zv);
+    if (b->fp.sure) {
+        b->qx = b->fp.qx;
+        b->qy = b->fp.qy;
+        b->down_x = b->fp.down_x;
+        b->down_y = b->fp.down_y;
+    } else {
+        /* derivatives in depth steps per texel, scaled (spsm.h): raw per grid unit
+         * times OM_SUBPIX / OM__SPSM_STEP / OM_SPSM_DSCALE = 2^-11, exact in float */
+        const om__rtri *d = double_plane(b, t);
+        const float gx = (float)d->zx, gy = (float)d->zy, k = (float)(OM_SUBPIX / OM__SPSM_STEP / OM_SPSM_DSCALE);
+        b->qx = om__spsm_q_encode_f(&b->m->q, gx * k);
+        b->qy = om__spsm_q_encode_f(&b->m->q, gy * k);
+        b->down_x = gx > 0.0f;   /* the least depth over a square is at its left side */
+        b->down_y = gy > 0.0f;
+    }
     b->have = true;
 }
 
@@ -188,7 +216,9 @@ static void texel(build_ctx *b, int32_t x, int32_t y, const om__rtri *t)
         b->row = y;
         b->have_row = true;
     }
-    om__spsm_pack_row(&m->tex[i], t, x, y, b->qx, b->qy, b->vy);
+    int32_t zc = om__spsm_centre_zf(&b->fp, t, x, y);
+    if (zc < 0) zc = om__spsm_centre_z(double_plane(b, t), x, y);
+    om__spsm_pack_row(&m->tex[i], t, x, b->qx, b->qy, b->vy, (uint16_t)zc);
 }
 
 /* Sets rows [y0, y0 + rows) of a buffer to the far plane (empty) at the needed texels,

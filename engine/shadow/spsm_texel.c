@@ -183,22 +183,29 @@ void om__spsm_row_codes(uint16_t vy[3], const om__rtri *t, int32_t y)
     for (int i = 0; i < 3; i++) vy[i] = o16_encode(t->e.y[i] - cy);
 }
 
-void om__spsm_pack_row(om__spsm_texel *out, const om__rtri *t, int32_t x, int32_t y, uint8_t qx,
-                       uint8_t qy, const uint16_t vy[3])
+void om__spsm_pack_row(om__spsm_texel *out, const om__rtri *t, int32_t x, uint8_t qx, uint8_t qy,
+                       const uint16_t vy[3], uint16_t z)
 {
     const om__tri2 *e = &t->e;
-    const int64_t cx = (int64_t)x * OM_SUBPIX + OM_SUBPIX / 2, cy = (int64_t)y * OM_SUBPIX + OM_SUBPIX / 2;
+    const int64_t cx = (int64_t)x * OM_SUBPIX + OM_SUBPIX / 2;
     for (int i = 0; i < 3; i++) {
         out->vx[i] = o16_encode(e->x[i] - cx);
         out->vy[i] = vy[i];
     }
+    out->z = z;
+    out->qx = qx;
+    out->qy = qy;
+}
+
+uint16_t om__spsm_centre_z(const om__rtri *t, int32_t x, int32_t y)
+{
+    const om__tri2 *e = &t->e;
+    const int64_t cx = (int64_t)x * OM_SUBPIX + OM_SUBPIX / 2, cy = (int64_t)y * OM_SUBPIX + OM_SUBPIX / 2;
     /* The plane at the centre, not clamped to the triangle's depth range: the lookup
      * extrapolates from here with the derivatives (Equation 1). */
     double z = t->z0 + t->zx * (double)(cx - e->x[0]) + t->zy * (double)(cy - e->y[0]);
     double s = floor(z / 65536.0 + 0.5);
-    out->z = (uint16_t)(s >= 0.0 ? (s > 65535.0 ? 65535.0 : s) : 0.0);   /* NaN: 0 */
-    out->qx = qx;
-    out->qy = qy;
+    return (uint16_t)(s >= 0.0 ? (s > 65535.0 ? 65535.0 : s) : 0.0);   /* NaN: 0 */
 }
 
 void om__spsm_pack(om__spsm_texel *out, const om__rtri *t, int32_t x, int32_t y, uint8_t qx,
@@ -206,5 +213,91 @@ void om__spsm_pack(om__spsm_texel *out, const om__rtri *t, int32_t x, int32_t y,
 {
     uint16_t vy[3];
     om__spsm_row_codes(vy, t, y);
-    om__spsm_pack_row(out, t, x, y, qx, qy, vy);
+    om__spsm_pack_row(out, t, x, qx, qy, vy, om__spsm_centre_z(t, x, y));
+}
+
+/* ---- the build's plane without double (om__spsm_fplane, spsm.h)
+ *
+ * om__rtri_plane's slope along x is zx = fl(fl(fl(dz1 y2) - fl(dz2 y1)) fl(1 / area2))
+ * (offsets from vertex 0, each product below 2^62): it is within 2^-50 S / area2 of
+ * the exact nx / area2, nx = dz1 y2 - dz2 y1 (exact here in 64 bits) and S = |dz1 y2| +
+ * |dz2 y1| (two roundings of the products, one of the difference, two of the
+ * reciprocal and product, each 2^-53, and |nx| <= S). The float nx / area2 is within
+ * 2^-21 of itself (three roundings of at most an ulp). So the double slope lies within
+ * B = 2^-20 |zx_f| + 2^-49 S / area2 of the float one, twice the sum of the bounds.
+ * A slope's code and direction follow the double slope monotonically (its float, then
+ * a bisection of the code's boundaries), so where both ends of [zx_f - B, zx_f + B] give
+ * the same ones, so does the double. nx = 0 is exact: the products are then equal, as
+ * are their roundings, and the double slope is +0.
+ *
+ * The centre depth: om__rtri_zat at the centre is floor(Z + 1/2 + e) modulo 2^32, Z the
+ * exact plane there and |e| <= 2^-33 (|dx| + |dy|) (the fixed-point slopes' rounding,
+ * raster.h), dx, dy the centre's offsets from vertex 0; the double plane's value there
+ * is within 2^-49 (S_x / area2 |dx| + S_y / area2 |dy|) + 2^-19 of Z (the slopes' bound
+ * above and three roundings of sums below 2^33 and those terms). A touched texel's
+ * centre is within half a texel, each way, of a point of the triangle, where Z lies
+ * between the vertex depths; so when those, widened by the slopes over half a texel,
+ * stay 2^18 inside [0, 2^32), no centre's depth wraps, and the double's code
+ * floor(z / 2^16 + 1/2) is the integer's (n + 2^15) >> 16 wherever n + 2^15 lies more
+ * than the sum of those bounds and 1/2 inside its multiple of 2^16 (`reach`). */
+static void slope_code(const om__spsm_qtable *q, int64_t n, float a, float b, bool *sure, uint8_t *code, bool *down)
+{
+    if (n == 0) {   /* the double slope is +0 */
+        *code = 127;
+        *down = false;
+        return;
+    }
+    const float w = b + om__fabsf(a) * 0x1p-22f, lo = a - w, hi = a + w;
+    const float k = (float)OM_SUBPIX / 65536.0f / (float)OM_SPSM_DSCALE;   /* build's scale, 2^-11 */
+    *code = om__spsm_q_encode_f(q, lo * k);
+    *down = lo > 0.0f;
+    *sure &= *code == om__spsm_q_encode_f(q, hi * k) && (lo > 0.0f || hi <= 0.0f);
+}
+
+void om__spsm_fplane_setup(om__spsm_fplane *f, const om__spsm_qtable *q, const om__rtri *t, const uint32_t z[3])
+{
+    const om__tri2 *e = &t->e;
+    uint32_t zlo = z[0], zhi = z[0];
+    for (int i = 1; i < 3; i++) {
+        if (z[i] < zlo) zlo = z[i];
+        if (z[i] > zhi) zhi = z[i];
+    }
+    int64_t nx = 0, ny = 0;
+    float rx = 0.0f, ry = 0.0f;   /* S / area2 along x and y */
+    f->zx = f->zy = 0.0f;
+    if (e->area2 > 0) {   /* else the double plane is flat: slopes 0 */
+        const int64_t dz1 = (int64_t)z[1] - z[0], dz2 = (int64_t)z[2] - z[0];
+        const int64_t x1 = e->x[1] - e->x[0], y1 = e->y[1] - e->y[0], x2 = e->x[2] - e->x[0], y2 = e->y[2] - e->y[0];
+        nx = dz1 * y2 - dz2 * y1;
+        ny = dz2 * x1 - dz1 * x2;
+        const float A = (float)e->area2;
+        f->zx = (float)nx / A;
+        f->zy = (float)ny / A;
+        /* |dz| < 2^32 and offsets below 2^30: in 32 bits */
+        const float a1 = (float)(uint32_t)(dz1 < 0 ? -dz1 : dz1), a2 = (float)(uint32_t)(dz2 < 0 ? -dz2 : dz2);
+        const float fx1 = om__fabsf((float)(int32_t)x1), fy1 = om__fabsf((float)(int32_t)y1);
+        const float fx2 = om__fabsf((float)(int32_t)x2), fy2 = om__fabsf((float)(int32_t)y2);
+        rx = (a1 * fy2 + a2 * fy1) / A;
+        ry = (a2 * fx1 + a1 * fx2) / A;
+    }
+    const float bx = om__fabsf(f->zx) * 0x1p-20f + rx * 0x1p-49f, by = om__fabsf(f->zy) * 0x1p-20f + ry * 0x1p-49f;
+    f->sure = true;
+    slope_code(q, nx, f->zx, bx, &f->sure, &f->qx, &f->down_x);
+    slope_code(q, ny, f->zy, by, &f->sure, &f->qy, &f->down_y);
+    /* the centre depths */
+    f->reach = 0;
+    int64_t lx = e->x[0], hx = e->x[0], ly = e->y[0], hy = e->y[0];
+    for (int i = 1; i < 3; i++) {
+        if (e->x[i] < lx) lx = e->x[i];
+        if (e->x[i] > hx) hx = e->x[i];
+        if (e->y[i] < ly) ly = e->y[i];
+        if (e->y[i] > hy) hy = e->y[i];
+    }
+    if (hx - lx > (1 << 28) || hy - ly > (1 << 28)) return;
+    const float half = (float)(OM_SUBPIX / 2);
+    const float dx = (float)(int32_t)(hx - lx) + half, dy = (float)(int32_t)(hy - ly) + half;
+    const float wide = (om__fabsf(f->zx) + bx + om__fabsf(f->zy) + by) * half * 1.001f + 2.0f;
+    if (!((float)zlo - wide >= 0x1p18f && (float)zhi + wide <= 0x1p32f - 0x1p18f)) return;
+    const float err = (rx * dx + ry * dy) * 0x1p-48f + (dx + dy) * 0x1p-32f + 0x1p-16f;
+    if (err < 4096.0f) f->reach = (uint32_t)(err + 0.5f) + 1u;
 }
