@@ -151,10 +151,11 @@ static sample_pt project(const om__spsm_state *m, om_vec3 p)
     return s;
 }
 
-static int64_t floordiv(int64_t a, int64_t b)
+/* floor(a / 2^bits), without a division (a library routine for 64 bits on a 32-bit
+ * CPU) and without shifting a negative number (implementation-defined in C). */
+static int64_t floor_shift(int64_t a, int bits)
 {
-    int64_t q = a / b;
-    return (a % b != 0 && a < 0) ? q - 1 : q;
+    return a >= 0 ? a >> bits : -((((int64_t)1 << bits) - 1 - a) >> bits);
 }
 
 /* The texel holding grid position (x, y), clamped to the map (so negative positions
@@ -225,19 +226,33 @@ static void decode(const om__spsm_state *m, int64_t tx, int64_t ty, om__spsm_dtr
      * at all is its area, as the setup finds it (offsets stay far inside its range) */
     o->ok = (X[1] - X[0]) * (Y[2] - Y[0]) - (X[2] - X[0]) * (Y[1] - Y[0]) != 0;
     o->have_e = false;
-    const double u = OM__SPSM_STEP * OM_SPSM_DSCALE / (double)OM_SUBPIX;   /* code -> raw per unit */
-    o->z = (double)r->z * OM__SPSM_STEP;
-    o->gx = m->q.dec[r->qx] * u;
-    o->gy = m->q.dec[r->qy] * u;
-    o->ex = m->q.err[r->qx] * u;
-    o->ey = m->q.err[r->qy] * u;
-    o->zf = (float)o->z;
-    o->gxf = (float)o->gx;
-    o->gyf = (float)o->gy;
-    o->exf = (float)o->ex;
-    o->eyf = (float)o->ey;
+    /* the plane in float (a 16-bit depth times 2^16 is exact in float); in double only
+     * when a test needs it (dtri_double) */
+    o->qx = r->qx;
+    o->qy = r->qy;
+    o->have_d = false;
+    o->zf = (float)r->z * (float)OM__SPSM_STEP;
+    o->gxf = m->q.decf[r->qx];
+    o->gyf = m->q.decf[r->qy];
+    o->exf = m->q.errf[r->qx];
+    o->eyf = m->q.errf[r->qy];
     o->have_cmin = false;
     o->have_vz = false;
+}
+
+/* The decoded plane in double, for the double tests (those float is not sure of, or
+ * all of them where double is not a library routine): the centre depth, the slopes and
+ * their bounds as decoded from the codes. */
+static void dtri_double(const om__spsm_state *m, om__spsm_dtri *o)
+{
+    if (o->have_d) return;
+    const double u = OM__SPSM_STEP * OM_SPSM_DSCALE / (double)OM_SUBPIX;   /* code -> raw per unit */
+    o->z = (double)o->zf;   /* exact */
+    o->gx = m->q.dec[o->qx] * u;
+    o->gy = m->q.dec[o->qy] * u;
+    o->ex = m->q.err[o->qx] * u;
+    o->ey = m->q.err[o->qy] * u;
+    o->have_d = true;
 }
 
 /* The sample's texel stepped to a neighbour, (dx, dy) texels away: the decoded texels
@@ -259,11 +274,16 @@ static void move_entry(om__spsm_dtri *to, const om__spsm_dtri *from)
     memcpy(to->ry, from->ry, sizeof to->ry);
     to->cx = from->cx;
     to->cy = from->cy;
-    to->z = from->z;
-    to->gx = from->gx;
-    to->gy = from->gy;
-    to->ex = from->ex;
-    to->ey = from->ey;
+    to->have_d = from->have_d;
+    if (from->have_d) {
+        to->z = from->z;
+        to->gx = from->gx;
+        to->gy = from->gy;
+        to->ex = from->ex;
+        to->ey = from->ey;
+    }
+    to->qx = from->qx;
+    to->qy = from->qy;
     to->zf = from->zf;
     to->gxf = from->gxf;
     to->gyf = from->gyf;
@@ -335,13 +355,21 @@ static double pat_tol(const om__spsm_dtri *t, int64_t px, int64_t py)
     return tol < OM__SPSM_TOL0 + PAT_CAP ? tol : OM__SPSM_TOL0 + PAT_CAP;
 }
 
-/* Algorithm 1: the stored triangle covers the point in 2-D and is nearer there (its
- * edges set up: edges). */
-static bool hits(const om__spsm_dtri *t, int64_t px, int64_t py, uint32_t pz, float pzf)
+/* Algorithm 1's depth half: the stored plane is nearer than the sample at (px, py). */
+static bool nearer(const om__spsm_state *m, om__spsm_dtri *t, int64_t px, int64_t py, uint32_t pz, float pzf)
 {
-    if (!t->ok || !om__spsm_covers(&t->e, px, py)) return false;
     const int below = OM_FAST_FLOAT ? om__spsm_below_f(t, px, py, pzf, -1.0f, 0.0f) : -1;
-    return below >= 0 ? below == 1 : om__spsm_plane_at(t, px, py) < (double)pz - om__spsm_tol_at(t, px, py);
+    if (below >= 0) return below == 1;
+    dtri_double(m, t);
+    return om__spsm_plane_at(t, px, py) < (double)pz - om__spsm_tol_at(t, px, py);
+}
+
+/* Algorithm 1 at texel k of the 3x3: its stored triangle covers the point in 2-D and is
+ * nearer there. The depth first: most neighbours lie in the sample's own surface, and
+ * their edges are then not set up. */
+static bool hits(const om__spsm_state *m, om__spsm_dtri t[9], int k, int64_t px, int64_t py, uint32_t pz, float pzf)
+{
+    return t[k].ok && nearer(m, &t[k], px, py, pz, pzf) && om__spsm_covers(edges(t, k), px, py);
 }
 
 /* Figure 9: the least depth the triangle reaches inside its texel's square, found where
@@ -353,7 +381,8 @@ static double consistent_min(const om__spsm_dtri *t)
 {
     const int64_t H = OM_SUBPIX / 2;
     const float h = (float)H;
-    int64_t kx = t->cx + (t->gx > 0 ? -H : H), ky = t->cy + (t->gy > 0 ? -H : H);
+    /* (the float slopes have the double ones' signs) */
+    int64_t kx = t->cx + (t->gxf > 0.0f ? -H : H), ky = t->cy + (t->gyf > 0.0f ? -H : H);
     /* the plane at the corner: its least over the square */
     if (om__spsm_covers(&t->e, kx, ky)) return t->zf - (om__fabsf(t->gxf) + om__fabsf(t->gyf)) * h;
     /* in the texel's own coordinates (from the square's corner), so that the value does
@@ -458,19 +487,20 @@ static bool centre_test(const om__spsm_state *m, const receiver *r, int64_t tx, 
 /* The plain map around a point of the pixel at grid offset (qx, qy) from the centre of
  * texel (tx, ty), the sample itself being at (px, py): whether the four points of the
  * map nearest to it all hold something nearer than the sample's plane carried there.
- * The map is `buf`, `side` points a side, one every `step` grid units (its point i at
- * i step + step / 2): the texel centres (cdepth), or with spsm.fine the points a
+ * The map is `buf`, `side` points a side, one every step = 2^bits grid units (its point
+ * i at i step + step / 2): the texel centres (cdepth), or with spsm.fine the points a
  * quarter texel from them (fdepth). The point then lies inside a shadow wider than the
  * map's spacing, whatever outline recovery found: a record keeps one triangle per
  * texel, and across a thin bar or along a finely tessellated rim the 3x3 can miss the
  * triangles that reach the point; the band such a rim leaves lit is as wide as the
  * spacing. */
-static bool plain_shadow(const uint32_t *buf, int64_t side, int64_t step, const receiver *r, int64_t tx,
+static bool plain_shadow(const uint32_t *buf, int64_t side, int bits, const receiver *r, int64_t tx,
                          int64_t ty, int64_t px, int64_t py, int64_t qx, int64_t qy)
 {
     /* the texel centre, the point and the sample in the map's own grid units */
+    const int64_t step = (int64_t)1 << bits;
     const int64_t ox = tx * OM_SUBPIX + OM_SUBPIX / 2, oy = ty * OM_SUBPIX + OM_SUBPIX / 2, h = step / 2;
-    const int64_t ax = floordiv(ox + qx - h, step), ay = floordiv(oy + qy - h, step);
+    const int64_t ax = floor_shift(ox + qx - h, bits), ay = floor_shift(oy + qy - h, bits);
     for (int64_t j = ay; j <= ay + 1; j++)
         for (int64_t i = ax; i <= ax + 1; i++) {
             if (i < 0 || j < 0 || i >= side || j >= side) return false;
@@ -529,7 +559,10 @@ static void occluders_of(const om__spsm_state *m, om__spsm_win *w, om__spsm_dtri
         while (j < w->nocc && (memcmp(w->occ[j]->e.x, t[k].e.x, sizeof t[k].e.x) ||
                                memcmp(w->occ[j]->e.y, t[k].e.y, sizeof t[k].e.y)))
             j++;
-        if (j == w->nocc) w->occ[w->nocc++] = &t[k];
+        if (j == w->nocc) {
+            w->occ_k[w->nocc] = (uint8_t)k;
+            w->occ[w->nocc++] = &t[k];
+        }
         /* the texel's centre, when the plain map saw this occluder's surface there
          * but its stored triangle does not reach it */
         const int64_t x = tx + k % 3 - 1, y = ty + k / 3 - 1;
@@ -607,6 +640,7 @@ static uint8_t lookup(const om__spsm_state *m, om__spsm_win *w, uint32_t n[8], c
         if (below == 0) on = om__spsm_below_f(&t[4], px, py, p.zf, 1.0f, 0.0f);
         if (on == 1) close = om__spsm_tol_within_f(&t[4], px, py, (float)(OM__SPSM_TOL0 + LIT_CAP));
         if (below < 0 || on < 0 || close < 0) {
+            dtri_double(m, &t[4]);
             const double z = om__spsm_plane_at(&t[4], px, py), tol = om__spsm_tol_at(&t[4], px, py);
             const double pz = p.zi;
             below = z < pz - tol;
@@ -624,8 +658,7 @@ static uint8_t lookup(const om__spsm_state *m, om__spsm_win *w, uint32_t n[8], c
     for (int k = 0; k < 9; k++) {
         if (k == 4) continue;
         if (!((w->t_have >> k) & 1u)) { decode(m, tx, ty, t, k); w->t_have |= 1u << k; }
-        if (t[k].ok) edges(t, k);
-        if (hits(&t[k], px, py, p.zi, p.zf)) { n[N_SHADOWED]++; return 0; }
+        if (hits(m, t, k, px, py, p.zi, p.zf)) { n[N_SHADOWED]++; return 0; }
     }
     return recover(m, w, n, st, i, &p, tx, ty);
 }
@@ -658,6 +691,7 @@ OM_NOINLINE static uint8_t recover(const om__spsm_state *m, om__spsm_win *w, uin
         if (t[k].empty) continue;
         const int below =
             OM_FAST_FLOAT ? om__spsm_below_f(&t[k], px, py, p.zf, -1.0f, (float)(OM__SPSM_TOL0 + PAT_CAP)) : -1;
+        if (below < 0) dtri_double(m, &t[k]);
         if (below == 0 || (below < 0 && !(om__spsm_plane_at(&t[k], px, py) < (double)p.zi - pat_tol(&t[k], px, py))))
             continue;
         if (!have_rp) { rp = receiver_plane(m, smp, &p); have_rp = true; }
@@ -671,7 +705,10 @@ OM_NOINLINE static uint8_t recover(const om__spsm_state *m, om__spsm_win *w, uin
         /* pat_tol at the texel's centre is OM__SPSM_TOL0: its offsets are 0 and its
          * error bounds finite */
         int in = OM_FAST_FLOAT ? om__spsm_less_f(t[k].cminf, p.zf, 0.0f, 0.0f, 0.0f, 0.0f, (float)OM__SPSM_TOL0) : -1;
-        if (in < 0) in = t[k].cmin < (double)p.zi - pat_tol(&t[k], t[k].cx, t[k].cy);
+        if (in < 0) {
+            dtri_double(m, &t[k]);
+            in = t[k].cmin < (double)p.zi - pat_tol(&t[k], t[k].cx, t[k].cy);
+        }
         if (in) pat |= 1u << k;
     }
     const om__spsm_tangent *tg = &m->lut[pat];
@@ -679,7 +716,6 @@ OM_NOINLINE static uint8_t recover(const om__spsm_state *m, om__spsm_win *w, uin
      * and `keep`: the next uncertain sample in this texel with the same pattern reuses
      * them. */
     if (!w->bd_have || w->bd_keep != tg->keep) occluders_of(m, w, t, tg->keep, tx, ty);
-    const om__spsm_dtri *const *occ = w->occ;
     const int nocc = w->nocc;
     const om__spsm_boundary *bd = &w->bd;
 
@@ -707,7 +743,7 @@ OM_NOINLINE static uint8_t recover(const om__spsm_state *m, om__spsm_win *w, uin
         bool shadow = false;
         /* at the sample itself the lookup found no hit in the whole 3x3 */
         if (K > 1)
-            for (int k = 0; k < nocc && !shadow; k++) shadow = hits(occ[k], qx, qy, q.zi, q.zf);
+            for (int k = 0; k < nocc && !shadow; k++) shadow = hits(m, t, w->occ_k[k], qx, qy, q.zi, q.zf);
         if (!shadow && bd->nh) shadow = om__spsm_outline_inside(bd, qx, qy);
         if (!shadow && w->ncand) {
             if (!have_use) { use = centres_nearer(m, w, &rp, &have_rp, smp, &p, tx, ty, px, py); have_use = true; }
@@ -716,8 +752,8 @@ OM_NOINLINE static uint8_t recover(const om__spsm_state *m, om__spsm_win *w, uin
         if (!shadow && tg->keep == 511) shadow = centre_test(m, &rp, tx, ty, px, py);   /* rp set */
         if (!shadow) {
             if (!have_rp) { rp = receiver_plane(m, smp, &p); have_rp = true; }
-            shadow = m->fine ? plain_shadow(m->fdepth, 2 * (int64_t)m->size, OM_SUBPIX / 2, &rp, tx, ty, px, py, qx, qy)
-                             : plain_shadow(m->cdepth, m->size, OM_SUBPIX, &rp, tx, ty, px, py, qx, qy);
+            shadow = m->fine ? plain_shadow(m->fdepth, 2 * (int64_t)m->size, OM_SUBPIX_BITS - 1, &rp, tx, ty, px, py, qx, qy)
+                             : plain_shadow(m->cdepth, m->size, OM_SUBPIX_BITS, &rp, tx, ty, px, py, qx, qy);
         }
         nlit += !shadow;
     }

@@ -53,6 +53,9 @@ typedef struct om__spsm_qtable {
     float up[128];         /* up[k]: where code 127 + k gives way to the next (the
                               boundary decode_at(127.5 + k), rounded to float); up[127]
                               is infinite */
+    float decf[256], errf[256];   /* dec and err in raw depth per grid unit (times
+                              65536 * OM_SPSM_DSCALE / OM_SUBPIX, exact in double),
+                              rounded to float: what the lookup's float tests read */
 } om__spsm_qtable;
 
 uint8_t om__spsm_q_encode(double d);

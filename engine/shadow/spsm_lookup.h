@@ -22,7 +22,10 @@ typedef struct om__spsm_dtri {
     om__tri2 e;
     int64_t rx[3], ry[3];        /* the vertices as decoded (e holds them reordered) */
     int64_t cx, cy;              /* this texel's centre */
-    double z, gx, gy, ex, ey;    /* centre depth, slopes and their error bounds */
+    double z, gx, gy, ex, ey;    /* centre depth, slopes and their error bounds (have_d:
+                                    made for the double tests when they run) */
+    bool have_d;
+    uint8_t qx, qy;              /* the record's derivative codes */
     float zf, gxf, gyf, exf, eyf;   /* the same rounded to float (om__spsm_below_f) */
     double cmin;                 /* consistent_min, once computed (have_cmin) */
     bool have_cmin;
@@ -141,11 +144,12 @@ static inline uint32_t om__spsm_zdepth(float z, float w)
  * arithmetic's own error is under 2^-49 S. A difference beyond 2^-19 S has the same
  * sign in both, and so does the cap's choice; equality lies inside that band, so < and
  * <= agree outside it. Offsets beyond 2^20 grid units (exact in float below 2^24) and
- * non-finite values answer -1. */
+ * non-finite values answer -1. px, py and the centre lie within 2^30 (taken in 32 bits). */
 static inline int om__spsm_below_f(const om__spsm_dtri *t, int64_t px, int64_t py, float pz, float sign,
                                    float cap)
 {
-    const int64_t ix = px - t->cx, iy = py - t->cy;
+    /* in 32 bits: the lookup's points and centres lie below 2^27 (om__spsm_edge) */
+    const int32_t ix = (int32_t)px - (int32_t)t->cx, iy = (int32_t)py - (int32_t)t->cy;
     if (ix < -(1 << 20) || ix > (1 << 20) || iy < -(1 << 20) || iy > (1 << 20)) return -1;
     const float dx = (float)ix, dy = (float)iy;
     const float gdx = t->gxf * dx, gdy = t->gyf * dy, a = t->zf + gdx + gdy;
@@ -163,7 +167,7 @@ static inline int om__spsm_below_f(const om__spsm_dtri *t, int64_t px, int64_t p
  * or -1 when float cannot be sure (the same bounds). */
 static inline int om__spsm_tol_within_f(const om__spsm_dtri *t, int64_t px, int64_t py, float cap)
 {
-    const int64_t ix = px - t->cx, iy = py - t->cy;
+    const int32_t ix = (int32_t)px - (int32_t)t->cx, iy = (int32_t)py - (int32_t)t->cy;
     if (ix < -(1 << 20) || ix > (1 << 20) || iy < -(1 << 20) || iy > (1 << 20)) return -1;
     const float tol = (float)OM__SPSM_TOL0 + t->exf * om__fabsf((float)ix) + t->eyf * om__fabsf((float)iy);
     const float e = tol * 0x1p-19f;

@@ -41,6 +41,7 @@ typedef struct om__spsm_win {
     size_t t4_at;
     uint32_t t_have;
     const om__spsm_dtri *occ[9];
+    uint8_t occ_k[9];            /* occ[j] is t[occ_k[j]] */
     int nocc;
     om__spsm_outline_pt cand[9];
     uint8_t cand_k[9];

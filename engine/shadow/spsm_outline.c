@@ -5,11 +5,13 @@
  * tested. The pattern, the occluders and the decisions around it are in spsm.c. */
 #include "spsm_lookup.h"
 
-/* Twice the signed area of (o, a, b): > 0 when b lies left of o -> a. Exact: offsets
- * stay below 2^27 (the o16 range), so the products stay below 2^55. */
+/* Twice the signed area of (o, a, b): > 0 when b lies left of o -> a. Exact: points
+ * stay below 2^27 (the o16 range; the lookup's points, om__spsm_edge), so differences
+ * fit 32 bits and their products, taken 32 by 32 bits (one multiply on a 32-bit CPU),
+ * stay below 2^56. */
 static int64_t turn(int64_t ox, int64_t oy, int64_t ax, int64_t ay, int64_t bx, int64_t by)
 {
-    return (ax - ox) * (by - oy) - (ay - oy) * (bx - ox);
+    return (int64_t)(int32_t)(ax - ox) * (int32_t)(by - oy) - (int64_t)(int32_t)(ay - oy) * (int32_t)(bx - ox);
 }
 
 /* Each piece's convex hull (Andrew's monotone chain on its points sorted by x, then

@@ -91,6 +91,10 @@ void om__spsm_qtable_build(om__spsm_qtable *t)
         t->err[q] = t->err[254 - q];
     }
     t->dec[255] = t->err[255] = 0.0;
+    for (int q = 0; q < 256; q++) {
+        t->decf[q] = (float)(t->dec[q] * (65536.0 * OM_SPSM_DSCALE / OM_SUBPIX));
+        t->errf[q] = (float)(t->err[q] * (65536.0 * OM_SPSM_DSCALE / OM_SUBPIX));
+    }
     for (int k = 0; k < 127; k++) t->up[k] = (float)decode_at(127.5 + k);
     t->up[127] = HUGE_VALF;
 }
