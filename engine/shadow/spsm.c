@@ -162,7 +162,8 @@ static int64_t floor_shift(int64_t a, int bits)
  * need no floor division: they clamp to 0). */
 static int64_t texel_of(const om__spsm_state *m, int64_t g)
 {
-    const int64_t t = g < 0 ? 0 : g / OM_SUBPIX, last = (int64_t)m->size - 1;
+    /* in 32 bits: om__project_xy's positions lie below 2^26 */
+    const int32_t t = g < 0 ? 0 : (int32_t)((uint32_t)g >> OM_SUBPIX_BITS), last = (int32_t)m->size - 1;
     return t > last ? last : t;
 }
 
@@ -220,8 +221,8 @@ static void decode(const om__spsm_state *m, int64_t tx, int64_t ty, om__spsm_dtr
         X[i] = o->cx + om__spsm_o16_decode(r->vx[i]);
         Y[i] = o->cy + om__spsm_o16_decode(r->vy[i]);
     }
-    memcpy(o->rx, X, sizeof X);
-    memcpy(o->ry, Y, sizeof Y);
+    om__spsm_copy3(o->rx, X);
+    om__spsm_copy3(o->ry, Y);
     /* the edge setup waits until a test needs it (edges); whether there is a triangle
      * at all is its area, as the setup finds it (offsets stay far inside its range) */
     o->ok = (X[1] - X[0]) * (Y[2] - Y[0]) - (X[2] - X[0]) * (Y[1] - Y[0]) != 0;
@@ -270,8 +271,8 @@ static void move_entry(om__spsm_dtri *to, const om__spsm_dtri *from)
     to->ok = from->ok;
     to->have_e = from->have_e;
     if (from->have_e) to->e = from->e;
-    memcpy(to->rx, from->rx, sizeof to->rx);
-    memcpy(to->ry, from->ry, sizeof to->ry);
+    om__spsm_copy3(to->rx, from->rx);
+    om__spsm_copy3(to->ry, from->ry);
     to->cx = from->cx;
     to->cy = from->cy;
     to->have_d = from->have_d;
@@ -294,8 +295,10 @@ static void move_entry(om__spsm_dtri *to, const om__spsm_dtri *from)
     to->cminf = from->cminf;
     to->have_vz = from->have_vz;
     if (from->have_vz) {
-        memcpy(to->vzf, from->vzf, sizeof to->vzf);
-        memcpy(to->vtolf, from->vtolf, sizeof to->vtolf);
+        for (int i = 0; i < 3; i++) {
+            to->vzf[i] = from->vzf[i];
+            to->vtolf[i] = from->vtolf[i];
+        }
     }
 }
 
@@ -339,7 +342,7 @@ static const om__tri2 *edges(om__spsm_dtri t[9], int k)
     int same = -1;
     for (int j = 0; j < 9 && same < 0; j++)
         if (j != k && t[j].have_e && !t[j].empty && t[j].rx[0] == o->rx[0] && t[j].ry[0] == o->ry[0] &&
-            !memcmp(t[j].rx, o->rx, sizeof o->rx) && !memcmp(t[j].ry, o->ry, sizeof o->ry))
+            om__spsm_same3(t[j].rx, o->rx) && om__spsm_same3(t[j].ry, o->ry))
             same = j;
     if (same >= 0) o->e = t[same].e;
     else om__tri2_setup(&o->e, o->rx, o->ry, false);
@@ -556,8 +559,7 @@ static void occluders_of(const om__spsm_state *m, om__spsm_win *w, om__spsm_dtri
         if (!((keep >> k) & 1u) || !t[k].ok) continue;
         edges(t, k);
         int j = 0;   /* neighbours often hold the same triangle */
-        while (j < w->nocc && (memcmp(w->occ[j]->e.x, t[k].e.x, sizeof t[k].e.x) ||
-                               memcmp(w->occ[j]->e.y, t[k].e.y, sizeof t[k].e.y)))
+        while (j < w->nocc && !(om__spsm_same3(w->occ[j]->e.x, t[k].e.x) && om__spsm_same3(w->occ[j]->e.y, t[k].e.y)))
             j++;
         if (j == w->nocc) {
             w->occ_k[w->nocc] = (uint8_t)k;

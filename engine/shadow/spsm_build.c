@@ -84,8 +84,8 @@ static const om__rtri *double_plane(build_ctx *b, const om__rtri *t)
 static void tri_setup(build_ctx *b, const om__rtri *t)
 {
     const om__tri2 *e = &t->e;
-    memcpy(b->ex, e->x, sizeof b->ex);
-    memcpy(b->ey, e->y, sizeof b->ey);
+    om__spsm_copy3(b->ex, e->x);
+    om__spsm_copy3(b->ey, e->y);
     b->zq[0] = t->zq0;
     b->zq[1] = t->zqx;
     b->zq[2] = t->zqy;
@@ -117,10 +117,8 @@ static void tri_setup(build_ctx *b, const om__rtri *t)
 
 static bool same_tri(const build_ctx *b, const om__rtri *t)
 {
-    /* (compared in line: memcmp is a call per texel) */
-    return b->have && b->zq[0] == t->zq0 && b->zq[1] == t->zqx && b->zq[2] == t->zqy && b->ex[0] == t->e.x[0] &&
-           b->ex[1] == t->e.x[1] && b->ex[2] == t->e.x[2] && b->ey[0] == t->e.y[0] && b->ey[1] == t->e.y[1] &&
-           b->ey[2] == t->e.y[2];
+    return b->have && b->zq[0] == t->zq0 && b->zq[1] == t->zqx && b->zq[2] == t->zqy && om__spsm_same3(b->ex, t->e.x) &&
+           om__spsm_same3(b->ey, t->e.y);
 }
 
 /* The least depth of the triangle inside the texel square at grid corner (x0, y0),
@@ -212,9 +210,9 @@ static void texel(build_ctx *b, int32_t x, int32_t y, const om__rtri *t)
         if (dz > od) return;
         m->depth[i] = dz | 1u;
     }
-    if (!b->have_row || y != b->row || b->ry[0] != e->y[0] || b->ry[1] != e->y[1] || b->ry[2] != e->y[2]) {
+    if (!b->have_row || y != b->row || !om__spsm_same3(b->ry, e->y)) {
         om__spsm_row_codes(b->vy, t, y);
-        memcpy(b->ry, e->y, sizeof b->ry);
+        om__spsm_copy3(b->ry, e->y);
         b->row = y;
         b->have_row = true;
     }

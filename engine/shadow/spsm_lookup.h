@@ -35,10 +35,12 @@ typedef struct om__spsm_dtri {
     bool have_vz;
 } om__spsm_dtri;   /* a new field is moved in spsm.c's move_entry too */
 
-/* The recovered silhouette of an uncertain sample (4.2; spsm_outline.c). */
+/* The recovered silhouette of an uncertain sample (4.2; spsm_outline.c). Its points are
+ * a record's vertices, texel centres of the 3x3 and the lookup's points, all below 2^27
+ * (om__spsm_edge): 32 bits hold them. */
 typedef struct om__spsm_boundary {
     int nv;
-    int64_t x[OM__SPSM_MAXV], y[OM__SPSM_MAXV];
+    int32_t x[OM__SPSM_MAXV], y[OM__SPSM_MAXV];
     uint8_t piece[OM__SPSM_MAXV];
     uint8_t first[9];            /* a vertex of each occluder (its piece's) */
     /* the pieces' hulls, counter-clockwise without collinear points, one after another:
@@ -46,7 +48,7 @@ typedef struct om__spsm_boundary {
      * (a point, a segment) have none */
     int nh;
     uint8_t hoff[OM__SPSM_MAXV + 1];
-    int64_t hx[OM__SPSM_MAXV], hy[OM__SPSM_MAXV];
+    int32_t hx[OM__SPSM_MAXV], hy[OM__SPSM_MAXV];
 } om__spsm_boundary;
 
 /* Equation 1: the stored plane at grid point (px, py), and what it cannot resolve. */
@@ -58,6 +60,21 @@ static inline double om__spsm_plane_at(const om__spsm_dtri *t, int64_t px, int64
 static inline double om__spsm_tol_at(const om__spsm_dtri *t, int64_t px, int64_t py)
 {
     return OM__SPSM_TOL0 + t->ex * fabs((double)(px - t->cx)) + t->ey * fabs((double)(py - t->cy));
+}
+
+/* Three coordinates copied and compared in line: the firmware is built freestanding,
+ * where memcpy and memcmp are calls, and the lookup and the build do these per sample
+ * and per texel. */
+static inline void om__spsm_copy3(int64_t to[3], const int64_t from[3])
+{
+    to[0] = from[0];
+    to[1] = from[1];
+    to[2] = from[2];
+}
+
+static inline bool om__spsm_same3(const int64_t a[3], const int64_t b[3])
+{
+    return a[0] == b[0] && a[1] == b[1] && a[2] == b[2];
 }
 
 /* A grid offset as a float: offsets inside the rasterizer's range (om__tri2's, below

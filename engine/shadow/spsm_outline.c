@@ -6,12 +6,11 @@
 #include "spsm_lookup.h"
 
 /* Twice the signed area of (o, a, b): > 0 when b lies left of o -> a. Exact: points
- * stay below 2^27 (the o16 range; the lookup's points, om__spsm_edge), so differences
- * fit 32 bits and their products, taken 32 by 32 bits (one multiply on a 32-bit CPU),
- * stay below 2^56. */
-static int64_t turn(int64_t ox, int64_t oy, int64_t ax, int64_t ay, int64_t bx, int64_t by)
+ * stay below 2^27 (spsm_lookup.h), so differences fit 32 bits and their products,
+ * taken 32 by 32 bits (one multiply on a 32-bit CPU), stay below 2^56. */
+static int64_t turn(int32_t ox, int32_t oy, int32_t ax, int32_t ay, int32_t bx, int32_t by)
 {
-    return (int64_t)(int32_t)(ax - ox) * (int32_t)(by - oy) - (int64_t)(int32_t)(ay - oy) * (int32_t)(bx - ox);
+    return (int64_t)(ax - ox) * (by - oy) - (int64_t)(ay - oy) * (bx - ox);
 }
 
 /* Each piece's convex hull (Andrew's monotone chain on its points sorted by x, then
@@ -23,7 +22,7 @@ static void hulls_build(om__spsm_boundary *b)
     int used = 0;
     for (int pc = 0; pc < b->nv; pc++) {
         if (b->piece[pc] != pc) continue;   /* a piece is labelled by its first vertex */
-        int64_t px[OM__SPSM_MAXV], py[OM__SPSM_MAXV];
+        int32_t px[OM__SPSM_MAXV], py[OM__SPSM_MAXV];
         int n = 0;
         for (int i = 0; i < b->nv; i++) {
             if (b->piece[i] != pc) continue;
@@ -36,8 +35,8 @@ static void hulls_build(om__spsm_boundary *b)
             py[j] = b->y[i];
         }
         if (n < 3) continue;
-        int64_t *hx = b->hx + used, *hy = b->hy + used;
-        int64_t cx[2 * OM__SPSM_MAXV], cy[2 * OM__SPSM_MAXV];   /* the chain; its last point repeats the first */
+        int32_t *hx = b->hx + used, *hy = b->hy + used;
+        int32_t cx[2 * OM__SPSM_MAXV], cy[2 * OM__SPSM_MAXV];   /* the chain; its last point repeats the first */
         int k = 0;
         for (int i = 0; i < n; i++) {         /* lower chain */
             while (k >= 2 && turn(cx[k - 2], cy[k - 2], cx[k - 1], cy[k - 1], px[i], py[i]) <= 0) k--;
@@ -94,7 +93,7 @@ void om__spsm_outline_build(om__spsm_boundary *b, const om__spsm_dtri *const occ
     for (int k = 0; k < nocc; k++) {
         up[k] = (uint8_t)k;
         for (int i = 0; i < 3; i++) {
-            int64_t x = occ[k]->e.x[i], y = occ[k]->e.y[i];
+            const int32_t x = (int32_t)occ[k]->e.x[i], y = (int32_t)occ[k]->e.y[i];
             int j = 0;
             while (j < b->nv && (b->x[j] != x || b->y[j] != y)) j++;
             if (j == b->nv) { b->x[j] = x; b->y[j] = y; owner[j] = (uint8_t)k; b->nv++; }
@@ -104,7 +103,7 @@ void om__spsm_outline_build(om__spsm_boundary *b, const om__spsm_dtri *const occ
     }
     for (int i = 0; i < b->nv && sets > 1; i++)   /* (one piece: nothing to link) */
         for (int j = i + 1; j < b->nv; j++) {
-            int64_t dx = b->x[j] - b->x[i], dy = b->y[j] - b->y[i];
+            const int32_t dx = b->x[j] - b->x[i], dy = b->y[j] - b->y[i];
             if (dx > OM_SPSM_LINK || dx < -OM_SPSM_LINK || dy > OM_SPSM_LINK || dy < -OM_SPSM_LINK) continue;
             if (root(up, owner[i]) == root(up, owner[j])) continue;   /* joined already */
             /* one surface: i's triangle's plane, carried to j, meets j's triangle there
@@ -140,8 +139,8 @@ void om__spsm_outline_extend(om__spsm_boundary *out, const om__spsm_boundary *ba
         out->piece[i] = base->piece[i];
     }
     for (int p = 0; p < npts && out->nv < OM__SPSM_MAXV; p++) {
-        out->x[out->nv] = pts[p].x;
-        out->y[out->nv] = pts[p].y;
+        out->x[out->nv] = (int32_t)pts[p].x;
+        out->y[out->nv] = (int32_t)pts[p].y;
         out->piece[out->nv] = base->piece[base->first[pts[p].owner]];
         out->nv++;
     }
@@ -149,8 +148,9 @@ void om__spsm_outline_extend(om__spsm_boundary *out, const om__spsm_boundary *ba
 }
 
 /* Strictly inside the hull of one piece: strictly left of each of its edges. */
-bool om__spsm_outline_inside(const om__spsm_boundary *b, int64_t px, int64_t py)
+bool om__spsm_outline_inside(const om__spsm_boundary *b, int64_t qx, int64_t qy)
 {
+    const int32_t px = (int32_t)qx, py = (int32_t)qy;   /* below 2^27 */
     for (int h = 0; h < b->nh; h++) {
         int a = b->hoff[h], e = b->hoff[h + 1];
         bool in = true;
