@@ -580,7 +580,8 @@ static void occluders_of(const om__spsm_state *m, om__spsm_win *w, om__spsm_dtri
     }
     /* one triangle's hull is itself (hits decides there), but its points may be
      * extended */
-    om__spsm_outline_build(&w->bd, w->occ, w->nocc);
+    if (w->nocc < 2 && !w->ncand) w->bd.nv = w->bd.nh = 0;
+    else om__spsm_outline_build(&w->bd, w->occ, w->nocc);
     if (w->nocc < 2) w->bd.nh = 0;
     w->bd_keep = keep;
     w->bx_pts = 0;   /* none built yet (0 is never asked for) */

@@ -189,7 +189,7 @@ static void texel(build_ctx *b, int32_t x, int32_t y, const om__rtri *t)
     if (!alone) {
         const int64_t qx = kx + (b->down_x ? 0 : OM_SUBPIX), qy = ky + (b->down_y ? 0 : OM_SUBPIX);
         /* inside the triangle the fixed-point plane is exact to a unit (raster.h) */
-        z = om__tri2_covers(e, qx, qy) ? om__rtri_zat(t, qx, qy) : clipped_min(b, e, kx, ky);
+        z = om__spsm_covers(e, qx, qy) ? om__rtri_zat(t, qx, qy) : clipped_min(b, e, kx, ky);
         if (z < b->zmin) z = b->zmin;
     }
     uint32_t dz = z & ~OM__SPSM_TIES;

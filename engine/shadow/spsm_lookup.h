@@ -103,6 +103,8 @@ static inline float om__spsm_tol_at_f(const om__spsm_dtri *t, int64_t px, int64_
  * centre (the o16 range), so the edges' a and b (vertex differences) are below 2^28,
  * and every point tested (a sample or sub-sample on the map's grid, below 2^26, less
  * its texel's centre, below 2^22; a texel centre or corner of the 3x3) is below 2^27.
+ * The build's triangles (om__project's vertices, below 2^26) and texel corners (below
+ * 2^21) are inside the same bounds.
  * On a 32-bit CPU a 64-by-64-bit product is three multiplies, a 32-by-32 one one. */
 static inline int64_t om__spsm_edge(const om__tri2 *e, int i, int64_t px, int64_t py)
 {

@@ -255,7 +255,11 @@ static void slope_code(const om__spsm_qtable *q, int64_t n, float a, float b, bo
     const float k = (float)OM_SUBPIX / 65536.0f / (float)OM_SPSM_DSCALE;   /* build's scale, 2^-11 */
     *code = om__spsm_q_encode_f(q, lo * k);
     *down = lo > 0.0f;
-    *sure &= *code == om__spsm_q_encode_f(q, hi * k) && (lo > 0.0f || hi <= 0.0f);
+    /* the same code at hi: no boundary up[] between |lo k| and |hi k| (a code's
+     * distance from 127 counts the boundaries at or below its magnitude) */
+    if (lo > 0.0f) *sure &= hi * k < q->up[*code - 127];              /* up[127] is infinite */
+    else if (hi <= 0.0f) *sure &= *code == 127 || -(hi * k) >= q->up[126 - *code];
+    else *sure = false;
 }
 
 void om__spsm_fplane_setup(om__spsm_fplane *f, const om__spsm_qtable *q, const om__rtri *t, const uint32_t z[3])
