@@ -139,14 +139,13 @@ static om_status spsm_begin(void *state, const om_view *v, om_diag *d)
  * tests, the double tests convert zi when they run), clip-space point q. */
 typedef struct sample_pt { int64_t x, y; uint32_t zi; float zf; bool ok; om_vec4 q; } sample_pt;
 
-/* om__project's position and depth (the depth by om__spsm_zdepth where a 64-bit
- * division is a library routine: the same integer). */
+/* om__project's position and depth. */
 static sample_pt project(const om__spsm_state *m, om_vec3 p)
 {
     sample_pt s;
     s.q = om__mat_apply(&m->view.light_vp, p);
-    s.ok = om__project_xy(&s.q, m->size, m->size, &s.x, &s.y);
-    s.zi = !s.ok ? 0u : OM_FAST_FLOAT ? om__spsm_zdepth(s.q.z, s.q.w) : om__zdepth(s.q.z, s.q.w);
+    s.zi = 0;
+    s.ok = om__project(&s.q, m->size, m->size, &s.x, &s.y, &s.zi);
     s.zf = (float)s.zi;
     return s;
 }

@@ -116,39 +116,6 @@ static inline bool om__spsm_covers(const om__tri2 *e, int64_t px, int64_t py)
     return (om__spsm_edge(e, 0, px, py) | om__spsm_edge(e, 1, px, py) | om__spsm_edge(e, 2, px, py)) >= 0;
 }
 
-/* om__zdepth(z, w) (raster.h), the sample's depth, by 32-bit divisions: on a 32-bit
- * CPU its one 64-bit division is a library routine of a hundred instructions or so,
- * and the lookup projects every sample. The same integer: with mz, mw the
- * significands (mw >= 1) and z/w * 2^32 = mz / mw * 2^s, the quotient for s <= 0 is
- * floor(floor(mz / 2^-s) / mw), which is floor(mz / (mw 2^-s)); for s > 0 it is long
- * division by mw, 8 bits of the dividend at a time: the remainder stays below mw <
- * 2^24, so the remainder times 2^8 fits 32 bits, and the quotient below 2^32 (z < w). */
-static inline uint32_t om__spsm_zdepth(float z, float w)
-{
-    if (!(z > 0.0f)) return 0;
-    if (!(z < w)) return 0xFFFFFFFFu;
-    union { float f; uint32_t u; } fz, fw;
-    fz.f = z;
-    fw.f = w;
-    const uint32_t bz = fz.u, bw = fw.u;
-    int ez = (int)(bz >> 23), ew = (int)(bw >> 23);
-    const uint32_t mz = (bz & 0x7FFFFFu) | (ez ? 0x800000u : 0u), mw = (bw & 0x7FFFFFu) | (ew ? 0x800000u : 0u);
-    ez += !ez;
-    ew += !ew;
-    int s = ez - ew + 32;
-    if (s < -24) return 0;
-    if (s <= 0) return (mz >> -s) / mw;
-    uint32_t q = mz / mw, r = mz % mw;
-    while (s > 0) {
-        const int k = s < 8 ? s : 8;
-        r <<= k;
-        q = q << k | r / mw;
-        r %= mw;
-        s -= k;
-    }
-    return q;
-}
-
 /* Their float paths run where OM_FAST_FLOAT is 1 (core.h). */
 
 /* The depth tests of the lookup in float, for a CPU whose double is a library call (a
