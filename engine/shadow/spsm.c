@@ -603,7 +603,7 @@ static bool inside_extended(om__spsm_win *w, uint16_t use, int64_t qx, int64_t q
 }
 
 OM_NOINLINE static uint8_t recover(const om__spsm_state *m, om__spsm_win *w, uint32_t n[8], const om_strip *st,
-                                   size_t i, const sample_pt *pp, int64_t tx, int64_t ty);
+                                   size_t i, const sample_pt *p, int64_t tx, int64_t ty, int64_t px, int64_t py);
 
 /* The whole lookup of one sample; returns the term value (255 lit, 0 shadowed, partial
  * with AA). */
@@ -662,20 +662,16 @@ static uint8_t lookup(const om__spsm_state *m, om__spsm_win *w, uint32_t n[8], c
         if (!((w->t_have >> k) & 1u)) { decode(m, tx, ty, t, k); w->t_have |= 1u << k; }
         if (hits(m, t, k, px, py, p.zi, p.zf)) { n[N_SHADOWED]++; return 0; }
     }
-    return recover(m, w, n, st, i, &p, tx, ty);
+    return recover(m, w, n, st, i, &p, tx, ty, px, py);
 }
 
 /* 4.2 for an uncertain sample: its term. Out of line: few samples come here, and the
  * decisions above stay small enough to sit in the strip's loop. p is the sample's
  * projection, (tx, ty) its texel, whose 3x3 is decoded in w->t. */
 OM_NOINLINE static uint8_t recover(const om__spsm_state *m, om__spsm_win *w, uint32_t n[8], const om_strip *st,
-                                   size_t i, const sample_pt *pp, int64_t tx, int64_t ty)
+                                   size_t i, const sample_pt *p, int64_t tx, int64_t ty, int64_t px, int64_t py)
 {
     const om_sample *smp = &st->samples[i];
-    const om_vec3 pw = om__v3(smp->p[0], smp->p[1], smp->p[2]);
-    const sample_pt p = *pp;
-    const int64_t ox = tx * OM_SUBPIX + OM_SUBPIX / 2, oy = ty * OM_SUBPIX + OM_SUBPIX / 2;
-    const int64_t px = p.x - ox, py = p.y - oy;
     om__spsm_dtri *t = w->t;
 
     /* 4.2 uncertain: the silhouette from partial geometry. Consistent depth tests give
@@ -692,11 +688,11 @@ OM_NOINLINE static uint8_t recover(const om__spsm_state *m, om__spsm_win *w, uin
         /* cheapest test first; the receiver's plane only when a texel needs it */
         if (t[k].empty) continue;
         const int below =
-            OM_FAST_FLOAT ? om__spsm_below_f(&t[k], px, py, p.zf, -1.0f, (float)(OM__SPSM_TOL0 + PAT_CAP)) : -1;
+            OM_FAST_FLOAT ? om__spsm_below_f(&t[k], px, py, p->zf, -1.0f, (float)(OM__SPSM_TOL0 + PAT_CAP)) : -1;
         if (below < 0) dtri_double(m, &t[k]);
-        if (below == 0 || (below < 0 && !(om__spsm_plane_at(&t[k], px, py) < (double)p.zi - pat_tol(&t[k], px, py))))
+        if (below == 0 || (below < 0 && !(om__spsm_plane_at(&t[k], px, py) < (double)p->zi - pat_tol(&t[k], px, py))))
             continue;
-        if (!have_rp) { rp = receiver_plane(m, smp, &p); have_rp = true; }
+        if (!have_rp) { rp = receiver_plane(m, smp, p); have_rp = true; }
         if (t[k].ok && behind_receiver(&t[k], &rp, px, py)) continue;
         if (!t[k].have_cmin) {
             edges(t, k);
@@ -706,10 +702,10 @@ OM_NOINLINE static uint8_t recover(const om__spsm_state *m, om__spsm_win *w, uin
         }
         /* pat_tol at the texel's centre is OM__SPSM_TOL0: its offsets are 0 and its
          * error bounds finite */
-        int in = OM_FAST_FLOAT ? om__spsm_less_f(t[k].cminf, p.zf, 0.0f, 0.0f, 0.0f, 0.0f, (float)OM__SPSM_TOL0) : -1;
+        int in = OM_FAST_FLOAT ? om__spsm_less_f(t[k].cminf, p->zf, 0.0f, 0.0f, 0.0f, 0.0f, (float)OM__SPSM_TOL0) : -1;
         if (in < 0) {
             dtri_double(m, &t[k]);
-            in = t[k].cmin < (double)p.zi - pat_tol(&t[k], t[k].cx, t[k].cy);
+            in = t[k].cmin < (double)p->zi - pat_tol(&t[k], t[k].cx, t[k].cy);
         }
         if (in) pat |= 1u << k;
     }
@@ -728,7 +724,7 @@ OM_NOINLINE static uint8_t recover(const om__spsm_state *m, om__spsm_win *w, uin
     om_vec3 sx = om__v3(0, 0, 0), sy = sx;
     if (K > 1) pixel_steps(m, st, i, &sx, &sy);
     for (uint32_t s = 0; s < K; s++) {
-        sample_pt q = p;
+        sample_pt q = *p;
         int64_t qx = px, qy = py;
         if (K > 1) {
             /* a fixed stratified pattern in the pixel: rows by index, columns by the
@@ -736,11 +732,12 @@ OM_NOINLINE static uint8_t recover(const om__spsm_state *m, om__spsm_win *w, uin
             double a = ((double)s + 0.5) / (double)K - 0.5;
             double g = ((double)s + 0.5) * 0.6180339887498949;
             double b = g - floor(g) - 0.5;
+            const om_vec3 pw = om__v3(smp->p[0], smp->p[1], smp->p[2]);
             om_vec3 at = om__add(pw, om__add(om__scale(sx, (float)a), om__scale(sy, (float)b)));
             q = project(m, at);
-            if (!q.ok) q = p;
-            qx = q.x - ox;
-            qy = q.y - oy;
+            if (!q.ok) q = *p;
+            qx = px + (q.x - p->x);   /* q relative to the texel's centre, as px is */
+            qy = py + (q.y - p->y);
         }
         bool shadow = false;
         /* at the sample itself the lookup found no hit in the whole 3x3 */
@@ -748,12 +745,12 @@ OM_NOINLINE static uint8_t recover(const om__spsm_state *m, om__spsm_win *w, uin
             for (int k = 0; k < nocc && !shadow; k++) shadow = hits(m, t, w->occ_k[k], qx, qy, q.zi, q.zf);
         if (!shadow && bd->nh) shadow = om__spsm_outline_inside(bd, qx, qy);
         if (!shadow && w->ncand) {
-            if (!have_use) { use = centres_nearer(m, w, &rp, &have_rp, smp, &p, tx, ty, px, py); have_use = true; }
+            if (!have_use) { use = centres_nearer(m, w, &rp, &have_rp, smp, p, tx, ty, px, py); have_use = true; }
             if (use) shadow = inside_extended(w, use, qx, qy);
         }
         if (!shadow && tg->keep == 511) shadow = centre_test(m, &rp, tx, ty, px, py);   /* rp set */
         if (!shadow) {
-            if (!have_rp) { rp = receiver_plane(m, smp, &p); have_rp = true; }
+            if (!have_rp) { rp = receiver_plane(m, smp, p); have_rp = true; }
             shadow = m->fine ? plain_shadow(m->fdepth, 2 * (int64_t)m->size, OM_SUBPIX_BITS - 1, &rp, tx, ty, px, py, qx, qy)
                              : plain_shadow(m->cdepth, m->size, OM_SUBPIX_BITS, &rp, tx, ty, px, py, qx, qy);
         }
