@@ -379,25 +379,13 @@ static trange texels_in(const hybrid_state *m, int64_t lox, int64_t loy, int64_t
 
 /* A projected triangle's bounds and nearest vertex depth; false when it needs
  * clipping (or the projection is not kept). */
-static bool vbox_of(const hybrid_state *m, uint32_t t, om__hbox *v)
+static bool vbox_of(const hybrid_state *m, uint32_t t, om__lvbox *v)
 {
     if (!m->ls.verts) return false;
     const uint32_t *ix = m->scene->idx + (size_t)t * 3;
     const om__lvert *a = &m->ls.verts[ix[0]], *b = &m->ls.verts[ix[1]], *c = &m->ls.verts[ix[2]];
     if (a->x == INT32_MIN || b->x == INT32_MIN || c->x == INT32_MIN) return false;
-    v->lox = v->hix = a->x;
-    v->loy = v->hiy = a->y;
-    v->z = a->z;
-    if (b->x < v->lox) v->lox = b->x;
-    if (b->x > v->hix) v->hix = b->x;
-    if (c->x < v->lox) v->lox = c->x;
-    if (c->x > v->hix) v->hix = c->x;
-    if (b->y < v->loy) v->loy = b->y;
-    if (b->y > v->hiy) v->hiy = b->y;
-    if (c->y < v->loy) v->loy = c->y;
-    if (c->y > v->hiy) v->hiy = c->y;
-    if (b->z < v->z) v->z = b->z;
-    if (c->z < v->z) v->z = c->z;
+    *v = om__lvert_box(a, b, c);
     return true;
 }
 
@@ -410,7 +398,7 @@ static bool vbox_of(const hybrid_state *m, uint32_t t, om__hbox *v)
  * triangle takes the full path. */
 static bool add_small(hybrid_state *m, uint32_t t)
 {
-    om__hbox v;
+    om__lvbox v;
     if (!vbox_of(m, t, &v)) return false;
     if ((int64_t)v.hix - v.lox >= m->T - 1 && (int64_t)v.hiy - v.loy >= m->T - 1) return false;
     trange r = texels_in(m, v.lox, v.loy, v.hix, v.hiy);

@@ -29,9 +29,6 @@ static inline bool om__square_touches(const om__tri2 *e, int64_t x0, int64_t y0,
 typedef struct om__hkey { int32_t x, y; uint32_t z, tri, idx; } om__hkey;
 #define OM_HKEY_DONE 0x80000000u
 
-/* Grid bounds and a depth: a projected triangle's bounds and nearest vertex depth, or
- * a tile's samples' bounds and farthest depth. */
-typedef struct om__hbox { int32_t lox, loy, hix, hiy; uint32_t z; } om__hbox;
 
 /* A tile of uncertain samples and its scratch: the samples as they come (raw, n of
  * them, at most cap), then sorted into a grid of cells fitted to their bounds (smp,
@@ -42,7 +39,7 @@ typedef struct om__htile {
     om__odepth *od;
     uint32_t *cell, *cend, *bzmax;
     uint32_t cap, n;
-    om__hbox box;          /* the samples' bounds and farthest depth */
+    om__lvbox box;          /* the samples' bounds and farthest depth */
     /* The grid (hybrid_tile.c, fit_cells): cell (cx, cy) is the square of grid points
      * from (ox + cx 2^cs, oy + cy 2^cs), side 2^cs; cw x ch of them, in blocks of 4 x 4
      * cells, cbw a row. */

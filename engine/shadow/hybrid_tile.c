@@ -63,7 +63,7 @@ void om__htile_carve(om__htile *t, void *mem, uint32_t cap)
  * with at most CELL_SAMPLES cells a sample. */
 static void fit_cells(om__htile *t, uint32_t n)
 {
-    const om__hbox *x = &t->box;
+    const om__lvbox *x = &t->box;
     const uint64_t want = (uint64_t)n * CELL_SAMPLES;
     const uint32_t sx = (uint32_t)((int64_t)x->hix - x->lox), sy = (uint32_t)((int64_t)x->hiy - x->loy);
     int cs = 0;
@@ -81,7 +81,7 @@ static void fit_cells(om__htile *t, uint32_t n)
  * depths. */
 static void sort_tile(om__htile *t, uint32_t n)
 {
-    om__hbox *x = &t->box;
+    om__lvbox *x = &t->box;
     x->lox = x->loy = INT32_MAX;
     x->hix = x->hiy = INT32_MIN;
     x->z = 0;
@@ -121,7 +121,7 @@ typedef struct crange { uint32_t x0, y0, x1, y1; } crange;
 
 static inline crange cells_in(const om__htile *t, int64_t lox, int64_t loy, int64_t hix, int64_t hiy)
 {
-    const om__hbox *x = &t->box;
+    const om__lvbox *x = &t->box;
     crange r;
     r.x0 = (uint32_t)((lox > x->lox ? lox : x->lox) - t->ox) >> t->cs;
     r.y0 = (uint32_t)((loy > x->loy ? loy : x->loy) - t->oy) >> t->cs;
@@ -137,14 +137,14 @@ static inline int32_t max3(int32_t a, int32_t b, int32_t c) { return a > b ? (a 
  * bounds miss the tile's or it is nowhere nearer than their farthest (it blocks none
  * of them), 1 with v its bounds and nearest vertex depth, 0 when it needs clipping (or
  * the projection is not kept). */
-static int vbox_near(const om__hscene *h, const om__htile *t, uint32_t tri, om__hbox *v)
+static int vbox_near(const om__hscene *h, const om__htile *t, uint32_t tri, om__lvbox *v)
 {
     const om__lvert *vs = h->ls->verts;
     if (!vs) return 0;
     const uint32_t *ix = h->scene->idx + (size_t)tri * 3;
     const om__lvert *a = &vs[ix[0]], *b = &vs[ix[1]], *c = &vs[ix[2]];
     if (a->x == INT32_MIN || b->x == INT32_MIN || c->x == INT32_MIN) return 0;
-    const om__hbox *x = &t->box;
+    const om__lvbox *x = &t->box;
     v->lox = min3(a->x, b->x, c->x);
     v->hix = max3(a->x, b->x, c->x);
     if (v->hix < x->lox || v->lox > x->hix) return -1;
@@ -167,7 +167,7 @@ static bool any_farther(const om__htile *t, const crange *r, uint32_t z)
 
 /* Is an open sample in the cells of r inside v's bounds and farther than its nearest
  * vertex? */
-static bool any_within(const om__htile *t, const crange *r, const om__hbox *v)
+static bool any_within(const om__htile *t, const crange *r, const om__lvbox *v)
 {
     const int32_t lox = v->lox, hix = v->hix, loy = v->loy, hiy = v->hiy;
     const uint32_t z = v->z;
@@ -195,7 +195,7 @@ static bool cell_touches(const om__htile *t, const om__ltri *lt, uint32_t cx, ui
 /* Triangle tri against the tile's samples; returns how many it shadowed opaquely. */
 static uint32_t cast(const om__hscene *h, om__htile *t, uint32_t tri)
 {
-    om__hbox v;
+    om__lvbox v;
     const int near = vbox_near(h, t, tri, &v);
     if (near < 0) return 0;
     if (near > 0) {
@@ -207,7 +207,7 @@ static uint32_t cast(const om__hscene *h, om__htile *t, uint32_t tri)
     om__ltri lt;
     if (!om__lspace_tri(h->ls, tri, &lt)) return 0;
     t->setups++;
-    const om__hbox *x = &t->box;
+    const om__lvbox *x = &t->box;
     if (lt.hix < x->lox || lt.lox > x->hix || lt.hiy < x->loy || lt.loy > x->hiy) return 0;
     const om__odepth *od = &h->mat_od[h->scene->tri_mat[tri]];
     const crange r = cells_in(t, lt.lox, lt.loy, lt.hix, lt.hiy);

@@ -178,20 +178,9 @@ OM_INLINE void cast(om__izb *z, uint32_t t)
     if (a && a->x != INT32_MIN && b->x != INT32_MIN && c->x != INT32_MIN) {
         /* The plane's depth lies within its vertices', and the triangle's bounds are
          * its vertices': the same culls visit() makes, before any setup. */
-        int32_t lox = a->x, hix = a->x, loy = a->y, hiy = a->y;
-        uint32_t zlo = a->z;
-        if (b->x < lox) lox = b->x;
-        if (b->x > hix) hix = b->x;
-        if (c->x < lox) lox = c->x;
-        if (c->x > hix) hix = c->x;
-        if (b->y < loy) loy = b->y;
-        if (b->y > hiy) hiy = b->y;
-        if (c->y < loy) loy = c->y;
-        if (c->y > hiy) hiy = c->y;
-        if (b->z < zlo) zlo = b->z;
-        if (c->z < zlo) zlo = c->z;
-        if (zlo >= root->zmax || !cell_range(z, lox, loy, hix, hiy, &cr)) return;
-        vbox vb = {lox, loy, hix, hiy, zlo, 0, 0};
+        const om__lvbox lb = om__lvert_box(a, b, c);
+        if (lb.z >= root->zmax || !cell_range(z, lb.lox, lb.loy, lb.hix, lb.hiy, &cr)) return;
+        vbox vb = {lb.lox, lb.loy, lb.hix, lb.hiy, lb.z, 0, 0};
         if ((uint64_t)(cr.x1 - cr.x0 + 1) * (cr.y1 - cr.y0 + 1) <= DIRECT) {
             nhit = 0;
             for (uint32_t cy = cr.y0; cy <= cr.y1; cy++)
@@ -199,8 +188,8 @@ OM_INLINE void cast(om__izb *z, uint32_t t)
                     uint32_t ni = cell_at(z, cx, cy);
                     if (ni == OM_IZB_NONE) continue;
                     const om__izb_node *nd = &z->nodes[ni];
-                    if (nd->open && zlo < nd->zmax && lox <= nd->x1 && hix >= nd->x0 &&
-                        loy <= nd->y1 && hiy >= nd->y0)
+                    if (nd->open && lb.z < nd->zmax && lb.lox <= nd->x1 && lb.hix >= nd->x0 &&
+                        lb.loy <= nd->y1 && lb.hiy >= nd->y0)
                         hit[nhit++] = ni;
                 }
             if (nhit == 0) return;

@@ -82,16 +82,8 @@ void om__lgrid_boxes(const om__lgrid *g, uint32_t first, uint32_t end)
             g->box[t] = WIDE;
             continue;
         }
-        int32_t lox = a->x, hix = a->x, loy = a->y, hiy = a->y;
-        if (b->x < lox) lox = b->x;
-        if (b->x > hix) hix = b->x;
-        if (c->x < lox) lox = c->x;
-        if (c->x > hix) hix = c->x;
-        if (b->y < loy) loy = b->y;
-        if (b->y > hiy) hiy = b->y;
-        if (c->y < loy) loy = c->y;
-        if (c->y > hiy) hiy = c->y;
-        const uint32_t x0 = cell_of(g, lox), x1 = cell_of(g, hix), y0 = cell_of(g, loy), y1 = cell_of(g, hiy);
+        const om__lvbox vb = om__lvert_box(a, b, c);
+        const uint32_t x0 = cell_of(g, vb.lox), x1 = cell_of(g, vb.hix), y0 = cell_of(g, vb.loy), y1 = cell_of(g, vb.hiy);
         g->box[t] = (x1 - x0 + 1) * (y1 - y0 + 1) > LGRID_MOST ? WIDE : x0 | y0 << 8 | x1 << 16 | y1 << 24;
     }
 }

@@ -61,6 +61,27 @@ typedef struct om__lpoint {
 /* A vertex projected once per frame; x == INT32_MIN marks one that needs clipping. */
 typedef struct om__lvert { int32_t x, y; uint32_t z; } om__lvert;
 
+/* Grid bounds and a depth: a projected triangle's bounds and nearest vertex depth
+ * (om__lvert_box), or a set of samples' bounds and farthest depth (hybrid's tiles). */
+typedef struct om__lvbox { int32_t lox, loy, hix, hiy; uint32_t z; } om__lvbox;
+
+/* The box of three projected vertices, none of which needs clipping. */
+static inline om__lvbox om__lvert_box(const om__lvert *a, const om__lvert *b, const om__lvert *c)
+{
+    om__lvbox v = {a->x, a->y, a->x, a->y, a->z};
+    if (b->x < v.lox) v.lox = b->x;
+    if (b->x > v.hix) v.hix = b->x;
+    if (c->x < v.lox) v.lox = c->x;
+    if (c->x > v.hix) v.hix = c->x;
+    if (b->y < v.loy) v.loy = b->y;
+    if (b->y > v.hiy) v.hiy = b->y;
+    if (c->y < v.loy) v.loy = c->y;
+    if (c->y > v.hiy) v.hiy = c->y;
+    if (b->z < v.z) v.z = b->z;
+    if (c->z < v.z) v.z = c->z;
+    return v;
+}
+
 typedef struct om__lspace {
     const om_scene *scene;
     om_mat4 vp;            /* the light's world -> clip */
