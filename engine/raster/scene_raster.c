@@ -216,6 +216,7 @@ static inline void lanes_project(lanes *restrict b, float *restrict px, float *r
 #define VERT_LANES 0
 #endif
 
+#if VERT_LANES
 /* om__zdepth of the lanes' z and w up to its division, a loop over the lanes on the
  * floats' bits (copied out whole: a union a lane would stop a compiler's lanes), with
  * its tests and steps in its order: kind 0 for depth 0 (z <= 0, NaN, or below one
@@ -241,6 +242,7 @@ static inline void lanes_depth(depths *restrict d, const lanes *restrict l)
         d->kind[i] = pos & below ? (int32_t)(e >= -24) : 2 * pos;
     }
 }
+#endif
 
 /* The bins' vertices [v0, v1): each snapped alone as om__raster_tri would snap it when
  * it needs no clipping, its depth with it (a triangle's strips and bands share it),
