@@ -10,8 +10,9 @@
  * touches a texel when its edge functions admit a point of the texel's square (tested
  * against the square's extreme corner per edge: never missed, sometimes extra). Per
  * texel the build keeps
- *   lo      a plane below every touching triangle's depth over the square (clamped as
- *           the predicate clamps) plus its snapping bound;
+ *   lo      a plane below every touching triangle's depth (clamped as the predicate
+ *           clamps) plus its snapping bound, at every point of the square inside the
+ *           box of the triangle's vertices;
  *   hi, cid over opaque triangles of one sub-triangle whose edges admit all four
  *           corners of the square (so every point of it: the admitted set is convex):
  *           the least of (their depth at the square's corner where their plane is
@@ -23,8 +24,10 @@
  * texel e (om__blocks: a triangle t blocks p when t != p's own triangle, g is inside
  * t's first sub-triangle that admits it, and that sub-triangle's depth at g plus its
  * bound is below p.z):
- *   certainly lit when lo at g >= p.z. A blocker t admits g, so it touches e, and lo at
- *     g is at most its depth at g plus its bound, which is below p.z: lo < p.z.
+ *   certainly lit when lo at g >= p.z. A blocker t admits g, so it touches e; g is in
+ *     the closed triangle of t's vertices (every edge function >= 0: the tie rule only
+ *     takes points away), so in their box; and lo at g is at most t's depth at g plus
+ *     its bound, which is below p.z: lo < p.z.
  *   certainly shadowed when hi < p.z and cid != own. cid is one sub-triangle admitting
  *     every point of e, g among them (so it is the first that admits g), with depth
  *     at g at most its depth at the corner where its plane is greatest (the clamp
@@ -333,13 +336,19 @@ static void add_sub(hybrid_state *m, const om__rtri *r, double bound, uint32_t t
                 h->gy = (float)r->zy;
                 h->z = FLT_MAX;
             }
-            /* The clamped depth is at least min(plane, zmax): the least of each over
-             * the square, less the texel's plane, bounds how far down z must go. */
+            /* The clamped depth is at least min(plane, zmax): the least of each, less
+             * the texel's plane, bounds how far down z must go, over the points the
+             * triangle can admit in the square, which lie in its box too (where the
+             * square reaches past the triangle's far corner, the plane there is
+             * beyond zmax, and over the whole square min(plane, zmax) would fall by
+             * up to a texel's depth slope below what any admitted point has). */
+            const int64_t ax0 = x0 > lox ? x0 : lox, ax1 = x1 < hix ? x1 : hix;
+            const int64_t ay0 = y0 > loy ? y0 : loy, ay1 = y1 < hiy ? y1 : hiy;
             double gx = h->gx, gy = h->gy;
-            double p0 = gx * (double)(x0 - xc) + gy * (double)(y0 - yc);
-            double d0 = r->z0 + r->zx * (double)(x0 - e->x[0]) + r->zy * (double)(y0 - e->y[0]);
-            double a = least_diff(d0, r->zx, r->zy, p0, gx, gy, x1 - x0, y1 - y0);
-            double b = least_diff(r->zmax, 0.0, 0.0, p0, gx, gy, x1 - x0, y1 - y0);
+            double p0 = gx * (double)(ax0 - xc) + gy * (double)(ay0 - yc);
+            double d0 = r->z0 + r->zx * (double)(ax0 - e->x[0]) + r->zy * (double)(ay0 - e->y[0]);
+            double a = least_diff(d0, r->zx, r->zy, p0, gx, gy, ax1 - ax0, ay1 - ay0);
+            double b = least_diff(r->zmax, 0.0, 0.0, p0, gx, gy, ax1 - ax0, ay1 - ay0);
             float z = f_down((a < b ? a : b) + bound - 1.0);
             if (z < h->z) h->z = z;
             if (cover && lox <= x0 && hix >= x1 && loy <= y0 && hiy >= y1 &&
