@@ -29,6 +29,8 @@ typedef struct job_slot {
     uint32_t counts[8];
     void *scratch;
     size_t dirty;   /* bytes of scratch its first job zeroes (a pass slot: band_job) */
+    uint32_t run;    /* the band that job k of a stage runs is slots[k].run (order_bands) */
+    uint32_t weight; /* order_bands' estimate of band k's work */
 } job_slot;
 
 static size_t bins_bytes(const om_scene *s)
@@ -207,6 +209,7 @@ static void band_job(void *user, uint32_t b)
         else om__bins_make_rows(fd->scene, c->mk_vp, c->mk_w, c->mk_h, c->mk, a, e);
         return;
     }
+    b = c->slots[b].run;   /* the heaviest bands first (order_bands) */
     if (c->stage == STAGE_BUILD) {
         uint32_t y0 = b * c->map_band, rows = c->map_size - y0;
         c->bands->build_rows(fd->method_state, c->map_bins.rows ? &c->map_bins : NULL, y0,
@@ -238,6 +241,40 @@ static void band_job(void *user, uint32_t b)
         fb.pixels += (size_t)r0 * fb.stride;
         fb.rows = st.rows;
         om__shade_strip(fd->scene, c->view, fd->shade, &st, &fb);
+    }
+}
+
+/* At most this many triangles' rows are read to weigh the bands (order_bands). */
+#define ORDER_SAMPLES 1024
+
+/* The order the `nb` bands of `band` rows from row y0 run in (slots[k].run): the
+ * heaviest first, weighed by the triangles whose bins' rows reach each (every
+ * ntris / ORDER_SAMPLES + 1-th triangle, on the calling thread), ties in row order;
+ * in row order without rows. A host hands jobs out in order, and a heavy band that
+ * comes last keeps one thread busy while the others wait (a scene whose triangles
+ * crowd a few rows: issue 26's random cloud); longest first is the classic cure.
+ * Which band a job runs changes when it finishes, never a pixel. */
+static void order_bands(frame_ctx *c, const uint32_t *rows, uint32_t y0, uint32_t band, uint32_t nb)
+{
+    job_slot *sl = c->slots;
+    for (uint32_t k = 0; k < nb; k++) {
+        sl[k].run = k;
+        sl[k].weight = 0;
+    }
+    if (!rows || nb <= c->jobs) return;
+    const uint32_t nt = c->fd->scene->ntris, step = nt / ORDER_SAMPLES + 1, y1 = y0 + band * nb;
+    for (uint32_t t = 0; t < nt; t += step) {
+        uint32_t r0 = rows[t] & 0xFFFFu, r1 = rows[t] >> 16;
+        if (r0 > r1 || r1 < y0 || r0 >= y1) continue;
+        r0 = r0 < y0 ? 0 : (r0 - y0) / band;
+        r1 = r1 >= y1 ? nb - 1 : (r1 - y0) / band;
+        for (uint32_t k = r0; k <= r1; k++) sl[k].weight++;
+    }
+    for (uint32_t k = 1; k < nb; k++) {   /* insertion sort of the runs, stable */
+        const uint32_t b = sl[k].run;
+        uint32_t i = k;
+        for (; i > 0 && sl[sl[i - 1].run].weight < sl[b].weight; i--) sl[i].run = sl[i - 1].run;
+        sl[i].run = b;
     }
 }
 
@@ -283,6 +320,7 @@ static void build_map(frame_ctx *c)
     c->map_band = ((c->map_size + n - 1) / n + 15) / 16 * 16;
     const uint32_t nb = (c->map_size + c->map_band - 1) / c->map_band;
     for (uint32_t j = 0; j < nb; j++) memset(c->slots[j].counts, 0, sizeof c->slots[j].counts);
+    order_bands(c, c->map_bins.rows, 0, c->map_band, nb);
     run_stage(c, STAGE_BUILD, nb);
     uint32_t sum[8] = {0};
     for (uint32_t j = 0; j < nb; j++)
@@ -367,12 +405,15 @@ static void prepare(frame_ctx *c, bool eye, bool mark, om_frame_stats *fs)
     }
 }
 
-/* Moves the strip (and its target) to rows [y, y + rows). */
+/* Moves the strip (and its target) to rows [y, y + rows), and orders its bands. */
 static void strip_at(frame_ctx *c, uint32_t y, uint32_t rows)
 {
     uint32_t H = c->strip.height;
     c->strip.y0 = c->tg.y0 = y;
     c->strip.rows = c->tg.rows = y + rows > H ? H - y : rows;
+    if (OM_WITH_JOBS && c->jobs > 1)
+        order_bands(c, c->bins ? c->bins->rows : NULL, y, c->band_rows,
+                    (c->strip.rows + c->band_rows - 1) / c->band_rows);
 }
 
 /* Carves the jobs' slots: as many as the host asks for and the arena holds beyond
