@@ -577,7 +577,8 @@ static void odd_inputs(void)
 /* The lookup's depth tests in float (om__spsm_below_f, om__spsm_tol_within_f) give the
  * double arithmetic's answers whenever they answer: records with random codes, points
  * around the texel, depths at random and next to each test's threshold, with and
- * without the cap. */
+ * without the cap. And so do all four asked of one float plane (om__spsm_pf_at), as the
+ * lookup asks them: the lit test's three, then recovery's capped one. */
 static uint32_t next_rand(uint32_t *s)
 {
     *s = *s * 1664525u + 1013904223u;
@@ -590,6 +591,7 @@ static void float_tests_are_the_double_ones(void)
     om__spsm_qtable_build(&q);
     uint32_t s = 13;
     unsigned long long wrong = 0, far_answered = 0, near_answered = 0, far = 0;
+    unsigned long long shared_wrong = 0, shared_answered = 0, shared_asked = 0;
     const double u = 65536.0 * OM_SPSM_DSCALE / (double)OM_SUBPIX;
     for (int it = 0; it < 300000; it++) {
         om__spsm_dtri t;
@@ -630,6 +632,18 @@ static void float_tests_are_the_double_ones(void)
             got = om__spsm_below_f(&t, px, py, pzf, mode == 1 ? 1.0f : -1.0f, mode == 2 ? (float)cap : 0.0f);
             want = mode == 1 ? plane <= pz + tol : plane < pz - used;
         }
+        om__spsm_pf f;
+        om__spsm_pf_at(&f, &t, px, py, pzf);
+        const double cap16 = 1.5 * 65536.0 + 16.0 * 65536.0, cap64 = 1.5 * 65536.0 + 64.0 * 65536.0;
+        const int all[4] = {om__spsm_pf_below(&f, pzf, -1.0f, 0.0f), om__spsm_pf_below(&f, pzf, 1.0f, 0.0f),
+                            om__spsm_pf_below(&f, pzf, -1.0f, (float)cap16), om__spsm_pf_within(&f, (float)cap64)};
+        const int all_want[4] = {plane < pz - tol, plane <= pz + tol, plane < pz - (tol < cap16 ? tol : cap16),
+                                 tol <= cap64};
+        for (int j = 0; j < 4; j++) {
+            shared_asked++;
+            if (all[j] >= 0) shared_answered++;
+            if (all[j] >= 0 && all[j] != all_want[j]) shared_wrong++;
+        }
         far += r >= 2;
         if (got >= 0) {
             far_answered += r >= 2;
@@ -640,6 +654,8 @@ static void float_tests_are_the_double_ones(void)
         }
     }
     CHECK_EQ_U(wrong, 0);
+    CHECK_EQ_U(shared_wrong, 0);
+    CHECK_MSG(shared_answered * 4 > shared_asked * 3, "%llu of %llu answered", shared_answered, shared_asked);
     CHECK(near_answered > 1000);
     CHECK_MSG(far_answered * 10 > far * 9, "%llu of %llu answered away from the threshold", far_answered, far);
 }

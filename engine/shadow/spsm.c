@@ -357,10 +357,16 @@ static double pat_tol(const om__spsm_dtri *t, int64_t px, int64_t py)
     return tol < OM__SPSM_TOL0 + PAT_CAP ? tol : OM__SPSM_TOL0 + PAT_CAP;
 }
 
-/* Algorithm 1's depth half: the stored plane is nearer than the sample at (px, py). */
-static bool nearer(const om__spsm_state *m, om__spsm_dtri *t, int64_t px, int64_t py, uint32_t pz, float pzf)
+/* Algorithm 1's depth half: the stored plane is nearer than the sample at (px, py).
+ * The float plane there is left in *f (where OM_FAST_FLOAT), for recovery's test. */
+static bool nearer(const om__spsm_state *m, om__spsm_dtri *t, int64_t px, int64_t py, uint32_t pz, float pzf,
+                   om__spsm_pf *f)
 {
-    const int below = OM_FAST_FLOAT ? om__spsm_below_f(t, px, py, pzf, -1.0f, 0.0f) : -1;
+    int below = -1;
+    if (OM_FAST_FLOAT) {
+        om__spsm_pf_at(f, t, px, py, pzf);
+        below = om__spsm_pf_below(f, pzf, -1.0f, 0.0f);
+    }
     if (below >= 0) return below == 1;
     dtri_double(m, t);
     return om__spsm_plane_at(t, px, py) < (double)pz - om__spsm_tol_at(t, px, py);
@@ -369,9 +375,10 @@ static bool nearer(const om__spsm_state *m, om__spsm_dtri *t, int64_t px, int64_
 /* Algorithm 1 at texel k of the 3x3: its stored triangle covers the point in 2-D and is
  * nearer there. The depth first: most neighbours lie in the sample's own surface, and
  * their edges are then not set up. */
-static bool hits(const om__spsm_state *m, om__spsm_dtri t[9], int k, int64_t px, int64_t py, uint32_t pz, float pzf)
+static bool hits(const om__spsm_state *m, om__spsm_dtri t[9], int k, int64_t px, int64_t py, uint32_t pz, float pzf,
+                 om__spsm_pf *f)
 {
-    return t[k].ok && nearer(m, &t[k], px, py, pz, pzf) && om__spsm_covers(edges(t, k), px, py);
+    return t[k].ok && nearer(m, &t[k], px, py, pz, pzf, f) && om__spsm_covers(edges(t, k), px, py);
 }
 
 /* Figure 9: the least depth the triangle reaches inside its texel's square, found where
@@ -637,10 +644,16 @@ static uint8_t lookup(const om__spsm_state *m, om__spsm_win *w, uint32_t n[8], c
     }
     if (t[4].empty) { n[N_LIT]++; return 255; }
     if (t[4].ok) {
-        /* in float where that is sure of the double's answers (om__spsm_below_f) */
-        int below = OM_FAST_FLOAT ? om__spsm_below_f(&t[4], px, py, p.zf, -1.0f, 0.0f) : -1, on = 0, close = 0;
-        if (below == 0) on = om__spsm_below_f(&t[4], px, py, p.zf, 1.0f, 0.0f);
-        if (on == 1) close = om__spsm_tol_within_f(&t[4], px, py, (float)(OM__SPSM_TOL0 + LIT_CAP));
+        /* in float where that is sure of the double's answers (om__spsm_below_f), from
+         * one float plane at the sample (kept for recovery's test) */
+        int below = -1, on = 0, close = 0;
+        om__spsm_pf f;
+        if (OM_FAST_FLOAT) {
+            om__spsm_pf_at(&f, &t[4], px, py, p.zf);
+            below = om__spsm_pf_below(&f, p.zf, -1.0f, 0.0f);
+            if (below == 0) on = om__spsm_pf_below(&f, p.zf, 1.0f, 0.0f);
+            if (on == 1) close = om__spsm_pf_within(&f, (float)(OM__SPSM_TOL0 + LIT_CAP));
+        }
         if (below < 0 || on < 0 || close < 0) {
             dtri_double(m, &t[4]);
             const double z = om__spsm_plane_at(&t[4], px, py), tol = om__spsm_tol_at(&t[4], px, py);
@@ -655,12 +668,13 @@ static uint8_t lookup(const om__spsm_state *m, om__spsm_win *w, uint32_t n[8], c
             n[N_LIT]++;
             return 255;
         }
+        if (OM_FAST_FLOAT) w->pf[4] = f;
     }
     /* 4.1 shadowed: Algorithm 1 on the 3x3 neighbourhood */
     for (int k = 0; k < 9; k++) {
         if (k == 4) continue;
         if (!((w->t_have >> k) & 1u)) { decode(m, tx, ty, t, k); w->t_have |= 1u << k; }
-        if (hits(m, t, k, px, py, p.zi, p.zf)) { n[N_SHADOWED]++; return 0; }
+        if (hits(m, t, k, px, py, p.zi, p.zf, &w->pf[k])) { n[N_SHADOWED]++; return 0; }
     }
     return recover(m, w, n, st, i, &p, tx, ty, px, py);
 }
@@ -687,8 +701,10 @@ OM_NOINLINE static uint8_t recover(const om__spsm_state *m, om__spsm_win *w, uin
     for (int k = 0; k < 9; k++) {
         /* cheapest test first; the receiver's plane only when a texel needs it */
         if (t[k].empty) continue;
-        const int below =
-            OM_FAST_FLOAT ? om__spsm_below_f(&t[k], px, py, p->zf, -1.0f, (float)(OM__SPSM_TOL0 + PAT_CAP)) : -1;
+        /* the float plane at the sample is w->pf[k] where the tests above found it (a
+         * texel with a triangle) */
+        if (OM_FAST_FLOAT && !t[k].ok) om__spsm_pf_at(&w->pf[k], &t[k], px, py, p->zf);
+        const int below = OM_FAST_FLOAT ? om__spsm_pf_below(&w->pf[k], p->zf, -1.0f, (float)(OM__SPSM_TOL0 + PAT_CAP)) : -1;
         if (below < 0) dtri_double(m, &t[k]);
         if (below == 0 || (below < 0 && !(om__spsm_plane_at(&t[k], px, py) < (double)p->zi - pat_tol(&t[k], px, py))))
             continue;
@@ -742,7 +758,10 @@ OM_NOINLINE static uint8_t recover(const om__spsm_state *m, om__spsm_win *w, uin
         bool shadow = false;
         /* at the sample itself the lookup found no hit in the whole 3x3 */
         if (K > 1)
-            for (int k = 0; k < nocc && !shadow; k++) shadow = hits(m, t, w->occ_k[k], qx, qy, q.zi, q.zf);
+            for (int k = 0; k < nocc && !shadow; k++) {
+                om__spsm_pf f;   /* another point: not the sample's */
+                shadow = hits(m, t, w->occ_k[k], qx, qy, q.zi, q.zf, &f);
+            }
         if (!shadow && bd->nh) shadow = om__spsm_outline_inside(bd, qx, qy);
         if (!shadow && w->ncand) {
             if (!have_use) { use = centres_nearer(m, w, &rp, &have_rp, smp, p, tx, ty, px, py); have_use = true; }

@@ -131,33 +131,66 @@ static inline bool om__spsm_covers(const om__tri2 *e, int64_t px, int64_t py)
  * sign in both, and so does the cap's choice; equality lies inside that band, so < and
  * <= agree outside it. Offsets beyond 2^20 grid units (exact in float below 2^24) and
  * non-finite values answer -1. px, py and the centre lie within 2^30 (taken in 32 bits). */
-static inline int om__spsm_below_f(const om__spsm_dtri *t, int64_t px, int64_t py, float pz, float sign,
-                                   float cap)
+/* The part of those tests that does not depend on the sign or the cap: the plane's
+ * value a, the tolerance tol and the bound e at one point against one depth pz, found
+ * once per sample and texel (the lit test asks three questions of the sample's own
+ * texel, and recovery asks again of each texel that Algorithm 1 tested); ok false
+ * where every answer is -1 (offsets beyond 2^20). */
+typedef struct om__spsm_pf { float a, tol, e; bool ok; } om__spsm_pf;
+
+static inline void om__spsm_pf_at(om__spsm_pf *f, const om__spsm_dtri *t, int64_t px, int64_t py, float pz)
 {
     /* in 32 bits: the lookup's points and centres lie below 2^27 (om__spsm_edge) */
     const int32_t ix = (int32_t)px - (int32_t)t->cx, iy = (int32_t)py - (int32_t)t->cy;
-    if (ix < -(1 << 20) || ix > (1 << 20) || iy < -(1 << 20) || iy > (1 << 20)) return -1;
+    f->ok = !(ix < -(1 << 20) || ix > (1 << 20) || iy < -(1 << 20) || iy > (1 << 20));
+    if (!f->ok) {
+        f->a = f->tol = f->e = 0.0f;
+        return;
+    }
     const float dx = (float)ix, dy = (float)iy;
-    const float gdx = t->gxf * dx, gdy = t->gyf * dy, a = t->zf + gdx + gdy;
-    float tol = (float)OM__SPSM_TOL0 + t->exf * om__fabsf(dx) + t->eyf * om__fabsf(dy);
-    const float e = (om__fabsf(t->zf) + om__fabsf(gdx) + om__fabsf(gdy) + om__fabsf(pz) + tol) * 0x1p-19f;
+    const float gdx = t->gxf * dx, gdy = t->gyf * dy;
+    f->a = t->zf + gdx + gdy;
+    f->tol = (float)OM__SPSM_TOL0 + t->exf * om__fabsf(dx) + t->eyf * om__fabsf(dy);
+    f->e = (om__fabsf(t->zf) + om__fabsf(gdx) + om__fabsf(gdy) + om__fabsf(pz) + f->tol) * 0x1p-19f;
+}
+
+/* om__spsm_below_f's answer from the shared part f (found against the same pz). */
+static inline int om__spsm_pf_below(const om__spsm_pf *f, float pz, float sign, float cap)
+{
+    if (!f->ok) return -1;
+    float tol = f->tol;
+    const float e = f->e;
     if (cap > 0.0f) {
         if (tol > cap + e) tol = cap;
         else if (!(tol < cap - e)) return -1;
     }
-    const float d = a - (pz + sign * tol);
+    const float d = f->a - (pz + sign * tol);
     return d < -e ? 1 : d > e ? 0 : -1;
+}
+
+/* om__spsm_tol_within_f's answer from the shared part f. */
+static inline int om__spsm_pf_within(const om__spsm_pf *f, float cap)
+{
+    if (!f->ok) return -1;
+    const float e = f->tol * 0x1p-19f;
+    return f->tol < cap - e ? 1 : f->tol > cap + e ? 0 : -1;
+}
+
+static inline int om__spsm_below_f(const om__spsm_dtri *t, int64_t px, int64_t py, float pz, float sign,
+                                   float cap)
+{
+    om__spsm_pf f;
+    om__spsm_pf_at(&f, t, px, py, pz);
+    return om__spsm_pf_below(&f, pz, sign, cap);
 }
 
 /* Whether om__spsm_tol_at(t, px, py) <= cap as the double arithmetic finds it (1, 0),
  * or -1 when float cannot be sure (the same bounds). */
 static inline int om__spsm_tol_within_f(const om__spsm_dtri *t, int64_t px, int64_t py, float cap)
 {
-    const int32_t ix = (int32_t)px - (int32_t)t->cx, iy = (int32_t)py - (int32_t)t->cy;
-    if (ix < -(1 << 20) || ix > (1 << 20) || iy < -(1 << 20) || iy > (1 << 20)) return -1;
-    const float tol = (float)OM__SPSM_TOL0 + t->exf * om__fabsf((float)ix) + t->eyf * om__fabsf((float)iy);
-    const float e = tol * 0x1p-19f;
-    return tol < cap - e ? 1 : tol > cap + e ? 0 : -1;
+    om__spsm_pf f;
+    om__spsm_pf_at(&f, t, px, py, 0.0f);
+    return om__spsm_pf_within(&f, cap);
 }
 
 /* Whether a < b + c dx + d dy - e, each a double and the sum taken in that order, as

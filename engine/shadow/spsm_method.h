@@ -50,6 +50,10 @@ typedef struct om__spsm_win {
     om__spsm_boundary bd, bx;
     uint16_t bd_keep;
     bool bd_have;
+    /* the float plane of each texel at the sample being looked up (om__spsm_pf_at:
+     * the lit test's at t[4], Algorithm 1's at the others), which recovery's pattern
+     * test reads again: set for every t[k].ok before recover runs */
+    om__spsm_pf pf[9];
 } om__spsm_win;
 
 /* Forgets what the window holds (all of it, so that nothing is read unset). */
