@@ -274,6 +274,40 @@ static void grid_lists(void)
     for (uint32_t k = 7; k-- > 0;) om__lgrid_fill(&p, rows * k / 7, rows * (k + 1) / 7);
     CHECK(p.ready == 1 && !memcmp(p.start, g.start, ((size_t)g.lists + 1) * sizeof *g.start) &&
           !memcmp(p.tris, g.tris, (size_t)g.start[g.lists] * sizeof *g.tris));
+    /* made by parts of the triangles (the frame's jobs: lgrid.h's counting sort), over
+     * memory that held other bytes, each step's parts last first */
+    static const uint32_t nparts[] = {1, 2, 3, 7};
+    for (int i = 0; i < 4; i++) {
+        const uint32_t P = nparts[i];
+        uint32_t *cnt[7], at[257];
+        uint64_t entries[7];
+        memset(p.box, 0xA5, (size_t)n * sizeof *p.box);
+        memset(p.start, 0xA5, ((size_t)p.lists + 1) * sizeof *p.start);
+        memset(p.tris, 0xA5, (size_t)p.cap * sizeof *p.tris);
+        p.ready = 0;
+        for (uint32_t k = P; k-- > 0;) {
+            cnt[k] = malloc(om__lgrid_part_bytes(&p));
+            memset(cnt[k], 0xA5, om__lgrid_part_bytes(&p));
+            om__lgrid_boxes_count(&p, k, P, cnt[k]);
+        }
+        for (uint32_t k = P; k-- > 0;) entries[k] = om__lgrid_sum_rows(&p, cnt, k, P);
+        om__lgrid_bases(&p, entries, P, at);
+        for (uint32_t k = P; k-- > 0;) om__lgrid_fill_part(&p, at, k, P, cnt[k]);
+        CHECK_MSG(p.ready == 1 && !memcmp(p.start, g.start, ((size_t)g.lists + 1) * sizeof *g.start) &&
+                      !memcmp(p.tris, g.tris, (size_t)g.start[g.lists] * sizeof *g.tris),
+                  "grid: the lists made by %u parts differ", P);
+        /* with one entry fewer than the lists need, bases says so */
+        if (P == 3) {
+            const uint32_t cap = p.cap;
+            p.cap = g.start[g.lists] - 1;
+            for (uint32_t k = 0; k < P; k++) om__lgrid_boxes_count(&p, k, P, cnt[k]);
+            for (uint32_t k = 0; k < P; k++) entries[k] = om__lgrid_sum_rows(&p, cnt, k, P);
+            om__lgrid_bases(&p, entries, P, at);
+            CHECK_MSG(p.ready == -1, "grid: %u entries in %u", g.start[g.lists], p.cap);
+            p.cap = cap;
+        }
+        for (uint32_t k = 0; k < P; k++) free(cnt[k]);
+    }
     /* each triangle where its box lies; each list ascending */
     uint32_t *seen = calloc(n, sizeof *seen);
     uint32_t wide = 0, bad = 0, order = 0;

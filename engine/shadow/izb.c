@@ -509,34 +509,48 @@ static size_t izb_pass_scratch(const void *state, const om_scene *s)
     return pool_bytes_of(most > 0xFFFFFFFFu ? 0xFFFFFFFFu : (uint32_t)most, 64) + up16(om__lgrid_sel_bytes(s));
 }
 
-/* The grid's steps as jobs of the pass's slots (om__lend): each of `parts` jobs takes
- * its share of the triangles, then of the rows of lists. */
-typedef struct grid_job { om__lgrid *g; uint32_t parts, step; } grid_job;
+/* The grid's steps as jobs of the pass's slots (om__lend), by parts of the triangles
+ * (lgrid.h's counting sort, each part counting in its slot's scratch, which the tiles
+ * overwrite later), so that no job reads every triangle: at most GRID_PARTS parts. */
+#define GRID_PARTS 64u
+
+typedef struct grid_job {
+    om__lgrid *g;
+    uint32_t parts, step;
+    uint32_t *cnt[GRID_PARTS];      /* part k's counts, in the scratch of the slot that ran it */
+    uint64_t entries[GRID_PARTS];   /* range k's, from sum_rows */
+    uint32_t at[257];               /* each row's base: om__lgrid_rows, at most 257 */
+} grid_job;
 
 static void grid_part(void *user, uint32_t k, void *scratch)
 {
-    (void)scratch;
-    const grid_job *j = (const grid_job *)user;
-    const uint32_t n = j->step ? om__lgrid_rows(j->g) : j->g->ntris;
-    const uint32_t first = (uint32_t)((uint64_t)n * k / j->parts), end = (uint32_t)((uint64_t)n * (k + 1) / j->parts);
-    if (j->step == 0) om__lgrid_boxes(j->g, first, end);
-    else if (j->step == 1) om__lgrid_count(j->g, first, end);
-    else om__lgrid_fill(j->g, first, end);
+    grid_job *j = (grid_job *)user;
+    if (j->step == 0) {
+        j->cnt[k] = (uint32_t *)scratch;
+        om__lgrid_boxes_count(j->g, k, j->parts, j->cnt[k]);
+    } else if (j->step == 1) {
+        j->entries[k] = om__lgrid_sum_rows(j->g, j->cnt, k, j->parts);
+    } else {
+        om__lgrid_fill_part(j->g, j->at, k, j->parts, j->cnt[k]);
+    }
 }
 
 /* The frame's grid, once, before its first strip's tiles: by jobs where the frame
- * lends its slots, else on this thread (the same lists). */
+ * lends its slots and their scratch holds a part's counts, else on this thread (the
+ * same lists). */
 static void make_grid(izb_state *m)
 {
     if (!m->z.grid || m->grid.ready) return;
-    if (!m->lend) {
+    if (!m->lend || izb_pass_scratch(m, NULL) < om__lgrid_part_bytes(&m->grid)) {
         om__izb_grid(&m->z);
         return;
     }
-    grid_job j = {&m->grid, m->lend->slots, 0};
+    grid_job j;
+    j.g = &m->grid;
+    j.parts = m->lend->slots < GRID_PARTS ? m->lend->slots : GRID_PARTS;
     for (j.step = 0; j.step < 3; j.step++) {
         if (j.step == 2) {
-            om__lgrid_sum(&m->grid);
+            om__lgrid_bases(&m->grid, j.entries, j.parts, j.at);
             if (m->grid.ready != 1) return;
         }
         m->lend->run(m->lend, grid_part, &j, j.parts);

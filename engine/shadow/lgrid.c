@@ -143,6 +143,75 @@ void om__lgrid_fill(const om__lgrid *g, uint32_t row0, uint32_t row1)
     }
 }
 
+size_t om__lgrid_part_bytes(const om__lgrid *g) { return (size_t)g->lists * sizeof(uint32_t); }
+
+/* Part k of P: triangles [n k / P, n (k + 1) / P) of the n, and rows [m k / P,
+ * m (k + 1) / P) of the m of om__lgrid_rows. */
+static uint32_t cut(uint32_t n, uint32_t k, uint32_t parts) { return (uint32_t)((uint64_t)n * k / parts); }
+
+/* A row's lists: cells [y side, (y + 1) side), or for row `side` the wide list. */
+static uint32_t row_end(const om__lgrid *g, uint32_t y) { return y == g->side ? g->lists : (y + 1) * g->side; }
+
+void om__lgrid_boxes_count(const om__lgrid *g, uint32_t k, uint32_t parts, uint32_t *cnt)
+{
+    const uint32_t first = cut(g->ntris, k, parts), end = cut(g->ntris, k + 1, parts), side = g->side;
+    om__lgrid_boxes(g, first, end);
+    memset(cnt, 0, om__lgrid_part_bytes(g));
+    for (uint32_t t = first; t < end; t++) {
+        const uint32_t b = g->box[t];
+        if (b == WIDE) {
+            cnt[side * side]++;
+            continue;
+        }
+        for (uint32_t y = b >> 8 & 255; y <= b >> 24; y++)
+            for (uint32_t x = b & 255; x <= (b >> 16 & 255); x++) cnt[y * side + x]++;
+    }
+}
+
+uint64_t om__lgrid_sum_rows(const om__lgrid *g, uint32_t *const *cnt, uint32_t k, uint32_t parts)
+{
+    const uint32_t rows = om__lgrid_rows(g), row0 = cut(rows, k, parts), row1 = cut(rows, k + 1, parts);
+    const uint32_t c1 = row1 > row0 ? row_end(g, row1 - 1) : row0 * g->side;
+    uint64_t run = 0;
+    for (uint32_t c = row0 * g->side; c < c1; c++) {
+        g->start[c] = (uint32_t)run;
+        for (uint32_t j = 0; j < parts; j++) {
+            const uint32_t n = cnt[j][c];
+            cnt[j][c] = (uint32_t)run;
+            run += n;
+        }
+    }
+    return run;
+}
+
+void om__lgrid_bases(om__lgrid *g, const uint64_t *entries, uint32_t parts, uint32_t *at)
+{
+    const uint32_t rows = om__lgrid_rows(g);
+    uint64_t total = 0;
+    for (uint32_t k = 0; k < parts; k++) {
+        for (uint32_t y = cut(rows, k, parts); y < cut(rows, k + 1, parts); y++) at[y] = (uint32_t)total;
+        total += entries[k];
+    }
+    g->start[g->lists] = total > g->cap ? g->cap : (uint32_t)total;
+    g->ready = total <= g->cap ? 1 : -1;
+}
+
+void om__lgrid_fill_part(const om__lgrid *g, const uint32_t *at, uint32_t k, uint32_t parts, uint32_t *cnt)
+{
+    const uint32_t side = g->side, rows = om__lgrid_rows(g);
+    for (uint32_t t = cut(g->ntris, k, parts); t < cut(g->ntris, k + 1, parts); t++) {
+        const uint32_t b = g->box[t];
+        if (b == WIDE) {
+            g->tris[at[side] + cnt[side * side]++] = t;
+            continue;
+        }
+        for (uint32_t y = b >> 8 & 255; y <= b >> 24; y++)
+            for (uint32_t x = b & 255; x <= (b >> 16 & 255); x++) g->tris[at[y] + cnt[y * side + x]++] = t;
+    }
+    for (uint32_t y = cut(rows, k, parts); y < cut(rows, k + 1, parts); y++)
+        for (uint32_t c = y * side; c < row_end(g, y); c++) g->start[c] += at[y];
+}
+
 void om__lgrid_make(om__lgrid *g)
 {
     om__lgrid_boxes(g, 0, g->ntris);

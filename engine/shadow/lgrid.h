@@ -14,11 +14,12 @@
  * same answer and counts as walking every triangle, provided that a triangle whose
  * vertices' box holds none of the tile's samples costs the tile nothing but its skip.
  *
- * Making the grid is three steps, each over disjoint ranges, so a frame may run each
- * as jobs (the answer is the same for any cut): every triangle's cells (boxes, by
- * ranges of triangles), each row of cells' counts (count, by ranges of rows, each job
- * reading every triangle's cells), the lists' starts (sum, on one thread), each row's
- * lists (fill, by ranges of rows). Where the lists would need more entries than the
+ * Making the grid is three steps, each over disjoint ranges (the answer is the same for
+ * any cut): every triangle's cells (boxes, by ranges of triangles), each row of cells'
+ * counts (count, by ranges of rows, each range reading every triangle's cells), the
+ * lists' starts (sum), each row's lists (fill, by ranges of rows). Jobs make the same
+ * lists by parts of the triangles (om__lgrid_boxes_count, below), where no job reads
+ * every triangle. Where the lists would need more entries than the
  * grid holds (triangles much larger than their share of the cells), sum says so and
  * the tiles walk every triangle this frame. No state beyond the struct; memory from
  * the caller's arena. */
@@ -59,6 +60,25 @@ void om__lgrid_sum(om__lgrid *g);
 void om__lgrid_fill(const om__lgrid *g, uint32_t row0, uint32_t row1);   /* rows */
 /* All four on one thread. */
 void om__lgrid_make(om__lgrid *g);
+
+/* The same lists made in P parts (a counting sort), so that no job reads every
+ * triangle's cells. Part k of P takes the k-th of P even ranges of the triangles and
+ * of the rows (om__lgrid_rows); each step's parts may run in any order, or at once:
+ * - boxes_count: part k takes its triangles' boxes and counts their entries a list
+ *   into cnt (om__lgrid_part_bytes, its own: cnt[k] below);
+ * - sum_rows: part k lays the lists of its rows out from 0, the parts' entries in part
+ *   order (cnt[j][c] becomes part j's place in list c), and returns their entries;
+ * - bases (one thread): each row's base (at: om__lgrid_rows of them) from the parts'
+ *   entries, start[lists] and ready, as sum does;
+ * - fill_part (when ready is 1): part k puts its triangles at their places, and moves
+ *   its rows' starts by their base.
+ * The lists are those of om__lgrid_make: ascending, as each part's triangles follow
+ * those of the parts before. */
+size_t om__lgrid_part_bytes(const om__lgrid *g);
+void om__lgrid_boxes_count(const om__lgrid *g, uint32_t k, uint32_t parts, uint32_t *cnt);
+uint64_t om__lgrid_sum_rows(const om__lgrid *g, uint32_t *const *cnt, uint32_t k, uint32_t parts);
+void om__lgrid_bases(om__lgrid *g, const uint64_t *entries, uint32_t parts, uint32_t *at);
+void om__lgrid_fill_part(const om__lgrid *g, const uint32_t *at, uint32_t k, uint32_t parts, uint32_t *cnt);
 
 /* A tile's selection, in `sel` (om__lgrid_sel_bytes, aligned to 4): clear, then mark
  * the cell of each of the tile's samples, then select; the triangles to walk are then
