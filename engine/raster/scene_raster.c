@@ -382,6 +382,63 @@ static void walk_batches(const om_scene *s, const om_mat4 *vp, om_raster *r, uin
     }
 }
 
+/* One triangle of the walk with vertex bins (om__scene_raster_hiz), its rows reaching
+ * the target's. */
+static inline void bin_tri(const om_scene *s, const om_mat4 *vp, om_raster *r, uint32_t *hiz, om__cull *cl,
+                           bool cull, const om__vsnap *vs, om__guard g, uint32_t t)
+{
+    const om_target *tg = r->target;
+    const uint32_t *ix = s->idx + (size_t)t * 3;
+    const om__vsnap *va = &vs[ix[0]], *vb = &vs[ix[1]], *vc = &vs[ix[2]];
+    if (va->x != INT32_MIN && vb->x != INT32_MIN && vc->x != INT32_MIN) {
+        /* in 32 bits first: most triangles a strip's rows reach hold none of its
+         * pixel centres (conservative coverage reaches beyond them) */
+        if (r->mode != OM_RASTER_CONSERVATIVE && !holds_centre(va->x, vb->x, vc->x, va->y, vb->y, vc->y, tg))
+            return;
+        r->cull_back = cull && om__cull_next(cl, t);
+        const int64_t x[3] = {va->x, vb->x, vc->x}, y[3] = {va->y, vb->y, vc->y};
+        const uint32_t z[3] = {va->z, vb->z, vc->z};
+        om__raster_projected(r, hiz, x, y, z, NULL, t);
+        return;
+    }
+    r->cull_back = cull && om__cull_next(cl, t);
+    om_vec4 c[3];
+    om__clip_tri(s, vp, t, c);
+    om__raster_tri_guarded(r, hiz, c, t, tg->width, tg->height, g);
+}
+
+#if VERT_LANES
+/* Where the CPU has lanes, the bins' rows are scanned SCAN triangles at a time: which
+ * of them reach the target's rows [y0, y1], in a loop over lanes with no branch (a
+ * compiler tests four an instruction), so that a band passes over the many triangles
+ * outside it at a fraction of a test each (issue 26: every band of a frame scans every
+ * triangle's rows). Without lanes (a Cortex-M) the hits would only be stored and read
+ * again, and each triangle is tested as it comes. The same triangles either way. */
+#define SCAN 32
+
+static inline uint32_t rows_reach(const uint32_t *restrict rows, uint32_t y0, uint32_t y1, uint32_t *restrict hit)
+{
+    uint32_t any = 0;
+    for (int k = 0; k < SCAN; k++) {
+        const uint32_t w = rows[k];
+        hit[k] = ((w & 0xFFFFu) <= y1) & ((w >> 16) >= y0);
+        any |= hit[k];
+    }
+    return any;
+}
+
+/* The same for the last n < SCAN triangles. */
+static uint32_t rows_reach_few(const uint32_t *rows, uint32_t n, uint32_t y0, uint32_t y1, uint32_t *hit)
+{
+    uint32_t any = 0;
+    for (uint32_t k = 0; k < n; k++) {
+        hit[k] = (rows[k] & 0xFFFFu) <= y1 && rows[k] >> 16 >= y0;
+        any |= hit[k];
+    }
+    return any;
+}
+#endif
+
 void om__scene_raster_hiz(const om_scene *s, const om_mat4 *vp, const om_target *tg,
                           om_raster_mode mode, bool cull, const om__bins *bins, uint32_t *hiz)
 {
@@ -411,24 +468,19 @@ void om__scene_raster_hiz(const om_scene *s, const om_mat4 *vp, const om_target 
     om__cull cl;
     om__cull_begin(&cl, s, vp);
     const om__guard g = om__guard_band(tg->width, tg->height);
-    const bool cons = mode == OM_RASTER_CONSERVATIVE;
+#if VERT_LANES
+    uint32_t hit[SCAN];
+    for (uint32_t t0 = 0; t0 < s->ntris; t0 += SCAN) {
+        const uint32_t n = s->ntris - t0 < SCAN ? s->ntris - t0 : SCAN;
+        if (rows && (n == SCAN ? !rows_reach(rows + t0, y0, y1, hit) : !rows_reach_few(rows + t0, n, y0, y1, hit)))
+            continue;
+        for (uint32_t k = 0; k < n; k++)
+            if (!rows || hit[k]) bin_tri(s, vp, &r, hiz, &cl, cull, vs, g, t0 + k);
+    }
+#else
     for (uint32_t t = 0; t < s->ntris; t++) {
         if (rows && ((rows[t] & 0xFFFFu) > y1 || rows[t] >> 16 < y0)) continue;
-        const uint32_t *ix = s->idx + (size_t)t * 3;
-        const om__vsnap *va = &vs[ix[0]], *vb = &vs[ix[1]], *vc = &vs[ix[2]];
-        if (va->x != INT32_MIN && vb->x != INT32_MIN && vc->x != INT32_MIN) {
-            /* in 32 bits first: most triangles a strip's rows reach hold none of its
-             * pixel centres (conservative coverage reaches beyond them) */
-            if (!cons && !holds_centre(va->x, vb->x, vc->x, va->y, vb->y, vc->y, tg)) continue;
-            r.cull_back = cull && om__cull_next(&cl, t);
-            const int64_t x[3] = {va->x, vb->x, vc->x}, y[3] = {va->y, vb->y, vc->y};
-            const uint32_t z[3] = {va->z, vb->z, vc->z};
-            om__raster_projected(&r, hiz, x, y, z, NULL, t);
-            continue;
-        }
-        r.cull_back = cull && om__cull_next(&cl, t);
-        om_vec4 c[3];
-        om__clip_tri(s, vp, t, c);
-        om__raster_tri_guarded(&r, hiz, c, t, tg->width, tg->height, g);
+        bin_tri(s, vp, &r, hiz, &cl, cull, vs, g, t);
     }
+#endif
 }
