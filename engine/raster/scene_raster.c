@@ -263,11 +263,19 @@ void om__bins_make_verts(const om_scene *s, const om_mat4 *vp, uint32_t width, u
     for (uint32_t v = v0; v < v1; v += LANES) {
         const uint32_t n = v1 - v < LANES ? v1 - v : LANES;
         const om_vec3 *p = s->verts + v;
-        for (uint32_t i = 0; i < LANES; i++) {   /* a short last batch repeats its first vertex */
-            const uint32_t k = i < n ? i : 0;
-            px[i] = p[k].x;
-            py[i] = p[k].y;
-            pz[i] = p[k].z;
+        if (n == LANES) {   /* a loop of its own: the compiler's lanes load three lanes' worth */
+            for (uint32_t i = 0; i < LANES; i++) {
+                px[i] = p[i].x;
+                py[i] = p[i].y;
+                pz[i] = p[i].z;
+            }
+        } else {
+            for (uint32_t i = 0; i < LANES; i++) {   /* a short last batch repeats its first vertex */
+                const uint32_t k = i < n ? i : 0;
+                px[i] = p[k].x;
+                py[i] = p[k].y;
+                pz[i] = p[k].z;
+            }
         }
         lanes_project(&l, px, py, pz, vp, g, sx, sy);
         lanes_depth(&d, &l);
