@@ -47,19 +47,25 @@ static size_t compare_walks(const om_scene *s, const om_mat4 *vp, uint32_t W, ui
     size_t n = (size_t)W * H, drawn = 0;
     uint32_t *da = malloc(n * 4), *db = malloc(n * 4), *ia = malloc(n * 4), *ib = malloc(n * 4);
     uint32_t *ha = malloc(om__hiz_words(W, H) * 4), *hb = malloc(om__hiz_words(W, H) * 4);
-    om__bins bins = {malloc((size_t)s->ntris * 4), malloc((size_t)s->nverts * sizeof(om__vsnap))};
-    CHECK(da && db && ia && ib && ha && hb && bins.rows && bins.verts);
-    if (bins.rows && bins.verts) om__bins_make(s, vp, W, H, &bins);
-    for (int mode = 0; da && db && ia && ib && ha && hb && bins.rows && bins.verts && mode < 8; mode++) {
-        /* mode 4..7 with the bins (rows and snapped vertices) */
-        const bool id = mode & 1, cull = mode & 2, binned = mode & 4;
+    om__bins bins = {malloc((size_t)s->ntris * 4), malloc((size_t)s->nverts * sizeof(om__vsnap)), false};
+    om__bins exact = {malloc((size_t)s->ntris * 4), bins.verts, true};
+    CHECK(da && db && ia && ib && ha && hb && bins.rows && bins.verts && exact.rows);
+    if (bins.rows && bins.verts && exact.rows) {
+        om__bins_make(s, vp, W, H, &bins);
+        om__bins_make_rows(s, vp, W, H, &exact, 0, s->ntris);
+    }
+    for (int mode = 0; da && db && ia && ib && ha && hb && bins.rows && bins.verts && exact.rows && mode < 12; mode++) {
+        /* mode 4..7 with the bins (rows and snapped vertices), 8..11 with rows of pixel
+         * centres (om__bins.centres, where the CPU has lanes) */
+        const bool id = mode & 1, cull = mode & 2, binned = mode >= 4;
+        const om__bins *with = mode >= 8 ? &exact : &bins;
         for (uint32_t y0 = 0; y0 < H; y0 += strip) {
             const uint32_t rows = H - y0 < strip ? H - y0 : strip;
             om_target ta = {W, H, y0, rows, da + (size_t)y0 * W, id ? ia + (size_t)y0 * W : NULL};
             om_target tb = {W, H, y0, rows, db + (size_t)y0 * W, id ? ib + (size_t)y0 * W : NULL};
             const bool coarse = !id && om__hiz_fits(&ta);
             const om_raster_mode m = id ? OM_RASTER_DEPTH_ID : OM_RASTER_DEPTH;
-            om__scene_raster_hiz(s, vp, &ta, m, cull, binned ? &bins : NULL, coarse ? ha : NULL);
+            om__scene_raster_hiz(s, vp, &ta, m, cull, binned ? with : NULL, coarse ? ha : NULL);
             walk_one_by_one(s, vp, &tb, m, cull, coarse ? hb : NULL);
         }
         size_t diff = 0;
@@ -77,6 +83,7 @@ static size_t compare_walks(const om_scene *s, const om_mat4 *vp, uint32_t W, ui
     free(hb);
     free(bins.rows);
     free(bins.verts);
+    free(exact.rows);
     return drawn;
 }
 
@@ -86,8 +93,8 @@ static size_t compare_walks(const om_scene *s, const om_mat4 *vp, uint32_t W, ui
  * x = INT32_MIN when not; the rows the same however cut. Returns how many were alone. */
 static size_t check_bins(const om_scene *s, const om_mat4 *vp, uint32_t W, uint32_t H)
 {
-    om__bins a = {malloc((size_t)s->ntris * 4), malloc((size_t)s->nverts * sizeof(om__vsnap))};
-    om__bins b = {malloc((size_t)s->ntris * 4), malloc((size_t)s->nverts * sizeof(om__vsnap))};
+    om__bins a = {malloc((size_t)s->ntris * 4), malloc((size_t)s->nverts * sizeof(om__vsnap)), false};
+    om__bins b = {malloc((size_t)s->ntris * 4), malloc((size_t)s->nverts * sizeof(om__vsnap)), false};
     size_t alone = 0;
     CHECK(a.rows && a.verts && b.rows && b.verts);
     if (!(a.rows && a.verts && b.rows && b.verts)) goto out;
@@ -194,7 +201,7 @@ static void bins_depths_at_the_edges(void)
     vp.m[10] = 1.0f;   /* z' = z */
     vp.m[12] = 1.0f;   /* w' = x */
     om__vsnap vs[N];
-    om__bins b = {NULL, vs};
+    om__bins b = {NULL, vs, false};
     size_t wrong = 0, inside = 0;
     for (uint32_t v0 = 0; v0 < 24; v0 += 7) {   /* batches starting anywhere */
         memset(vs, 0x5A, sizeof vs);
@@ -212,8 +219,54 @@ static void bins_depths_at_the_edges(void)
     CHECK(inside > N);   /* most pairs are inside the near and far planes */
 }
 
+/* Rows of pixel centres (om__bins.centres) where they are tightest: triangles on a
+ * 16 x 16 image whose corners lie on pixel centres, a sub-pixel unit either side of
+ * them, and between (x/w, y/w chosen so that om__project_xy lands on those grid points
+ * exactly), walked by strips of 1, 2 and 3 rows with and without the bins, against
+ * every triangle on its own. A row too few at a box's top or left shows here (moving
+ * those ends by a sub-pixel unit fails it); the bottom and right ends hold a centre
+ * only at a corner there, which the top-left rule never covers. */
+static void centre_rows_at_the_edges(void)
+{
+    enum { W = 16, T = 1500 };   /* a 16 x 16 image: om__project_xy's scale is 2048 */
+    om_vec3 verts[3 * T];
+    uint32_t idx[3 * T];
+    uint32_t rng = 12345;
+    int32_t g[3 * T][2];
+    for (int i = 0; i < 3 * T; i++) {
+        for (int k = 0; k < 2; k++) {
+            rng = rng * 1664525u + 1013904223u;
+            const int32_t off[] = {-1, 0, 0, 0, 1, 127, -128};
+            const int32_t at = i % 3 ? g[i - i % 3][k] / 256 + (int32_t)(rng >> 8) % 5 - 2   /* near corner 0 */
+                                     : (int32_t)(rng >> 8) % (W + 2) - 1;
+            g[i][k] = at * 256 + 128 + off[(rng >> 4) % 7];
+        }
+        /* a horizontal or vertical edge in many (a centre on a top or left edge counts) */
+        if (i % 3 == 1 && (rng >> 20) % 2) g[i][1] = g[i - 1][1];
+        if (i % 3 == 2 && (rng >> 21) % 2) g[i][0] = g[i - 2][0];
+        /* X = (x + 1) * 2048 + 0.5 and Y = (1 - y) * 2048 + 0.5 are g exactly */
+        verts[i] = om__v3(((float)g[i][0] - 0.5f) / 2048.0f - 1.0f, 1.0f - ((float)g[i][1] - 0.5f) / 2048.0f,
+                          0.25f + (float)(i % 7) / 16.0f);
+        idx[i] = (uint32_t)i;
+    }
+    om_scene sc;
+    memset(&sc, 0, sizeof sc);
+    sc.nverts = 3 * T;
+    sc.verts = verts;
+    sc.ntris = T;
+    sc.idx = idx;
+    om_mat4 vp;
+    memset(&vp, 0, sizeof vp);
+    vp.m[0] = vp.m[5] = vp.m[10] = vp.m[15] = 1.0f;   /* clip = (x, y, z, 1) */
+    const size_t drawn = compare_walks(&sc, &vp, W, W, 1);
+    compare_walks(&sc, &vp, W, W, 2);
+    compare_walks(&sc, &vp, W, W, 3);
+    CHECK(drawn > W * W / 2);
+}
+
 void suite_scene_raster(void)
 {
     RUN(scene_walk_same_as_one_by_one);
     RUN(bins_depths_at_the_edges);
+    RUN(centre_rows_at_the_edges);
 }

@@ -377,6 +377,7 @@ static bool carve_bins(om_arena *fa, const om_scene *s, om__bins *b)
     void *pb, *pv;
     b->rows = NULL;
     b->verts = NULL;
+    b->centres = false;
     if (!s->ntris || om_arena_left(fa) < om__bins_rows_bytes(s) ||
         om__arena_alloc_raw(fa, (size_t)s->ntris * sizeof(uint32_t), 8, &pb, NULL) != OM_OK)
         return false;
@@ -513,7 +514,7 @@ om_status om_render_frame(const om_frame_desc *fd, om_arena *fa, om_frame_stats 
      * pixels; without room, every strip walks every triangle). The camera's matrix
      * does not change within the frame. With strips the bins come before the jobs'
      * slots, as they did before there were jobs; one strip needs them only for bands. */
-    om__bins bins = {NULL, NULL};
+    om__bins bins = {NULL, NULL, false};
     bool eye_bins = !single && carve_bins(fa, s, &bins);
     /* The jobs, keeping beside them the bins they use when two jobs fit as well: one
      * strip's bands want the camera's, a map built by bands the light's. */
@@ -525,6 +526,7 @@ om_status om_render_frame(const om_frame_desc *fd, om_arena *fa, om_frame_stats 
     if (single && OM_WITH_JOBS && c.jobs > 1) eye_bins = carve_bins(fa, s, &bins);
     if (eye_bins) {
         uint64_t tb = now(fd);
+        bins.centres = true;   /* the eye samples pixel centres alone */
         make_bins(&c, &view.cam_vp, W, H, &bins);
         fs->ns_eye += now(fd) - tb;
         c.bins = &bins;

@@ -3,6 +3,17 @@
  * walk over the scene's triangles that the eye pass and the light depth passes share. */
 #include "scene_raster.h"
 
+/* Whether the CPU runs several float lanes an instruction (SSE2, NEON): there the
+ * bins' vertices go LANES at a time (below), which costs a quarter of one at a time;
+ * on a CPU without lanes (a Cortex-M) the batch would only add its loads and stores,
+ * and each vertex goes alone. The same bits either way: lanes_project's tests and
+ * projection are om__inside_band's and om__project's. */
+#if defined(__SSE2__) || defined(__ARM_NEON)
+#define VERT_LANES 1
+#else
+#define VERT_LANES 0
+#endif
+
 /* A margin in front of the near plane, in clip z over w: the vertices are inside the
  * box, but their clip coordinates are rounded on their own. */
 #define CULL_MARGIN 1e-4f
@@ -73,18 +84,85 @@ static inline uint32_t rows_between32(int32_t lo, int32_t hi, int32_t height)
     return r0 > r1 ? 0x0000FFFFu : (uint32_t)r0 | (uint32_t)r1 << 16;
 }
 
+#if VERT_LANES
+/* om__bins.centres' rows of a triangle of snapped vertices on a width x height image:
+ * the rows of the pixel centres its box holds, as holds_centre finds them (the same
+ * steps), 0x0000FFFF when it holds none. holds_centre on a target of rows [y0, y1] is
+ * then these rows reaching [y0, y1]: its clamps to the target's rows are these clamped
+ * further. */
+static inline uint32_t centre_rows(const om__vsnap *va, const om__vsnap *vb, const om__vsnap *vc, int32_t width,
+                                   int32_t height)
+{
+    const int32_t B = 1 << 27, b = B >> OM_SUBPIX_BITS;
+    int32_t x0 = va->x < vb->x ? va->x : vb->x, x1 = va->x < vb->x ? vb->x : va->x;
+    int32_t y0 = va->y < vb->y ? va->y : vb->y, y1 = va->y < vb->y ? vb->y : va->y;
+    x0 = vc->x < x0 ? vc->x : x0;
+    x1 = vc->x > x1 ? vc->x : x1;
+    y0 = vc->y < y0 ? vc->y : y0;
+    y1 = vc->y > y1 ? vc->y : y1;
+    x0 = ((x0 + 127 + B) >> OM_SUBPIX_BITS) - b;
+    y0 = ((y0 + 127 + B) >> OM_SUBPIX_BITS) - b;
+    x1 = ((x1 - 128 + B) >> OM_SUBPIX_BITS) - b;
+    y1 = ((y1 - 128 + B) >> OM_SUBPIX_BITS) - b;
+    x0 = x0 < 0 ? 0 : x0;
+    x1 = x1 > width - 1 ? width - 1 : x1;
+    y0 = y0 < 0 ? 0 : y0;
+    y1 = y1 > height - 1 ? height - 1 : y1;
+    return x0 <= x1 && y0 <= y1 ? (uint32_t)y0 | (uint32_t)y1 << 16 : 0x0000FFFFu;
+}
+#endif
+
 void om__bins_make(const om_scene *s, const om_mat4 *vp, uint32_t width, uint32_t height, const om__bins *b)
 {
     om__bins_make_verts(s, vp, width, height, b, 0, s->nverts);
     om__bins_make_rows(s, vp, width, height, b, 0, s->ntris);
 }
 
+/* The rows of triangle t that has a vertex to clip (or outside the bins' vertices):
+ * from its clip-space vertices. */
+static uint32_t rows_clipped(const om_scene *s, const om_mat4 *vp, uint32_t width, uint32_t height, uint32_t t)
+{
+    const uint32_t all = (height - 1) << 16;
+    om_vec4 c[3];
+    om__clip_tri(s, vp, t, c);
+    unsigned out_all = 0x3F, out_any = 0;
+    for (int k = 0; k < 3; k++) {
+        unsigned o = om__outcode(&c[k], width, height);
+        out_all &= o;
+        out_any |= o;
+    }
+    if (out_all) return 0x0000FFFFu;   /* wholly beyond one plane */
+    if (out_any) return all;           /* clipped: every row */
+    /* Inside every plane: the rasterizer snaps these very positions. */
+    int64_t lo = INT64_MAX, hi = INT64_MIN;
+    for (int k = 0; k < 3; k++) {
+        int64_t gx, gy;
+        if (!om__project_xy(&c[k], width, height, &gx, &gy)) return all;
+        if (gy < lo) lo = gy;
+        if (gy > hi) hi = gy;
+    }
+    return rows_between(lo, hi, height);
+}
+
 void om__bins_make_rows(const om_scene *s, const om_mat4 *vp, uint32_t width, uint32_t height, const om__bins *b,
                         uint32_t t0, uint32_t t1)
 {
-    const uint32_t all = (height - 1) << 16;
     const om__vsnap *vs = b->verts;
-    for (uint32_t t = t0; b->rows && t < t1 && t < s->ntris; t++) {
+    if (!b->rows) return;
+    if (t1 > s->ntris) t1 = s->ntris;
+#if VERT_LANES
+    if (vs && b->centres) {   /* the eye's rows of pixel centres: a loop of their own */
+        for (uint32_t t = t0; t < t1; t++) {
+            const uint32_t *ix = s->idx + (size_t)t * 3;
+            const om__vsnap *va = &vs[ix[0]], *vb = &vs[ix[1]], *vc = &vs[ix[2]];
+            const bool alone = (va->x != INT32_MIN) & (vb->x != INT32_MIN) & (vc->x != INT32_MIN);
+            b->rows[t] = alone ? centre_rows(va, vb, vc, (int32_t)width, (int32_t)height)
+                               : rows_clipped(s, vp, width, height, t);
+        }
+        return;
+    }
+#endif
+    for (uint32_t t = t0; t < t1; t++) {
         const uint32_t *ix = s->idx + (size_t)t * 3;
         if (vs) {
             const om__vsnap *va = &vs[ix[0]], *vb = &vs[ix[1]], *vc = &vs[ix[2]];
@@ -96,26 +174,7 @@ void om__bins_make_rows(const om_scene *s, const om_mat4 *vp, uint32_t width, ui
                 continue;
             }
         }
-        om_vec4 c[3];
-        om__clip_tri(s, vp, t, c);
-        unsigned out_all = 0x3F, out_any = 0;
-        for (int k = 0; k < 3; k++) {
-            unsigned o = om__outcode(&c[k], width, height);
-            out_all &= o;
-            out_any |= o;
-        }
-        if (out_all) { b->rows[t] = 0x0000FFFFu; continue; }   /* wholly beyond one plane */
-        if (out_any) { b->rows[t] = all; continue; }            /* clipped: every row */
-        /* Inside every plane: the rasterizer snaps these very positions. */
-        int64_t lo = INT64_MAX, hi = INT64_MIN;
-        bool ok = true;
-        for (int k = 0; k < 3; k++) {
-            int64_t gx, gy;
-            if (!om__project_xy(&c[k], width, height, &gx, &gy)) { ok = false; break; }
-            if (gy < lo) lo = gy;
-            if (gy > hi) hi = gy;
-        }
-        b->rows[t] = ok ? rows_between(lo, hi, height) : all;
+        b->rows[t] = rows_clipped(s, vp, width, height, t);
     }
 }
 
@@ -205,16 +264,6 @@ static inline void lanes_project(lanes *restrict b, float *restrict px, float *r
     }
 }
 
-/* Whether the CPU runs several float lanes an instruction (SSE2, NEON): there the
- * bins' vertices go LANES at a time, which costs a quarter of one at a time; on a CPU
- * without lanes (a Cortex-M) the batch would only add its loads and stores, and each
- * vertex goes alone. The same bits either way: lanes_project's tests and projection
- * are om__inside_band's and om__project's. */
-#if defined(__SSE2__) || defined(__ARM_NEON)
-#define VERT_LANES 1
-#else
-#define VERT_LANES 0
-#endif
 
 #if VERT_LANES
 /* om__zdepth of the lanes' z and w up to its division, a loop over the lanes on the
@@ -391,9 +440,9 @@ static void walk_batches(const om_scene *s, const om_mat4 *vp, om_raster *r, uin
 }
 
 /* One triangle of the walk with vertex bins (om__scene_raster_hiz), its rows reaching
- * the target's. */
+ * the target's; `box`: its box is yet to be tested for a pixel centre of the target. */
 static inline void bin_tri(const om_scene *s, const om_mat4 *vp, om_raster *r, uint32_t *hiz, om__cull *cl,
-                           bool cull, const om__vsnap *vs, om__guard g, uint32_t t)
+                           bool cull, const om__vsnap *vs, om__guard g, bool box, uint32_t t)
 {
     const om_target *tg = r->target;
     const uint32_t *ix = s->idx + (size_t)t * 3;
@@ -401,8 +450,7 @@ static inline void bin_tri(const om_scene *s, const om_mat4 *vp, om_raster *r, u
     if (va->x != INT32_MIN && vb->x != INT32_MIN && vc->x != INT32_MIN) {
         /* in 32 bits first: most triangles a strip's rows reach hold none of its
          * pixel centres (conservative coverage reaches beyond them) */
-        if (r->mode != OM_RASTER_CONSERVATIVE && !holds_centre(va->x, vb->x, vc->x, va->y, vb->y, vc->y, tg))
-            return;
+        if (box && !holds_centre(va->x, vb->x, vc->x, va->y, vb->y, vc->y, tg)) return;
         r->cull_back = cull && om__cull_next(cl, t);
         const int64_t x[3] = {va->x, vb->x, vc->x}, y[3] = {va->y, vb->y, vc->y};
         const uint32_t z[3] = {va->z, vb->z, vc->z};
@@ -477,18 +525,21 @@ void om__scene_raster_hiz(const om_scene *s, const om_mat4 *vp, const om_target 
     om__cull_begin(&cl, s, vp);
     const om__guard g = om__guard_band(tg->width, tg->height);
 #if VERT_LANES
+    /* conservative coverage reaches pixels beyond the centres; centre rows have
+     * tested the boxes already (om__bins.centres) */
+    const bool box = mode != OM_RASTER_CONSERVATIVE && !(rows && bins->centres);
     uint32_t hit[SCAN];
     for (uint32_t t0 = 0; t0 < s->ntris; t0 += SCAN) {
         const uint32_t n = s->ntris - t0 < SCAN ? s->ntris - t0 : SCAN;
         if (rows && (n == SCAN ? !rows_reach(rows + t0, y0, y1, hit) : !rows_reach_few(rows + t0, n, y0, y1, hit)))
             continue;
         for (uint32_t k = 0; k < n; k++)
-            if (!rows || hit[k]) bin_tri(s, vp, &r, hiz, &cl, cull, vs, g, t0 + k);
+            if (!rows || hit[k]) bin_tri(s, vp, &r, hiz, &cl, cull, vs, g, box, t0 + k);
     }
 #else
     for (uint32_t t = 0; t < s->ntris; t++) {
         if (rows && ((rows[t] & 0xFFFFu) > y1 || rows[t] >> 16 < y0)) continue;
-        bin_tri(s, vp, &r, hiz, &cl, cull, vs, g, t);
+        bin_tri(s, vp, &r, hiz, &cl, cull, vs, g, mode != OM_RASTER_CONSERVATIVE, t);
     }
 #endif
 }

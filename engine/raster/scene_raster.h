@@ -47,6 +47,13 @@ typedef struct om__vsnap { int32_t x, y; uint32_t z; } om__vsnap;
 typedef struct om__bins {
     uint32_t *rows;
     om__vsnap *verts;
+    /* Rows of pixel centres (a pass that samples pixel centres alone: the eye's): where
+     * the CPU has lanes, rows[t] of a triangle of three snapped vertices is then
+     * exactly the image rows of pixel centres its box holds, 0x0000FFFF where it holds
+     * none (nor a column's), so a strip or band finds the triangles whose box holds one
+     * of its centres by the rows alone, as the walk's batches do by their boxes.
+     * Ignored elsewhere (a Cortex-M): the rows stay conservative. */
+    bool centres;
 } om__bins;
 
 size_t om__bins_rows_bytes(const om_scene *s);

@@ -120,7 +120,7 @@ static om_status sm_build(void *state, om_diag *d)
 {
     (void)d;
     sm_state *m = (sm_state *)state;
-    const om__bins b = {NULL, m->verts};
+    const om__bins b = {NULL, m->verts, false};
     if (m->verts) om__bins_make(m->scene, &m->view.light_vp, m->size, m->size, &b);
     uint32_t counts[8] = {0};
     sm_build_rows(state, m->verts ? &b : NULL, 0, m->size, counts);
