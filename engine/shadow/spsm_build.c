@@ -314,6 +314,7 @@ uint32_t om__spsm_map_of(void *state, const om_mat4 **vp)
     om__spsm_state *m = (om__spsm_state *)state;
     m->win.t4_at = (size_t)-1;   /* no texel index: the map is about to change */
     m->win.bd_have = false;
+    m->win.rd_have = false;      /* and the light's matrix may have moved */
     m->needed = grow_needs(m);
     if (m->fine && m->cfg.spsm_aa <= 1 && m->marks) grow_fine_needs(m);
     *vp = &m->view.light_vp;

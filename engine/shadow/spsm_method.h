@@ -54,6 +54,11 @@ typedef struct om__spsm_win {
      * the lit test's at t[4], Algorithm 1's at the others), which recovery's pattern
      * test reads again: set for every t[k].ok before recover runs */
     om__spsm_pf pf[9];
+    /* spsm.c's receiver_plane: the light's matrix applied to two directions in the
+     * surface of normal rn (while rd_have) */
+    float rn[3];
+    float rd[2][4];
+    bool rd_have;
 } om__spsm_win;
 
 /* Forgets what the window holds (all of it, so that nothing is read unset). */
