@@ -214,7 +214,7 @@ static const struct { const char *method, *sweep; } sweeps[] = {
     {"asm", "asm.cap=1048576,4194304,8388608,16777216"},
     {"rtw", "map=512,1024,2048 rtw.exact=1,0"},
     {"spsm", "map=512,1024,2048,4096"},
-    {"hybrid", "hybrid.map=256,512,1024"},
+    {"hybrid", "hybrid.map=128,256,512"},
 };
 
 const char *cli_sweep(const om_method *m)
