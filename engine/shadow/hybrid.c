@@ -496,9 +496,9 @@ static inline bool plane_at_or_beyond(const htexel *h, int64_t dx, int64_t dy, d
 
 /* The map's answer for a sample: 1 certainly lit, 2 certainly shadowed (t set to 0),
  * 0 uncertain, with *tex its texel. */
-static inline int classify(const hybrid_state *m, const om__lpoint *p, om_term *t, int64_t *tex)
+static inline int classify_at(const hybrid_state *m, const om__lpoint *p, int64_t tx, int64_t ty, om_term *t,
+                              int64_t *tex)
 {
-    int64_t tx = texel_of(m, p->x), ty = texel_of(m, p->y);
     const htexel *h = &m->map[ty * (int64_t)m->side + tx];
     *tex = ty * (int64_t)m->side + tx;
     int64_t xc = tx * m->T + m->T / 2, yc = ty * m->T + m->T / 2;
@@ -518,6 +518,12 @@ static inline int classify(const hybrid_state *m, const om__lpoint *p, om_term *
         return 2;
     }
     return 0;
+}
+
+/* classify_at in the texel of p's grid point. */
+static inline int classify(const hybrid_state *m, const om__lpoint *p, om_term *t, int64_t *tex)
+{
+    return classify_at(m, p, texel_of(m, p->x), texel_of(m, p->y), t, tex);
 }
 
 int om__hybrid_decide(void *state, const om__lpoint *p, om_term *t)
@@ -540,11 +546,13 @@ static void put_key(om__hkey *q, const om__lpoint *p, size_t i)
 }
 
 /* Samples go onto the light's grid LANES exposed ones at a time: first the light's
- * matrix times each one's point, in one loop over the lanes that a compiler can run on
- * vector registers (om__mat_apply, the same float operations in the same order as
- * om__lspace_point's: the same bits), then each lane's snap and lookup. The products
- * no longer wait in line behind the branches of the lookup before them. One lane
- * where a double is a software routine (OM_FAST_FLOAT): no vector unit there. */
+ * matrix times each one's point, its division and snap and its texel, in loops over
+ * the lanes with no branch on the data that a compiler can run on vector registers
+ * (om__mat_apply's and om__project_xy's float operations in their order, as
+ * om__lspace_point's: the same bits), then each lane's depth (om__zdepth: an integer
+ * division) and lookup. The products and divisions no longer wait in line behind the
+ * branches of the lookup before them. One lane where a double is a software routine
+ * (OM_FAST_FLOAT): no vector unit there, and om__project_xy itself. */
 #if OM_FAST_FLOAT
 #define LANES 1
 #else
@@ -558,8 +566,9 @@ static void put_key(om__hkey *q, const om__lpoint *p, size_t i)
 static uint32_t look_up(const hybrid_state *m, om_strip *st, size_t *i, size_t n, uint32_t counts[3],
                         om__hkey q[LANES])
 {
-    float px[LANES], py[LANES], pz[LANES], cx[LANES], cy[LANES], cz[LANES], cw[LANES];
-    uint32_t at[LANES], k = 0, u = 0;
+    float px[LANES], py[LANES], pz[LANES], cz[LANES], cw[LANES];
+    int32_t gx[LANES], gy[LANES], tx[LANES], ty[LANES], ok[LANES];
+    uint32_t at[LANES], tri[LANES], k = 0, u = 0;
     for (; *i < n && k < LANES; ++*i) {
         om_term *t = &st->terms[*i];
         t->r = t->g = t->b = 255;
@@ -568,28 +577,72 @@ static uint32_t look_up(const hybrid_state *m, om_strip *st, size_t *i, size_t n
         px[k] = s->p[0];
         py[k] = s->p[1];
         pz[k] = s->p[2];
+        tri[k] = s->tri;
         at[k++] = (uint32_t)*i;
     }
     for (uint32_t j = k; j < LANES; j++) {   /* lanes left over */
         px[j] = py[j] = pz[j] = 0.0f;
-        at[j] = 0;
+        at[j] = tri[j] = 0;
     }
+#if LANES > 1
+    /* om__project_xy's operations in its order, lane by lane, with no branch on the
+     * data: the same bits where ok (on a lane that fails, X and Y may be infinite or
+     * NaN, and are clamped only so that every lane converts) */
+    const float sx = (float)OM_LIGHT_GRID * (OM_SUBPIX / 2), sy = sx, lim = 67108864.0f;
     for (uint32_t j = 0; j < LANES; j++) {
         const om_vec4 c = om__mat_apply(&m->ls.vp, om__v3(px[j], py[j], pz[j]));
-        cx[j] = c.x;
-        cy[j] = c.y;
+        const float iw = 1.0f / c.w;
+        const float X = (c.x * iw + 1.0f) * sx + 0.5f, Y = (1.0f - c.y * iw) * sy + 0.5f;
+        ok[j] = (c.w > 0.0f) & (X > -lim) & (X < lim) & (Y > -lim) & (Y < lim);
+        const float Xc = X > -lim ? X : -lim, Yc = Y > -lim ? Y : -lim;
+        px[j] = Xc < lim ? Xc : lim;
+        py[j] = Yc < lim ? Yc : lim;
         cz[j] = c.z;
         cw[j] = c.w;
     }
+    /* a loop of its own, as scene_raster.c's lanes: in the one above a compiler would
+     * convert only the lanes it knows in range, under a branch */
+    for (uint32_t j = 0; j < LANES; j++) {
+        gx[j] = om__floorf_i32(px[j]);
+        gy[j] = om__floorf_i32(py[j]);
+    }
+    /* texel_of's texels, in lanes where T is a power of two (the default sides) */
+    if (m->tshift >= 0) {
+        const int sh = m->tshift;
+        const int32_t last = (int32_t)m->side - 1;
+        for (uint32_t j = 0; j < LANES; j++) {
+            const int32_t x = gx[j] < 0 ? 0 : gx[j] >> sh, y = gy[j] < 0 ? 0 : gy[j] >> sh;
+            tx[j] = x < last ? x : last;
+            ty[j] = y < last ? y : last;
+        }
+    } else {
+        for (uint32_t j = 0; j < LANES; j++) {
+            tx[j] = (int32_t)texel_of(m, gx[j]);
+            ty[j] = (int32_t)texel_of(m, gy[j]);
+        }
+    }
+#else
+    for (uint32_t j = 0; j < k; j++) {   /* one lane: om__project itself */
+        const om_vec4 c = om__mat_apply(&m->ls.vp, om__v3(px[j], py[j], pz[j]));
+        int64_t x = 0, y = 0;
+        ok[j] = om__project_xy(&c, OM_LIGHT_GRID, OM_LIGHT_GRID, &x, &y);
+        gx[j] = (int32_t)x;   /* within 2^26 where ok */
+        gy[j] = (int32_t)y;
+        cz[j] = c.z;
+        cw[j] = c.w;
+        tx[j] = (int32_t)texel_of(m, gx[j]);
+        ty[j] = (int32_t)texel_of(m, gy[j]);
+    }
+#endif
     for (uint32_t j = 0; j < k; j++) {
-        const om_vec4 c = {cx[j], cy[j], cz[j], cw[j]};
+        if (!ok[j]) continue;
         om__lpoint p;
-        uint32_t z = 0;
         int64_t tex;
-        if (!om__project(&c, OM_LIGHT_GRID, OM_LIGHT_GRID, &p.x, &p.y, &z)) continue;
-        p.z = z;
-        p.tri = st->samples[at[j]].tri;
-        const int a = classify(m, &p, &st->terms[at[j]], &tex);
+        p.x = gx[j];
+        p.y = gy[j];
+        p.z = om__zdepth(cz[j], cw[j]);
+        p.tri = tri[j];
+        const int a = classify_at(m, &p, tx[j], ty[j], &st->terms[at[j]], &tex);
         counts[a == 1 ? 0 : a == 2 ? 1 : 2]++;
         if (a == 0) put_key(&q[u++], &p, at[j]);
     }
