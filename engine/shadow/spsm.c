@@ -150,11 +150,11 @@ static sample_pt project(const om__spsm_state *m, om_vec3 p)
     return s;
 }
 
-/* floor(a / 2^bits), without a division (a library routine for 64 bits on a 32-bit
- * CPU) and without shifting a negative number (implementation-defined in C). */
-static int64_t floor_shift(int64_t a, int bits)
+/* floor(a / 2^bits), without a division and without shifting a negative number
+ * (implementation-defined in C). */
+static int32_t floor_shift(int32_t a, int bits)
 {
-    return a >= 0 ? a >> bits : -((((int64_t)1 << bits) - 1 - a) >> bits);
+    return a >= 0 ? a >> bits : -((((int32_t)1 << bits) - 1 - a) >> bits);
 }
 
 /* The texel holding grid position (x, y), clamped to the map (so negative positions
@@ -520,19 +520,23 @@ static bool centre_test(const om__spsm_state *m, const receiver *r, int64_t tx, 
  * texel, and across a thin bar or along a finely tessellated rim the 3x3 can miss the
  * triangles that reach the point; the band such a rim leaves lit is as wide as the
  * spacing. */
-static bool plain_shadow(const uint32_t *buf, int64_t side, int bits, const receiver *r, int64_t tx,
+static bool plain_shadow(const uint32_t *buf, int32_t side, int bits, const receiver *r, int64_t tx,
                          int64_t ty, int64_t px, int64_t py, int64_t qx, int64_t qy)
 {
-    /* the texel centre, the point and the sample in the map's own grid units */
-    const int64_t step = (int64_t)1 << bits;
-    const int64_t ox = tx * OM_SUBPIX + OM_SUBPIX / 2, oy = ty * OM_SUBPIX + OM_SUBPIX / 2, h = step / 2;
-    const int64_t ax = floor_shift(ox + qx - h, bits), ay = floor_shift(oy + qy - h, bits);
-    for (int64_t j = ay; j <= ay + 1; j++)
-        for (int64_t i = ax; i <= ax + 1; i++) {
+    /* the texel centre, the point and the sample in the map's own grid units; in 32
+     * bits: centres lie below 2^22, the lookup's offsets below 2^28 (om__project_xy's
+     * positions, below 2^26, less a centre or another position), and a point of the
+     * map is read (i, j in range) before its offset is taken */
+    const int32_t step = (int32_t)1 << bits, h = step / 2;
+    const int32_t ox = (int32_t)tx * OM_SUBPIX + OM_SUBPIX / 2, oy = (int32_t)ty * OM_SUBPIX + OM_SUBPIX / 2;
+    const int32_t sx = (int32_t)px, sy = (int32_t)py;
+    const int32_t ax = floor_shift(ox + (int32_t)qx - h, bits), ay = floor_shift(oy + (int32_t)qy - h, bits);
+    for (int32_t j = ay; j <= ay + 1; j++)
+        for (int32_t i = ax; i <= ax + 1; i++) {
             if (i < 0 || j < 0 || i >= side || j >= side) return false;
             const uint32_t c = buf[(size_t)j * (size_t)side + (size_t)i];
             if (c == 0xFFFFFFFFu) return false;
-            const float dx = om__spsm_off_f(i * step + h - ox - px), dy = om__spsm_off_f(j * step + h - oy - py);
+            const float dx = (float)(i * step + h - ox - sx), dy = (float)(j * step + h - oy - sy);
             const float z = r->ok ? r->zf + r->gxf * dx + r->gyf * dy : r->zf;
             if (!((float)c < z - (float)OM__SPSM_TOL0)) return false;   /* in float, as the plane is */
         }
@@ -787,7 +791,7 @@ OM_NOINLINE static uint8_t recover(const om__spsm_state *m, om__spsm_win *w, uin
         if (!shadow && tg->keep == 511) shadow = centre_test(m, &rp, tx, ty, px, py);   /* rp set */
         if (!shadow) {
             if (!have_rp) { rp = receiver_plane(m, w, smp, p); have_rp = true; }
-            shadow = m->fine ? plain_shadow(m->fdepth, 2 * (int64_t)m->size, OM_SUBPIX_BITS - 1, &rp, tx, ty, px, py, qx, qy)
+            shadow = m->fine ? plain_shadow(m->fdepth, 2 * (int32_t)m->size, OM_SUBPIX_BITS - 1, &rp, tx, ty, px, py, qx, qy)
                              : plain_shadow(m->cdepth, m->size, OM_SUBPIX_BITS, &rp, tx, ty, px, py, qx, qy);
         }
         nlit += !shadow;
