@@ -84,31 +84,41 @@ static inline uint32_t rows_between32(int32_t lo, int32_t hi, int32_t height)
     return r0 > r1 ? 0x0000FFFFu : (uint32_t)r0 | (uint32_t)r1 << 16;
 }
 
+/* The box of the pixel centres that the box of three grid points within 2^26
+ * (om__project's) holds, as raster.c's bounds finds them, in 32 bits and without a
+ * branch (the bias, a multiple of 256, makes every shifted value non-negative):
+ * centres lie at 256 i + 128; the first at or after the box's low side and the last
+ * at or before its high side, not yet clamped to an image. */
+typedef struct centre_box { int32_t x0, x1, y0, y1; } centre_box;
+
+static inline centre_box centres_in(int32_t xa, int32_t xb, int32_t xc, int32_t ya, int32_t yb, int32_t yc)
+{
+    const int32_t B = 1 << 27, b = B >> OM_SUBPIX_BITS;
+    int32_t x0 = xa < xb ? xa : xb, x1 = xa < xb ? xb : xa, y0 = ya < yb ? ya : yb, y1 = ya < yb ? yb : ya;
+    x0 = xc < x0 ? xc : x0;
+    x1 = xc > x1 ? xc : x1;
+    y0 = yc < y0 ? yc : y0;
+    y1 = yc > y1 ? yc : y1;
+    const centre_box c = {((x0 + 127 + B) >> OM_SUBPIX_BITS) - b, ((x1 - 128 + B) >> OM_SUBPIX_BITS) - b,
+                          ((y0 + 127 + B) >> OM_SUBPIX_BITS) - b, ((y1 - 128 + B) >> OM_SUBPIX_BITS) - b};
+    return c;
+}
+
 #if VERT_LANES
 /* om__bins.centres' rows of a triangle of snapped vertices on a width x height image:
- * the rows of the pixel centres its box holds, as holds_centre finds them (the same
- * steps), 0x0000FFFF when it holds none. holds_centre on a target of rows [y0, y1] is
- * then these rows reaching [y0, y1]: its clamps to the target's rows are these clamped
+ * the rows of the pixel centres its box holds (centres_in, clamped to the image),
+ * 0x0000FFFF when it holds none. holds_centre on a target of rows [y0, y1] is then
+ * these rows reaching [y0, y1]: its clamps to the target's rows are these clamped
  * further. */
 static inline uint32_t centre_rows(const om__vsnap *va, const om__vsnap *vb, const om__vsnap *vc, int32_t width,
                                    int32_t height)
 {
-    const int32_t B = 1 << 27, b = B >> OM_SUBPIX_BITS;
-    int32_t x0 = va->x < vb->x ? va->x : vb->x, x1 = va->x < vb->x ? vb->x : va->x;
-    int32_t y0 = va->y < vb->y ? va->y : vb->y, y1 = va->y < vb->y ? vb->y : va->y;
-    x0 = vc->x < x0 ? vc->x : x0;
-    x1 = vc->x > x1 ? vc->x : x1;
-    y0 = vc->y < y0 ? vc->y : y0;
-    y1 = vc->y > y1 ? vc->y : y1;
-    x0 = ((x0 + 127 + B) >> OM_SUBPIX_BITS) - b;
-    y0 = ((y0 + 127 + B) >> OM_SUBPIX_BITS) - b;
-    x1 = ((x1 - 128 + B) >> OM_SUBPIX_BITS) - b;
-    y1 = ((y1 - 128 + B) >> OM_SUBPIX_BITS) - b;
-    x0 = x0 < 0 ? 0 : x0;
-    x1 = x1 > width - 1 ? width - 1 : x1;
-    y0 = y0 < 0 ? 0 : y0;
-    y1 = y1 > height - 1 ? height - 1 : y1;
-    return x0 <= x1 && y0 <= y1 ? (uint32_t)y0 | (uint32_t)y1 << 16 : 0x0000FFFFu;
+    centre_box c = centres_in(va->x, vb->x, vc->x, va->y, vb->y, vc->y);
+    c.x0 = c.x0 < 0 ? 0 : c.x0;
+    c.x1 = c.x1 > width - 1 ? width - 1 : c.x1;
+    c.y0 = c.y0 < 0 ? 0 : c.y0;
+    c.y1 = c.y1 > height - 1 ? height - 1 : c.y1;
+    return c.x0 <= c.x1 && c.y0 <= c.y1 ? (uint32_t)c.y0 | (uint32_t)c.y1 << 16 : 0x0000FFFFu;
 }
 #endif
 
@@ -184,30 +194,18 @@ void om__scene_raster(const om_scene *s, const om_mat4 *vp, const om_target *tg,
     om__scene_raster_hiz(s, vp, tg, mode, cull, bins, NULL);
 }
 
-/* Whether the box of three grid points within 2^26 (om__project's) holds the centre
- * of a pixel of tg, as raster.c's bounds finds them, in 32 bits and without a branch
- * (the bias, a multiple of 256, makes every shifted value non-negative): 1 or 0.
- * Centres lie at 256 i + 128; the first at or after the box's low side and the last
- * at or before its high side, clamped to the target. */
+/* Whether the box of three grid points holds the centre of a pixel of tg (centres_in,
+ * clamped to the target): 1 or 0. */
 static inline int32_t holds_centre(int32_t xa, int32_t xb, int32_t xc, int32_t ya, int32_t yb, int32_t yc,
                                    const om_target *tg)
 {
-    const int32_t B = 1 << 27, b = B >> OM_SUBPIX_BITS;
-    int32_t x0 = xa < xb ? xa : xb, x1 = xa < xb ? xb : xa, y0 = ya < yb ? ya : yb, y1 = ya < yb ? yb : ya;
-    x0 = xc < x0 ? xc : x0;
-    x1 = xc > x1 ? xc : x1;
-    y0 = yc < y0 ? yc : y0;
-    y1 = yc > y1 ? yc : y1;
-    x0 = ((x0 + 127 + B) >> OM_SUBPIX_BITS) - b;
-    y0 = ((y0 + 127 + B) >> OM_SUBPIX_BITS) - b;
-    x1 = ((x1 - 128 + B) >> OM_SUBPIX_BITS) - b;
-    y1 = ((y1 - 128 + B) >> OM_SUBPIX_BITS) - b;
+    centre_box c = centres_in(xa, xb, xc, ya, yb, yc);
     const int32_t xe = (int32_t)tg->width - 1, ya0 = (int32_t)tg->y0, ye = (int32_t)(tg->y0 + tg->rows) - 1;
-    x0 = x0 < 0 ? 0 : x0;
-    x1 = x1 > xe ? xe : x1;
-    y0 = y0 < ya0 ? ya0 : y0;
-    y1 = y1 > ye ? ye : y1;
-    return (x0 <= x1) & (y0 <= y1);
+    c.x0 = c.x0 < 0 ? 0 : c.x0;
+    c.x1 = c.x1 > xe ? xe : c.x1;
+    c.y0 = c.y0 < ya0 ? ya0 : c.y0;
+    c.y1 = c.y1 > ye ? ye : c.y1;
+    return (c.x0 <= c.x1) & (c.y0 <= c.y1);
 }
 
 /* ---- vertices a batch at a time
