@@ -25,8 +25,11 @@ static int term_diff(void)
 
 /* Every certain answer of the map, held against the reference's term for the sample,
  * in the one-pass arena or (least) the minimum one, where no vertex projection is kept
- * and every triangle takes the map's full path. Returns how many samples the map
- * decided. */
+ * and every triangle takes the map's full path. Then the method's own resolve, whose
+ * float test decides most lit samples without their exact depth: its counts of each
+ * answer must be the map's exact ones, sample for sample (a float "lit" where the exact
+ * test is not sure would move a sample from uncertain to lit). Returns how many
+ * samples the map decided. */
 static uint32_t certain_agree(const om_scene *s, const om_method_cfg *c, const char *what, bool least)
 {
     const om_method *m = om_method_find("hybrid");
@@ -38,9 +41,11 @@ static uint32_t certain_agree(const om_scene *s, const om_method_cfg *c, const c
     void *mem = malloc(least ? mn : full), *state;
     om_arena a;
     om_arena_init(&a, mem, least ? mn : full, "method");
-    uint32_t decided = 0, wrong = 0;
+    uint32_t decided = 0, wrong = 0, answers[3] = {0, 0, 0};
+    bool ran = false;
     if (m->init(&state, &a, c, s, W, H, &d) == OM_OK && m->begin(state, &v, &d) == OM_OK &&
         m->build(state, &d) == OM_OK) {
+        ran = true;
         const om__lspace *ls = om__hybrid_lspace(state);
         for (int i = 0; i < W * H; i++) {
             if (!(ref_t[i].flags & OM_TERM_EXPOSED)) continue;
@@ -48,6 +53,7 @@ static uint32_t certain_agree(const om_scene *s, const om_method_cfg *c, const c
             if (!om__lspace_point(ls, &smp[i], &p)) continue;
             om_term t = {255, 255, 255, ref_t[i].flags};
             int k = om__hybrid_decide(state, &p, &t);
+            answers[k == 1 ? 0 : k == 2 ? 1 : 2]++;
             if (k == 0) continue;
             decided++;
             bool lit = ref_t[i].r == 255 && ref_t[i].g == 255 && ref_t[i].b == 255;
@@ -61,6 +67,22 @@ static uint32_t certain_agree(const om_scene *s, const om_method_cfg *c, const c
         }
     }
     CHECK_MSG(wrong == 0, "%s: %u certain samples differ from the reference", what, wrong);
+    CHECK_MSG(ran, "%s: the method did not start", what);
+    if (ran) {
+        static om_term terms[W * H];
+        for (int i = 0; i < W * H; i++) terms[i] = ref_t[i];
+        om_strip st = {W, H, 0, H, smp, terms};
+        om_method_stats ms;
+        CHECK_OK(m->resolve(state, &st, &d));
+        m->stats(state, &ms);
+        for (int k = 0; k < 3; k++)
+            CHECK_MSG(ms.counters[k] == answers[k], "%s: resolve's %s %u, the map's %u", what,
+                      ms.counter_names[k], (unsigned)ms.counters[k], answers[k]);
+        int diff = 0;
+        for (int i = 0; i < W * H; i++)
+            diff += terms[i].r != ref_t[i].r || terms[i].g != ref_t[i].g || terms[i].b != ref_t[i].b;
+        CHECK_MSG(diff == 0, "%s: %d of resolve's terms differ from the reference", what, diff);
+    }
     free(mem);
     return decided;
 }

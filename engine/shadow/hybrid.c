@@ -549,14 +549,49 @@ static void put_key(om__hkey *q, const om__lpoint *p, size_t i)
  * matrix times each one's point, its division and snap and its texel, in loops over
  * the lanes with no branch on the data that a compiler can run on vector registers
  * (om__mat_apply's and om__project_xy's float operations in their order, as
- * om__lspace_point's: the same bits), then each lane's depth (om__zdepth: an integer
- * division) and lookup. The products and divisions no longer wait in line behind the
- * branches of the lookup before them. One lane where a double is a software routine
+ * om__lspace_point's: the same bits), then the float test that proves most of them
+ * lit (surely_lit), and only for the rest each one's exact depth (om__zdepth: an
+ * integer division) and lookup. One lane where a double is a software routine
  * (OM_FAST_FLOAT): no vector unit there, and om__project_xy itself. */
 #if OM_FAST_FLOAT
 #define LANES 1
 #else
 #define LANES 16
+#endif
+
+#if LANES > 1
+/* Is the sample certainly lit, decided in single precision without its exact depth:
+ * the answer classify_at's first test would give (the texel's plane, in double, at or
+ * beyond om__zdepth of the sample's clip z and w), where this says so; 0 where it
+ * cannot tell. hz, gx, gy: the texel's plane (hz FLT_MAX: empty, every sample in it
+ * lit); dx, dy: the sample's grid point less the texel's centre; zf: its clip z
+ * times 1/w (the float reciprocal om__project_xy takes) times 2^32. Compares and
+ * arithmetic only, no branch and no division: lanes. Why a yes is classify_at's
+ * (each float operation rounds within 2^-24 of its result, x87's wider ones too; the
+ * double's within 2^-53; below, S = |hz| + |a| + |b|):
+ *   the depth: om__zdepth is 0 for z <= 0 (zf <= 0), for z/w below a unit (zf's
+ *     product underflowed to 0 or beyond) and for NaN; else it is at most q = z/w 2^32
+ *     (truncated, clamped), and zf = q (1 + d1)(1 + d2), |d1|, |d2| <= 2^-24, so
+ *     for zf > 0, zh = zf + |zf| 2^-21 (rounded, at least zf (1 + 2^-22)) is at
+ *     least q. The test asks v - e >= zh and >= 0: at least om__zdepth either way
+ *     (a NaN zh answers no);
+ *   the plane: dx, dy convert within 2^-24 (exactly below 2^24), so a = gx dx and
+ *     b = gy dy are within 2^-22.9 of |a| and |b|, and the two sums within 2^-24 of
+ *     theirs: v is within 2^-21.9 S of the exact plane, the double's (classify_at)
+ *     within 2^-50.9 S;
+ *   the test: fl(v - e) >= zh, 0 gives v - e >= max(zh, 0) - 2^-24 |zh| (rounding is
+ *     monotone, zh and 0 are floats), and e is at least 2^-20.01 (S + |zh|) (three
+ *     sums rounded down at most) plus 1/2 for the underflows of tiny products (below
+ *     2^-126 each): so the double's plane is above max(zh, 0) + (2^-20.01 - 2^-21.9 -
+ *     2^-50.9) S >= om__zdepth.
+ * Infinities and NaN (an empty texel's NaN slopes, z/w beyond the float's range) make
+ * the tests false; an empty texel is lit by its own test. */
+static inline int32_t surely_lit(float hz, float gx, float gy, int32_t dx, int32_t dy, float zf)
+{
+    const float a = gx * (float)dx, b = gy * (float)dy, v = hz + a + b, zh = zf + om__fabsf(zf) * 0x1p-21f;
+    const float e = (om__fabsf(hz) + om__fabsf(a) + om__fabsf(b) + om__fabsf(zh)) * 0x1p-20f + 1.0f, d = v - e;
+    return (hz == FLT_MAX) | ((d >= zh) & (d >= 0.0f));
+}
 #endif
 
 /* The next batch of the strip's samples from *i on: every term set to 255 on the way,
@@ -567,7 +602,10 @@ static uint32_t look_up(const hybrid_state *m, om_strip *st, size_t *i, size_t n
                         om__hkey q[LANES])
 {
     float px[LANES], py[LANES], pz[LANES], cz[LANES], cw[LANES];
-    int32_t gx[LANES], gy[LANES], tx[LANES], ty[LANES], ok[LANES];
+#if LANES > 1
+    float zf[LANES], hz[LANES], hgx[LANES], hgy[LANES];   /* surely_lit's */
+#endif
+    int32_t gx[LANES], gy[LANES], tx[LANES], ty[LANES], ok[LANES], lit[LANES];
     uint32_t at[LANES], tri[LANES], k = 0, u = 0;
     for (; *i < n && k < LANES; ++*i) {
         om_term *t = &st->terms[*i];
@@ -599,6 +637,7 @@ static uint32_t look_up(const hybrid_state *m, om_strip *st, size_t *i, size_t n
         py[j] = Yc < lim ? Yc : lim;
         cz[j] = c.z;
         cw[j] = c.w;
+        zf[j] = c.z * iw * OM_DEPTH_ONE_F;
     }
     /* a loop of its own, as scene_raster.c's lanes: in the one above a compiler would
      * convert only the lanes it knows in range, under a branch */
@@ -621,6 +660,17 @@ static uint32_t look_up(const hybrid_state *m, om_strip *st, size_t *i, size_t n
             ty[j] = (int32_t)texel_of(m, gy[j]);
         }
     }
+    /* each lane's texel plane (a loop of loads), then the float test in lanes; the
+     * grid and its texels' centres fit in 32 bits (2^21 units, a sample within 2^26) */
+    const int32_t T = (int32_t)m->T, side = (int32_t)m->side;
+    for (uint32_t j = 0; j < LANES; j++) {
+        const htexel *h = &m->map[ty[j] * side + tx[j]];
+        hz[j] = h->z;
+        hgx[j] = h->gx;
+        hgy[j] = h->gy;
+    }
+    for (uint32_t j = 0; j < LANES; j++)
+        lit[j] = surely_lit(hz[j], hgx[j], hgy[j], gx[j] - (tx[j] * T + T / 2), gy[j] - (ty[j] * T + T / 2), zf[j]);
 #else
     for (uint32_t j = 0; j < k; j++) {   /* one lane: om__project itself */
         const om_vec4 c = om__mat_apply(&m->ls.vp, om__v3(px[j], py[j], pz[j]));
@@ -632,10 +682,15 @@ static uint32_t look_up(const hybrid_state *m, om_strip *st, size_t *i, size_t n
         cw[j] = c.w;
         tx[j] = (int32_t)texel_of(m, gx[j]);
         ty[j] = (int32_t)texel_of(m, gy[j]);
+        lit[j] = 0;   /* classify_at's float test instead (plane_at_or_beyond) */
     }
 #endif
     for (uint32_t j = 0; j < k; j++) {
         if (!ok[j]) continue;
+        if (lit[j]) {   /* the term is already 255 */
+            counts[0]++;
+            continue;
+        }
         om__lpoint p;
         int64_t tex;
         p.x = gx[j];
