@@ -448,7 +448,9 @@ size_t om_frame_bytes_scene(const om_scene *s, uint32_t width, uint32_t strip_ro
  * shading run on bands at once, and so does the resolve of the built-in methods whose
  * resolve allows it (DESIGN.md lists them); the others resolve a strip at a
  * time. A whole-frame render (one strip) also uses the bins when they fit after the
- * jobs' scratch. */
+ * jobs' scratch, but for one on two jobs whose scene has more than one vertex for
+ * every 8 pixels: its eye pass splits the triangles in halves instead, with no more
+ * memory (DESIGN.md). */
 size_t om_frame_bytes_jobs(const struct om_method *m, const om_scene *s, uint32_t threads);
 /* What the frame arena may hold beyond those so that a frame through strips keeps the
  * triangle under every pixel of a width x height image from its first eye pass (2

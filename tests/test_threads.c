@@ -157,6 +157,32 @@ static void fewer_jobs(void)
     h_scene_free(&hs);
 }
 
+/* One strip on two jobs and a scene of more than one vertex for every 8 pixels: the
+ * eye pass rasterizes by halves of the triangles (frame.c). Two planes that coincide,
+ * one in each half: where they tie the first one's colour wins, as in one walk of
+ * every triangle; and no bins are carved (the frame arena's peak is the same with
+ * room for them and without). Three jobs take the bins. */
+static void eye_halves(void)
+{
+    static const char two_planes[] =
+        "camera eye 0 4 4 target 0 0 0 fov 60\n"
+        "light spot pos 0 6 0 target 0 0 0 fov 90\n"
+        "plane size 4 4 albedo 1 0 0\n"
+        "plane size 4 4 albedo 0 0 1\n";
+    h_scene hs;
+    if (!h_scene_parse(&hs, two_planes)) return;
+    const om_method *m = om_method_find("none");
+    const size_t two_b = om_frame_bytes_jobs(m, &hs.s, 2), three_b = om_frame_bytes_jobs(m, &hs.s, 3);
+    frame_out one = render(&hs.s, m, 8, 6, 0, NULL, NULL, 1, 0, true);
+    frame_out two = render(&hs.s, m, 8, 6, 0, backwards, NULL, 2, two_b, true);
+    frame_out lean = render(&hs.s, m, 8, 6, 0, backwards, NULL, 2, two_b, false);
+    frame_out three = render(&hs.s, m, 8, 6, 0, backwards, NULL, 3, three_b, true);
+    CHECK(two.jobs == 2 && lean.jobs == 2 && three.jobs == 3);
+    CHECK(two.hash == one.hash && lean.hash == one.hash && three.hash == one.hash);
+    CHECK_EQ_U(two.peak, lean.peak);
+    h_scene_free(&hs);
+}
+
 /* ---- asm: its bands look up with caches of their own and write nothing of the tree;
  * the use stamps of their lookups are put on the tree after the bands (om__bands.
  * finish). A state kept over frames, a still light, a moving camera and one sample
@@ -559,6 +585,7 @@ void suite_threads(void)
 {
     RUN(same_bits);
     RUN(fewer_jobs);
+    RUN(eye_halves);
     RUN(hybrid_bands);
     RUN(asm_bands);
     RUN(asm_jobs_tree);

@@ -253,13 +253,18 @@ static void resolve_ids(const om_scene *s, const om_view *v, const om_target *tg
     }
 }
 
+/* Culling is exact in the eye pass: the visible point of a pixel is the nearest, and
+ * the nearest surface of a closed shape the camera is outside of faces the camera. */
 static void eye_pass(const om_scene *s, const om_view *v, const om_target *tg, om_strip *st,
                      const om__bins *bins, bool mark)
 {
-    /* Culling is exact here too: the visible point of a pixel is the nearest, and the
-     * nearest surface of a closed shape the camera is outside of faces the camera. */
     om__scene_raster(s, &v->cam_vp, tg, OM_RASTER_DEPTH_ID, true, bins);
     resolve_ids(s, v, tg, st, mark);
+}
+
+void om__eye_raster_part(const om_scene *s, const om_view *v, const om_target *tg, uint32_t t0, uint32_t t1)
+{
+    om__scene_raster_part(s, &v->cam_vp, tg, OM_RASTER_DEPTH_ID, true, t0, t1);
 }
 
 void om__eye_resolve(const om_scene *s, const om_view *v, const om_target *tg, om_strip *st, bool mark)

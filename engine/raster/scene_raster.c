@@ -401,7 +401,7 @@ static void batch_boxes(batch *b, const om_target *tg, bool cons)
 }
 
 static void walk_batches(const om_scene *s, const om_mat4 *vp, om_raster *r, uint32_t *hiz, bool cull,
-                         const uint32_t *rows)
+                         const uint32_t *rows, uint32_t ta, uint32_t tb)
 {
     const om_target *tg = r->target;
     const uint32_t y0 = tg->y0, y1 = tg->y0 + tg->rows - 1;
@@ -410,8 +410,8 @@ static void walk_batches(const om_scene *s, const om_mat4 *vp, om_raster *r, uin
     om__cull cl;
     om__cull_begin(&cl, s, vp);
     batch b;
-    for (uint32_t t0 = 0; t0 < s->ntris; t0 += BATCH) {
-        const uint32_t n = s->ntris - t0 < BATCH ? s->ntris - t0 : BATCH;
+    for (uint32_t t0 = ta; t0 < tb; t0 += BATCH) {
+        const uint32_t n = tb - t0 < BATCH ? tb - t0 : BATCH;
         batch_project(&b, s, t0, n, vp, g, sx, sy);
         batch_boxes(&b, tg, r->mode == OM_RASTER_CONSERVATIVE);
         for (uint32_t k = 0; k < n; k++) {
@@ -493,30 +493,45 @@ static uint32_t rows_reach_few(const uint32_t *rows, uint32_t n, uint32_t y0, ui
 }
 #endif
 
+/* A plain pass of `mode` into tg: pixel centres, no spans, masks or grid. */
+static void raster_plain(om_raster *r, const om_target *tg, om_raster_mode mode)
+{
+    r->target = tg;
+    r->mode = mode;
+    r->span = NULL;
+    r->user = NULL;
+    r->centres = NULL;
+    r->centre_mask = NULL;
+    r->grid_x = r->grid_y = NULL;
+    r->grid_xs = r->grid_ys = NULL;
+    r->grid_shift = r->grid_buckets = 0;
+    r->mask_words = 0;
+    r->cull_back = false;
+    r->row_mask = NULL;
+    r->row_shift = 0;
+}
+
+void om__scene_raster_part(const om_scene *s, const om_mat4 *vp, const om_target *tg, om_raster_mode mode,
+                           bool cull, uint32_t t0, uint32_t t1)
+{
+    om_raster r;
+    raster_plain(&r, tg, mode);
+    om__target_clear(tg);
+    walk_batches(s, vp, &r, NULL, cull, NULL, t0 < s->ntris ? t0 : s->ntris, t1 < s->ntris ? t1 : s->ntris);
+}
+
 void om__scene_raster_hiz(const om_scene *s, const om_mat4 *vp, const om_target *tg,
                           om_raster_mode mode, bool cull, const om__bins *bins, uint32_t *hiz)
 {
     om_raster r;
-    r.target = tg;
-    r.mode = mode;
-    r.span = NULL;
-    r.user = NULL;
-    r.centres = NULL;
-    r.centre_mask = NULL;
-    r.grid_x = r.grid_y = NULL;
-    r.grid_xs = r.grid_ys = NULL;
-    r.grid_shift = r.grid_buckets = 0;
-    r.mask_words = 0;
-    r.cull_back = false;
-    r.row_mask = NULL;
-    r.row_shift = 0;
+    raster_plain(&r, tg, mode);
     om__target_clear(tg);
     om__hiz_clear(hiz, tg);
     const uint32_t y0 = tg->y0, y1 = tg->y0 + tg->rows - 1;
     const uint32_t *rows = bins ? bins->rows : NULL;
     const om__vsnap *vs = bins ? bins->verts : NULL;
     if (!vs) {
-        walk_batches(s, vp, &r, hiz, cull, rows);
+        walk_batches(s, vp, &r, hiz, cull, rows, 0, s->ntris);
         return;
     }
     om__cull cl;

@@ -77,6 +77,14 @@ void om__bins_make_rows(const om_scene *s, const om_mat4 *vp, uint32_t width, ui
  * setup; NULL walks every triangle. The same pixels either way. */
 void om__scene_raster(const om_scene *s, const om_mat4 *vp, const om_target *tg,
                       om_raster_mode mode, bool cull, const om__bins *bins);
+/* om__scene_raster without bins of the triangles [t0, t1) alone: one part of a pass
+ * split by triangles, each part into a target of its own, cleared here. The parts
+ * merged pixel by pixel (the nearer depth; on a tie the part of the lower triangles)
+ * hold what one walk of every triangle gives: the depth test is strict, so among equal
+ * depths the first triangle drawn wins, and a pixel's depth depends on its triangle
+ * alone. */
+void om__scene_raster_part(const om_scene *s, const om_mat4 *vp, const om_target *tg, om_raster_mode mode,
+                           bool cull, uint32_t t0, uint32_t t1);
 /* The same with a coarse depth of tg's image (om__hiz_words; NULL: none), cleared
  * with the target: for the depth-only light passes, the same texels. */
 void om__scene_raster_hiz(const om_scene *s, const om_mat4 *vp, const om_target *tg,
