@@ -241,17 +241,17 @@ static inline void lanes_project(lanes *restrict b, float *restrict px, float *r
         const float iw = 1.0f / w;
         const float X = (x * iw + 1.0f) * sx + 0.5f, Y = (1.0f - y * iw) * sy + 0.5f;
         /* an infinite or NaN x, y or z fails a plane test, an infinite w its w - w */
+        const int32_t in = (X > -lim) & (X < lim) & (Y > -lim) & (Y < lim);
         const int32_t ok = (z >= 0.0f) & (w - z >= 0.0f) & (x + g.x * w >= 0.0f) & (g.x * w - x >= 0.0f) &
-                           (y + g.y * w >= 0.0f) & (g.y * w - y >= 0.0f) & (w > 0.0f) & (w - w == 0.0f) &
-                           (X > -lim) & (X < lim) & (Y > -lim) & (Y < lim);
+                           (y + g.y * w >= 0.0f) & (g.y * w - y >= 0.0f) & (w > 0.0f) & (w - w == 0.0f) & in;
         b->x[i] = x;
         b->y[i] = y;
         b->z[i] = z;
         b->w[i] = w;
-        /* clamped, NaN included, so that every lane converts (below) */
-        const float Xc = X > -lim ? X : -lim, Yc = Y > -lim ? Y : -lim;
-        px[i] = Xc < lim ? Xc : lim;
-        py[i] = Yc < lim ? Yc : lim;
+        /* 0 off the grid (NaN included), so that every lane converts (below): one
+         * mask, where clamping each side costs a compare and a blend */
+        px[i] = in ? X : 0.0f;
+        py[i] = in ? Y : 0.0f;
         b->ok[i] = ok;
     }
     /* a loop of its own: in the one above, a compiler would convert only the lanes it
