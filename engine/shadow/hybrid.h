@@ -24,11 +24,8 @@ static inline bool om__square_touches(const om__tri2 *e, int64_t x0, int64_t y0,
 }
 
 /* An uncertain sample on the light's grid (the grid fits in 27 bits, its depth is a
- * whole unit: om__lspace_point); idx is its place in the strip, with OM_HKEY_DONE set
- * once it is opaquely shadowed. */
+ * whole unit: om__lspace_point); idx is its place in the strip. */
 typedef struct om__hkey { int32_t x, y; uint32_t z, tri, idx; } om__hkey;
-#define OM_HKEY_DONE 0x80000000u
-
 
 /* A tile of uncertain samples and its scratch: the samples as they come (raw, n of
  * them, at most cap), then sorted into a grid of cells fitted to their bounds (smp,
@@ -37,7 +34,10 @@ typedef struct om__hkey { int32_t x, y; uint32_t z, tri, idx; } om__hkey;
 typedef struct om__htile {
     om__hkey *raw, *smp;
     om__odepth *od;
-    uint32_t *cell, *cend, *bzmax;
+    /* cell: each raw sample's cell while sorting; oend, the same memory after: each
+     * cell's end of open samples (its samples from cend[c - 1] on, the open ones
+     * first); cend: each cell's end; bzmax: each block's farthest depth */
+    uint32_t *cell, *oend, *cend, *bzmax;
     uint32_t cap, n;
     om__lvbox box;          /* the samples' bounds and farthest depth */
     /* The grid (hybrid_tile.c, fit_cells): cell (cx, cy) is the square of grid points

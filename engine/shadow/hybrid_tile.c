@@ -12,9 +12,12 @@
  * whether any open sample there lies within them, farther; so a triangle near no
  * uncertain sample costs a few comparisons. Every sample it reaches gets the shared
  * predicate, om__blocks; semi-transparent casters add their optical depth (integer
- * sums, the same in any order), and an opaquely shadowed sample is done. The grid
- * depends on the tile's samples alone, so the terms and the counts do not depend on
- * where the tile runs or what its memory held. */
+ * sums, the same in any order), and an opaquely shadowed sample is done: it leaves
+ * its cell's open samples (each cell keeps them first), so no later triangle visits
+ * it. The grid depends on the tile's samples alone, and every triangle visits each
+ * sample that is still open in the cells it reaches once, whatever their order in a
+ * cell, so the terms and the counts do not depend on where the tile runs or what its
+ * memory held. */
 #include "hybrid.h"
 
 /* Cells per side of a block (the coarse level a triangle looks at first). */
@@ -28,6 +31,9 @@
 #define NEAR_CELLS 16u
 
 static uint32_t cells_cap(uint32_t cap) { return (cap ? cap : 1) * CELL_SAMPLES; }
+/* Once sorted, the samples' cells (om__htile.cell, one a sample) become each cell's
+ * end of open samples (oend, one a cell): as many while a cell is a sample at most. */
+typedef char one_cell_a_sample[CELL_SAMPLES == 1 ? 1 : -1];
 /* ceil(w / 4) ceil(h / 4) <= w h / 16 + (w + h) / 4 + 1, and w + h <= w h + 1 */
 static uint32_t blocks_cap(uint32_t cap) { return cells_cap(cap) / 16 + (cells_cap(cap) + 1) / 4 + 2; }
 
@@ -52,7 +58,7 @@ void om__htile_carve(om__htile *t, void *mem, uint32_t cap)
     p += up16((size_t)cap * sizeof(om__hkey));
     t->od = (om__odepth *)p;
     p += up16((size_t)cap * sizeof(om__odepth));
-    t->cell = (uint32_t *)p;
+    t->cell = t->oend = (uint32_t *)p;
     p += up16((size_t)cap * sizeof(uint32_t));
     t->cend = (uint32_t *)p;
     p += up16((size_t)cells_cap(cap) * sizeof(uint32_t));
@@ -113,6 +119,7 @@ static void sort_tile(om__htile *t, uint32_t n)
         sum += k;
     }
     for (uint32_t i = 0; i < n; i++) t->smp[t->cend[t->cell[i]]++] = t->raw[i];   /* starts -> ends */
+    memcpy(t->oend, t->cend, nc * sizeof *t->oend);   /* every sample open */
 }
 
 /* The cells a grid box reaches (one that meets the tile's bounds): clamped to the
@@ -174,10 +181,9 @@ static bool any_within(const om__htile *t, const crange *r, const om__lvbox *v)
     for (uint32_t cy = r->y0; cy <= r->y1; cy++)
         for (uint32_t cx = r->x0; cx <= r->x1; cx++) {
             const size_t c = (size_t)cy * t->cw + cx;
-            const om__hkey *q = t->smp + (c ? t->cend[c - 1] : 0), *end = t->smp + t->cend[c];
+            const om__hkey *q = t->smp + (c ? t->cend[c - 1] : 0), *end = t->smp + t->oend[c];
             for (; q < end; q++)
-                if (q->x >= lox && q->x <= hix && q->y >= loy && q->y <= hiy && q->z > z && !(q->idx & OM_HKEY_DONE))
-                    return true;
+                if (q->x >= lox && q->x <= hix && q->y >= loy && q->y <= hiy && q->z > z) return true;
         }
     return false;
 }
@@ -190,6 +196,19 @@ static bool cell_touches(const om__htile *t, const om__ltri *lt, uint32_t cx, ui
     for (int k = 0; k < lt->n; k++)
         if (om__square_touches(&lt->sub[k].e, x0, y0, x1, y1)) return true;
     return false;
+}
+
+/* Sample i of a cell whose open samples end at *oend is done: the last open one takes
+ * its place (with its optical depth) and it goes after them. */
+static void close_sample(om__htile *t, uint32_t i, uint32_t *oend)
+{
+    const uint32_t j = --*oend;
+    const om__hkey q = t->smp[i];
+    const om__odepth o = t->od[i];
+    t->smp[i] = t->smp[j];
+    t->od[i] = t->od[j];
+    t->smp[j] = q;
+    t->od[j] = o;
 }
 
 /* Triangle tri against the tile's samples; returns how many it shadowed opaquely. */
@@ -220,20 +239,25 @@ static uint32_t cast(const om__hscene *h, om__htile *t, uint32_t tri)
             for (uint32_t cy = ya; cy <= yb; cy++)
                 for (uint32_t cx = xa; cx <= xb; cx++) {
                     const size_t c = (size_t)cy * t->cw + cx;
-                    uint32_t i = c ? t->cend[c - 1] : 0, end = t->cend[c];
-                    if (i == end || !cell_touches(t, &lt, cx, cy)) continue;
-                    for (; i < end; i++) {
-                        om__hkey *q = &t->smp[i];
-                        if ((q->idx & OM_HKEY_DONE) || q->x < lt.lox || q->x > lt.hix || q->y < lt.loy || q->y > lt.hiy)
+                    uint32_t i = c ? t->cend[c - 1] : 0;
+                    if (i == t->oend[c] || !cell_touches(t, &lt, cx, cy)) continue;
+                    while (i < t->oend[c]) {
+                        const om__hkey *q = &t->smp[i];
+                        if (q->x < lt.lox || q->x > lt.hix || q->y < lt.loy || q->y > lt.hiy) {
+                            i++;
                             continue;
+                        }
                         om__lpoint p = {q->x, q->y, (double)q->z, q->tri};
                         t->tested++;
-                        if (!om__blocks(&lt, &p)) continue;
-                        om__odepth_add(&t->od[i], od);
-                        if (om__odepth_opaque(&t->od[i])) {
-                            q->idx |= OM_HKEY_DONE;
-                            closed++;
+                        if (om__blocks(&lt, &p)) {
+                            om__odepth_add(&t->od[i], od);
+                            if (om__odepth_opaque(&t->od[i])) {
+                                close_sample(t, i, &t->oend[c]);   /* i holds the next one now */
+                                closed++;
+                                continue;
+                            }
                         }
+                        i++;
                     }
                 }
         }
@@ -251,7 +275,7 @@ void om__htile_run(const om__hscene *h, om__htile *t, uint32_t n, const om_strip
     om__odepth last = {{0, 0, 0}};
     om_term lt = {255, 255, 255, 0};
     for (uint32_t i = 0; i < n; i++) {
-        om_term *term = &st->terms[t->smp[i].idx & ~OM_HKEY_DONE];
+        om_term *term = &st->terms[t->smp[i].idx];
         if (memcmp(&t->od[i], &last, sizeof last)) {
             om__odepth_term(&t->od[i], &lt);
             last = t->od[i];
