@@ -177,7 +177,10 @@ run_one() {
         timeout 600 $runner "$out/$name" >"$out/$name.txt" 2>&1 || ok=false
         # A kernel built without 32-bit support cannot exec the i386 builds: run them
         # under qemu-i386 then, which gives the same bits (it emulates the arithmetic).
-        if ! $ok && [ -z "$runner" ] && grep -q "Exec format error" "$out/$name.txt" &&
+        # The refusal reads "Exec format error", or, where the C library's execvp hands
+        # the file to /bin/sh as a script, the shell's complaint about it.
+        if ! $ok && [ -z "$runner" ] &&
+           grep -Eq "Exec format error|Syntax error|cannot execute binary file" "$out/$name.txt" &&
            command -v qemu-i386 >/dev/null 2>&1; then
             echo "cross: $name: this kernel does not run it natively, so under qemu-i386"
             ok=true
