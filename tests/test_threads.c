@@ -161,7 +161,7 @@ static void fewer_jobs(void)
  * eye pass rasterizes by halves of the triangles (frame.c). Two planes that coincide,
  * one in each half: where they tie the first one's colour wins, as in one walk of
  * every triangle; and no bins are carved (the frame arena's peak is the same with
- * room for them and without). Three jobs take the bins. */
+ * room for them and without). Three jobs (with the bins) give the same frame. */
 static void eye_halves(void)
 {
     static const char two_planes[] =

@@ -152,7 +152,6 @@ typedef struct frame_ctx {
     bool ids16;                /* as uint16_t (OM_NO_TRI as 0xFFFF): under 65535 triangles */
     bool ids_have;             /* the first pass is over: later passes resolve from ids */
     uint32_t *half_depth, *half_id;   /* one strip, two jobs: the second half's target, or NULL */
-    bool rastered;             /* STAGE_PREPARE: tg holds the ids, the eye pass only resolves */
 } frame_ctx;
 
 static size_t ids_bytes(const om_scene *s, uint32_t width, uint32_t height)
@@ -262,7 +261,7 @@ static void band_job(void *user, uint32_t b)
             tg.rows = st.rows;
             tg.depth += off;
             tg.id += off;
-            if (c->rastered) om__eye_resolve(fd->scene, c->view, &tg, &st, c->mark);
+            if (c->half_depth) om__eye_resolve(fd->scene, c->view, &tg, &st, c->mark);   /* merged */
             else eye_rows(c, &tg, &st, c->mark);
         } else if (c->mark) {
             mark_exposed(c->view, &st);
@@ -439,8 +438,7 @@ static void prepare(frame_ctx *c, bool eye, bool mark, om_frame_stats *fs)
     if (OM_WITH_JOBS && c->jobs > 1) {
         c->eye = eye;
         c->mark = mark;
-        c->rastered = eye && c->half_depth;
-        if (c->rastered) {
+        if (eye && c->half_depth) {
             run_stage(c, STAGE_EYE_HALF, 2);
             run_bands(c, STAGE_EYE_MERGE);
         }
