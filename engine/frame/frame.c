@@ -12,10 +12,11 @@
  * With the host's parallel-for and more than one thread, each strip is cut into bands
  * of rows, and the eye pass, the exposure marks, shading and (for methods with
  * om__bands) the resolve run on the bands at once, each band a job of the host's
- * parallel-for (up to BANDS_PER_JOB a thread, so the host can even out the work and a
- * stalled thread holds up one small band). A band's pixels are those of the strip (every stage is strip-invariant), so the frame is the same
- * whatever the number of jobs; the stages that fold the whole strip into one answer
- * (the light's fit, observe, a serial resolve) stay on the calling thread.
+ * parallel-for (several a thread, so the host can even out the work and a stalled
+ * thread holds up one small band). A band's pixels are those of the strip (every
+ * stage is strip-invariant), so the frame is the same whatever the number of jobs;
+ * the stages that fold the whole strip into one answer (the light's fit, observe, a
+ * serial resolve) stay on the calling thread.
  *
  * The bands' eye pass needs bins (each band sets up only the triangles that reach its
  * rows, from vertices projected once), and on a scene of many small triangles making
@@ -30,8 +31,14 @@
 
 /* Bands per thread: a strip (or a map) is cut into at most this many bands a thread,
  * and the host's parallel-for hands them out, so a thread that the system stalls holds
- * up one small band, not a thread's share. */
+ * up one small band, not a thread's share. An eye pass that rasterizes and the map's
+ * build take BANDS_PER_JOB: each band sets up every triangle that reaches its rows.
+ * The stages whose work is per pixel (a method's resolve, shading, the eye pass that
+ * resolves ids, the halves' merge) take FINE_BANDS_PER_JOB, which costs no more: their
+ * work can crowd a few rows (ref's rays where random 100K's cloud stands: one of 8
+ * bands held a third of the frame's rays, and the other thread waited 6 to 13 ms). */
 #define BANDS_PER_JOB 4
+#define FINE_BANDS_PER_JOB 16
 
 /* One band's method counts and resolve scratch (from the frame arena): a band is one
  * job of the host's parallel-for, so it owns its slot whichever thread runs it. */
@@ -63,7 +70,7 @@ static size_t pass_slot_bytes(size_t scratch)
 /* A job's band slots: counts, and the bands' scratch. */
 static size_t band_job_bytes(const om__bands *b)
 {
-    return BANDS_PER_JOB *
+    return FINE_BANDS_PER_JOB *
            (om_arena_need(sizeof(job_slot), 8) + (b ? om_arena_need(b->scratch ? b->scratch : 1, 16) : 0));
 }
 
@@ -134,8 +141,8 @@ typedef struct frame_ctx {
     const om__pass *pass;      /* NULL: no pass of its own (or no room for one) */
     om_target tg;              /* the strip's */
     om_strip strip;
-    uint32_t jobs, band_rows;
-    job_slot *slots;           /* BANDS_PER_JOB * jobs of them */
+    uint32_t jobs, band_rows, fine_rows;   /* rows of a band, of a fine band */
+    job_slot *slots;           /* FINE_BANDS_PER_JOB * jobs of them */
     job_slot *pass_slots;      /* the pass's, pass_max of them */
     uint32_t pass_max, pass_jobs, pass_slots_now;   /* STAGE_PASS, STAGE_LEND: K jobs on P slots */
     uint32_t setup_items;      /* STAGE_PASS_SETUP: the pass's per-frame items */
@@ -191,6 +198,14 @@ static void eye_rows(const frame_ctx *c, const om_target *tg, om_strip *st, bool
     }
 }
 
+/* The rows of stage sg's bands: fine bands but for an eye pass that rasterizes by
+ * bands (each sets up every triangle that reaches its rows). */
+static uint32_t stage_rows(const frame_ctx *c, stage sg)
+{
+    const bool raster = sg == STAGE_PREPARE && c->eye && !c->half_depth && !(c->ids && c->ids_have);
+    return raster ? c->band_rows : c->fine_rows;
+}
+
 static void band_job(void *user, uint32_t b)
 {
     const frame_ctx *c = (const frame_ctx *)user;
@@ -238,11 +253,11 @@ static void band_job(void *user, uint32_t b)
                              rows < c->map_band ? rows : c->map_band, c->slots[b].counts);
         return;
     }
-    uint32_t r0 = b * c->band_rows;
+    const uint32_t band = stage_rows(c, c->stage), r0 = b * band;
     size_t off = (size_t)r0 * c->strip.width;
     om_strip st = c->strip;
     st.y0 += r0;
-    st.rows = c->strip.rows - r0 < c->band_rows ? c->strip.rows - r0 : c->band_rows;
+    st.rows = c->strip.rows - r0 < band ? c->strip.rows - r0 : band;
     st.samples += off;
     st.terms += off;
     if (c->stage == STAGE_EYE_MERGE) {   /* the second half's nearer pixels; a tie keeps the first's */
@@ -331,7 +346,8 @@ static void run_stage(frame_ctx *c, stage sg, uint32_t nbands)
 /* The same over the current strip's bands. */
 static void run_bands(frame_ctx *c, stage sg)
 {
-    run_stage(c, sg, (c->strip.rows + c->band_rows - 1) / c->band_rows);
+    const uint32_t band = stage_rows(c, sg);
+    run_stage(c, sg, (c->strip.rows + band - 1) / band);
 }
 
 /* om__bins_make on the host's threads: the vertices, then the triangles' rows, each
@@ -442,6 +458,8 @@ static void prepare(frame_ctx *c, bool eye, bool mark, om_frame_stats *fs)
             run_stage(c, STAGE_EYE_HALF, 2);
             run_bands(c, STAGE_EYE_MERGE);
         }
+        const uint32_t band = stage_rows(c, STAGE_PREPARE);
+        order_bands(c, c->bins ? c->bins->rows : NULL, c->strip.y0, band, (c->strip.rows + band - 1) / band);
         run_bands(c, STAGE_PREPARE);
     } else {
         if (eye) eye_rows(c, &c->tg, &c->strip, mark);
@@ -453,15 +471,12 @@ static void prepare(frame_ctx *c, bool eye, bool mark, om_frame_stats *fs)
     }
 }
 
-/* Moves the strip (and its target) to rows [y, y + rows), and orders its bands. */
+/* Moves the strip (and its target) to rows [y, y + rows). */
 static void strip_at(frame_ctx *c, uint32_t y, uint32_t rows)
 {
     uint32_t H = c->strip.height;
     c->strip.y0 = c->tg.y0 = y;
     c->strip.rows = c->tg.rows = y + rows > H ? H - y : rows;
-    if (OM_WITH_JOBS && c->jobs > 1)
-        order_bands(c, c->bins ? c->bins->rows : NULL, y, c->band_rows,
-                    (c->strip.rows + c->band_rows - 1) / c->band_rows);
 }
 
 /* Carves the jobs' slots: as many as the host asks for and the arena holds beyond
@@ -486,7 +501,7 @@ static void carve_jobs(frame_ctx *c, om_arena *fa, size_t keep)
     }
     uint32_t jobs = fit < fd->threads ? (uint32_t)fit : fd->threads;
     void *p;
-    const uint32_t nslots = BANDS_PER_JOB * jobs;
+    const uint32_t nslots = FINE_BANDS_PER_JOB * jobs;
     if (jobs < 2 || om_arena_alloc(fa, nslots * sizeof(job_slot), 8, &p, NULL)) return;
     c->slots = (job_slot *)p;
     for (uint32_t j = 0; b && j < nslots; j++)
@@ -509,8 +524,10 @@ static void carve_jobs(frame_ctx *c, om_arena *fa, size_t keep)
     c->jobs = jobs;
     /* Bands of whole 16-row blocks (methods tile strips by 16 from their top row, so a
      * band resolves the same blocks the strip would), at most one a slot. */
-    uint32_t rows = c->tg.rows, want = (rows + nslots - 1) / nslots;
+    uint32_t rows = c->tg.rows, want = (rows + BANDS_PER_JOB * jobs - 1) / (BANDS_PER_JOB * jobs);
     c->band_rows = (want + 15) / 16 * 16;
+    want = (rows + nslots - 1) / nslots;
+    c->fine_rows = (want + 15) / 16 * 16;
 }
 
 om_status om_render_frame(const om_frame_desc *fd, om_arena *fa, om_frame_stats *stats,
@@ -643,11 +660,11 @@ om_status om_render_frame(const om_frame_desc *fd, om_arena *fa, om_frame_stats 
         t0 = now(fd);
         if (OM_WITH_JOBS && (c.bands || c.pass)) {
             if (c.bands) {
-                for (uint32_t j = 0; j < BANDS_PER_JOB * c.jobs; j++)
+                for (uint32_t j = 0; j < FINE_BANDS_PER_JOB * c.jobs; j++)
                     memset(c.slots[j].counts, 0, sizeof c.slots[j].counts);
                 run_bands(&c, STAGE_RESOLVE);
                 uint32_t sum[8] = {0};
-                for (uint32_t j = 0; j < BANDS_PER_JOB * c.jobs; j++)
+                for (uint32_t j = 0; j < FINE_BANDS_PER_JOB * c.jobs; j++)
                     for (int k = 0; k < 8; k++) sum[k] += c.slots[j].counts[k];
                 c.bands->merge(fd->method_state, sum);
             }
