@@ -198,12 +198,23 @@ static void eye_rows(const frame_ctx *c, const om_target *tg, om_strip *st, bool
     }
 }
 
-/* The rows of stage sg's bands: fine bands but for an eye pass that rasterizes by
- * bands (each sets up every triangle that reaches its rows). */
+/* Whether stage sg is an eye pass that rasterizes by bands (each sets up every
+ * triangle that reaches its rows): it takes bands of band_rows, heaviest first
+ * (order_bands); every other stage fine bands, in row order. */
+static bool rasters(const frame_ctx *c, stage sg)
+{
+    return sg == STAGE_PREPARE && c->eye && !c->half_depth && !(c->ids && c->ids_have);
+}
+
 static uint32_t stage_rows(const frame_ctx *c, stage sg)
 {
-    const bool raster = sg == STAGE_PREPARE && c->eye && !c->half_depth && !(c->ids && c->ids_have);
-    return raster ? c->band_rows : c->fine_rows;
+    return rasters(c, sg) ? c->band_rows : c->fine_rows;
+}
+
+/* The number of stage sg's bands over the current strip. */
+static uint32_t stage_bands(const frame_ctx *c, stage sg)
+{
+    return (c->strip.rows + stage_rows(c, sg) - 1) / stage_rows(c, sg);
 }
 
 static void band_job(void *user, uint32_t b)
@@ -346,8 +357,7 @@ static void run_stage(frame_ctx *c, stage sg, uint32_t nbands)
 /* The same over the current strip's bands. */
 static void run_bands(frame_ctx *c, stage sg)
 {
-    const uint32_t band = stage_rows(c, sg);
-    run_stage(c, sg, (c->strip.rows + band - 1) / band);
+    run_stage(c, sg, stage_bands(c, sg));
 }
 
 /* om__bins_make on the host's threads: the vertices, then the triangles' rows, each
@@ -458,8 +468,8 @@ static void prepare(frame_ctx *c, bool eye, bool mark, om_frame_stats *fs)
             run_stage(c, STAGE_EYE_HALF, 2);
             run_bands(c, STAGE_EYE_MERGE);
         }
-        const uint32_t band = stage_rows(c, STAGE_PREPARE);
-        order_bands(c, c->bins ? c->bins->rows : NULL, c->strip.y0, band, (c->strip.rows + band - 1) / band);
+        order_bands(c, rasters(c, STAGE_PREPARE) && c->bins ? c->bins->rows : NULL, c->strip.y0,
+                    stage_rows(c, STAGE_PREPARE), stage_bands(c, STAGE_PREPARE));
         run_bands(c, STAGE_PREPARE);
     } else {
         if (eye) eye_rows(c, &c->tg, &c->strip, mark);
