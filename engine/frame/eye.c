@@ -21,6 +21,7 @@
  * expo_setup asks of that grown triangle: 256 float roundings. */
 #define EYE_SLACK (1.0f / 1024.0f)
 #define EYE_WAYS 16
+#define EYE_RUNS 32
 #define EYE_LAZY 16
 #define EYE_GROW (1.0f / 512.0f)
 #define EYE_MARGIN (1.0f / 65536.0f)
@@ -103,10 +104,19 @@ static void expo_setup(const om_view *v, const eye_frame *f, eye_tri *et)
     et->sure = true;
 }
 
-void om__persp_setup(const om_scene *s, const om_mat4 *vp, uint32_t t, om__persp_tri *c)
+/* Triangle t's vertices. */
+static void tri_verts(const om_scene *s, uint32_t t, om_vec3 v[3])
+{
+    const uint32_t *ix = s->idx + (size_t)t * 3;
+    for (int k = 0; k < 3; k++) v[k] = s->verts[ix[k]];
+}
+
+/* The setup of the triangle whose vertices are in c->v (the clip-space vertices are
+ * om__clip_tri's, made from those copies). */
+static void persp_finish(const om_mat4 *vp, om__persp_tri *c)
 {
     om_vec4 q[3];
-    om__clip_tri(s, vp, t, q);
+    for (int k = 0; k < 3; k++) q[k] = om__mat_apply(vp, c->v[k]);
     /* M has columns (x_i, y_i, w_i); we need M^-1 up to scale: the adjugate. */
     float m[9] = {q[0].x, q[1].x, q[2].x, q[0].y, q[1].y, q[2].y, q[0].w, q[1].w, q[2].w};
     c->adj[0] = m[4] * m[8] - m[5] * m[7];
@@ -118,12 +128,16 @@ void om__persp_setup(const om_scene *s, const om_mat4 *vp, uint32_t t, om__persp
     c->adj[6] = m[3] * m[7] - m[4] * m[6];
     c->adj[7] = m[1] * m[6] - m[0] * m[7];
     c->adj[8] = m[0] * m[4] - m[1] * m[3];
-    const uint32_t *ix = s->idx + (size_t)t * 3;
-    for (int k = 0; k < 3; k++) c->v[k] = s->verts[ix[k]];
     c->d1 = om__sub(c->v[1], c->v[0]);
     c->d2 = om__sub(c->v[2], c->v[0]);
     c->n = om__normalize(om__cross(c->d1, c->d2));
+}
+
+void om__persp_setup(const om_scene *s, const om_mat4 *vp, uint32_t t, om__persp_tri *c)
+{
     c->tri = t;
+    tri_verts(s, t, c->v);
+    persp_finish(vp, c);
 }
 
 om_vec3 om__persp_point(const om__persp_tri *c, float sx, float sy)
@@ -195,6 +209,34 @@ static void resolve_run(const om_view *v, const eye_tri *et, uint32_t x0, uint32
     }
 }
 
+/* The next batch of a row's runs, from *xe on: at most EYE_RUNS runs, their ends in
+ * run_end, and the vertices of the triangles that the cache will lack when the runs
+ * come (tag: the cache's triangle per way, kept a batch ahead) in `fetched`, in the
+ * order they will be set up. Their loads are made together, so that they overlap: on
+ * a scene of many small triangles (issue 26's random 100K) nearly every run is a
+ * triangle not yet set up, whose indices and vertices lie anywhere in the scene, and a
+ * setup that waited on its own loads spent most of its time there. Returns the number
+ * of runs; *xe moves past them. */
+static uint32_t fetch_batch(const om_scene *s, const uint32_t *id, uint32_t w, uint32_t *xe,
+                            uint32_t *tag, uint32_t *run_end, om_vec3 (*fetched)[3])
+{
+    uint32_t miss[EYE_RUNS], nr = 0, nm = 0, x = *xe;
+    while (x < w && nr < EYE_RUNS) {
+        const uint32_t t = id[x];
+        uint32_t x1 = x + 1;
+        while (x1 < w && id[x1] == t) x1++;   /* the run of pixels t covers */
+        if (t != OM_NO_TRI && tag[t % EYE_WAYS] != t) {
+            tag[t % EYE_WAYS] = t;
+            miss[nm++] = t;
+        }
+        run_end[nr++] = x1;
+        x = x1;
+    }
+    for (uint32_t k = 0; k < nm; k++) tri_verts(s, miss[k], fetched[k]);
+    *xe = x;
+    return nr;
+}
+
 /* The samples (and with `mark` the terms) of st's rows from the triangle ids in tg. */
 static void resolve_ids(const om_scene *s, const om_view *v, const om_target *tg, om_strip *st, bool mark)
 {
@@ -202,7 +244,9 @@ static void resolve_ids(const om_scene *s, const om_view *v, const om_target *tg
      * cross the same few triangles in turn, and each setup costs about as much as
      * thirty pixels. */
     eye_tri cache[EYE_WAYS];
+    uint32_t tag[EYE_WAYS];
     for (int k = 0; k < EYE_WAYS; k++) {
+        tag[k] = OM_NO_TRI;
         cache[k].t.tri = OM_NO_TRI;
         cache[k].sure = cache[k].tried = false;
         cache[k].seen = 0;
@@ -216,39 +260,45 @@ static void resolve_ids(const om_scene *s, const om_view *v, const om_target *tg
         const uint32_t *id = tg->id + (size_t)y * w;
         om_sample *smp = st->samples + (size_t)y * w;
         om_term *terms = mark ? st->terms + (size_t)y * w : NULL;
-        for (uint32_t x = 0; x < w;) {
-            const uint32_t t = id[x];
-            uint32_t x1 = x + 1;
-            while (x1 < w && id[x1] == t) x1++;   /* the run of pixels t covers */
-            if (t == OM_NO_TRI) {
-                for (; x < x1; x++) {   /* field by field: a freestanding build calls memset */
-                    smp[x].p[0] = smp[x].p[1] = smp[x].p[2] = 0.0f;
-                    smp[x].n[0] = smp[x].n[1] = smp[x].n[2] = 0.0f;
-                    smp[x].tri = OM_NO_TRI;
-                    smp[x].nl = 0.0f;
-                    if (terms) {
-                        terms[x].r = terms[x].g = terms[x].b = 255;
-                        terms[x].flags = 0;
+        for (uint32_t x = 0, xe = 0; x < w;) {
+            uint32_t run_end[EYE_RUNS];
+            om_vec3 fetched[EYE_RUNS][3];
+            const uint32_t nr = fetch_batch(s, id, w, &xe, tag, run_end, fetched);
+            for (uint32_t r = 0, k = 0; r < nr; r++) {
+                const uint32_t t = id[x], x1 = run_end[r];
+                if (t == OM_NO_TRI) {
+                    for (; x < x1; x++) {   /* field by field: a freestanding build calls memset */
+                        smp[x].p[0] = smp[x].p[1] = smp[x].p[2] = 0.0f;
+                        smp[x].n[0] = smp[x].n[1] = smp[x].n[2] = 0.0f;
+                        smp[x].tri = OM_NO_TRI;
+                        smp[x].nl = 0.0f;
+                        if (terms) {
+                            terms[x].r = terms[x].g = terms[x].b = 255;
+                            terms[x].flags = 0;
+                        }
                     }
+                    continue;
                 }
-                continue;
+                eye_tri *et = &cache[t % EYE_WAYS];
+                if (et->t.tri != t) {   /* fetch_batch's next triangle */
+                    et->t.tri = t;
+                    for (int j = 0; j < 3; j++) et->t.v[j] = fetched[k][j];
+                    k++;
+                    persp_finish(&v->cam_vp, &et->t);
+                    et->sure = et->tried = false;
+                    et->seen = 0;
+                }
+                /* expo_setup costs about what it saves on eight pixels: tried once the
+                 * triangle has EYE_LAZY pixels in the strip (its answer changes no bit,
+                 * only the work; 16 gave the fewest instructions on the M4, 4 to 32 within
+                 * 0.5% of it) */
+                if (mark && !et->tried && (et->seen += x1 - x) >= EYE_LAZY) {
+                    expo_setup(v, &fr, et);
+                    et->tried = true;
+                }
+                resolve_run(v, et, x, x1, sy, sxk, smp, terms);
+                x = x1;
             }
-            eye_tri *et = &cache[t % EYE_WAYS];
-            if (et->t.tri != t) {
-                om__persp_setup(s, &v->cam_vp, t, &et->t);
-                et->sure = et->tried = false;
-                et->seen = 0;
-            }
-            /* expo_setup costs about what it saves on eight pixels: tried once the
-             * triangle has EYE_LAZY pixels in the strip (its answer changes no bit,
-             * only the work; 16 gave the fewest instructions on the M4, 4 to 32 within
-             * 0.5% of it) */
-            if (mark && !et->tried && (et->seen += x1 - x) >= EYE_LAZY) {
-                expo_setup(v, &fr, et);
-                et->tried = true;
-            }
-            resolve_run(v, et, x, x1, sy, sxk, smp, terms);
-            x = x1;
         }
     }
 }
