@@ -118,6 +118,9 @@ rows=$(tail -n +2 "$dir/bench/bench.csv" | wc -l)
 if [ "$rows" -eq 4 ]; then ok; else bad "bench.csv has $rows rows, wanted 4 (ref + 3 izb pools)"; fi
 if awk -F, 'NR == 1 {n = NF} NF != n {exit 1} {for (i = 1; i <= NF; i++) if ($i == "") exit 1}' "$dir/bench/bench.csv"; then ok; else bad "bench.csv has empty or missing columns"; fi
 if [ -s "$dir/bench/ok.scene-time.svg" ] && [ -s "$dir/bench/ok.scene-bytes.svg" ]; then ok; else bad "bench charts written"; fi
+has "$dir/out" "^machine *compute *[0-9.]* *[0-9.]* *[0-9.]*x" "bench scaling table has the machine's compute row"
+has "$dir/out" "^machine *memory *[0-9.]* *[0-9.]* *[0-9.]*x" "bench scaling table has the machine's memory row"
+has "$dir/out" "^ok.scene *izb *[0-9.]* *[0-9.]* *[0-9.]*x" "bench scaling table has a method's row"
 if command -v xmllint >/dev/null 2>&1; then
     xmllint --noout "$dir"/bench/*.svg && ok || bad "bench SVG is not well-formed"
 fi

@@ -36,7 +36,8 @@ static const char bench_help[] =
     "  --threads N       threads each frame runs on (default: the CPUs online); the\n"
     "                    CSV's threads column says how many jobs ran at once\n"
     "  --no-scaling      leave out the scaling table (each method at its defaults on\n"
-    "                    1, 2 and the machine's cores: median frame, speed-up on 1)\n"
+    "                    1, 2 and the machine's cores: median frame, speed-up on 1,\n"
+    "                    beside the machine's own on work of pure compute and memory)\n"
     "  --tri-sweep       also time the exact methods on 1K..1M random triangles\n"
     "  --out DIR         where bench.csv and the charts go (default out/bench)\n";
 
@@ -491,19 +492,132 @@ static int write_outputs(const char *dir, char **names, size_t nn, const cli_poi
     return st == OM_OK ? 0 : cli_error(NULL, &d, st);
 }
 
-/* The scaling table: each method of the sweep at its defaults on each scene, `runs`
- * frames on each of 1, 2 and the machine's cores threads (one after another, in that
- * order, a fresh state each): the median frame (init apart) and its speed-up on one
- * thread; then a row "eye" per scene, the eye pass alone (its median within the first
- * method's frames: the bins and the visible samples of every strip). The pool is the
- * user's again afterwards. */
+/* The machine's own scaling, the table's first two rows: the same work in CALIB_JOBS
+ * jobs on each thread count, as a frame's is. `compute` needs no memory (a job runs
+ * eight independent float chains); `memory` is nothing but memory (a job copies its
+ * MiB of one CALIB_JOBS MiB buffer into another: more than most caches). Cores
+ * that share a power budget or a memory bus, or a virtual machine among others, gain
+ * less than their count even here; a frame, which both computes and streams, mostly
+ * gains between the two. */
+#define CALIB_JOBS 64
+#define CALIB_BYTES ((size_t)1 << 20)
+
+typedef struct calib {
+    unsigned char *buf;        /* two of CALIB_JOBS * CALIB_BYTES: from, to */
+    float out[CALIB_JOBS];     /* each job's result, so that no compiler drops its work */
+} calib;
+
+static void calib_compute(void *user, uint32_t i)
+{
+    float y[8];
+    for (int k = 0; k < 8; k++) y[k] = (float)(i + (uint32_t)k);
+    for (int n = 0; n < 100000; n++)
+        for (int k = 0; k < 8; k++) y[k] = y[k] * 0.9999f + 0.5f;   /* tends to 5000 */
+    ((calib *)user)->out[i] = y[0] + y[1] + y[2] + y[3] + y[4] + y[5] + y[6] + y[7];
+}
+
+static void calib_memory(void *user, uint32_t i)
+{
+    calib *c = (calib *)user;
+    unsigned char *to = c->buf + (CALIB_JOBS + (size_t)i) * CALIB_BYTES;
+    memcpy(to, c->buf + (size_t)i * CALIB_BYTES, CALIB_BYTES);
+    c->out[i] = (float)to[i];
+}
+
+/* The median time of `runs` calls of fn's jobs on the current pool, in ms. */
+static double calib_ms(om_job_fn fn, calib *c, int runs)
+{
+    om_frame_desc fd;
+    memset(&fd, 0, sizeof fd);
+    cli_frame_jobs(&fd);
+    double t[16];
+    if (runs > 16) runs = 16;
+    for (int r = 0; r < runs; r++) {
+        const uint64_t t0 = om_clock_ns(NULL);
+        if (fd.parallel_for && fd.threads > 1) fd.parallel_for(fd.parallel_user, fn, c, CALIB_JOBS);
+        else
+            for (uint32_t i = 0; i < CALIB_JOBS; i++) fn(c, i);
+        t[r] = (double)(om_clock_ns(NULL) - t0) / 1e6;
+    }
+    return median(t, runs);
+}
+
+/* The scaling table's rounds: each takes the thread counts in turn, so that a machine
+ * whose speed drifts while it runs (another load, a power state) moves every count
+ * alike. A row's time on a count is the median over the rounds, its speed-up the
+ * median of each round's own (that round's one-thread time over its time). */
+#define SCALING_ROUNDS 3
+
+typedef struct scale_row {
+    double ms[3][SCALING_ROUNDS];
+    bool fewer[3];   /* fewer jobs ran than threads asked, in some round */
+} scale_row;
+
+static void scale_print(const char *scene, const char *name, scale_row *r, int nc)
+{
+    printf("%-12s %-6s", scene, name);
+    for (int c = 0; c < nc; c++) {
+        double ratio[SCALING_ROUNDS], ms[SCALING_ROUNDS];
+        for (int k = 0; k < SCALING_ROUNDS; k++) {
+            ratio[k] = r->ms[c][k] > 0.0 ? r->ms[0][k] / r->ms[c][k] : 0.0;
+            ms[k] = r->ms[c][k];
+        }
+        printf(" %10.2f", median(ms, SCALING_ROUNDS));
+        if (c) printf(" %6.2fx%c", median(ratio, SCALING_ROUNDS), r->fewer[c] ? '*' : ' ');
+    }
+    printf("\n");
+}
+
+/* Starts the pool of `n` threads; false when it would not start (said). */
+static bool pool_of(const char *cmd, uint32_t n)
+{
+    char arg[16];
+    snprintf(arg, sizeof arg, "%u", n);
+    return cli_threads_start(cmd, arg);
+}
+
+/* The machine's two rows; false when a pool would not start (said). */
+static bool calib_rows(const char *cmd, const uint32_t *counts, int nc, int runs)
+{
+    calib c;
+    memset(&c, 0, sizeof c);
+    if ((c.buf = malloc(2 * CALIB_JOBS * CALIB_BYTES)))
+        memset(c.buf, 1, 2 * CALIB_JOBS * CALIB_BYTES);   /* its pages mapped before any timing */
+    for (int row = 0; row < 2; row++) {
+        if (row && !c.buf) {
+            printf("%-12s %-6s (no room for its %u MiB)\n", "machine", "memory", 2 * CALIB_JOBS);
+            break;
+        }
+        scale_row r;
+        memset(&r, 0, sizeof r);
+        for (int k = 0; k < SCALING_ROUNDS; k++)
+            for (int i = 0; i < nc; i++) {
+                if (!pool_of(cmd, counts[i])) {
+                    free(c.buf);
+                    return false;
+                }
+                r.ms[i][k] = calib_ms(row ? calib_memory : calib_compute, &c, runs);
+            }
+        scale_print("machine", row ? "memory" : "compute", &r, nc);
+        fflush(stdout);
+    }
+    free(c.buf);
+    return true;
+}
+
+/* The scaling table: first the machine's own rows (calib), then each method of the
+ * sweep at its defaults on each scene, `runs` frames on each of 1, 2 and the
+ * machine's cores threads in each round (a fresh state each): the median frame (init
+ * apart) and its speed-up on one thread; then a row "eye" per scene, the eye pass
+ * alone (its median within the first method's frames: the bins and the visible
+ * samples of every strip). The pool is the user's again afterwards. */
 static int scaling(const char *cmd, char **names, size_t nn, const uint32_t *sw, const uint32_t *sh,
                    uint32_t w, uint32_t h, const char *methods, int runs, const char *threads)
 {
     uint32_t counts[3] = {1, 2, om_cpus_online()};
     const int nc = counts[2] > 2 ? 3 : 2;
-    printf("\nscaling: median frame in ms (%d frames) on 1, 2%s threads; speed-up on 1\n", runs,
-           nc == 3 ? " and the machine's cores" : " (the machine's cores)");
+    printf("\nscaling: median frame in ms on 1, 2%s threads, %d rounds of %d frames; speed-up on 1 thread\n",
+           nc == 3 ? " and the machine's cores" : " (the machine's cores)", SCALING_ROUNDS, runs);
     printf("%-12s %-6s", "scene", "meth");
     for (int c = 0; c < nc; c++) {
         char head[16];
@@ -511,7 +625,7 @@ static int scaling(const char *cmd, char **names, size_t nn, const uint32_t *sw,
         printf(c ? " %10s %7s" : " %10s", head, "speedup");
     }
     printf("\n");
-    int rc = 0;
+    int rc = calib_rows(cmd, counts, nc, runs) ? 0 : 1;
     for (size_t si = 0; si < nn && !rc; si++) {
         om_diag d;
         memset(&d, 0, sizeof d);
@@ -522,44 +636,35 @@ static int scaling(const char *cmd, char **names, size_t nn, const uint32_t *sw,
         if (st == OM_OK && (st = cli_scene_view(&cs, sw[si] ? sw[si] : w, sw[si] ? sh[si] : h, &v, &d)) == OM_OK &&
             !(mask = malloc((size_t)v.cam.width * v.cam.height)))
             st = cli_oom(&d);
-        double eye[3] = {0.0, 0.0, 0.0};
-        uint32_t eye_jobs[3] = {0, 0, 0};
+        scale_row eye;
+        memset(&eye, 0, sizeof eye);
         bool have_eye = false;
         for (size_t k = 0; k < om_method_count() && st == OM_OK && !rc; k++) {
             const om_method *m = om_method_at(k);
             if ((cli_sweep(m) && !cli_sweep(m)[0]) || !in_list(methods, m->name)) continue;
             om_method_cfg cfg;
             om_method_cfg_default(&cfg, m);
-            printf("%-12s %-6s", cli_base_name(names[si]), m->name);
-            double one = 0.0;
-            for (int c = 0; c < nc && st == OM_OK; c++) {
-                char arg[16];
-                snprintf(arg, sizeof arg, "%u", counts[c]);
-                if (!cli_threads_start(cmd, arg)) { rc = 1; break; }
-                cli_point p;
-                memset(&p, 0, sizeof p);
-                st = cli_measure(m, &cfg, &cs, &v, runs, mask, NULL, &p, &d);
-                if (st != OM_OK) break;
-                if (!c) one = p.total;
-                if (!have_eye) {
-                    eye[c] = p.eye;
-                    eye_jobs[c] = p.threads;
+            scale_row r;
+            memset(&r, 0, sizeof r);
+            for (int round = 0; round < SCALING_ROUNDS && st == OM_OK && !rc; round++)
+                for (int c = 0; c < nc && st == OM_OK; c++) {
+                    if (!pool_of(cmd, counts[c])) { rc = 1; break; }
+                    cli_point p;
+                    memset(&p, 0, sizeof p);
+                    st = cli_measure(m, &cfg, &cs, &v, runs, mask, NULL, &p, &d);
+                    r.ms[c][round] = p.total;
+                    r.fewer[c] |= p.threads != counts[c];
+                    if (!have_eye) {
+                        eye.ms[c][round] = p.eye;
+                        eye.fewer[c] = r.fewer[c];
+                    }
                 }
-                printf(" %10.2f", p.total);
-                if (c) printf(" %6.2fx%c", p.total > 0.0 ? one / p.total : 0.0, p.threads == counts[c] ? ' ' : '*');
-                fflush(stdout);
-            }
-            printf("\n");
+            if (st != OM_OK || rc) break;
+            scale_print(cli_base_name(names[si]), m->name, &r, nc);
+            fflush(stdout);
             have_eye = true;
         }
-        if (have_eye && st == OM_OK && !rc) {
-            printf("%-12s %-6s", cli_base_name(names[si]), "eye");
-            for (int c = 0; c < nc; c++) {
-                printf(" %10.2f", eye[c]);
-                if (c) printf(" %6.2fx%c", eye[c] > 0.0 ? eye[0] / eye[c] : 0.0, eye_jobs[c] == counts[c] ? ' ' : '*');
-            }
-            printf("\n");
-        }
+        if (have_eye && st == OM_OK && !rc) scale_print(cli_base_name(names[si]), "eye", &eye, nc);
         if (st != OM_OK && !rc) rc = cli_error(names[si], &d, st);
         free(mask);
         cli_scene_free(&cs);
