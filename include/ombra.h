@@ -411,6 +411,14 @@ typedef uint64_t (*om_clock_fn)(void *user);
  * and whatever order the jobs run in. NULL runs every job inline, in order. */
 typedef void (*om_job_fn)(void *job_user, uint32_t i);
 typedef void (*om_parallel_for_fn)(void *host, om_job_fn fn, void *job_user, uint32_t n);
+/* Optional beside the parallel-for: worker(host), called from inside a job, returns the
+ * index in [0, threads) of the host's thread that runs it, the same index for the same
+ * thread throughout a frame, so that two jobs running at once never share one. With
+ * it, the jobs that need scratch of their own (izb's and hybrid's tiles of samples)
+ * are handed out one at a time to whichever thread is free, on that thread's scratch;
+ * without it, each thread's scratch takes a fixed share of them. The same frames
+ * either way. */
+typedef uint32_t (*om_worker_fn)(void *host);
 
 typedef struct om_frame_desc {
     const om_scene *scene;
@@ -429,6 +437,7 @@ typedef struct om_frame_desc {
     uint32_t threads;      /* jobs at once (0 or 1: inline); each needs its share of the
                               frame arena (om_frame_bytes_jobs), and a frame arena with
                               room for fewer runs that many */
+    om_worker_fn worker;   /* may be NULL (above) */
 } om_frame_desc;
 
 /* Bytes the frame arena needs for width x strip_rows (samples, terms and the eye

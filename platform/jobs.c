@@ -165,6 +165,18 @@ uint32_t om_jobs_threads(const om_jobs *j)
     return j ? j->nworkers + 1 : 1;
 }
 
+/* By the thread's place in `workers` (a frame's pool has a few): the array is written
+ * before om_jobs_start returns, and a worker runs jobs only after a call has come
+ * through the mutex. */
+uint32_t om_jobs_worker(void *host)
+{
+    const om_jobs *j = (const om_jobs *)host;
+    const pthread_t self = pthread_self();
+    for (uint32_t k = 0; j && k < j->nworkers; k++)
+        if (pthread_equal(j->workers[k], self)) return k + 1;
+    return 0;
+}
+
 void om_jobs_stop(om_jobs *j)
 {
     if (!j) return;

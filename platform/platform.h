@@ -52,6 +52,9 @@ om_status om_jobs_start(om_jobs **out, uint32_t threads, om_diag *d);
 void om_jobs_for(void *host, om_job_fn fn, void *user, uint32_t n);
 /* The threads a pool runs jobs on (1 for NULL), the caller's included. */
 uint32_t om_jobs_threads(const om_jobs *j);
+/* An om_worker_fn: the calling thread's index in the pool (0 for the caller's, which
+ * runs jobs too; 1.. for the workers). */
+uint32_t om_jobs_worker(void *host);
 void om_jobs_stop(om_jobs *j);
 /* The CPUs online (at least 1). */
 uint32_t om_cpus_online(void);

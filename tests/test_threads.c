@@ -18,6 +18,30 @@ static void backwards(void *host, om_job_fn fn, void *user, uint32_t n)
     for (uint32_t i = n; i-- > 0;) fn(user, i);
 }
 
+/* A worker index for `backwards`: each job another slot of 5 (its jobs run one at a
+ * time, so any index is one that no running job holds); host counts the calls. */
+static uint32_t rotating(void *host)
+{
+    return (*(uint32_t *)host)++ % 5;
+}
+
+/* The hosts the pass tests run on: the pools of 2, 3, 7 and 16 threads as they hand out
+ * jobs without and with the worker index, backwards, backwards with rotating slots,
+ * and one without room for the pass's slots (lean: the tiles inline). */
+typedef struct pass_host {
+    int pool;              /* index into the test's pools, -1 for backwards */
+    bool worker, lean;
+    const char *what;
+} pass_host;
+
+static const uint32_t pass_threads[] = {2, 3, 7, 16};
+static const pass_host pass_hosts[] = {
+    {0, false, false, ""}, {1, false, false, ""}, {2, false, false, ""}, {3, false, false, ""},
+    {-1, false, false, " backwards"}, {-1, false, true, " inline tiles"},
+    {0, true, false, " by worker"}, {3, true, false, " by worker"}, {-1, true, false, " backwards, rotating slots"},
+};
+#define PASS_HOSTS (sizeof pass_hosts / sizeof pass_hosts[0])
+
 typedef struct frame_out {
     uint64_t hash;             /* pixels, terms and samples, strip by strip */
     om_method_stats ms;
@@ -38,9 +62,9 @@ static om_status on_strip(void *user, const om_strip *st, const om_framebuffer *
 
 /* One frame of method m with a fresh state; frame arena of om_frame_bytes_scene (or
  * without bins, om_frame_bytes) plus job_bytes for the jobs. */
-static frame_out render_set(const om_scene *s, const om_method *m, const char *set, uint32_t W,
-                            uint32_t H, uint32_t rows, om_parallel_for_fn pf, void *host,
-                            uint32_t threads, size_t job_bytes, bool bins)
+static frame_out render_on(const om_scene *s, const om_method *m, const char *set, uint32_t W,
+                           uint32_t H, uint32_t rows, om_parallel_for_fn pf, void *host, om_worker_fn worker,
+                           uint32_t threads, size_t job_bytes, bool bins)
 {
     frame_out o;
     memset(&o, 0, sizeof o);
@@ -67,7 +91,7 @@ static frame_out render_set(const om_scene *s, const om_method *m, const char *s
         om_frame_desc fd;
         h_frame_desc(&fd, &shade, s, &v, m, state, &fb, rows);
         fd.on_strip = on_strip; fd.user = &o.hash;
-        fd.parallel_for = pf; fd.parallel_user = host; fd.threads = threads;
+        fd.parallel_for = pf; fd.parallel_user = host; fd.threads = threads; fd.worker = worker;
         o.hash = OM_HASH_INIT;
         om_frame_stats fs;
         o.st = om_render_frame(&fd, &fa, &fs, &d);
@@ -79,6 +103,14 @@ static frame_out render_set(const om_scene *s, const om_method *m, const char *s
     free(fm);
     free(px);
     return o;
+}
+
+/* The same without the host's worker index. */
+static frame_out render_set(const om_scene *s, const om_method *m, const char *set, uint32_t W,
+                            uint32_t H, uint32_t rows, om_parallel_for_fn pf, void *host,
+                            uint32_t threads, size_t job_bytes, bool bins)
+{
+    return render_on(s, m, set, W, H, rows, pf, host, NULL, threads, job_bytes, bins);
 }
 
 /* The same with the settings "map=512". */
@@ -409,42 +441,46 @@ static void asm_jobs_tree(void)
  * of jobs and their order, whole frames and strips, one tile of uncertain samples a
  * strip or tiles of a few (izb.pool); a frame arena without room for two tiles runs
  * inline (the bands unused), the same again. */
-static frame_out hybrid_frame(const om_scene *s, uint32_t pool, uint32_t rows, om_parallel_for_fn pf,
-                              void *host, uint32_t threads, bool lean)
+/* A pass frame (izb, hybrid) on pass host h (the pools started for pass_threads). */
+static frame_out pass_frame(const om_scene *s, const om_method *m, const char *set, uint32_t rows,
+                            const pass_host *h, om_jobs *const *pools, uint32_t *calls)
 {
-    const om_method *m = om_method_find("hybrid");
-    char set[32];
-    snprintf(set, sizeof set, "izb.pool=%u", pool);
-    return render_set(s, m, set, 160, 120, rows, pf, host, threads, om_frame_bytes_jobs(m, lean ? NULL : s, threads),
-                      true);
+    const uint32_t n = h->pool >= 0 ? pass_threads[h->pool] : 5;
+    return render_on(s, m, set, 160, 120, rows, h->pool >= 0 ? om_jobs_for : backwards,
+                     h->pool >= 0 ? (void *)pools[h->pool] : (void *)calls,
+                     !h->worker ? NULL : h->pool >= 0 ? om_jobs_worker : rotating, n,
+                     om_frame_bytes_jobs(m, h->lean ? NULL : s, n), true);
 }
 
 static void hybrid_bands(void)
 {
-    static const uint32_t threads[] = {2, 3, 7, 16};
     om_jobs *pools[4];
-    for (int k = 0; k < 4; k++) CHECK_OK(om_jobs_start(&pools[k], threads[k], NULL));
+    uint32_t calls = 0;
+    const om_method *m = om_method_find("hybrid");
+    for (int k = 0; k < 4; k++) CHECK_OK(om_jobs_start(&pools[k], pass_threads[k], NULL));
     for (int li = 0; li < 2; li++) {
         h_scene hs;
         if (!h_scene_parse(&hs, li ? directional : om_scene_default_text())) continue;
         for (int pi = 0; pi < 2; pi++)
             for (uint32_t rows = 0; rows <= 24; rows += 24) {
                 uint32_t pool = pi ? 97 : 0;
-                frame_out one = hybrid_frame(&hs.s, pool, rows, NULL, NULL, 1, false);
+                char set[32];
+                snprintf(set, sizeof set, "izb.pool=%u", pool);
+                frame_out one = render_set(&hs.s, m, set, 160, 120, rows, NULL, NULL, 1, 0, true);
                 CHECK_MSG(one.st == OM_OK && one.jobs == 1, "hybrid: inline frame");
                 /* a pool of 97 leaves several tiles a strip; the counters say how many */
                 CHECK_MSG(one.ms.counters[2] > 0 && (pool == 0 || one.ms.counters[5] > one.ms.counters[2] / 97),
                           "hybrid: %u uncertain in %u tiles", one.ms.counters[2], one.ms.counters[5]);
                 size_t last_peak = 0;
-                for (int k = 0; k < 6; k++) {
-                    uint32_t n = k < 4 ? threads[k] : 5;
-                    bool lean = k == 5;   /* room for the bands' slots only: inline */
-                    frame_out o = hybrid_frame(&hs.s, pool, rows, k < 4 ? om_jobs_for : backwards, k < 4 ? pools[k] : NULL,
-                                               n, lean);
+                for (size_t k = 0; k < PASS_HOSTS; k++) {
+                    const pass_host *h = &pass_hosts[k];
+                    const uint32_t n = h->pool >= 0 ? pass_threads[h->pool] : 5;
+                    const bool lean = h->lean;   /* room for the bands' slots only: inline */
+                    frame_out o = pass_frame(&hs.s, m, set, rows, h, pools, &calls);
                     CHECK_MSG(o.st == OM_OK && o.jobs == n, "hybrid: %u jobs ran %u", n, o.jobs);
                     CHECK_MSG(o.hash == one.hash && !memcmp(o.ms.counters, one.ms.counters, sizeof o.ms.counters),
                               "hybrid light %d pool %u strips %u: %u threads%s change the frame", li, pool, rows,
-                              n, k < 4 ? "" : lean ? " inline tiles" : " backwards");
+                              n, h->what);
                     /* the tiles of two jobs at least (two keys of 20 bytes a sample); the
                      * lean frame (5 jobs, as the one before it) without them */
                     size_t tile = pool ? pool : 160 * 120;   /* below hybrid's most, 32768 */
@@ -456,6 +492,7 @@ static void hybrid_bands(void)
             }
         h_scene_free(&hs);
     }
+    CHECK_MSG(calls > 0, "hybrid: the pass never asked the host which thread runs a job");
     for (int k = 0; k < 4; k++) om_jobs_stop(pools[k]);
 }
 
@@ -465,10 +502,10 @@ static void hybrid_bands(void)
  * without room for two pools runs the tiles inline, the same again. */
 static void izb_pass(void)
 {
-    static const uint32_t threads[] = {2, 3, 7, 16};
     om_jobs *pools[4];
+    uint32_t calls = 0;
     const om_method *m = om_method_find("izb");
-    for (int k = 0; k < 4; k++) CHECK_OK(om_jobs_start(&pools[k], threads[k], NULL));
+    for (int k = 0; k < 4; k++) CHECK_OK(om_jobs_start(&pools[k], pass_threads[k], NULL));
     for (int li = 0; li < 2; li++) {
         h_scene hs;
         if (!h_scene_parse(&hs, li ? directional : om_scene_default_text())) continue;
@@ -483,16 +520,15 @@ static void izb_pass(void)
                 /* a pool of 397 leaves many tiles a strip */
                 CHECK_MSG(pi != 1 || one.ms.counters[5] > 3 * (rows ? 120 / rows : 1), "izb pool %u: %u tiles",
                           pool_of[pi], one.ms.counters[5]);
-                for (int k = 0; k < 6; k++) {
-                    uint32_t n = k < 4 ? threads[k] : 5;
-                    bool lean = k == 5;   /* room for the bands' slots only: the tiles inline */
-                    frame_out o = render_set(&hs.s, m, set, 160, 120, rows, k < 4 ? om_jobs_for : backwards,
-                                             k < 4 ? pools[k] : NULL, n, om_frame_bytes_jobs(m, lean ? NULL : &hs.s, n),
-                                             true);
+                for (size_t k = 0; k < PASS_HOSTS; k++) {
+                    const pass_host *h = &pass_hosts[k];
+                    const uint32_t n = h->pool >= 0 ? pass_threads[h->pool] : 5;
+                    const bool lean = h->lean;   /* room for the bands' slots only: the tiles inline */
+                    frame_out o = pass_frame(&hs.s, m, set, rows, h, pools, &calls);
                     CHECK_MSG(o.st == OM_OK && o.jobs == n, "izb: %u jobs ran %u", n, o.jobs);
                     CHECK_MSG(o.hash == one.hash && !memcmp(o.ms.counters, one.ms.counters, sizeof o.ms.counters),
                               "izb light %d pool %u strips %u: %u threads%s change the frame", li, pool_of[pi],
-                              rows, n, k < 4 ? "" : lean ? " inline tiles" : " backwards");
+                              rows, n, h->what);
                     /* the pools of two jobs at least (keys of 24 bytes, two buffers); the
                      * lean frame (5 jobs, as the one before it) without them */
                     size_t pool = pool_of[pi] ? pool_of[pi] : 160 * 120;
@@ -504,6 +540,7 @@ static void izb_pass(void)
             }
         h_scene_free(&hs);
     }
+    CHECK_MSG(calls > 0, "izb: the pass never asked the host which thread runs a job");
     for (int k = 0; k < 4; k++) om_jobs_stop(pools[k]);
 }
 

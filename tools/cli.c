@@ -349,4 +349,5 @@ void cli_frame_jobs(om_frame_desc *fd)
     fd->parallel_for = pool ? om_jobs_for : NULL;
     fd->parallel_user = pool;
     fd->threads = om_jobs_threads(pool);
+    fd->worker = pool ? om_jobs_worker : NULL;
 }

@@ -131,7 +131,7 @@ static void grow_light_box(const om_view *v, const om_strip *st, om_vec3 *lo, om
 /* The bands of the strip: band b is job b of the host's parallel-for, with slot b and
  * rows of its own. */
 typedef enum { STAGE_PREPARE, STAGE_RESOLVE, STAGE_SHADE, STAGE_BUILD, STAGE_PASS, STAGE_PASS_SETUP, STAGE_LEND,
-               STAGE_BIN_VERTS, STAGE_BIN_ROWS, STAGE_EYE_HALF, STAGE_EYE_MERGE } stage;
+               STAGE_BIN_VERTS, STAGE_BIN_ROWS, STAGE_EYE_HALF, STAGE_EYE_MERGE, STAGE_PASS_ANY } stage;
 
 typedef struct frame_ctx {
     const om_frame_desc *fd;
@@ -230,6 +230,15 @@ static void band_job(void *user, uint32_t b)
         for (uint32_t k = b; k < c->pass_jobs; k += c->pass_slots_now)
             if (c->stage == STAGE_PASS) c->pass->job(fd->method_state, &c->strip, k, sl->scratch, sl->counts);
             else c->lend_fn(c->lend_user, k, sl->scratch);   /* a method's own stage (om__lend) */
+        return;
+    }
+    if (c->stage == STAGE_PASS_ANY) {   /* pass job b, on the slot of the thread that runs it */
+        job_slot *sl = &c->pass_slots[fd->worker(fd->parallel_user) % c->pass_max];   /* in bounds whatever the host says */
+        if (sl->dirty) {
+            memset(sl->scratch, 0, sl->dirty);
+            sl->dirty = 0;
+        }
+        c->pass->job(fd->method_state, &c->strip, b, sl->scratch, sl->counts);
         return;
     }
     if (c->stage == STAGE_PASS_SETUP) {   /* part b of BANDS_PER_JOB * jobs */
@@ -398,17 +407,25 @@ static void build_map(frame_ctx *c)
 }
 
 /* The method's pass over the current strip (om__pass): plan, the jobs on their slots,
- * then their counts added up in slot order. */
+ * then their counts added up in slot order. Where the host says which thread runs a
+ * job (om_frame_desc.worker) and every thread has a slot, each job is one of the
+ * host's, on its thread's slot: the host hands them out as threads come free, so a
+ * thread that the system slows or a heavy tile holds up no fixed share (on this
+ * project's 2-CPU machine the same thread runs up to a third slower than the other
+ * for a while). Otherwise slot p runs jobs p, p + P, ... */
 static void run_pass(frame_ctx *c)
 {
     void *state = c->fd->method_state;
     uint32_t k = c->pass->plan(state, &c->strip);
     if (k == 0) return;
+    const bool any = c->fd->worker && c->pass_max >= c->fd->threads;
     uint32_t p = k < c->pass_max ? k : c->pass_max;
     c->pass_jobs = k;
     c->pass_slots_now = p;
+    if (any) p = c->pass_max;   /* any slot may be used */
     for (uint32_t j = 0; j < p; j++) memset(c->pass_slots[j].counts, 0, sizeof c->pass_slots[j].counts);
-    run_stage(c, STAGE_PASS, p);
+    if (any) run_stage(c, STAGE_PASS_ANY, k);
+    else run_stage(c, STAGE_PASS, p);
     uint32_t sum[8] = {0};
     for (uint32_t j = 0; j < p; j++)
         for (int i = 0; i < 8; i++) sum[i] += c->pass_slots[j].counts[i];

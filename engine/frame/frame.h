@@ -140,7 +140,9 @@ const om__bands *om__method_bands(const om_method *m);
  *   the state and the strip's terms) and returns K; then job(state, strip, k, scratch,
  *   counts) runs for every k in [0, K) on P = min(K, slots) slots, slot p running
  *   k = p, p + P, ... one after another with its own scratch, in parallel with the
- *   other slots; then merge gets the counts added up over the jobs (integer sums: the
+ *   other slots (or, where the host gives om_frame_desc.worker and every thread has a
+ *   slot, each k as a job of its own on the slot of the thread that runs it); then
+ *   merge gets the counts added up over the jobs (integer sums: the
  *   same whatever P and the order). A job reads the state, writes only its own
  *   samples' terms, its scratch and counts; its terms and counts must not depend on
  *   which slot ran it or on what the scratch held before (the frame zeroes it once a
