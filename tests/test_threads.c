@@ -435,23 +435,29 @@ static void asm_jobs_tree(void)
     h_scene_free(&hs);
 }
 
-/* ---- hybrid: its bands look the map up and mark the samples they leave uncertain;
- * its pass (om__pass) then runs the tiles of those as jobs, each with a tile's memory
- * of its own from the frame arena. The same terms, pixels and counters for any number
- * of jobs and their order, whole frames and strips, one tile of uncertain samples a
- * strip or tiles of a few (izb.pool); a frame arena without room for two tiles runs
- * inline (the bands unused), the same again. */
+/* The threads pass host h runs its frames on. */
+static uint32_t host_threads(const pass_host *h)
+{
+    return h->pool >= 0 ? pass_threads[h->pool] : 5;
+}
+
 /* A pass frame (izb, hybrid) on pass host h (the pools started for pass_threads). */
 static frame_out pass_frame(const om_scene *s, const om_method *m, const char *set, uint32_t rows,
                             const pass_host *h, om_jobs *const *pools, uint32_t *calls)
 {
-    const uint32_t n = h->pool >= 0 ? pass_threads[h->pool] : 5;
+    const uint32_t n = host_threads(h);
     return render_on(s, m, set, 160, 120, rows, h->pool >= 0 ? om_jobs_for : backwards,
                      h->pool >= 0 ? (void *)pools[h->pool] : (void *)calls,
                      !h->worker ? NULL : h->pool >= 0 ? om_jobs_worker : rotating, n,
                      om_frame_bytes_jobs(m, h->lean ? NULL : s, n), true);
 }
 
+/* ---- hybrid: its bands look the map up and mark the samples they leave uncertain;
+ * its pass (om__pass) then runs the tiles of those as jobs, each with a tile's memory
+ * of its own from the frame arena. The same terms, pixels and counters for any number
+ * of jobs and their order, whole frames and strips, one tile of uncertain samples a
+ * strip or tiles of a few (izb.pool); a frame arena without room for two tiles runs
+ * inline (the bands unused), the same again. */
 static void hybrid_bands(void)
 {
     om_jobs *pools[4];
@@ -474,7 +480,7 @@ static void hybrid_bands(void)
                 size_t last_peak = 0;
                 for (size_t k = 0; k < PASS_HOSTS; k++) {
                     const pass_host *h = &pass_hosts[k];
-                    const uint32_t n = h->pool >= 0 ? pass_threads[h->pool] : 5;
+                    const uint32_t n = host_threads(h);
                     const bool lean = h->lean;   /* room for the bands' slots only: inline */
                     frame_out o = pass_frame(&hs.s, m, set, rows, h, pools, &calls);
                     CHECK_MSG(o.st == OM_OK && o.jobs == n, "hybrid: %u jobs ran %u", n, o.jobs);
@@ -522,7 +528,7 @@ static void izb_pass(void)
                           pool_of[pi], one.ms.counters[5]);
                 for (size_t k = 0; k < PASS_HOSTS; k++) {
                     const pass_host *h = &pass_hosts[k];
-                    const uint32_t n = h->pool >= 0 ? pass_threads[h->pool] : 5;
+                    const uint32_t n = host_threads(h);
                     const bool lean = h->lean;   /* room for the bands' slots only: the tiles inline */
                     frame_out o = pass_frame(&hs.s, m, set, rows, h, pools, &calls);
                     CHECK_MSG(o.st == OM_OK && o.jobs == n, "izb: %u jobs ran %u", n, o.jobs);

@@ -217,28 +217,32 @@ static uint32_t stage_bands(const frame_ctx *c, stage sg)
     return (c->strip.rows + stage_rows(c, sg) - 1) / stage_rows(c, sg);
 }
 
+/* A pass slot's scratch, zeroed by the slot's first job (on its thread, not all on the
+ * caller's: for izb it is megabytes a thread). */
+static void *slot_scratch(job_slot *sl)
+{
+    if (sl->dirty) {
+        memset(sl->scratch, 0, sl->dirty);
+        sl->dirty = 0;
+    }
+    return sl->scratch;
+}
+
 static void band_job(void *user, uint32_t b)
 {
     const frame_ctx *c = (const frame_ctx *)user;
     const om_frame_desc *fd = c->fd;
     if (c->stage == STAGE_PASS || c->stage == STAGE_LEND) {   /* slot b: jobs b, b + P, ... (om__pass) */
         job_slot *sl = &c->pass_slots[b];
-        if (sl->dirty) {   /* zeroed here, on the slot's thread, not all on the caller's */
-            memset(sl->scratch, 0, sl->dirty);
-            sl->dirty = 0;
-        }
+        void *scratch = slot_scratch(sl);
         for (uint32_t k = b; k < c->pass_jobs; k += c->pass_slots_now)
-            if (c->stage == STAGE_PASS) c->pass->job(fd->method_state, &c->strip, k, sl->scratch, sl->counts);
-            else c->lend_fn(c->lend_user, k, sl->scratch);   /* a method's own stage (om__lend) */
+            if (c->stage == STAGE_PASS) c->pass->job(fd->method_state, &c->strip, k, scratch, sl->counts);
+            else c->lend_fn(c->lend_user, k, scratch);   /* a method's own stage (om__lend) */
         return;
     }
     if (c->stage == STAGE_PASS_ANY) {   /* pass job b, on the slot of the thread that runs it */
         job_slot *sl = &c->pass_slots[fd->worker(fd->parallel_user) % c->pass_max];   /* in bounds whatever the host says */
-        if (sl->dirty) {
-            memset(sl->scratch, 0, sl->dirty);
-            sl->dirty = 0;
-        }
-        c->pass->job(fd->method_state, &c->strip, b, sl->scratch, sl->counts);
+        c->pass->job(fd->method_state, &c->strip, b, slot_scratch(sl), sl->counts);
         return;
     }
     if (c->stage == STAGE_PASS_SETUP) {   /* part b of BANDS_PER_JOB * jobs */
@@ -419,15 +423,14 @@ static void run_pass(frame_ctx *c)
     uint32_t k = c->pass->plan(state, &c->strip);
     if (k == 0) return;
     const bool any = c->fd->worker && c->pass_max >= c->fd->threads;
-    uint32_t p = k < c->pass_max ? k : c->pass_max;
+    const uint32_t p = k < c->pass_max ? k : c->pass_max, used = any ? c->pass_max : p;
     c->pass_jobs = k;
     c->pass_slots_now = p;
-    if (any) p = c->pass_max;   /* any slot may be used */
-    for (uint32_t j = 0; j < p; j++) memset(c->pass_slots[j].counts, 0, sizeof c->pass_slots[j].counts);
+    for (uint32_t j = 0; j < used; j++) memset(c->pass_slots[j].counts, 0, sizeof c->pass_slots[j].counts);
     if (any) run_stage(c, STAGE_PASS_ANY, k);
     else run_stage(c, STAGE_PASS, p);
     uint32_t sum[8] = {0};
-    for (uint32_t j = 0; j < p; j++)
+    for (uint32_t j = 0; j < used; j++)
         for (int i = 0; i < 8; i++) sum[i] += c->pass_slots[j].counts[i];
     c->pass->merge(state, sum);
 }
