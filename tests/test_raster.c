@@ -525,7 +525,8 @@ static void grid_matches_point_tests(void)
  * of the triangles covering its centre, by the point-in-triangle test and the plane
  * (as near the exact plane as raster.h promises), and the id of the first triangle drawn at
  * that depth: random layered triangles whose depths span [0, 2^32), and flat ones at
- * the ends of the range and around 2^31, where a wrap or a sign would show. */
+ * the ends of the range and around 2^31, where a wrap or a sign would show. Drawn last
+ * to first, the same pixels: a tie goes to the lower id in any order. */
 static void fill_matches_point_tests(void)
 {
     enum { W = 61, H = 37, NT = 30 };
@@ -535,7 +536,8 @@ static void fill_matches_point_tests(void)
     static uint32_t vz[NT][3];
     static const uint32_t flat[] = {2147483647u, 2147483648u, 4294967294u, 4294967295u, 0u, 1u};
     rng_state = 31;
-    int bad = 0, covered = 0, inexact = 0;
+    int bad = 0, covered = 0, inexact = 0, reordered = 0;
+    static uint32_t kept_depth[W * H], kept_id[W * H];
     for (int round = 0; round < 30; round++) {
         om_target t = target(W, H);
         om_raster r = {&t, OM_RASTER_DEPTH_ID, NULL, NULL, NULL, NULL, 0, false, NULL, NULL, NULL, NULL, 0, 0, NULL, 0};
@@ -571,9 +573,15 @@ static void fill_matches_point_tests(void)
                 covered += id != OM_NO_TRI;
                 bad += depth_buf[j * W + i] != d || id_buf[j * W + i] != id;
             }
+        memcpy(kept_depth, depth_buf, sizeof kept_depth);
+        memcpy(kept_id, id_buf, sizeof kept_id);
+        om__target_clear(&t);
+        for (int k = nt; k-- > 0;) om__raster_snapped(&r, vx[k], vy[k], vz[k], ids[k]);
+        reordered += memcmp(kept_depth, depth_buf, sizeof kept_depth) != 0 || memcmp(kept_id, id_buf, sizeof kept_id) != 0;
     }
     CHECK_EQ_U(bad, 0);
     CHECK_EQ_U(inexact, 0);
+    CHECK_EQ_U(reordered, 0);
     CHECK(covered > 30 * W * H / 2);
 }
 

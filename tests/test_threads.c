@@ -189,11 +189,20 @@ static void fewer_jobs(void)
     h_scene_free(&hs);
 }
 
+/* A worker index for `backwards` that names the thread *host says. */
+static uint32_t named(void *host)
+{
+    return *(const uint32_t *)host;
+}
+
 /* One strip on two jobs and a scene of more than one vertex for every 8 pixels: the
- * eye pass rasterizes by halves of the triangles (frame.c). Two planes that coincide,
- * one in each half: where they tie the first one's colour wins, as in one walk of
- * every triangle; and no bins are carved (the frame arena's peak is the same with
- * room for them and without). Three jobs (with the bins) give the same frame. */
+ * eye pass rasterizes by parts of the triangles (frame.c), the halves, or with the
+ * host's worker index many parts, each into its thread's target. Two planes that
+ * coincide, one in each half: where they tie the first one's colour wins, as in one
+ * walk of every triangle, whichever target holds which part and in whatever order
+ * they are drawn (every part in one target, drawn last to first, leaves the tie to the
+ * depth test); and no bins are carved (the frame arena's peak is the same with room
+ * for them and without). Three jobs (with the bins) give the same frame. */
 static void eye_halves(void)
 {
     static const char two_planes[] =
@@ -212,6 +221,16 @@ static void eye_halves(void)
     CHECK(two.jobs == 2 && lean.jobs == 2 && three.jobs == 3);
     CHECK(two.hash == one.hash && lean.hash == one.hash && three.hash == one.hash);
     CHECK_EQ_U(two.peak, lean.peak);
+    uint32_t calls = 0, first = 0, second = 1;
+    om_jobs *pool = NULL;
+    CHECK_OK(om_jobs_start(&pool, 2, NULL));
+    const frame_out spread = render_on(&hs.s, m, "map=512", 8, 6, 0, backwards, &calls, rotating, 2, two_b, true);
+    const frame_out in0 = render_on(&hs.s, m, "map=512", 8, 6, 0, backwards, &first, named, 2, two_b, true);
+    const frame_out in1 = render_on(&hs.s, m, "map=512", 8, 6, 0, backwards, &second, named, 2, two_b, true);
+    const frame_out pooled = render_on(&hs.s, m, "map=512", 8, 6, 0, om_jobs_for, pool, om_jobs_worker, 2, two_b, true);
+    CHECK(spread.jobs == 2 && in0.jobs == 2 && in1.jobs == 2 && pooled.jobs == 2);
+    CHECK(spread.hash == one.hash && in0.hash == one.hash && in1.hash == one.hash && pooled.hash == one.hash);
+    om_jobs_stop(pool);
     h_scene_free(&hs);
 }
 

@@ -21,12 +21,14 @@
  * The bands' eye pass needs bins (each band sets up only the triangles that reach its
  * rows, from vertices projected once), and on a scene of many small triangles making
  * them costs a fifth of the pass (issue 26: random 100K). A frame of one strip on two
- * jobs splits the eye pass's rasterization by triangles instead: each job walks half
- * of them over the whole image, as one thread would walk all, the second half into a
- * depth and id target of its own (in the strip's samples, which the pass writes only
+ * jobs splits the eye pass's rasterization by triangles instead: each job walks part
+ * of them over the whole image, as one thread would walk all, into one of two depth
+ * and id targets (the second in the strip's samples, which the pass writes only
  * later); the bands then merge the two by depth (om__scene_raster_part says why that
- * is one walk's answer) and resolve their samples. More jobs would each need such a
- * target and a merge; they take the bins. */
+ * is one walk's answer) and resolve their samples. Where the host names the thread
+ * that runs a job, the parts are many and each goes to its thread's target, so a
+ * thread that runs slower takes fewer; else they are the halves. More jobs would each
+ * need such a target and a merge; they take the bins. */
 #include "frame.h"
 
 /* Bands per thread: a strip (or a map) is cut into at most this many bands a thread,
@@ -158,7 +160,9 @@ typedef struct frame_ctx {
     void *ids;                 /* the image's triangle ids from its first pass, or NULL */
     bool ids16;                /* as uint16_t (OM_NO_TRI as 0xFFFF): under 65535 triangles */
     bool ids_have;             /* the first pass is over: later passes resolve from ids */
-    uint32_t *half_depth, *half_id;   /* one strip, two jobs: the second half's target, or NULL */
+    uint32_t *half_depth, *half_id;   /* one strip, two jobs: the second target, or NULL */
+    uint32_t eye_parts;        /* STAGE_EYE_HALF: the parts of the triangles (2: the halves) */
+    bool part_drawn[2];        /* and whether each target is cleared and drawn into */
 } frame_ctx;
 
 static size_t ids_bytes(const om_scene *s, uint32_t width, uint32_t height)
@@ -259,14 +263,22 @@ static void band_job(void *user, uint32_t b)
         else om__bins_make_rows(fd->scene, c->mk_vp, c->mk_w, c->mk_h, c->mk, a, e);
         return;
     }
-    if (c->stage == STAGE_EYE_HALF) {   /* half b of the triangles, over the whole strip */
-        const uint32_t n = fd->scene->ntris;
+    if (c->stage == STAGE_EYE_HALF) {   /* part b of the triangles, over the whole strip */
+        const uint32_t n = fd->scene->ntris, k = c->eye_parts;
+        /* the halves: half b into target b; else its thread's target, cleared by
+         * the first part the thread runs (only that thread touches it) */
+        const uint32_t w = k == 2 ? b : fd->worker(fd->parallel_user) % 2;
         om_target tg = c->tg;
-        if (b == 1) {
+        if (w == 1) {
             tg.depth = c->half_depth;
             tg.id = c->half_id;
         }
-        om__eye_raster_part(fd->scene, c->view, &tg, b == 0 ? 0 : n / 2, b == 0 ? n / 2 : n);
+        if (!c->part_drawn[w]) {
+            om__target_clear(&tg);
+            ((frame_ctx *)user)->part_drawn[w] = true;
+        }
+        om__eye_raster_part(fd->scene, c->view, &tg, (uint32_t)((uint64_t)n * b / k),
+                            (uint32_t)((uint64_t)n * (b + 1) / k));
         return;
     }
     if (c->stage == STAGE_BUILD || c->stage == STAGE_PREPARE)   /* see order_bands */
@@ -284,12 +296,18 @@ static void band_job(void *user, uint32_t b)
     st.rows = c->strip.rows - r0 < band ? c->strip.rows - r0 : band;
     st.samples += off;
     st.terms += off;
-    if (c->stage == STAGE_EYE_MERGE) {   /* the second half's nearer pixels; a tie keeps the first's */
+    if (c->stage == STAGE_EYE_MERGE) {   /* the second target's nearer pixels; a tie to the lower triangle */
         const size_t n = (size_t)st.rows * st.width;
         uint32_t *depth = c->tg.depth + off, *id = c->tg.id + off;
         const uint32_t *hd = c->half_depth + off, *hi = c->half_id + off;
+        if (!c->part_drawn[1]) return;   /* every part in the first */
+        if (!c->part_drawn[0]) {         /* every part in the second */
+            memcpy(depth, hd, n * sizeof *depth);
+            memcpy(id, hi, n * sizeof *id);
+            return;
+        }
         for (size_t i = 0; i < n; i++)
-            if (hd[i] < depth[i]) {
+            if (hd[i] < depth[i] || (hd[i] == depth[i] && hi[i] < id[i])) {
                 depth[i] = hd[i];
                 id[i] = hi[i];
             }
@@ -322,6 +340,10 @@ static void band_job(void *user, uint32_t b)
  * CPU time by halves; the default scene, 12K vertices, and random 10K, 30K, take
  * less with the bins). */
 #define HALVES_PIXELS 8
+/* Parts of the triangles where the host names the thread: as many as the fine bands
+ * of two jobs, so that the slower thread waits for at most a small part at the end
+ * (random 100K at 1024x768: the halves' jobs took 5.9 and 4.2 ms in one frame). */
+#define EYE_PARTS (2 * FINE_BANDS_PER_JOB)
 
 /* At most this many triangles' rows are read to weigh the bands (order_bands). */
 #define ORDER_SAMPLES 1024
@@ -485,7 +507,8 @@ static void prepare(frame_ctx *c, bool eye, bool mark, om_frame_stats *fs)
         c->eye = eye;
         c->mark = mark;
         if (eye && c->half_depth) {
-            run_stage(c, STAGE_EYE_HALF, 2);
+            c->part_drawn[0] = c->part_drawn[1] = false;
+            run_stage(c, STAGE_EYE_HALF, c->eye_parts);
             run_bands(c, STAGE_EYE_MERGE);
         }
         order_bands(c, rasters(c, STAGE_PREPARE) && c->bins ? c->bins->rows : NULL, c->strip.y0,
@@ -622,6 +645,7 @@ om_status om_render_frame(const om_frame_desc *fd, om_arena *fa, om_frame_stats 
          * which the eye pass writes once the halves are merged */
         c.half_depth = (uint32_t *)ps;
         c.half_id = c.half_depth + n;
+        c.eye_parts = fd->worker && fd->threads == 2 ? EYE_PARTS : 2;
     } else if (single && OM_WITH_JOBS && c.jobs > 1) {
         eye_bins = carve_bins(fa, s, &bins);
     }

@@ -54,8 +54,9 @@ void om__eye_pass_mark(const om_scene *s, const om_view *v, const om_target *tg,
  * exposure marks too) from the triangle ids already in tg->id (tg->depth unread), as
  * om__eye_pass(_mark) gives them after rasterizing. */
 void om__eye_resolve(const om_scene *s, const om_view *v, const om_target *tg, om_strip *st, bool mark);
-/* The eye pass's rasterization alone, of the scene's triangles [t0, t1) into tg
- * (om__scene_raster_part: the parts merged by depth, then om__eye_resolve). */
+/* The eye pass's rasterization alone, of the scene's triangles [t0, t1) into tg,
+ * cleared before (om__scene_raster_part: the parts merged by depth, then
+ * om__eye_resolve). */
 void om__eye_raster_part(const om_scene *s, const om_view *v, const om_target *tg, uint32_t t0, uint32_t t1);
 
 /* Direction from a point towards the light (unit). */

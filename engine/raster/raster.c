@@ -283,7 +283,11 @@ static bool row_span(const int64_t E[3], const int64_t step[3], int64_t w, int64
 }
 
 /* The depth test along row y from texel x0 to x1, writing id too when `id_row` is
- * given (that row of the id buffer). */
+ * given (that row of the id buffer). With ids, a tie goes to the lower triangle: what
+ * one walk of the triangles in order gives (the first drawn stays), and so what a
+ * walk of any of them in any order gives, a pixel's depth being its triangle's alone
+ * (om__scene_raster_part). Not at the cleared depth, 2^32 - 1, which no triangle
+ * takes from the clear: so no drawn pixel has it. */
 static void depth_row(const om__rtri *t, const om_target *tg, int32_t y, int32_t x0, int32_t x1,
                       uint32_t *id_row, uint32_t id)
 {
@@ -294,7 +298,7 @@ static void depth_row(const om__rtri *t, const om_target *tg, int32_t y, int32_t
     uint32_t *dep = tg->depth + (size_t)(y - (int32_t)tg->y0) * tg->width;
     for (int32_t x = x0; x <= x1; x++, z += step) {
         const uint32_t d = (uint32_t)(z >> 32);
-        if (d < dep[x]) {
+        if (d < dep[x] || (id_row && d == dep[x] && id < id_row[x] && d != 0xFFFFFFFFu)) {
             dep[x] = d;
             if (id_row) id_row[x] = id;
         }

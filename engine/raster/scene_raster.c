@@ -516,7 +516,6 @@ void om__scene_raster_part(const om_scene *s, const om_mat4 *vp, const om_target
 {
     om_raster r;
     raster_plain(&r, tg, mode);
-    om__target_clear(tg);
     walk_batches(s, vp, &r, NULL, cull, NULL, t0 < s->ntris ? t0 : s->ntris, t1 < s->ntris ? t1 : s->ntris);
 }
 

@@ -77,12 +77,12 @@ void om__bins_make_rows(const om_scene *s, const om_mat4 *vp, uint32_t width, ui
  * setup; NULL walks every triangle. The same pixels either way. */
 void om__scene_raster(const om_scene *s, const om_mat4 *vp, const om_target *tg,
                       om_raster_mode mode, bool cull, const om__bins *bins);
-/* om__scene_raster without bins of the triangles [t0, t1) alone: one part of a pass
- * split by triangles, each part into a target of its own, cleared here. The parts
- * merged pixel by pixel (the nearer depth; on a tie the part of the lower triangles)
- * hold what one walk of every triangle gives: the depth test is strict, so among equal
- * depths the first triangle drawn wins, and a pixel's depth depends on its triangle
- * alone. */
+/* om__scene_raster without bins of the triangles [t0, t1) alone, into a target the
+ * caller has cleared: one part of a pass split by triangles. With ids, the parts drawn
+ * into any targets in any order, and the targets merged pixel by pixel (the nearer
+ * depth; on a tie the lower triangle), hold what one walk of every triangle gives: a
+ * pixel's depth depends on its triangle alone, and the depth test gives a tie to the
+ * lower triangle, which is the one a walk in order draws first. */
 void om__scene_raster_part(const om_scene *s, const om_mat4 *vp, const om_target *tg, om_raster_mode mode,
                            bool cull, uint32_t t0, uint32_t t1);
 /* The same with a coarse depth of tg's image (om__hiz_words; NULL: none), cleared
