@@ -6,6 +6,12 @@
 
 bool h_scene_parse(h_scene *hs, const char *text) { return h_scene_parse_ld(hs, text, NULL); }
 
+const char h_cloud_bar[] = "camera eye 0 6 14 target 0 1 0 fov 50 near 0.1 far 100\n"
+                           "light spot pos 8 20 6 target 0 0 0 fov 60 near 5 far 60\n"
+                           "plane size 14 14 albedo 0.7 0.7 0.7\n"
+                           "box size 0.3 0.05 14 rotate 0 45 0 translate 0 3.8 0\n"
+                           "triangles count 2000 seed 7 area 20 in -5 0.5 -5 5 3 5\n";
+
 bool h_scene_parse_ld(h_scene *hs, const char *text, const om_loader *ld)
 {
     om_diag d;

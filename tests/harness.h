@@ -13,6 +13,10 @@ typedef struct h_scene {
 
 /* Parses `text`; fails the current test (and returns false) on error. */
 bool h_scene_parse(h_scene *hs, const char *text);
+/* A cloud of 2000 small triangles over a plane, and a long bar above them: at 480x360
+ * the hybrid's map leaves 39K samples uncertain, in a tile of 32768 that it cuts into
+ * four regions (hybrid_tile.c), every one reached by the bar, and a tile of the rest. */
+extern const char h_cloud_bar[];
 /* The same with a loader for the scene's `mesh` files (NULL: none). */
 bool h_scene_parse_ld(h_scene *hs, const char *text, const om_loader *ld);
 void h_scene_free(h_scene *hs);

@@ -124,6 +124,32 @@ static void equals_ref(const char *text, const char *what, double least_certain)
 
 static void hybrid_default_scene(void) { equals_ref(om_scene_default_text(), "default scene", 0.8); }
 
+/* A tile of many uncertain samples, with room for the candidates, is cut into regions
+ * that walk apart (hybrid_tile.c): on h_cloud_bar at 480x360, the reference's terms,
+ * as without room for the candidates (every tile whole: the method's least memory). */
+static void hybrid_regions_equal_ref(void)
+{
+    enum { RW = 480, RH = 360 };
+    static om_term ref[RW * RH], hyb[RW * RH];
+    h_scene hs;
+    if (!h_scene_parse(&hs, h_cloud_bar)) return;
+    const om_method *m = om_method_find("hybrid");
+    om_method_cfg c;
+    om_method_cfg_default(&c, m);
+    size_t mn, full;
+    CHECK_OK(m->bytes(&c, &hs.s, RW, RH, &mn, &full));
+    CHECK_OK(h_render(&hs.s, "ref", NULL, RW, RH, 0, 0, NULL, ref, NULL));
+    for (int least = 0; least < 2; least++) {
+        CHECK_OK(h_render_in(&hs.s, "hybrid", &c, RW, RH, 0, 0, least ? mn : full, NULL, hyb, NULL));
+        int diff = 0;
+        for (int i = 0; i < RW * RH; i++)
+            diff += ref[i].r != hyb[i].r || ref[i].g != hyb[i].g || ref[i].b != hyb[i].b ||
+                    ref[i].flags != hyb[i].flags;
+        CHECK_MSG(diff == 0, "cloud%s: %d samples differ from the reference", least ? ", least memory" : "", diff);
+    }
+    h_scene_free(&hs);
+}
+
 static void hybrid_random_scenes(void)
 {
     for (int seed = 1; seed <= 3; seed++) {
@@ -164,4 +190,5 @@ void suite_hybrid(void)
 {
     RUN(hybrid_default_scene);
     RUN(hybrid_random_scenes);
+    RUN(hybrid_regions_equal_ref);
 }

@@ -393,7 +393,7 @@ static void asm_jobs_case(const om_scene *s, const char *set, uint32_t rows, flo
     lent3 h;
     const size_t sb = ps->scratch(state, s);
     for (int k = 0; k < 3; k++) h.slot[k] = calloc(1, sb ? sb : 1);
-    const om__lend l = {lent_run, &h, 3};
+    const om__lend l = {lent_run, lent_run, &h, 3};
     for (int f = 0; f < nframes && state && ps && ps->lend; f++) {
         om_camera cam, cam0;
         om_light light, moving;
@@ -518,6 +518,38 @@ static void hybrid_bands(void)
         h_scene_free(&hs);
     }
     CHECK_MSG(calls > 0, "hybrid: the pass never asked the host which thread runs a job");
+    for (int k = 0; k < 4; k++) om_jobs_stop(pools[k]);
+}
+
+/* hybrid's regions (hybrid_tile.c) on h_cloud_bar at 480x360: a strip of fewer tiles
+ * than two a thread runs them one after another, each tile's candidates and regions
+ * the jobs, on the hosts' slots by the worker index where they name it. The same frame
+ * and counters as inline, for every host, and more regions than tiles. */
+static void hybrid_regions(void)
+{
+    om_jobs *pools[4];
+    uint32_t calls = 0;
+    const om_method *m = om_method_find("hybrid");
+    for (int k = 0; k < 4; k++) CHECK_OK(om_jobs_start(&pools[k], pass_threads[k], NULL));
+    h_scene hs;
+    if (h_scene_parse(&hs, h_cloud_bar)) {
+        const frame_out one = render_set(&hs.s, m, "", 480, 360, 0, NULL, NULL, 1, 0, true);
+        CHECK_MSG(one.st == OM_OK && one.ms.counters[7] > one.ms.counters[5], "hybrid: %u regions in %u tiles",
+                  one.ms.counters[7], one.ms.counters[5]);
+        for (size_t k = 0; k < PASS_HOSTS; k++) {
+            const pass_host *h = &pass_hosts[k];
+            const uint32_t n = host_threads(h);
+            const frame_out o =
+                render_on(&hs.s, m, "", 480, 360, 0, h->pool >= 0 ? om_jobs_for : backwards,
+                          h->pool >= 0 ? (void *)pools[h->pool] : (void *)&calls,
+                          !h->worker ? NULL : h->pool >= 0 ? om_jobs_worker : rotating, n,
+                          om_frame_bytes_jobs(m, h->lean ? NULL : &hs.s, n), true);
+            CHECK_MSG(o.st == OM_OK && o.hash == one.hash &&
+                          !memcmp(o.ms.counters, one.ms.counters, sizeof o.ms.counters),
+                      "hybrid regions: %u threads%s change the frame", n, h->what);
+        }
+        h_scene_free(&hs);
+    }
     for (int k = 0; k < 4; k++) om_jobs_stop(pools[k]);
 }
 
@@ -649,6 +681,7 @@ void suite_threads(void)
     RUN(fewer_jobs);
     RUN(eye_halves);
     RUN(hybrid_bands);
+    RUN(hybrid_regions);
     RUN(asm_bands);
     RUN(asm_jobs_tree);
     RUN(izb_pass);

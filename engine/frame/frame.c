@@ -132,8 +132,9 @@ static void grow_light_box(const om_view *v, const om_strip *st, om_vec3 *lo, om
 
 /* The bands of the strip: band b is job b of the host's parallel-for, with slot b and
  * rows of its own. */
-typedef enum { STAGE_PREPARE, STAGE_RESOLVE, STAGE_SHADE, STAGE_BUILD, STAGE_PASS, STAGE_PASS_SETUP, STAGE_LEND,
-               STAGE_BIN_VERTS, STAGE_BIN_ROWS, STAGE_EYE_HALF, STAGE_EYE_MERGE, STAGE_PASS_ANY } stage;
+typedef enum { STAGE_PREPARE, STAGE_RESOLVE, STAGE_SHADE, STAGE_BUILD, STAGE_PASS, STAGE_PASS_SETUP,
+               STAGE_LEND, STAGE_LEND_ANY, STAGE_BIN_VERTS, STAGE_BIN_ROWS, STAGE_EYE_HALF, STAGE_EYE_MERGE,
+               STAGE_PASS_ANY } stage;
 
 typedef struct frame_ctx {
     const om_frame_desc *fd;
@@ -247,6 +248,10 @@ static void band_job(void *user, uint32_t b)
     if (c->stage == STAGE_PASS_ANY) {   /* pass job b, on the slot of the thread that runs it */
         job_slot *sl = &c->pass_slots[fd->worker(fd->parallel_user) % c->pass_max];   /* in bounds whatever the host says */
         c->pass->job(fd->method_state, &c->strip, b, slot_scratch(sl), sl->counts);
+        return;
+    }
+    if (c->stage == STAGE_LEND_ANY) {   /* a method's own job b, without scratch (om__lend.run_any) */
+        c->lend_fn(c->lend_user, b, NULL);
         return;
     }
     if (c->stage == STAGE_PASS_SETUP) {   /* part b of BANDS_PER_JOB * jobs */
@@ -481,6 +486,17 @@ static void lend_run(const om__lend *l, void (*fn)(void *user, uint32_t k, void 
     run_stage(c, STAGE_LEND, c->pass_slots_now);
 }
 
+/* om__lend.run_any: jobs without scratch, each one of the host's. */
+static void lend_run_any(const om__lend *l, void (*fn)(void *user, uint32_t k, void *scratch), void *user,
+                         uint32_t n)
+{
+    frame_ctx *c = (frame_ctx *)l->frame;
+    if (n == 0) return;
+    c->lend_fn = fn;
+    c->lend_user = user;
+    run_stage(c, STAGE_LEND_ANY, n);
+}
+
 /* Bins' memory: the rows, and the vertices when they fit too. False: no room. Not
  * zeroed: make_bins writes every triangle's rows and every vertex before any is read. */
 static bool carve_bins(om_arena *fa, const om_scene *s, om__bins *b)
@@ -658,7 +674,7 @@ om_status om_render_frame(const om_frame_desc *fd, om_arena *fa, om_frame_stats 
     }
     if (OM_WITH_JOBS && c.jobs > 1 && c.bands && c.bands->build_rows) carve_bins(fa, s, &c.map_bins);
     fs->jobs = c.jobs;
-    om__lend lend = {lend_run, &c, c.pass_max};
+    om__lend lend = {lend_run, lend_run_any, &c, c.pass_max};
     if (OM_WITH_JOBS && c.pass && c.pass->lend) c.pass->lend(fd->method_state, &lend);
     const bool observes = (m->flags & OM_METHOD_OBSERVES) && (!m->observes || m->observes(fd->method_state));
     const bool fit = view.light.kind == OM_LIGHT_DIRECTIONAL;

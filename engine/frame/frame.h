@@ -157,10 +157,15 @@ const om__bands *om__method_bands(const om_method *m);
  * thread while no stage of the frame's runs, calls
  * fn(user, k, scratch) for every k in [0, n) on min(n, slots) of the pass's slots at
  * once (slot p: k = p, p + P, ..., with its scratch) and returns when all have
- * returned. What fn writes must not depend on the slot that ran it. */
+ * returned. What fn writes must not depend on the slot that ran it. run_any does the
+ * same for jobs that need no scratch (fn gets NULL), each k a job of the host's
+ * parallel-for, so the threads take them as they come free: for jobs of uneven cost,
+ * and no slot's scratch is zeroed for them. */
 typedef struct om__lend {
     void (*run)(const struct om__lend *l, void (*fn)(void *user, uint32_t k, void *scratch), void *user,
                 uint32_t n);
+    void (*run_any)(const struct om__lend *l, void (*fn)(void *user, uint32_t k, void *scratch), void *user,
+                    uint32_t n);
     void *frame;
     uint32_t slots;
 } om__lend;

@@ -81,6 +81,8 @@ typedef struct hybrid_state {
     int tshift;            /* log2(T) when T is a power of two (the default sides), else -1 */
     om__hscene h;          /* what the irregular pass reads */
     om__htile tile;        /* its tile of uncertain samples, cap of them */
+    uint32_t cands;        /* the tile's room for candidates: the scene's triangles, or 0 */
+    const om__lend *lend;  /* the host's threads for this frame's tiles, or NULL */
     uint32_t cap;          /* samples the pool holds: a tile's */
     /* The pass (OM_WITH_JOBS): where each of the current strip's tiles begins in it,
      * ntiles + 1 of them (the last: the strip's end), and room for most_tiles. */
@@ -94,10 +96,11 @@ typedef struct hybrid_state {
  * are the jobs of the pass on the host's threads (om__pass, below), each with a
  * tile's memory of its own from the frame arena, which om_frame_bytes_jobs sizes from
  * the scene alone; and a strip's uncertain samples make several tiles to share out.
- * But every tile walks every triangle: twice the scene's triangles, at least
- * TILE_LEAST and at most TILE_CAP, keeps that walk small beside a tile's own work
- * (callgrind, one thread, 1024x768: tiles of 32768 cost random-100K 15% more frame
- * than one tile, the default scene 3% less). */
+ * But every tile walks every triangle (or with candidates, hybrid_tile.c, finds them
+ * among every triangle): twice the scene's triangles, at least TILE_LEAST and at
+ * most TILE_CAP, keeps that walk small beside a tile's own work (callgrind, one
+ * thread, 1024x768: tiles of 32768 cost random-100K 15% more frame than one tile,
+ * the default scene 3% less); a tile of many samples is cut into regions instead. */
 #define TILE_LEAST 32768u
 #define TILE_CAP 262144u
 
@@ -136,8 +139,9 @@ static size_t fixed_bytes(uint32_t side, const om_scene *s, bool cache)
            om_arena_need((size_t)side * side * sizeof(htexel), 16);
 }
 
-/* A pool of n uncertain samples: a tile's memory (hybrid_tile.c). */
-static size_t pool_bytes(uint32_t n) { return om_arena_need(om__htile_bytes(n), 16); }
+/* A pool of n uncertain samples: a tile's memory (hybrid_tile.c), with room for
+ * `cands` candidates. */
+static size_t pool_bytes(uint32_t n, uint32_t cands) { return om_arena_need(om__htile_bytes(n, cands), 16); }
 
 /* The pool's least and largest sizes: as set, or from one row up to the frame; never
  * above tile_most. */
@@ -167,8 +171,8 @@ static om_status need(const hybrid_cfg *c, const om_scene *s, uint32_t w, uint32
     uint32_t smallest, one_pass, side = map_side(c, w, h);
     pool_range(c, s, w, h, &smallest, &one_pass);
     const size_t starts = starts_bytes(most_tiles(w, h, smallest));
-    *min = fixed_bytes(side, s, false) + starts + pool_bytes(smallest);
-    *full = fixed_bytes(side, s, true) + starts + pool_bytes(one_pass);
+    *min = fixed_bytes(side, s, false) + starts + pool_bytes(smallest, 0);
+    *full = fixed_bytes(side, s, true) + starts + pool_bytes(one_pass, OM_WITH_JOBS ? s->ntris : 0);
     return OM_OK;
 }
 
@@ -219,7 +223,7 @@ static om_status hybrid_init(void **state, om_arena *a, const om_method_cfg *mc,
         if ((st = om_arena_alloc(a, ((size_t)m->most_tiles + 1) * sizeof(uint32_t), 4, &p, d))) return st;
         m->starts = (uint32_t *)p;
     }
-    if (om_arena_left(a) >= om__lspace_bytes(s) + mats_bytes(s) + pool_bytes(least)) {
+    if (om_arena_left(a) >= om__lspace_bytes(s) + mats_bytes(s) + pool_bytes(least, 0)) {
         if ((st = om__lspace_init(&m->ls, a, s, d))) return st;
     } else {
         om__lspace_init_lean(&m->ls, s);
@@ -228,16 +232,20 @@ static om_status hybrid_init(void **state, om_arena *a, const om_method_cfg *mc,
         return st;
     m->mat_od = (om__odepth *)p;
     for (uint32_t i = 0; i < s->nmats; i++) m->mat_od[i] = om__material_odepth(&s->mats[i]);
+    /* The candidates (hybrid_tile.c) with the projection, where the whole pool still
+     * fits beside them (the pool matters more), and the frame has threads to cut tiles
+     * for (OM_WITH_JOBS: not on Cortex-M, whose counts are then those of whole tiles). */
     size_t left = om_arena_left(a);
+    m->cands = OM_WITH_JOBS && m->ls.verts && pool_bytes(want, s->ntris) <= left ? s->ntris : 0;
     uint32_t cap = least, hi = want;
     while (cap < hi) {   /* the largest pool that fits */
         uint32_t mid = cap + (hi - cap + 1) / 2;
-        if (pool_bytes(mid) <= left) cap = mid;
+        if (pool_bytes(mid, m->cands) <= left) cap = mid;
         else hi = mid - 1;
     }
     m->cap = cap;
-    if ((st = om_arena_alloc(a, om__htile_bytes(cap), 16, &p, d))) return st;
-    om__htile_carve(&m->tile, p, cap);
+    if ((st = om_arena_alloc(a, om__htile_bytes(cap, m->cands), 16, &p, d))) return st;
+    om__htile_carve(&m->tile, p, cap, m->cands);
     m->h.scene = s;
     m->h.ls = &m->ls;
     m->h.mat_od = m->mat_od;
@@ -251,7 +259,7 @@ static om_status hybrid_init(void **state, om_arena *a, const om_method_cfg *mc,
 static uint32_t begin_view(hybrid_state *m, const om_view *v)
 {
     om__lspace_view(&m->ls, v);
-    m->lit = m->shadowed = m->uncertain = m->tiles = m->tile.setups = m->tile.tested = 0;
+    m->lit = m->shadowed = m->uncertain = m->tiles = m->tile.setups = m->tile.tested = m->tile.regions = 0;
     return m->ls.verts ? m->scene->nverts : 0;
 }
 
@@ -534,17 +542,6 @@ int om__hybrid_decide(void *state, const om__lpoint *p, om_term *t)
 
 const om__lspace *om__hybrid_lspace(const void *state) { return &((const hybrid_state *)state)->ls; }
 
-/* A tile's key for a sample: its grid point, depth and triangle, and its place i in
- * the strip. */
-static void put_key(om__hkey *q, const om__lpoint *p, size_t i)
-{
-    q->x = (int32_t)p->x;
-    q->y = (int32_t)p->y;
-    q->z = (uint32_t)p->z;
-    q->tri = p->tri;
-    q->idx = (uint32_t)i;
-}
-
 /* Samples go onto the light's grid LANES exposed ones at a time: first the light's
  * matrix times each one's point, its division and snap and its texel, in loops over
  * the lanes with no branch on the data that a compiler can run on vector registers
@@ -702,7 +699,7 @@ static uint32_t look_up(const hybrid_state *m, om_strip *st, size_t *i, size_t n
         p.tri = tri[j];
         const int a = classify_at(m, &p, tx[j], ty[j], &st->terms[at[j]], &tex);
         counts[a == 1 ? 0 : a == 2 ? 1 : 2]++;
-        if (a == 0) put_key(&q[u++], &p, at[j]);
+        if (a == 0) om__hkey_put(&q[u++], &p, at[j]);
     }
     return u;
 }
@@ -723,14 +720,14 @@ static om_status hybrid_resolve(void *state, om_strip *st, om_diag *d)
         for (uint32_t j = 0; j < u; j++) {
             m->tile.raw[k++] = q[j];
             if (k == m->cap) {   /* a tile is full: its samples' terms, before the next */
-                om__htile_run(&m->h, &m->tile, k, st);
+                om__htile_run(&m->h, &m->tile, k, st, NULL);
                 m->tiles++;
                 k = 0;
             }
         }
     }
     if (k) {
-        om__htile_run(&m->h, &m->tile, k, st);
+        om__htile_run(&m->h, &m->tile, k, st, NULL);
         m->tiles++;
     }
     m->lit += counts[0];
@@ -776,13 +773,31 @@ static void hybrid_merge(void *state, const uint32_t counts[8])
 
 const om__bands om__bands_hybrid = {hybrid_band, hybrid_merge, 0, NULL, NULL, NULL};
 
+/* A tile job's scratch: a tile like the state's, with its room for candidates. */
 static size_t hybrid_pass_scratch(const void *state, const om_scene *s)
 {
-    if (state) return om__htile_bytes(((const hybrid_state *)state)->cap);
-    return s ? om__htile_bytes(tile_most(s)) : 0;
+    const hybrid_state *m = (const hybrid_state *)state;
+    return m ? om__htile_bytes(m->cap, m->cands) : s ? om__htile_bytes(tile_most(s), s->ntris) : 0;
 }
 
-/* Where each tile of marked samples begins: at every cap-th of them. */
+/* Tile k's samples: the marked ones from its start, projected, into raw; how many. */
+static uint32_t tile_keys(const hybrid_state *m, const om_strip *st, uint32_t k, om__hkey *raw)
+{
+    uint32_t n = 0;
+    for (size_t i = m->starts[k]; i < m->starts[k + 1] && n < m->cap; i++) {
+        const om_term *term = &st->terms[i];
+        om__lpoint p;
+        if ((term->flags & OM_TERM_EXPOSED) && marked(term) && om__lspace_point(&m->ls, &st->samples[i], &p))
+            om__hkey_put(&raw[n++], &p, i);
+    }
+    return n;
+}
+
+/* Where each tile of marked samples begins: at every cap-th of them. Each tile is then
+ * a job with a tile's memory of its own (its regions one after another), or where a
+ * strip makes too few tiles to keep the threads busy (with candidates, fewer than
+ * two a slot), they run here one after another on the state's tile, their regions the
+ * jobs (0 returned: no job left). The same terms and counts either way. */
 static uint32_t hybrid_pass_plan(void *state, om_strip *st)
 {
     hybrid_state *m = (hybrid_state *)state;
@@ -798,25 +813,22 @@ static uint32_t hybrid_pass_plan(void *state, om_strip *st)
         left--;
     }
     m->starts[k] = (uint32_t)n;
-    return m->ntiles = k;
+    if (!m->cands || !m->lend || k >= 2 * m->lend->slots) return m->ntiles = k;
+    for (uint32_t j = 0; j < k; j++, m->tiles++)
+        om__htile_run(&m->h, &m->tile, tile_keys(m, st, j, m->tile.raw), st, m->lend);
+    return 0;
 }
 
 static void hybrid_pass_job(const void *state, const om_strip *st, uint32_t k, void *scratch, uint32_t counts[8])
 {
     const hybrid_state *m = (const hybrid_state *)state;
     om__htile t;
-    om__htile_carve(&t, scratch, m->cap);
-    uint32_t n = 0;
-    for (size_t i = m->starts[k]; i < m->starts[k + 1] && n < m->cap; i++) {
-        const om_term *term = &st->terms[i];
-        om__lpoint p;
-        if ((term->flags & OM_TERM_EXPOSED) && marked(term) && om__lspace_point(&m->ls, &st->samples[i], &p))
-            put_key(&t.raw[n++], &p, i);
-    }
-    om__htile_run(&m->h, &t, n, st);
+    om__htile_carve(&t, scratch, m->cap, m->cands);
+    om__htile_run(&m->h, &t, tile_keys(m, st, k, t.raw), st, NULL);
     counts[0] += t.setups;
     counts[1] += t.tested;
     counts[2]++;
+    counts[3] += t.regions;
 }
 
 static void hybrid_pass_merge(void *state, const uint32_t counts[8])
@@ -825,6 +837,7 @@ static void hybrid_pass_merge(void *state, const uint32_t counts[8])
     m->tile.setups += counts[0];
     m->tile.tested += counts[1];
     m->tiles += counts[2];
+    m->tile.regions += counts[3];
 }
 
 /* begin with the vertex projection left to the jobs, in ranges of vertices (300K
@@ -842,23 +855,30 @@ static void hybrid_pass_setup(const void *state, uint32_t first, uint32_t end)
     om__lspace_project(&((const hybrid_state *)state)->ls, first, end);
 }
 
+/* The slots the regions run on, this frame (NULL at its end or with fewer than two). */
+static void hybrid_pass_lend(void *state, const om__lend *l)
+{
+    if (state) ((hybrid_state *)state)->lend = l && l->slots > 1 ? l : NULL;
+}
+
 const om__pass om__pass_hybrid = {hybrid_pass_scratch, hybrid_pass_plan, hybrid_pass_job, hybrid_pass_merge,
-                                  hybrid_pass_begin, hybrid_pass_setup, NULL};
+                                  hybrid_pass_begin, hybrid_pass_setup, hybrid_pass_lend};
 
 static void hybrid_stats(const void *state, om_method_stats *out)
 {
     const hybrid_state *m = (const hybrid_state *)state;
     memset(out, 0, sizeof *out);
     out->bytes_used = fixed_bytes(m->side, m->scene, m->ls.verts != NULL) + starts_bytes(m->most_tiles) +
-                      pool_bytes(m->cap);
+                      pool_bytes(m->cap, m->cands);
     static const char *const names[] = {"certain lit", "certain shadowed", "uncertain", "triangles set up",
-                                        "samples tested", "tiles", "pool samples"};
-    uint32_t v[7] = {m->lit, m->shadowed, m->uncertain, m->tile.setups, m->tile.tested, m->tiles, m->cap};
-    for (int i = 0; i < 7; i++) {
+                                        "samples tested", "tiles", "pool samples", "regions"};
+    uint32_t v[8] = {m->lit, m->shadowed, m->uncertain, m->tile.setups, m->tile.tested, m->tiles, m->cap,
+                     m->tile.regions};
+    for (int i = 0; i < 8; i++) {
         out->counters[i] = v[i];
         out->counter_names[i] = names[i];
     }
-    out->ncounters = 7;
+    out->ncounters = 8;
 }
 
 static const om_setting settings[] = {

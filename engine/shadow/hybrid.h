@@ -27,10 +27,37 @@ static inline bool om__square_touches(const om__tri2 *e, int64_t x0, int64_t y0,
  * whole unit: om__lspace_point); idx is its place in the strip. */
 typedef struct om__hkey { int32_t x, y; uint32_t z, tri, idx; } om__hkey;
 
+/* The key of sample i of the strip, projected to p. */
+static inline void om__hkey_put(om__hkey *q, const om__lpoint *p, size_t i)
+{
+    q->x = (int32_t)p->x;
+    q->y = (int32_t)p->y;
+    q->z = (uint32_t)p->z;
+    q->tri = p->tri;
+    q->idx = (uint32_t)i;
+}
+
+/* Most regions a tile is cut into, and the parts its candidates are found in (both
+ * fixed: hybrid_tile.c says why). */
+#define OM__HTILE_REGIONS 32u
+#define OM__HTILE_PARTS 16u
+
+/* A triangle that may block a sample of the tile (a candidate): its projected
+ * vertices and their box and nearest depth where `near` has bit 0 (else it needs
+ * clipping), and the tile's regions it reaches in its other bits (hybrid_tile.c). 64
+ * bytes: a cache line. */
+typedef struct om__hcand { uint32_t tri, near; om__lvbox box; om__lvert v[3]; } om__hcand;
+
+/* A region of a tile: the cells [c0, c1) (whole rows of blocks), its samples' bounds
+ * and farthest depth, and the triangles set up and samples tested for it. */
+typedef struct om__hregion { uint32_t c0, c1, n; om__lvbox box; uint32_t setups, tested; } om__hregion;
+
 /* A tile of uncertain samples and its scratch: the samples as they come (raw, n of
  * them, at most cap), then sorted into a grid of cells fitted to their bounds (smp,
  * with each one's optical depth in od), and the triangles set up and samples tested
- * for it. The memory is om__htile_bytes(cap) bytes, om__htile_carve's. */
+ * for it. With room for the scene's triangles as candidates (cand), a tile of many
+ * samples is cut into regions that run apart. The memory is om__htile_bytes(cap,
+ * cands) bytes, om__htile_carve's. */
 typedef struct om__htile {
     om__hkey *raw, *smp;
     om__odepth *od;
@@ -46,7 +73,17 @@ typedef struct om__htile {
     int32_t ox, oy;
     int cs;
     uint32_t cw, ch, cbw;
-    uint32_t setups, tested;
+    uint32_t setups, tested, regions;   /* regions: walked, a tile not cut counting one */
+    om__hcand *cand;        /* a slot a triangle of the scene, or NULL: no regions */
+    uint32_t ncand[OM__HTILE_PARTS];   /* part k's candidates, from its first triangle's slot */
+    /* Each part's candidates listed by the regions their rows reach (two entries a
+     * slot, from the part's first triangle's; region r's in [at[r], at[r + 1]) of the
+     * part's row of OM__HTILE_REGIONS + 2, the list nreg those that reach more than
+     * two regions). */
+    uint32_t *list, *at;
+    uint8_t *breg;          /* each row of blocks' region */
+    om__hregion *reg;       /* OM__HTILE_REGIONS of them, with cand */
+    uint32_t nreg;
 } om__htile;
 
 /* What the irregular pass reads: the scene, its light space this frame and each
@@ -57,12 +94,24 @@ typedef struct om__hscene {
     const om__odepth *mat_od;
 } om__hscene;
 
-size_t om__htile_bytes(uint32_t cap);
-/* Lays a tile of cap samples over `mem` (om__htile_bytes(cap) bytes, 16-aligned). */
-void om__htile_carve(om__htile *t, void *mem, uint32_t cap);
+/* A tile of cap samples, with candidates' room for `cands` triangles (0: none, else
+ * the scene's). */
+size_t om__htile_bytes(uint32_t cap, uint32_t cands);
+/* Lays such a tile over `mem` (om__htile_bytes bytes, 16-aligned). */
+void om__htile_carve(om__htile *t, void *mem, uint32_t cap, uint32_t cands);
 /* Runs the tile's n samples (t->raw[0..n)) through every triangle of the scene and
- * writes their terms into st; adds to t->setups and t->tested. The same terms and
- * counts whatever the tile's memory held before. */
-void om__htile_run(const om__hscene *h, om__htile *t, uint32_t n, const om_strip *st);
+ * writes their terms into st; adds to t->setups, t->tested and t->regions. With `l`
+ * (NULL: on this thread), the candidates' parts and the regions run on its slots (run_any).
+ * The same terms and counts whatever the tile's memory held before. */
+void om__htile_run(const om__hscene *h, om__htile *t, uint32_t n, const om_strip *st, const om__lend *l);
+/* Its steps: begin (sorts the samples, returns the number of regions); with more than
+ * one, the candidates' parts (any order, or at once); the regions (any order, or at
+ * once: each writes its own samples' terms); end (adds the regions' counts up in
+ * their order). */
+uint32_t om__htile_begin(om__htile *t, uint32_t n);
+
+void om__htile_cands(const om__hscene *h, om__htile *t, uint32_t part);
+void om__htile_region(const om__hscene *h, om__htile *t, uint32_t r, const om_strip *st);
+void om__htile_end(om__htile *t);
 
 #endif

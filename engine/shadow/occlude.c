@@ -139,16 +139,31 @@ static void add_sub(const om__lspace *ls, om__ltri *lt, const int64_t x[3], cons
     lt->n++;
 }
 
-bool om__lspace_tri(const om__lspace *ls, uint32_t t, om__ltri *lt)
+/* An empty setup of triangle t. */
+static void ltri_begin(om__ltri *lt, uint32_t t)
 {
-    const uint32_t *ix = ls->scene->idx + (size_t)t * 3;
     lt->n = 0;
     lt->tri = t;
     lt->lox = lt->loy = INT64_MAX;
     lt->hix = lt->hiy = INT64_MIN;
     lt->zmin = OM_DEPTH_ONE;
+}
+
+bool om__lspace_tri_at(const om__lspace *ls, uint32_t t, const om__lvert v[3], om__ltri *lt)
+{
+    int64_t x[3] = {v[0].x, v[1].x, v[2].x}, y[3] = {v[0].y, v[1].y, v[2].y};
+    uint32_t z[3] = {v[0].z, v[1].z, v[2].z};
+    ltri_begin(lt, t);
+    add_sub(ls, lt, x, y, z);
+    return lt->n > 0;
+}
+
+bool om__lspace_tri(const om__lspace *ls, uint32_t t, om__ltri *lt)
+{
+    const uint32_t *ix = ls->scene->idx + (size_t)t * 3;
     const om__lvert *a = ls->verts ? &ls->verts[ix[0]] : NULL;
     const om__lvert *b = ls->verts ? &ls->verts[ix[1]] : NULL, *c = ls->verts ? &ls->verts[ix[2]] : NULL;
+    ltri_begin(lt, t);
     if (a && a->x != INT32_MIN && b->x != INT32_MIN && c->x != INT32_MIN) {
         int64_t x[3] = {a->x, b->x, c->x}, y[3] = {a->y, b->y, c->y};
         uint32_t z[3] = {a->z, b->z, c->z};

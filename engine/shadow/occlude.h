@@ -128,6 +128,9 @@ typedef struct om__ltri {
 
 /* Sets up triangle t; returns false when nothing of it is inside the light's frustum. */
 bool om__lspace_tri(const om__lspace *ls, uint32_t t, om__ltri *out);
+/* The same for a triangle the frame projected whole, from copies of its projected
+ * vertices v (none of which needs clipping): the same setup, without loading them. */
+bool om__lspace_tri_at(const om__lspace *ls, uint32_t t, const om__lvert v[3], om__ltri *out);
 
 /* The predicate. */
 static inline bool om__blocks(const om__ltri *lt, const om__lpoint *p)
