@@ -101,17 +101,9 @@ size_t om__htile_bytes(uint32_t cap, uint32_t cands);
 void om__htile_carve(om__htile *t, void *mem, uint32_t cap, uint32_t cands);
 /* Runs the tile's n samples (t->raw[0..n)) through every triangle of the scene and
  * writes their terms into st; adds to t->setups, t->tested and t->regions. With `l`
- * (NULL: on this thread), the candidates' parts and the regions run on its slots (run_any).
- * The same terms and counts whatever the tile's memory held before. */
+ * (NULL: on this thread), a tile cut into regions runs its candidates' parts and its
+ * regions as the host's jobs (om__lend.run_any). The same terms and counts whatever
+ * the tile's memory held before. */
 void om__htile_run(const om__hscene *h, om__htile *t, uint32_t n, const om_strip *st, const om__lend *l);
-/* Its steps: begin (sorts the samples, returns the number of regions); with more than
- * one, the candidates' parts (any order, or at once); the regions (any order, or at
- * once: each writes its own samples' terms); end (adds the regions' counts up in
- * their order). */
-uint32_t om__htile_begin(om__htile *t, uint32_t n);
-
-void om__htile_cands(const om__hscene *h, om__htile *t, uint32_t part);
-void om__htile_region(const om__hscene *h, om__htile *t, uint32_t r, const om_strip *st);
-void om__htile_end(om__htile *t);
 
 #endif

@@ -376,7 +376,11 @@ static void cut_regions(om__htile *t)
     t->nreg = nreg;
 }
 
-uint32_t om__htile_begin(om__htile *t, uint32_t n)
+/* A tile's steps: begin (sorts the samples, returns the number of regions); with more
+ * than one, the candidates' parts (any order, or at once); the regions (any order, or
+ * at once: each writes its own samples' terms); end (adds the regions' counts up in
+ * their order). */
+static uint32_t tile_begin(om__htile *t, uint32_t n)
 {
     t->n = n;
     sort_tile(t, n);
@@ -424,7 +428,7 @@ static void list_part(om__htile *t, uint32_t part, uint32_t first, uint32_t *cnt
     }
 }
 
-void om__htile_cands(const om__hscene *h, om__htile *t, uint32_t part)
+static void tile_cands(const om__hscene *h, om__htile *t, uint32_t part)
 {
     const uint32_t nt = h->scene->ntris, first = part_of(nt, part), end = part_of(nt, part + 1);
     om__hcand *c = t->cand + first;
@@ -492,7 +496,7 @@ static void walk_region(const om__hscene *h, const om__htile *t, uint32_t r)
     g->tested = rt.tested;
 }
 
-void om__htile_region(const om__hscene *h, om__htile *t, uint32_t r, const om_strip *st)
+static void tile_region(const om__hscene *h, om__htile *t, uint32_t r, const om_strip *st)
 {
     if (!OM_WITH_JOBS || t->nreg <= 1) {   /* the whole tile, every triangle */
         uint32_t open = t->n;
@@ -505,7 +509,7 @@ void om__htile_region(const om__hscene *h, om__htile *t, uint32_t r, const om_st
     write_terms(t, cell_first(t, g->c0), t->cend[g->c1 - 1], st);
 }
 
-void om__htile_end(om__htile *t)
+static void tile_end(om__htile *t)
 {
     t->regions += t->nreg;
     for (uint32_t r = 0; OM_WITH_JOBS && t->nreg > 1 && r < t->nreg; r++) {
@@ -526,24 +530,24 @@ static void region_part(void *user, uint32_t k, void *scratch)
 {
     (void)scratch;
     const region_job *j = (const region_job *)user;
-    if (j->regions) om__htile_region(j->h, j->t, k, j->st);
-    else om__htile_cands(j->h, j->t, k);
+    if (j->regions) tile_region(j->h, j->t, k, j->st);
+    else tile_cands(j->h, j->t, k);
 }
 
-/* n parts of job j: on the lent slots, or here. */
+/* n parts of job j: as the host's jobs, or here. */
 static void run_parts(const om__lend *l, region_job *j, uint32_t n)
 {
-    if (l) l->run_any(l, region_part, j, n);
+    if (OM_WITH_JOBS && l) l->run_any(l, region_part, j, n);
     else
         for (uint32_t k = 0; k < n; k++) region_part(j, k, NULL);
 }
 
 void om__htile_run(const om__hscene *h, om__htile *t, uint32_t n, const om_strip *st, const om__lend *l)
 {
-    const uint32_t nreg = om__htile_begin(t, n);
+    const uint32_t nreg = tile_begin(t, n);
     region_job j = {h, t, st, false};
     if (nreg > 1) run_parts(l, &j, OM__HTILE_PARTS);
     j.regions = true;
     run_parts(nreg > 1 ? l : NULL, &j, nreg);
-    om__htile_end(t);
+    tile_end(t);
 }

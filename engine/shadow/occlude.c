@@ -163,13 +163,11 @@ bool om__lspace_tri(const om__lspace *ls, uint32_t t, om__ltri *lt)
     const uint32_t *ix = ls->scene->idx + (size_t)t * 3;
     const om__lvert *a = ls->verts ? &ls->verts[ix[0]] : NULL;
     const om__lvert *b = ls->verts ? &ls->verts[ix[1]] : NULL, *c = ls->verts ? &ls->verts[ix[2]] : NULL;
-    ltri_begin(lt, t);
     if (a && a->x != INT32_MIN && b->x != INT32_MIN && c->x != INT32_MIN) {
-        int64_t x[3] = {a->x, b->x, c->x}, y[3] = {a->y, b->y, c->y};
-        uint32_t z[3] = {a->z, b->z, c->z};
-        add_sub(ls, lt, x, y, z);
-        return lt->n > 0;
+        const om__lvert v[3] = {*a, *b, *c};
+        return om__lspace_tri_at(ls, t, v, lt);
     }
+    ltri_begin(lt, t);
     om_vec4 clip[3];
     for (int k = 0; k < 3; k++) clip[k] = om__mat_apply(&ls->vp, ls->scene->verts[ix[k]]);
     for (int k = 0; k < 3; k++)
