@@ -24,6 +24,9 @@ int bench_load_random(bscene *b, unsigned count);
 /* fn on the default scene, then on the 10K and 100K random clouds. */
 void bench_default_and_clouds(void (*fn)(const bscene *b));
 
+/* The view of scene b at time t, its camera at W x H; non-zero when it has none. */
+int bench_view(const bscene *b, uint32_t W, uint32_t H, float t, om_view *v);
+
 double bench_median_ns(uint64_t *t, int n);   /* in ms */
 double bench_median(double *v, int n);
 
@@ -54,6 +57,7 @@ int bench_run_hooked(const bscene *b, const char *method, const om_method_cfg *c
     X(bench_asm_big) \
     X(bench_spsm) \
     X(bench_hybrid) \
+    X(bench_threads) \
     /* end of list */
 #define X(name) void name(void);
 OM_BENCHES

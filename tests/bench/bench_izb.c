@@ -15,15 +15,10 @@ static void table_row(const bscene *b, uint32_t W, uint32_t H)
     const om_method *m = om_method_find("izb");
     om_method_cfg cfg;
     om_method_cfg_default(&cfg, m);
-    om_camera cam;
-    om_light light;
-    om_scene_at(&b->s, 0, &cam, &light);
-    cam.width = W;
-    cam.height = H;
     om_view v;
     om_diag d;
     size_t mn, full, n = (size_t)W * H;
-    if (om_view_init(&v, &cam, &light, &b->s, &d) || m->bytes(&cfg, &b->s, W, H, &mn, &full)) return;
+    if (bench_view(b, W, H, 0, &v) || m->bytes(&cfg, &b->s, W, H, &mn, &full)) return;
     void *mem = malloc(full);
     om_target tg = {W, H, 0, H, malloc(n * 4), malloc(n * 4)};
     om_strip st = {W, H, 0, H, malloc(n * sizeof(om_sample)), malloc(n * sizeof(om_term))};

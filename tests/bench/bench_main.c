@@ -88,6 +88,17 @@ static om_status grab_mask(void *user, const om_strip *st, const om_framebuffer 
     return OM_OK;
 }
 
+int bench_view(const bscene *b, uint32_t W, uint32_t H, float t, om_view *v)
+{
+    om_camera cam;
+    om_light light;
+    om_diag d;
+    om_scene_at(&b->s, t, &cam, &light);
+    cam.width = W;
+    cam.height = H;
+    return om_view_init(v, &cam, &light, &b->s, &d) != OM_OK;
+}
+
 int bench_run(const bscene *b, const char *name, const om_method_cfg *cfg, uint32_t W,
               uint32_t H, float t, uint8_t *mask, mrun *out)
 {
@@ -101,16 +112,11 @@ int bench_run_hooked(const bscene *b, const char *name, const om_method_cfg *cfg
     const om_method *m = om_method_find(name);
     om_method_cfg c;
     om_method_cfg_from(&c, m, cfg);   /* the settings m shares with cfg's method */
-    om_camera cam;
-    om_light light;
-    om_scene_at(&b->s, t, &cam, &light);
-    cam.width = W;
-    cam.height = H;
     om_view v;
     om_diag d;
     size_t mn, full;
     memset(out, 0, sizeof *out);
-    if (!m || om_view_init(&v, &cam, &light, &b->s, &d) || m->bytes(&c, &b->s, W, H, &mn, &full)) {
+    if (!m || bench_view(b, W, H, t, &v) || m->bytes(&c, &b->s, W, H, &mn, &full)) {
         fprintf(stderr, "bench: cannot set up %s\n", name);
         return 1;
     }
@@ -157,7 +163,7 @@ int bench_run_hooked(const bscene *b, const char *name, const om_method_cfg *cfg
 int main(int argc, char **argv)
 {
     const char *filter = argc > 1 ? argv[1] : NULL;
-    printf("ombra bench: medians of several runs, one core\n");
+    printf("ombra bench: medians of several runs, one core (threads: two)\n");
 #define X(name) if (!filter || strstr(#name, filter)) { name(); fflush(stdout); }
     OM_BENCHES
 #undef X
