@@ -6,7 +6,7 @@
  * over the rounds, a speed-up the median of each round's own ratio.
  *
  * A virtual machine's CPUs need not run at one speed: on this project's 2-CPU host one
- * of them ran a one-thread frame for minutes at a time 10 to 45% slower than the other
+ * of them ran a one-thread frame for minutes at a time 10 to 65% slower than the other
  * (another guest on its core), and a one-thread frame takes whichever CPU the system
  * gives it. So where the host lets a thread be pinned (Linux), each round also runs one
  * thread on CPU 0 and on CPU 1: "mean" is two threads against the mean of those two
@@ -14,7 +14,7 @@
  * frame against its ideal on those two CPUs, t0 t1 / (t0 + t1), the time in which each
  * CPU at its own speed takes its share of the work. The first frame after a change of
  * kind finds the caches as the other kind left them (a one-thread frame on a CPU the
- * thread had just been moved to ran 13-15% slower here on the default scene than the
+ * thread had just been moved to ran 13-17% slower here on the default scene than the
  * next one there), so each timed frame follows an untimed one of its kind, as a host
  * that renders frame after frame would run it. Every frame is checked to be the bits
  * of the first. The load average is printed before and after. */
@@ -117,7 +117,7 @@ static void one_method(const bscene *b, const char *name, om_jobs *jobs, bool pi
     t.fb = (om_framebuffer){OM_RGB888, W, H, (size_t)W * 3, px};
     om_shade_cfg_default(&t.shade);
     const int kinds = pinned ? KINDS : 2;
-    double ms[KINDS][ROUNDS], eye[KINDS][ROUNDS], r[2][ROUNDS], mean[2][ROUNDS], eff[2][ROUNDS];
+    double ms[KINDS][ROUNDS], eye[KINDS][ROUNDS];
     uint64_t first = 0;
     bool same = true;
     for (int p = -1; p < ROUNDS; p++)   /* round -1 warms each kind up once more */
@@ -125,7 +125,10 @@ static void one_method(const bscene *b, const char *name, om_jobs *jobs, bool pi
             const int k = (q + (p < 0 ? 0 : p)) % kinds;
             double a, e;
 #if CAN_PIN
-            if (pinned) pin(k >= 2 ? k - 2 : -1);
+            if (pinned && !pin(k >= 2 ? k - 2 : -1)) {
+                printf("%-12s %-7s (a thread would not be pinned)\n", b->name, name);
+                goto out;
+            }
 #endif
             if (frame(b, &t, jobs, k, &a, &e) || frame(b, &t, jobs, k, &a, &e)) goto out;   /* the first settles */
             const uint64_t h = om_hash(0, px, (size_t)W * H * 3);
@@ -135,35 +138,26 @@ static void one_method(const bscene *b, const char *name, om_jobs *jobs, bool pi
             ms[k][p] = a;
             eye[k][p] = e;
         }
-#if CAN_PIN
-    if (pinned) pin(-1);
-#endif
-    for (int p = 0; p < ROUNDS; p++)
-        for (int s = 0; s < 2; s++) {
-            const double *v = s ? eye[0] : ms[0], *two = s ? eye[1] : ms[1];
-            r[s][p] = v[p] / two[p];
-            if (!pinned) continue;
-            const double c0 = s ? eye[2][p] : ms[2][p], c1 = s ? eye[3][p] : ms[3][p];
-            mean[s][p] = (c0 + c1) / 2 / two[p];
-            eff[s][p] = c0 * c1 / (c0 + c1) / two[p];
-        }
     printf("%-12s %-7s", b->name, name);
-    for (int s = 0; s < 2; s++) {
-        double one[ROUNDS], two[ROUNDS];
-        memcpy(one, s ? eye[0] : ms[0], sizeof one);
-        memcpy(two, s ? eye[1] : ms[1], sizeof two);
-        printf(" %s%7.2f %7.2f %5.2fx", s ? "| " : "", bench_median(one, ROUNDS), bench_median(two, ROUNDS),
-               bench_median(r[s], ROUNDS));
-        if (pinned) {
-            double c0[ROUNDS], c1[ROUNDS];
-            memcpy(c0, s ? eye[2] : ms[2], sizeof c0);
-            memcpy(c1, s ? eye[3] : ms[3], sizeof c1);
-            printf(" %7.2f %7.2f %5.2fx %4.2f", bench_median(c0, ROUNDS), bench_median(c1, ROUNDS),
-                   bench_median(mean[s], ROUNDS), bench_median(eff[s], ROUNDS));
+    for (int s = 0; s < 2; s++) {   /* the frame, then its eye pass */
+        double (*v)[ROUNDS] = s ? eye : ms, r[ROUNDS], mean[ROUNDS], eff[ROUNDS];   /* ratios before the medians sort */
+        for (int p = 0; p < ROUNDS; p++) {
+            r[p] = v[0][p] / v[1][p];
+            if (!pinned) continue;
+            mean[p] = (v[2][p] + v[3][p]) / 2 / v[1][p];
+            eff[p] = v[2][p] * v[3][p] / (v[2][p] + v[3][p]) / v[1][p];
         }
+        printf(" %s%7.2f %7.2f %5.2fx", s ? "| " : "", bench_median(v[0], ROUNDS), bench_median(v[1], ROUNDS),
+               bench_median(r, ROUNDS));
+        if (pinned)
+            printf(" %7.2f %7.2f %5.2fx %4.2f", bench_median(v[2], ROUNDS), bench_median(v[3], ROUNDS),
+                   bench_median(mean, ROUNDS), bench_median(eff, ROUNDS));
     }
     printf("%s\n", same ? "" : "  FRAMES DIFFER");
 out:
+#if CAN_PIN
+    if (pinned) pin(-1);
+#endif
     free(t.mem);
     free(t.fmem);
     free(px);
