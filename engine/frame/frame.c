@@ -486,6 +486,18 @@ static void lend_run(const om__lend *l, void (*fn)(void *user, uint32_t k, void 
     run_stage(c, STAGE_LEND, c->pass_slots_now);
 }
 
+static void table_fn(void *user, uint32_t k, void *scratch) { ((void **)user)[k] = scratch; }
+
+void *const *om__lend_table(const om__lend *l, uint32_t *n)
+{
+    void *reg[OM__LEND_SLOTS];
+    *n = l->slots < OM__LEND_SLOTS ? l->slots : OM__LEND_SLOTS;
+    l->run(l, table_fn, reg, *n);
+    void **tab = (void **)reg[0];
+    for (uint32_t k = 0; k < *n; k++) tab[k] = reg[k];
+    return (void *const *)tab;
+}
+
 /* om__lend.run_any: jobs without scratch, each one of the host's. */
 static void lend_run_any(const om__lend *l, void (*fn)(void *user, uint32_t k, void *scratch), void *user,
                          uint32_t n)

@@ -170,6 +170,14 @@ typedef struct om__lend {
     uint32_t slots;
 } om__lend;
 
+/* The slots a method's own analysis reads back after its jobs (asm, rtw) find each
+ * other through this: om__lend_table runs min(l->slots, OM__LEND_SLOTS) jobs, job k on
+ * slot k, and keeps every one's scratch in a table at the start of slot 0's (whose
+ * first OM__LEND_SLOTS pointers are the table's, the other slots' left unused);
+ * returns the table, its length in *n. Once a frame, from the pass's lend. */
+#define OM__LEND_SLOTS 64
+void *const *om__lend_table(const om__lend *l, uint32_t *n);
+
 typedef struct om__pass {
     size_t (*scratch)(const void *state, const om_scene *s);
     uint32_t (*plan)(void *state, om_strip *strip);

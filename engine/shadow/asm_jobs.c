@@ -26,9 +26,9 @@
 
 #if OM_WITH_JOBS
 
-/* Slots registered, and so jobs at once for the analysis (its accumulators are read
- * back from every slot): more threads render tiles but analyse with this many. */
-#define SLOTS 64
+/* Slots registered (om__lend_table), and so jobs at once for the analysis (its
+ * accumulators are read back from every slot): more threads render tiles but analyse
+ * with OM__LEND_SLOTS. */
 
 extern const om_method om__method_asm;
 
@@ -42,7 +42,7 @@ static void slot_layout_of(const om__asm_layout *l, uint32_t ntris, bool lean, s
 {
     const size_t count = l->count, c2 = (size_t)l->cells * l->cells, t2 = (size_t)l->tile * l->tile;
     const size_t n = ntris ? ntris : 1;
-    size_t w = SLOTS * sizeof(void *) / sizeof(uint32_t);
+    size_t w = OM__LEND_SLOTS * sizeof(void *) / sizeof(uint32_t);
     o->hdr = w;
     w += 4;
     o->stamp = w;
@@ -109,10 +109,7 @@ static uint32_t asm_pass_plan(void *state, om_strip *strip)
     return 0;
 }
 
-static void reg_fn(void *user, uint32_t k, void *scratch) { ((void **)user)[k] = scratch; }
-
-/* om__pass.lend: each slot's scratch found once a frame (SLOTS jobs at most run one
- * each, so job k has slot k) and kept in slot 0's table. */
+/* om__pass.lend: each slot's scratch found once a frame (om__lend_table). */
 static void asm_lend(void *state, const om__lend *l)
 {
     om__asm_state *m = (om__asm_state *)state;
@@ -121,17 +118,12 @@ static void asm_lend(void *state, const om__lend *l)
     m->slot = NULL;
     m->nslot = 0;
     if (!l || l->slots < 2) return;
-    void *reg[SLOTS];
-    const uint32_t n = l->slots < SLOTS ? l->slots : SLOTS;
-    l->run(l, reg_fn, reg, n);
-    void **tab = (void **)reg[0];
+    uint32_t n;
+    void *const *tab = om__lend_table(l, &n);
     slot_layout sl;
     slot_layout_m(m, &sl);
-    for (uint32_t k = 0; k < n; k++) {
-        tab[k] = reg[k];
-        ((uint32_t *)reg[k])[sl.hdr + 2] = UINT32_MAX;   /* no node touched yet */
-    }
-    m->slot = (void *const *)tab;
+    for (uint32_t k = 0; k < n; k++) ((uint32_t *)tab[k])[sl.hdr + 2] = UINT32_MAX;   /* no node touched yet */
+    m->slot = tab;
     m->nslot = n;
     m->lend = l;
 }

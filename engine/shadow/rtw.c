@@ -28,7 +28,7 @@ extern const om_method om__method_rtw;
 /* The importance map's side: as asked, or by default 512 (section 6's size), no finer
  * than the map itself (a super-cell narrower than a texel moves nothing); at least 8
  * either way (a side asked below 8 is 8, so every value the setting takes renders). */
-static uint32_t importance_side(const om__rtw_cfg *c)
+uint32_t om__rtw_importance_side(const om__rtw_cfg *c)
 {
     if (c->rtw_importance) return c->rtw_importance < 8 ? 8 : c->rtw_importance;
     uint32_t n = c->map_size < 512 ? c->map_size : 512;
@@ -52,7 +52,7 @@ static uint32_t grid_buckets(uint32_t size)
 
 static size_t rtw_need(const om__rtw_cfg *c)
 {
-    size_t n = importance_side(c), nn = n * n, s = c->map_size;
+    size_t n = om__rtw_importance_side(c), nn = n * n, s = c->map_size;
     size_t b = om_arena_need(sizeof(om__rtw), 16) + om_arena_need(nn * sizeof(float), 16) +
                om_arena_need((nn + 7) / 8, 16) + om_arena_need(n * sizeof(double), 16) * 3 +
                om_arena_need((OM_RTW_MAX_RADIUS + 1) * sizeof(double), 16) +
@@ -117,7 +117,7 @@ static om_status rtw_init(void **state, om_arena *a, const om_method_cfg *mc, co
     om__rtw *m = (om__rtw *)p;
     m->scene = s;
     m->cfg = *c;
-    m->n = importance_side(c);
+    m->n = om__rtw_importance_side(c);
     m->size = c->map_size;
     size_t n = m->n, nn = n * n;
     if ((st = carve(a, nn * sizeof(float), &p, d))) return st;
@@ -173,6 +173,12 @@ static om_status rtw_init(void **state, om_arena *a, const om_method_cfg *mc, co
     m->look.warp_n = m->n;
     m->look.unwarped_pcf = c->rtw_footprint == 1;
     for (uint32_t k = 0; k <= m->n; k++) m->px[k] = m->py[k] = (int32_t)(((int64_t)k * OM_RTW_ONE + m->n / 2) / m->n);
+#if OM_WITH_JOBS
+    m->lend = NULL;
+    m->slot = NULL;
+    m->nslot = 0;
+    m->slots_used = false;
+#endif
     m->hiz = NULL;
     if (om_arena_left(a) >= hiz_bytes(c) && carve(a, om__hiz_words(m->size, m->size) * sizeof(uint32_t), &p, NULL) == OM_OK)
         m->hiz = (uint32_t *)p;

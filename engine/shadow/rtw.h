@@ -162,7 +162,19 @@ typedef struct om__rtw {
     /* per frame */
     uint32_t samples, shadowed, tris_drawn;
     double dens_x, dens_y;     /* densest super-cell per axis (MER = size * density) */
+#if OM_WITH_JOBS
+    /* The host's threads for this frame (om__lend, rtw_jobs.c), NULL without; the
+     * slots' scratch, slot[j] for j < nslot; whether their maps hold this frame's
+     * analysis, not yet folded into imp and seen. */
+    const om__lend *lend;
+    void *const *slot;
+    uint32_t nslot;
+    bool slots_used;
+#endif
 } om__rtw;
+
+/* The importance map's side for settings c (rtw.c). */
+uint32_t om__rtw_importance_side(const om__rtw_cfg *c);
 
 /* Importance map stages (rtw_warp.c). begin clears, observe_strip records the backward
  * analysis of one strip of visible samples (section 4.1: each exposed sample, projected
@@ -171,6 +183,17 @@ typedef struct om__rtw {
  * combines the two, then puts the floor under visible samples' cells. */
 void om__rtw_importance_begin(om__rtw *m);
 void om__rtw_observe_strip(om__rtw *m, const om_strip *st);
+/* The backward analysis of `count` samples and their terms into the map imp and its
+ * seen bits (the state's, or a job's own: rtw_jobs.c). */
+void om__rtw_observe_into(const om__rtw *m, const om_sample *smp, const om_term *terms, size_t count,
+                          float *imp, uint8_t *seen);
+#if OM_WITH_JOBS
+/* rtw_jobs.c: observe_strip by bands of rows on the host's threads, each into its
+ * slot's map; false where there are none (nothing done). fold puts the slots' maps
+ * into the state's (finish calls it first); nothing to do where no band ran. */
+bool om__rtw_observe_jobs(om__rtw *m, const om_strip *st);
+void om__rtw_observe_fold(om__rtw *m);
+#endif
 void om__rtw_importance_finish(om__rtw *m);
 /* The 1-D tables of this frame's importance map: collapse, blur, warp (section 4.2).
  * Build runs finish, tables and the map in turn; each may run again on its own (the

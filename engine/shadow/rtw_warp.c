@@ -228,6 +228,15 @@ static size_t cell_of(const om__rtw *m, double u, double v)
 
 void om__rtw_observe_strip(om__rtw *m, const om_strip *st)
 {
+#if OM_WITH_JOBS
+    if (om__rtw_observe_jobs(m, st)) return;   /* the same map, by bands */
+#endif
+    om__rtw_observe_into(m, st->samples, st->terms, (size_t)st->rows * st->width, m->imp, m->seen);
+}
+
+void om__rtw_observe_into(const om__rtw *m, const om_sample *smp0, const om_term *terms, size_t count,
+                          float *imp, uint8_t *seen)
+{
     const om_view *v = &m->view;
     /* Backward analysis (section 4.1): samples not exposed to the light are unlit
      * whatever the map says, so they ask for no resolution. Forward analysis only
@@ -238,10 +247,9 @@ void om__rtw_observe_strip(om__rtw *m, const om_strip *st)
     const float *a = v->light_vp.m;
     const float nf = (float)m->n, hn = 0.5f * nf;
     (void)nf; (void)hn;
-    size_t count = (size_t)st->rows * st->width;
     for (size_t i = 0; i < count; i++) {
-        if (!(st->terms[i].flags & OM_TERM_EXPOSED)) continue;
-        const om_sample *smp = &st->samples[i];
+        if (!(terms[i].flags & OM_TERM_EXPOSED)) continue;
+        const om_sample *smp = &smp0[i];
         om_vec3 p = om__v3(smp->p[0], smp->p[1], smp->p[2]);
         /* x, y and w of the light's clip coordinates (z is not needed here) */
         float qx = a[0] * p.x + a[1] * p.y + a[2] * p.z + a[3];
@@ -265,11 +273,11 @@ void om__rtw_observe_strip(om__rtw *m, const om_strip *st)
             c = cell_of(m, u, w);
         }
         const om_vec3 nrm = om__v3(smp->n[0], smp->n[1], smp->n[2]);
-        m->seen[c >> 3] |= (uint8_t)(1u << (c & 7));
+        seen[c >> 3] |= (uint8_t)(1u << (c & 7));
         /* "only keeping the highest value point" (section 6.3) */
-        if (OM_FAST_FLOAT && !importance_above(&k, p, nrm, m->imp[c])) continue;
+        if (OM_FAST_FLOAT && !importance_above(&k, p, nrm, imp[c])) continue;
         float val = point_importance(&k, p, nrm);
-        if (val > m->imp[c]) m->imp[c] = val;
+        if (val > imp[c]) imp[c] = val;
     }
 }
 
@@ -352,6 +360,9 @@ static void forward(om__rtw *m)
 void om__rtw_importance_finish(om__rtw *m)
 {
     const size_t nn = (size_t)m->n * m->n;
+#if OM_WITH_JOBS
+    om__rtw_observe_fold(m);   /* the bands' maps, where they analysed */
+#endif
     if (m->cfg.rtw_analysis != OM_RTW_BACKWARD) forward(m);
     float top = 0.0f;
     for (size_t c = 0; c < nn; c++)
