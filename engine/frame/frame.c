@@ -498,6 +498,42 @@ void *const *om__lend_table(const om__lend *l, uint32_t *n)
     return (void *const *)tab;
 }
 
+void om__lent_take(om__lent *t, const om__lend *l)
+{
+    t->lend = NULL;
+    t->slot = NULL;
+    t->nslot = 0;
+    t->used = false;
+    if (!l || l->slots < 2) return;
+    t->slot = om__lend_table(l, &t->nslot);
+    t->lend = l;
+}
+
+typedef struct lent_job {
+    void (*fn)(void *user, uint32_t y0, uint32_t rows, void *scratch);
+    void *user;
+    uint32_t band, rows;
+} lent_job;
+
+static void lent_fn(void *user, uint32_t k, void *scratch)
+{
+    const lent_job *j = (const lent_job *)user;
+    const uint32_t y0 = k * j->band;
+    j->fn(j->user, y0, j->rows - y0 < j->band ? j->rows - y0 : j->band, scratch);
+}
+
+void om__lent_rows(om__lent *t, uint32_t rows, void (*fn)(void *user, uint32_t y0, uint32_t rows, void *scratch),
+                   void *user)
+{
+    if (rows == 0) return;
+    /* job k runs on slot k mod P: with more slots than registered, one job each */
+    uint32_t nb = t->nslot < t->lend->slots ? t->nslot : 4 * t->nslot;
+    if (nb > rows) nb = rows;
+    lent_job j = {fn, user, (rows + nb - 1) / nb, rows};
+    t->lend->run(t->lend, lent_fn, &j, (rows + j.band - 1) / j.band);
+    t->used = true;
+}
+
 /* om__lend.run_any: jobs without scratch, each one of the host's. */
 static void lend_run_any(const om__lend *l, void (*fn)(void *user, uint32_t k, void *scratch), void *user,
                          uint32_t n)
@@ -564,7 +600,8 @@ static void strip_at(frame_ctx *c, uint32_t y, uint32_t rows)
  * `keep` bytes (at least two, or none and the frame runs inline). A method with a pass
  * (om__pass) gets a pass slot a job, with the state's scratch; where fewer than two
  * fit, it resolves a strip at a time (its bands unused) and the jobs are only the eye
- * pass's and shading's. */
+ * pass's and shading's. A pass that only lends (frame.h) takes what the bands' jobs
+ * leave: as many slots as fit beside them, up to one a job, or none. */
 static void carve_jobs(frame_ctx *c, om_arena *fa, size_t keep)
 {
     const om_frame_desc *fd = c->fd;
@@ -572,15 +609,21 @@ static void carve_jobs(frame_ctx *c, om_arena *fa, size_t keep)
     if (!OM_WITH_JOBS || !fd->parallel_for || fd->threads <= 1) return;
     const om__bands *b = om__method_bands(fd->method);
     const om__pass *ps = om__method_pass(fd->method);
-    size_t per = band_job_bytes(b), pscratch = 0;
+    size_t per = band_job_bytes(b), pscratch = 0, pslot = 0;
     size_t left = om_arena_left(fa), room = left > keep ? left - keep : 0, fit = room / per;
     if (ps) {
         pscratch = ps->scratch(fd->method_state, fd->scene);
-        size_t with = room / (per + pass_slot_bytes(pscratch));
-        if (with >= 2) fit = with;
-        else ps = NULL, b = NULL;
+        pslot = pass_slot_bytes(pscratch);
+        size_t with = room / (per + pslot);
+        if (ps->job && with >= 2) fit = with;
+        else if (ps->job) ps = NULL, b = NULL;   /* its jobs pair with the bands */
     }
-    uint32_t jobs = fit < fd->threads ? (uint32_t)fit : fd->threads;
+    uint32_t jobs = fit < fd->threads ? (uint32_t)fit : fd->threads, lent = jobs;
+    if (ps && !ps->job) {   /* the bands' jobs first, then as many slots as fit beside them */
+        const size_t after = (room > jobs * per ? room - jobs * per : 0) / pslot;
+        lent = after < jobs ? (uint32_t)after : jobs;
+        if (lent < 2) ps = NULL;
+    }
     void *p;
     const uint32_t nslots = FINE_BANDS_PER_JOB * jobs;
     if (jobs < 2 || om_arena_alloc(fa, nslots * sizeof(job_slot), 8, &p, NULL)) return;
@@ -589,17 +632,17 @@ static void carve_jobs(frame_ctx *c, om_arena *fa, size_t keep)
         if (om_arena_alloc(fa, b->scratch ? b->scratch : 1, 16, &c->slots[j].scratch, NULL))
             return;   /* cannot happen: `per` counted it */
     if (ps) {
-        if (om_arena_alloc(fa, jobs * sizeof(job_slot), 8, &p, NULL)) return;
+        if (om_arena_alloc(fa, lent * sizeof(job_slot), 8, &p, NULL)) return;
         c->pass_slots = (job_slot *)p;
         /* The scratch is zeroed by each slot's first job (band_job), in parallel: for
          * izb it is megabytes a thread. */
-        for (uint32_t j = 0; j < jobs; j++) {
+        for (uint32_t j = 0; j < lent; j++) {
             if (om__arena_alloc_raw(fa, pscratch ? pscratch : 1, 16, &c->pass_slots[j].scratch, NULL))
                 return;   /* cannot happen: counted above */
             c->pass_slots[j].dirty = pscratch ? pscratch : 1;
         }
         c->pass = ps;
-        c->pass_max = jobs;
+        c->pass_max = lent;
     }
     c->bands = b;
     c->jobs = jobs;

@@ -151,7 +151,10 @@ const om__bands *om__method_bands(const om_method *m);
  * - The frame uses the pass only when it runs jobs and its arena has room for at least
  *   two slots' scratch beside the bands' (at most one slot a job); otherwise the
  *   method's bands are not used either and its resolve runs a strip at a time, which
- *   must give the same terms and counts. */
+ *   must give the same terms and counts. A pass that only lends its slots (job NULL:
+ *   asm, rtw, spsm) takes what the bands' jobs leave instead: as many slots as fit
+ *   beside them, up to one a job; below two, none (its lend is not called, and the
+ *   method runs its own stages on the calling thread). */
 /* The pass's slots lent to the method's own stages (asm: its analysis and tile renders
  * in observe and build, its bands' finish): run(l, fn, user, n), called on the calling
  * thread while no stage of the frame's runs, calls
@@ -177,6 +180,21 @@ typedef struct om__lend {
  * returns the table, its length in *n. Once a frame, from the pass's lend. */
 #define OM__LEND_SLOTS 64
 void *const *om__lend_table(const om__lend *l, uint32_t *n);
+
+/* A method's hold on the lent slots for its observe (rtw, spsm): the lend, every
+ * slot's scratch, and whether they hold this frame's work, not yet folded into the
+ * state. om__lent_take takes l's slots (none where l is NULL or has fewer than two);
+ * om__lent_rows runs fn(user, y0, rows, scratch) over a strip of `rows` rows by bands,
+ * about four a slot and never more jobs than registered slots, and marks them used. */
+typedef struct om__lent {
+    const om__lend *lend;
+    void *const *slot;
+    uint32_t nslot;
+    bool used;
+} om__lent;
+void om__lent_take(om__lent *t, const om__lend *l);
+void om__lent_rows(om__lent *t, uint32_t rows, void (*fn)(void *user, uint32_t y0, uint32_t rows, void *scratch),
+                   void *user);
 
 typedef struct om__pass {
     size_t (*scratch)(const void *state, const om_scene *s);

@@ -174,10 +174,7 @@ static om_status rtw_init(void **state, om_arena *a, const om_method_cfg *mc, co
     m->look.unwarped_pcf = c->rtw_footprint == 1;
     for (uint32_t k = 0; k <= m->n; k++) m->px[k] = m->py[k] = (int32_t)(((int64_t)k * OM_RTW_ONE + m->n / 2) / m->n);
 #if OM_WITH_JOBS
-    m->lend = NULL;
-    m->slot = NULL;
-    m->nslot = 0;
-    m->slots_used = false;
+    om__lent_take(&m->lent, NULL);
 #endif
     m->hiz = NULL;
     if (om_arena_left(a) >= hiz_bytes(c) && carve(a, om__hiz_words(m->size, m->size) * sizeof(uint32_t), &p, NULL) == OM_OK)

@@ -163,13 +163,7 @@ typedef struct om__rtw {
     uint32_t samples, shadowed, tris_drawn;
     double dens_x, dens_y;     /* densest super-cell per axis (MER = size * density) */
 #if OM_WITH_JOBS
-    /* The host's threads for this frame (om__lend, rtw_jobs.c), NULL without; the
-     * slots' scratch, slot[j] for j < nslot; whether their maps hold this frame's
-     * analysis, not yet folded into imp and seen. */
-    const om__lend *lend;
-    void *const *slot;
-    uint32_t nslot;
-    bool slots_used;
+    om__lent lent;             /* the host's threads for this frame's analysis (rtw_jobs.c) */
 #endif
 } om__rtw;
 

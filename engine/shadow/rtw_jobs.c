@@ -15,8 +15,7 @@
 
 #if OM_WITH_JOBS
 
-/* Jobs a slot for the bands and for the fold: a slot runs its jobs one after another,
- * so a band of few exposed samples leaves it time for another. */
+/* Jobs a slot for the fold. */
 #define PARTS 4
 
 extern const om_method om__method_rtw;
@@ -59,18 +58,10 @@ static uint32_t rtw_pass_plan(void *state, om_strip *strip)
     return 0;
 }
 
-/* om__pass.lend: each slot's scratch found once a frame (om__lend_table). */
+/* om__pass.lend: the slots for this frame. */
 static void rtw_lend(void *state, const om__lend *l)
 {
-    om__rtw *m = (om__rtw *)state;
-    if (!m) return;
-    m->lend = NULL;
-    m->slot = NULL;
-    m->nslot = 0;
-    m->slots_used = false;
-    if (!l || l->slots < 2) return;
-    m->slot = om__lend_table(l, &m->nslot);
-    m->lend = l;
+    if (state) om__lent_take(&((om__rtw *)state)->lent, l);
 }
 
 const om__pass om__pass_rtw = {rtw_pass_scratch, rtw_pass_plan, NULL, NULL, NULL, NULL, rtw_lend};
@@ -78,13 +69,11 @@ const om__pass om__pass_rtw = {rtw_pass_scratch, rtw_pass_plan, NULL, NULL, NULL
 typedef struct obs_job {
     const om__rtw *m;
     const om_strip *st;
-    uint32_t band;   /* rows a band */
 } obs_job;
 
-static void obs_fn(void *user, uint32_t k, void *scratch)
+static void obs_fn(void *user, uint32_t y0, uint32_t rows, void *scratch)
 {
     const obs_job *j = (const obs_job *)user;
-    const uint32_t y0 = k * j->band, rows = j->st->rows - y0 < j->band ? j->st->rows - y0 : j->band;
     const size_t at = (size_t)y0 * j->st->width;
     om__rtw_observe_into(j->m, j->st->samples + at, j->st->terms + at, (size_t)rows * j->st->width,
                          slot_imp(scratch), slot_seen(scratch, j->m->n));
@@ -92,15 +81,9 @@ static void obs_fn(void *user, uint32_t k, void *scratch)
 
 bool om__rtw_observe_jobs(om__rtw *m, const om_strip *st)
 {
-    if (!m->lend || st->rows == 0) return false;
-    obs_job j = {m, st, 0};
-    /* never more jobs than registered slots run at once: job k on slot k mod nslot */
-    uint32_t nb = m->nslot < m->lend->slots ? m->nslot : PARTS * m->nslot;
-    if (nb > st->rows) nb = st->rows;
-    j.band = (st->rows + nb - 1) / nb;
-    nb = (st->rows + j.band - 1) / j.band;
-    m->lend->run(m->lend, obs_fn, &j, nb);
-    m->slots_used = true;
+    if (!m->lent.lend) return false;
+    obs_job j = {m, st};
+    om__lent_rows(&m->lent, st->rows, obs_fn, &j);
     return true;
 }
 
@@ -115,9 +98,9 @@ static void fold_fn(void *user, uint32_t k, void *scratch)
     const fold_job *j = (const fold_job *)user;
     om__rtw *m = j->m;
     const size_t nn = (size_t)m->n * m->n, c0 = k * j->part, c1 = nn - c0 < j->part ? nn : c0 + j->part;
-    for (uint32_t s = 0; s < m->nslot; s++) {
-        const float *imp = slot_imp(m->slot[s]);
-        const uint8_t *seen = slot_seen(m->slot[s], m->n);
+    for (uint32_t s = 0; s < m->lent.nslot; s++) {
+        const float *imp = slot_imp(m->lent.slot[s]);
+        const uint8_t *seen = slot_seen(m->lent.slot[s], m->n);
         for (size_t c = c0; c < c1; c++)
             if (imp[c] > m->imp[c]) m->imp[c] = imp[c];
         for (size_t b = c0 / 8; b < (c1 + 7) / 8; b++) m->seen[b] |= seen[b];
@@ -126,12 +109,12 @@ static void fold_fn(void *user, uint32_t k, void *scratch)
 
 void om__rtw_observe_fold(om__rtw *m)
 {
-    if (!m->slots_used) return;
+    if (!m->lent.used) return;
     const size_t nn = (size_t)m->n * m->n;
-    const uint32_t parts = PARTS * m->nslot;
+    const uint32_t parts = PARTS * m->lent.nslot;
     fold_job j = {m, ((nn + parts - 1) / parts + 7) / 8 * 8};
-    m->lend->run_any(m->lend, fold_fn, &j, (uint32_t)((nn + j.part - 1) / j.part));
-    m->slots_used = false;
+    m->lent.lend->run_any(m->lent.lend, fold_fn, &j, (uint32_t)((nn + j.part - 1) / j.part));
+    m->lent.used = false;
 }
 
 #endif
