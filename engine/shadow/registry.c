@@ -85,10 +85,12 @@ const om__bands *om__method_bands(const om_method *m_)
 
 /* The methods with a pass of jobs of their own (frame.h, om__pass): izb's tiles, ref's
  * per-frame vertex projection (its begin; its bands resolve), asm, which lends the
- * threads to its analysis and tile renders (asm_jobs.c), rtw, which lends them to its
- * backward analysis (rtw_jobs.c), and hybrid's tiles of uncertain samples. */
+ * threads to its analysis and tile renders (asm_jobs.c), rtw and spsm, which lend them
+ * to their observe (rtw_jobs.c, spsm_observe.c), and hybrid's tiles of uncertain
+ * samples. */
 #define PASSED(X) \
-    X(izb, OM_WITH_IZB) X(ref, OM_WITH_REF) X(asm, OM_WITH_ASM) X(rtw, OM_WITH_RTW) X(hybrid, OM_WITH_HYBRID)
+    X(izb, OM_WITH_IZB) X(ref, OM_WITH_REF) X(asm, OM_WITH_ASM) X(rtw, OM_WITH_RTW) X(spsm, OM_WITH_SPSM) \
+    X(hybrid, OM_WITH_HYBRID)
 
 #define DECLARE_PASS(m, on) extern const om__pass om__pass_##m;
 PASSED(DECLARE_PASS)

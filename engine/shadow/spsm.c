@@ -3,7 +3,7 @@
  * rebuilt below texel size. The texel format, the derivative code and the tangent
  * table are in spsm_texel.c (spsm.h), the recovered outline in spsm_outline.c
  * (spsm_lookup.h), the build in spsm_build.c (spsm_method.h: the state); this file
- * owns the method's settings, observe and lookup.
+ * owns the method's settings and lookup, spsm_observe.c its observe.
  *
  * Observe (not in the paper; spsm.records, by default when the map is finer than the
  * image): each exposed sample marks its texel. The lookup reads the records of the
@@ -119,6 +119,9 @@ static om_status spsm_init(void **state, om_arena *a, const om_method_cfg *mc, c
         m->fneed = (uint32_t *)p;
     }
     om__spsm_win_reset(&m->win);
+#if OM_WITH_JOBS
+    om__lent_take(&m->lent, NULL);
+#endif
     om__spsm_qtable_build(&m->q);
     om__spsm_tangent_build(m->lut);
     *state = m;
@@ -157,42 +160,12 @@ static int32_t floor_shift(int32_t a, int bits)
     return a >= 0 ? a >> bits : -((((int32_t)1 << bits) - 1 - a) >> bits);
 }
 
-/* The texel holding grid position (x, y), clamped to the map (so negative positions
- * need no floor division: they clamp to 0). */
-static int64_t texel_of(const om__spsm_state *m, int64_t g)
-{
-    /* in 32 bits: om__project_xy's positions lie below 2^26 */
-    const int32_t t = g < 0 ? 0 : (int32_t)((uint32_t)g >> OM_SUBPIX_BITS), last = (int32_t)m->size - 1;
-    return t > last ? last : t;
-}
-
-/* For observe: the texel a sample's lookup will centre on, false when the sample does
- * not project. The lookup projects with om__project, whose position is this
- * om__project_xy's: the two agree on every sample. */
-static bool sample_texel(const om__spsm_state *m, const om_sample *smp, int64_t *tx, int64_t *ty)
-{
-    int64_t x, y;
-    om_vec4 q = om__mat_apply(&m->view.light_vp, om__v3(smp->p[0], smp->p[1], smp->p[2]));
-    if (!om__project_xy(&q, m->size, m->size, &x, &y)) return false;
-    *tx = texel_of(m, x);
-    *ty = texel_of(m, y);
-    return true;
-}
-
 static om_status spsm_observe(void *state, const om_strip *st, om_diag *d)
 {
     (void)d;
-    om__spsm_state *m = (om__spsm_state *)state;
-    size_t n = (size_t)st->rows * st->width;
-    for (size_t i = 0; i < n; i++) {
-        if (!(st->terms[i].flags & OM_TERM_EXPOSED)) continue;
-        int64_t tx, ty;
-        if (!sample_texel(m, &st->samples[i], &tx, &ty)) continue;
-        m->seen[(size_t)ty * m->words + (size_t)(tx >> 5)] |= 1u << (tx & 31);
-    }
+    om__spsm_observe((om__spsm_state *)state, st);
     return OM_OK;
 }
-
 
 /* ---------------------------------------------------------------- lookup (4) */
 
@@ -641,7 +614,7 @@ static uint8_t lookup(const om__spsm_state *m, om__spsm_win *w, uint32_t n[8], c
     om_vec3 pw = om__v3(smp->p[0], smp->p[1], smp->p[2]);
     sample_pt p = project(m, pw);
     if (!p.ok) { n[N_LIT]++; return 255; }
-    const int64_t tx = texel_of(m, p.x), ty = texel_of(m, p.y);
+    const int64_t tx = om__spsm_texel_of(m, p.x), ty = om__spsm_texel_of(m, p.y);
     /* the sample relative to its texel's centre */
     const int64_t ox = tx * OM_SUBPIX + OM_SUBPIX / 2, oy = ty * OM_SUBPIX + OM_SUBPIX / 2;
     const int64_t px = p.x - ox, py = p.y - oy;

@@ -312,6 +312,7 @@ static void span(void *user, int32_t y, int32_t x0, int32_t x1, const om__rtri *
 uint32_t om__spsm_map_of(void *state, const om_mat4 **vp)
 {
     om__spsm_state *m = (om__spsm_state *)state;
+    om__spsm_observe_fold(m);    /* the bands' marks, where they observed */
     m->win.t4_at = (size_t)-1;   /* no texel index: the map is about to change */
     m->win.bd_have = false;
     m->win.rd_have = false;      /* and the light's matrix may have moved */

@@ -95,7 +95,26 @@ typedef struct om__spsm_state {
     /* per frame */
     uint32_t samples, lit, shadowed, uncertain, recovered, needed;
     om__spsm_win win;            /* the lookup's, a strip at a time */
+#if OM_WITH_JOBS
+    om__lent lent;               /* the host's threads for this frame's observe (spsm_observe.c) */
+#endif
 } om__spsm_state;
+
+/* The texel holding grid position g (x or y), clamped to the map (so negative
+ * positions need no floor division: they clamp to 0). */
+static inline int64_t om__spsm_texel_of(const om__spsm_state *m, int64_t g)
+{
+    /* in 32 bits: om__project_xy's positions lie below 2^26 */
+    const int32_t t = g < 0 ? 0 : (int32_t)((uint32_t)g >> OM_SUBPIX_BITS), last = (int32_t)m->size - 1;
+    return t > last ? last : t;
+}
+
+/* Observe (spsm_observe.c): each exposed sample of the strip marks its texel in seen;
+ * on the host's threads by bands of rows, each into its slot's marks, which
+ * om__spsm_observe_fold puts into seen before the build reads it (map_of calls it;
+ * nothing to do where no band ran). */
+void om__spsm_observe(om__spsm_state *m, const om_strip *st);
+void om__spsm_observe_fold(om__spsm_state *m);
 
 /* The part of the segment (ax, ay) + t (dx, dy), t in [0, 1], that lies in the closed
  * square [0, side] x [0, side] (coordinates relative to its corner): its ends t0 <= t1
