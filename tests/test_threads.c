@@ -7,6 +7,8 @@
 #include "harness.h"
 #include "../platform/platform.h"
 #include "../engine/shadow/asm.h"
+#include "../engine/shadow/rtw.h"
+#include "../engine/shadow/spsm_method.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -553,6 +555,80 @@ static void hybrid_regions(void)
     for (int k = 0; k < 4; k++) om_jobs_stop(pools[k]);
 }
 
+/* rtw's and spsm's observe on three lent slots (in reverse slot order), whole and in
+ * strips of 8 rows: the bands did run (their slots hold work to fold after observe),
+ * and after build the state's importance map and seen bits (rtw) and the texels the
+ * build reads (spsm's need) are those of observe on the calling thread. */
+static void observe_lent(void)
+{
+    enum { W = 96, H = 72 };
+    h_scene hs;
+    if (!h_scene_parse(&hs, om_scene_default_text())) return;
+    uint32_t *depth = calloc((size_t)W * H, sizeof *depth), *id = calloc((size_t)W * H, sizeof *id);
+    om_sample *smp = calloc((size_t)W * H, sizeof *smp);
+    om_term *terms = calloc((size_t)W * H, sizeof *terms);
+    static const char *const sets[][2] = {{"rtw", "map=256"}, {"spsm", "map=256 spsm.records=2"}};
+    for (int i = 0; i < 2; i++) {
+        const om_method *m = om_method_find(sets[i][0]);
+        const om__pass *ps = om__method_pass(m);
+        CHECK(ps && ps->lend && !ps->job);
+        if (!ps) continue;
+        om_method_cfg c = h_cfg(sets[i][0], sets[i][1]);
+        size_t mn, full;
+        om_diag d;
+        CHECK_OK(m->bytes(&c, &hs.s, W, H, &mn, &full));
+        uint64_t hash[2][2] = {{0}};
+        for (int lend = 0; lend < 2; lend++)
+            for (uint32_t rows = 8; rows <= H; rows += H - 8) {
+                void *mm = calloc(1, full), *state = NULL;
+                om_arena ma;
+                om_arena_init(&ma, mm, full, "method");
+                CHECK_OK(m->init(&state, &ma, &c, &hs.s, W, H, &d));
+                lent3 h;
+                const size_t sb = ps->scratch(state, &hs.s);
+                CHECK(sb > 0);
+                for (int k = 0; k < 3; k++) h.slot[k] = calloc(1, sb ? sb : 1);
+                const om__lend l = {lent_run, lent_run, &h, 3};
+                om_camera cam;
+                om_light light;
+                om_view v;
+                om_scene_at(&hs.s, 0.0f, &cam, &light);
+                cam.width = W;
+                cam.height = H;
+                CHECK_OK(om_view_init(&v, &cam, &light, &hs.s, &d));
+                om_target tg = {W, H, 0, H, depth, id};
+                om_strip st = {W, H, 0, H, smp, terms};
+                om__eye_pass_mark(&hs.s, &v, &tg, &st, NULL);
+                ps->lend(state, lend ? &l : NULL);
+                CHECK_OK(m->begin(state, &v, &d));
+                for (uint32_t y = 0; y < H; y += rows) {
+                    om_strip sub = {W, H, y, y + rows > H ? H - y : rows, smp + (size_t)y * W, terms + (size_t)y * W};
+                    CHECK_OK(m->observe(state, &sub, &d));
+                }
+                const om__lent *lt = i ? &((const om__spsm_state *)state)->lent : &((const om__rtw *)state)->lent;
+                CHECK_MSG(lt->used == (lend == 1), "%s: bands %s", m->name, lend ? "did not run" : "ran unlent");
+                CHECK_OK(m->build(state, &d));
+                if (i == 0) {
+                    const om__rtw *r = (const om__rtw *)state;
+                    const size_t nn = (size_t)r->n * r->n;
+                    hash[lend][rows == H] = om_hash(om_hash(0, r->imp, nn * sizeof *r->imp), r->seen, (nn + 7) / 8);
+                } else {
+                    const om__spsm_state *sp = (const om__spsm_state *)state;
+                    hash[lend][rows == H] = om_hash(0, sp->need, (size_t)sp->size * sp->words * sizeof *sp->need);
+                }
+                ps->lend(state, NULL);
+                for (int k = 0; k < 3; k++) free(h.slot[k]);
+                free(mm);
+            }
+        CHECK_MSG(hash[1][0] == hash[0][0] && hash[1][1] == hash[0][1], "%s: lent observe differs", m->name);
+    }
+    free(depth);
+    free(id);
+    free(smp);
+    free(terms);
+    h_scene_free(&hs);
+}
+
 /* ---- izb: its tiles of exposed samples as jobs (om__pass), each with a pool of its
  * own from the frame arena. The same terms, pixels and counters for any number of jobs
  * and their order, whole frames and strips, one tile or many (izb.pool); a frame arena
@@ -685,6 +761,7 @@ void suite_threads(void)
     RUN(asm_bands);
     RUN(asm_jobs_tree);
     RUN(izb_pass);
+    RUN(observe_lent);
     RUN(settings_by_bands);
     RUN(kept_ids);
 }
