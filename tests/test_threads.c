@@ -9,6 +9,7 @@
 #include "../engine/shadow/asm.h"
 #include "../engine/shadow/rtw.h"
 #include "../engine/shadow/spsm_method.h"
+#include "../engine/shadow/hybrid_method.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -589,13 +590,8 @@ static void observe_lent(void)
                 CHECK(sb > 0);
                 for (int k = 0; k < 3; k++) h.slot[k] = calloc(1, sb ? sb : 1);
                 const om__lend l = {lent_run, lent_run, &h, 3};
-                om_camera cam;
-                om_light light;
                 om_view v;
-                om_scene_at(&hs.s, 0.0f, &cam, &light);
-                cam.width = W;
-                cam.height = H;
-                CHECK_OK(om_view_init(&v, &cam, &light, &hs.s, &d));
+                CHECK_OK(h_view(&v, &hs.s, 0.0f, W, H, &d));
                 om_target tg = {W, H, 0, H, depth, id};
                 om_strip st = {W, H, 0, H, smp, terms};
                 om__eye_pass_mark(&hs.s, &v, &tg, &st, NULL);
@@ -627,6 +623,59 @@ static void observe_lent(void)
     free(smp);
     free(terms);
     h_scene_free(&hs);
+}
+
+/* hybrid's map built by bands of rows on three lent slots (in reverse slot order) is
+ * the map built on the calling thread, byte for byte: on the default scene and on one
+ * whose triangles cross the light's near plane and leave the guard band (so they need
+ * clipping, and their rows come from their sub-triangles), at map sides of a power of
+ * two, of none (a division per texel) and below the number of bands. */
+static void hybrid_map_lent(void)
+{
+    enum { W = 96, H = 72 };
+    static const char clipped[] = "camera eye 0 6 12 target 0 1 0 fov 60 near 0.1 far 100\n"
+                                  "light spot pos 0 4 0 target 0.5 0 0 fov 100 near 1 far 30\n"
+                                  "plane size 60 60 albedo 0.7 0.7 0.7\n"
+                                  "triangles count 400 seed 3 area 3 in -4 2.5 -4 4 4.5 4\n";
+    const char *const scenes[] = {om_scene_default_text(), clipped};
+    static const char *const sets[] = {"hybrid.map=256", "hybrid.map=100", "hybrid.map=5"};
+    const om_method *m = om_method_find("hybrid");
+    const om__pass *ps = om__method_pass(m);
+    CHECK(ps && ps->lend);
+    for (int sc = 0; sc < 2 && ps; sc++) {
+        h_scene hs;
+        if (!h_scene_parse(&hs, scenes[sc])) return;
+        for (int i = 0; i < 3; i++) {
+            om_method_cfg c = h_cfg("hybrid", sets[i]);
+            size_t mn, full;
+            om_diag d;
+            CHECK_OK(m->bytes(&c, &hs.s, W, H, &mn, &full));
+            uint64_t hash[2] = {0, 0};
+            uint32_t clips = 0;
+            for (int lend = 0; lend < 2; lend++) {
+                void *mm = calloc(1, full), *state = NULL;
+                om_arena ma;
+                om_arena_init(&ma, mm, full, "method");
+                CHECK_OK(m->init(&state, &ma, &c, &hs.s, W, H, &d));
+                const hybrid_state *hy = (const hybrid_state *)state;
+                CHECK_MSG(hy->cands == hs.s.ntris, "hybrid: no room for the bands' reach");
+                lent3 h = {{NULL, NULL, NULL}};
+                const om__lend l = {lent_run, lent_run, &h, 3};
+                om_view v;
+                CHECK_OK(h_view(&v, &hs.s, 0.0f, W, H, &d));
+                ps->lend(state, lend ? &l : NULL);
+                CHECK_OK(m->begin(state, &v, &d));
+                for (uint32_t k = 0; k < hs.s.nverts && sc == 1; k++) clips += hy->ls.verts[k].x == INT32_MIN;
+                CHECK_OK(m->build(state, &d));
+                hash[lend] = om_hash(0, hy->map, (size_t)hy->side * hy->side * sizeof *hy->map);
+                ps->lend(state, NULL);
+                free(mm);
+            }
+            CHECK_MSG(hash[1] == hash[0], "hybrid %s, scene %d: the map by bands differs", sets[i], sc);
+            CHECK_MSG(sc == 0 || clips > 0, "hybrid: no vertex needs clipping");
+        }
+        h_scene_free(&hs);
+    }
 }
 
 /* ---- izb: its tiles of exposed samples as jobs (om__pass), each with a pool of its
@@ -762,6 +811,7 @@ void suite_threads(void)
     RUN(asm_jobs_tree);
     RUN(izb_pass);
     RUN(observe_lent);
+    RUN(hybrid_map_lent);
     RUN(settings_by_bands);
     RUN(kept_ids);
 }

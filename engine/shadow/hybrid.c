@@ -42,55 +42,8 @@
  * The uncertain samples go through an irregular z-buffer of their own, a tile of them
  * at a time (izb.pool, or as many as the arena holds; hybrid_tile.c): every test there
  * is the predicate, om__blocks, so those answers are the reference's too. */
-#include "shadow.h"
-#include "hybrid.h"
+#include "hybrid_method.h"
 #include "izb.h"   /* izb.pool, the setting both take */
-
-#include <float.h>
-
-/* A texel: a plane P(x, y) = z + gx (x - xc) + gy (y - yc) about the texel's centre,
- * below every touching triangle's depth plus bound over the texel (lo); and the
- * opaque triangle covering all of it whose greatest depth plus bound is least (hi,
- * cid). */
-typedef struct htexel { float z, gx, gy, hi; uint32_t cid; } htexel;
-
-/* Where a double operation is a software routine (OM_FAST_FLOAT, core.h), the
- * lookup's plane test and the small triangles' updates of the map try single
- * precision first and use double only where the float's error bound leaves the
- * answer open; elsewhere double costs what float does and runs alone. The answers
- * are the same either way (the float answers only where the double would answer
- * alike), and so the map and the frames. */
-
-/* hybrid's configuration: the sample pool's size and its map's side. */
-typedef struct hybrid_cfg {
-    uint32_t izb_pool;     /* 0: the whole frame in one pass */
-    uint32_t hybrid_map;   /* 0: auto (map_side) */
-} hybrid_cfg;
-OM__CFG_FITS(hybrid_cfg);
-
-extern const om_method om__method_hybrid;
-
-typedef struct hybrid_state {
-    const om_scene *scene;
-    om__lspace ls;
-    om__odepth *mat_od;    /* each material's optical depth */
-    hybrid_cfg cfg;
-    htexel *map;
-    uint32_t side;         /* texels per side */
-    int64_t T;             /* grid units per texel side */
-    int tshift;            /* log2(T) when T is a power of two (the default sides), else -1 */
-    om__hscene h;          /* what the irregular pass reads */
-    om__htile tile;        /* its tile of uncertain samples, cap of them */
-    uint32_t cands;        /* the tile's room for candidates: the scene's triangles, or 0 */
-    const om__lend *lend;  /* the host's threads for this frame's tiles, or NULL */
-    uint32_t cap;          /* samples the pool holds: a tile's */
-    /* The pass (OM_WITH_JOBS): where each of the current strip's tiles begins in it,
-     * ntiles + 1 of them (the last: the strip's end), and room for most_tiles. */
-    uint32_t *starts, ntiles, most_tiles;
-    uint32_t lit, shadowed, uncertain, tiles;   /* with the tile's setups and tested */
-} hybrid_state;
-
-#define GRID_SIDE ((int64_t)OM_LIGHT_GRID * OM_SUBPIX)   /* 2^21 grid units */
 
 /* Most uncertain samples a tile takes, whatever izb.pool says (tile_most): the tiles
  * are the jobs of the pass on the host's threads (om__pass, below), each with a
@@ -109,7 +62,6 @@ static uint32_t tile_most(const om_scene *s)
     const uint64_t t = 2 * (uint64_t)s->ntris;
     return t < TILE_LEAST ? TILE_LEAST : t > TILE_CAP ? TILE_CAP : (uint32_t)t;
 }
-#define FAR_OUT ((int64_t)1 << 27)   /* beyond every grid point a triangle can admit */
 
 /* The map's side: as set, or by default the largest power of two at most a quarter
  * of the image's larger side (at least 16): texels of about 4 x 4 pixels where the
@@ -277,209 +229,6 @@ static om_status hybrid_observe(void *state, const om_strip *st, om_diag *d)
     return OM_OK;
 }
 
-/* A double depth to float, never above it: when rounding went up, from a point a
- * depth unit and a millionth below, far beyond half a float step. */
-static float f_down(double v)
-{
-    float f = (float)v;
-    return (double)f > v ? (float)(v - fabs(v) * 1e-6 - 1.0) : f;
-}
-
-/* A double depth to float, never below it (as f_down, the other way). */
-static float f_up(double v)
-{
-    float f = (float)v;
-    return (double)f < v ? (float)(v + fabs(v) * 1e-6 + 1.0) : f;
-}
-
-/* Does every point of the square pass every edge of e? Each edge is tested at the
- * corner where it is least. */
-static bool square_inside(const om__tri2 *e, int64_t x0, int64_t y0, int64_t x1, int64_t y1)
-{
-    for (int i = 0; i < 3; i++)
-        if ((e->a[i] > 0 ? e->a[i] * x0 : e->a[i] * x1) + (e->b[i] > 0 ? e->b[i] * y0 : e->b[i] * y1) +
-                e->c[i] < 0)
-            return false;
-    return true;
-}
-
-/* The least of a - b over the square's corners, for a and b linear (a given at the
- * corner (x0, y0) with slopes ax, ay, b likewise): at the corner each slope picks. */
-static double least_diff(double a0, double ax, double ay, double b0, double bx, double by, int64_t w,
-                         int64_t h)
-{
-    double dx = ax - bx, dy = ay - by;
-    return a0 - b0 + (dx < 0.0 ? dx * (double)w : 0.0) + (dy < 0.0 ? dy * (double)h : 0.0);
-}
-
-/* Adds sub-triangle r (with its bound) of triangle t to the texels it touches; `cover`:
- * r is an opaque triangle's only sub-triangle, a candidate for hi. */
-static void add_sub(hybrid_state *m, const om__rtri *r, double bound, uint32_t t, bool cover)
-{
-    const om__tri2 *e = &r->e;
-    int64_t lox = e->x[0], hix = e->x[0], loy = e->y[0], hiy = e->y[0];
-    for (int i = 1; i < 3; i++) {
-        if (e->x[i] < lox) lox = e->x[i];
-        if (e->x[i] > hix) hix = e->x[i];
-        if (e->y[i] < loy) loy = e->y[i];
-        if (e->y[i] > hiy) hiy = e->y[i];
-    }
-    int64_t last = (int64_t)m->side - 1;
-    int64_t tx0 = lox / m->T, tx1 = hix / m->T, ty0 = loy / m->T, ty1 = hiy / m->T;
-    if (lox < 0) tx0 = 0;
-    if (loy < 0) ty0 = 0;
-    if (tx1 > last) tx1 = last;
-    if (ty1 > last) ty1 = last;
-    if (hix < 0 || hiy < 0 || tx0 > last || ty0 > last) return;
-    bool xlo = r->zx > 0.0, ylo = r->zy > 0.0;   /* where the plane is least */
-    for (int64_t ty = ty0; ty <= ty1; ty++) {
-        int64_t y0 = ty * m->T, y1 = y0 + m->T - 1;
-        if (ty == 0) y0 = -FAR_OUT;
-        if (ty == last) y1 = FAR_OUT;
-        for (int64_t tx = tx0; tx <= tx1; tx++) {
-            int64_t x0 = tx * m->T, x1 = x0 + m->T - 1;
-                if (tx == 0) x0 = -FAR_OUT;
-            if (tx == last) x1 = FAR_OUT;
-            if (!om__square_touches(e, x0, y0, x1, y1)) continue;
-            htexel *h = &m->map[ty * (int64_t)m->side + tx];
-            int64_t xc = tx * m->T + m->T / 2, yc = ty * m->T + m->T / 2;
-            if (h->gx != h->gx) {   /* empty (NaN): the texel takes this plane's slopes */
-                h->gx = (float)r->zx;
-                h->gy = (float)r->zy;
-                h->z = FLT_MAX;
-            }
-            /* The clamped depth is at least min(plane, zmax): the least of each, less
-             * the texel's plane, bounds how far down z must go, over the points the
-             * triangle can admit in the square, which lie in its box too (where the
-             * square reaches past the triangle's far corner, the plane there is
-             * beyond zmax, and over the whole square min(plane, zmax) would fall by
-             * up to a texel's depth slope below what any admitted point has). */
-            const int64_t ax0 = x0 > lox ? x0 : lox, ax1 = x1 < hix ? x1 : hix;
-            const int64_t ay0 = y0 > loy ? y0 : loy, ay1 = y1 < hiy ? y1 : hiy;
-            double gx = h->gx, gy = h->gy;
-            double p0 = gx * (double)(ax0 - xc) + gy * (double)(ay0 - yc);
-            double d0 = r->z0 + r->zx * (double)(ax0 - e->x[0]) + r->zy * (double)(ay0 - e->y[0]);
-            double a = least_diff(d0, r->zx, r->zy, p0, gx, gy, ax1 - ax0, ay1 - ay0);
-            double b = least_diff(r->zmax, 0.0, 0.0, p0, gx, gy, ax1 - ax0, ay1 - ay0);
-            float z = f_down((a < b ? a : b) + bound - 1.0);
-            if (z < h->z) h->z = z;
-            if (cover && lox <= x0 && hix >= x1 && loy <= y0 && hiy >= y1 &&
-                square_inside(e, x0, y0, x1, y1)) {
-                float hi = f_up(om__rtri_depth(r, xlo ? x1 : x0, ylo ? y1 : y0) + bound + 1.0);
-                if (hi < h->hi) {
-                    h->hi = hi;
-                    h->cid = t;
-                }
-            }
-        }
-    }
-}
-
-/* The texel of a grid coordinate: a shift rather than a division where it can be
- * (this runs once a sample); points off the grid take the border texels. Monotone, so
- * the texels of a range of points are those between its ends'. */
-static inline int64_t texel_of(const hybrid_state *m, int64_t v)
-{
-    if (v < 0) return 0;
-    int64_t t = m->tshift >= 0 ? v >> m->tshift : v / m->T;
-    return t < (int64_t)m->side ? t : (int64_t)m->side - 1;
-}
-
-/* The texels a grid box [lox, hix] x [loy, hiy] reaches. */
-typedef struct trange { uint32_t x0, y0, x1, y1; } trange;
-
-static trange texels_in(const hybrid_state *m, int64_t lox, int64_t loy, int64_t hix, int64_t hiy)
-{
-    trange r;
-    r.x0 = (uint32_t)texel_of(m, lox);
-    r.y0 = (uint32_t)texel_of(m, loy);
-    r.x1 = (uint32_t)texel_of(m, hix);
-    r.y1 = (uint32_t)texel_of(m, hiy);
-    return r;
-}
-
-/* A projected triangle's bounds and nearest vertex depth; false when it needs
- * clipping (or the projection is not kept). */
-static bool vbox_of(const hybrid_state *m, uint32_t t, om__lvbox *v)
-{
-    if (!m->ls.verts) return false;
-    const uint32_t *ix = m->scene->idx + (size_t)t * 3;
-    const om__lvert *a = &m->ls.verts[ix[0]], *b = &m->ls.verts[ix[1]], *c = &m->ls.verts[ix[2]];
-    if (a->x == INT32_MIN || b->x == INT32_MIN || c->x == INT32_MIN) return false;
-    *v = om__lvert_box(a, b, c);
-    return true;
-}
-
-/* A small triangle (projected without clipping, its bounds within 2 x 2 texels and too
- * narrow to cover one) lowers the texels its bounds reach (a superset of those its
- * edges reach) to its nearest vertex's depth, without a setup: the predicate's depth
- * is clamped to the vertices' range and its bound is positive, so depth plus bound is
- * above that everywhere. As sharp as the plane where the texel is larger than the
- * triangle (the plane, continued over the texel, falls below it). False: the
- * triangle takes the full path. */
-static bool add_small(hybrid_state *m, uint32_t t)
-{
-    om__lvbox v;
-    if (!vbox_of(m, t, &v)) return false;
-    if ((int64_t)v.hix - v.lox >= m->T - 1 && (int64_t)v.hiy - v.loy >= m->T - 1) return false;
-    trange r = texels_in(m, v.lox, v.loy, v.hix, v.hiy);
-    if ((r.x1 - r.x0 + 1) * (r.y1 - r.y0 + 1) > 4) return false;
-    int64_t last = (int64_t)m->side - 1;
-    for (int64_t ty = r.y0; ty <= r.y1; ty++)
-        for (int64_t tx = r.x0; tx <= r.x1; tx++) {
-            htexel *h = &m->map[ty * (int64_t)m->side + tx];
-            int64_t x0 = tx * m->T, y0 = ty * m->T, x1 = x0 + m->T - 1, y1 = y0 + m->T - 1;
-            int64_t xc = x0 + m->T / 2, yc = y0 + m->T / 2;
-            if (tx == 0) x0 = -FAR_OUT;
-            if (ty == 0) y0 = -FAR_OUT;
-            if (tx == last) x1 = FAR_OUT;
-            if (ty == last) y1 = FAR_OUT;
-            if (h->gx != h->gx) {   /* empty: a flat plane */
-                h->gx = h->gy = 0.0f;
-                h->z = FLT_MAX;
-            }
-#if OM_FAST_FLOAT
-            /* Most small triangles lie behind what the texel holds already: single
-             * precision says so first where it can (as in plane_at_or_beyond: the
-             * float is within s 2^-20 of the exact value, s the sum of its terms'
-             * magnitudes, and f_down goes below a value by at most 2 + 4e-6 of it),
-             * and then the double would leave z as it is. */
-            const float gxf = h->gx, gyf = h->gy;
-            const float a = gxf * (float)(int32_t)(x0 - xc), b = gyf * (float)(int32_t)(y0 - yc);
-            const float c = gxf > 0.0f ? gxf * (float)(int32_t)(x1 - x0) : 0.0f;
-            const float e = gyf > 0.0f ? gyf * (float)(int32_t)(y1 - y0) : 0.0f;
-            const float zf = (float)v.z, lo = zf - a - b - c - e - 1.0f;
-            const float err = (zf + om__fabsf(a) + om__fabsf(b) + c + e + 1.0f) * 0x1p-20f;
-            if ((lo - err) - (om__fabsf(lo) + err) * 4e-6f - 2.0f >= h->z) continue;
-#endif
-            double gx = h->gx, gy = h->gy;
-            double p0 = gx * (double)(x0 - xc) + gy * (double)(y0 - yc);
-            float z = f_down(least_diff((double)v.z, 0.0, 0.0, p0, gx, gy, x1 - x0, y1 - y0) - 1.0);
-            if (z < h->z) h->z = z;
-        }
-    return true;
-}
-
-static om_status hybrid_build(void *state, om_diag *d)
-{
-    (void)d;
-    hybrid_state *m = (hybrid_state *)state;
-    size_t n = (size_t)m->side * m->side;
-    for (size_t i = 0; i < n; i++) {
-        htexel *h = &m->map[i];
-        h->z = h->hi = FLT_MAX;
-        h->gx = h->gy = NAN;
-        h->cid = OM_NO_TRI;
-    }
-    const om_scene *s = m->scene;
-    for (uint32_t t = 0; t < s->ntris; t++) {
-        om__ltri lt;
-        if (add_small(m, t) || !om__lspace_tri(&m->ls, t, &lt)) continue;
-        bool cover = lt.n == 1 && om__odepth_opaque(&m->mat_od[s->tri_mat[t]]);
-        for (int k = 0; k < lt.n; k++) add_sub(m, &lt.sub[k], lt.bound[k], t, cover);
-    }
-    return OM_OK;
-}
 
 /* Is the texel's plane at offset (dx, dy) from its centre at depth z (zi, as an
  * integer) or beyond? The test is in double; with OM_FAST_FLOAT single
@@ -889,7 +638,7 @@ static const om_setting settings[] = {
 
 const om_method om__method_hybrid = {
     "hybrid", "exact: a conservative map decides most samples, an irregular z-buffer the rest",
-    OM_METHOD_EXACT, hybrid_bytes, hybrid_init, hybrid_begin, hybrid_observe, hybrid_build,
+    OM_METHOD_EXACT, hybrid_bytes, hybrid_init, hybrid_begin, hybrid_observe, om__hybrid_build,
     hybrid_resolve, hybrid_stats, NULL, settings, sizeof settings / sizeof settings[0],
     sizeof(hybrid_cfg),
 };
