@@ -529,15 +529,117 @@ static size_t hybrid_pass_scratch(const void *state, const om_scene *s)
     return m ? om__htile_bytes(m->cap, m->cands) : s ? om__htile_bytes(tile_most(s), s->ntris) : 0;
 }
 
+/* A sample the bands left to the pass. */
+static bool left_open(const om_term *t) { return (t->flags & OM_TERM_EXPOSED) && marked(t); }
+
 /* Tile k's samples: the marked ones from its start, projected, into raw; how many. */
 static uint32_t tile_keys(const hybrid_state *m, const om_strip *st, uint32_t k, om__hkey *raw)
 {
     uint32_t n = 0;
     for (size_t i = m->starts[k]; i < m->starts[k + 1] && n < m->cap; i++) {
-        const om_term *term = &st->terms[i];
         om__lpoint p;
-        if ((term->flags & OM_TERM_EXPOSED) && marked(term) && om__lspace_point(&m->ls, &st->samples[i], &p))
-            om__hkey_put(&raw[n++], &p, i);
+        if (left_open(&st->terms[i]) && om__lspace_point(&m->ls, &st->samples[i], &p)) om__hkey_put(&raw[n++], &p, i);
+    }
+    return n;
+}
+
+/* Where each tile begins, from the strip's samples on this thread; how many tiles. */
+static uint32_t starts_here(hybrid_state *m, const om_strip *st)
+{
+    const size_t n = (size_t)st->rows * st->width;
+    uint32_t k = 0, left = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (!left_open(&st->terms[i])) continue;
+        if (left == 0) {
+            m->starts[k++] = (uint32_t)i;
+            left = m->cap;
+        }
+        left--;
+    }
+    m->starts[k] = (uint32_t)n;
+    return k;
+}
+
+/* ---- the same on the lent threads, in `parts` parts of the strip's samples (about
+ * four a thread): each part counts its marked samples, and the counts say where each
+ * tile begins and where each part's keys go in a tile. A part writes the keys of its
+ * samples that fall in the tile, in their order, where its first one goes; a sample
+ * whose projection fails (none: the bands marked it after the same projection) would
+ * leave a gap, closed after. So the same keys as tile_keys, in the same order. The
+ * tiles run one after another, each writing its samples' terms: a part scans from the
+ * tile's start on. */
+typedef struct key_job {
+    hybrid_state *m;
+    const om_strip *st;
+    uint32_t parts, tile;
+} key_job;
+
+static size_t part_first(const key_job *j, uint32_t p)
+{
+    return (size_t)((uint64_t)j->st->rows * j->st->width * p / j->parts);
+}
+
+static void count_part(void *user, uint32_t p, void *scratch)
+{
+    (void)scratch;
+    const key_job *j = (const key_job *)user;
+    uint32_t c = 0;
+    for (size_t i = part_first(j, p); i < part_first(j, p + 1); i++) c += left_open(&j->st->terms[i]);
+    j->m->part_marked[p + 1] = c;
+}
+
+/* starts_here in parts; part_marked becomes each part's first marked sample's rank. */
+static uint32_t starts_by_parts(hybrid_state *m, const om_strip *st, uint32_t parts)
+{
+    key_job j = {m, st, parts, 0};
+    m->part_marked[0] = 0;
+    m->lend->run_any(m->lend, count_part, &j, parts);
+    for (uint32_t p = 0; p < parts; p++) m->part_marked[p + 1] += m->part_marked[p];
+    const uint32_t k = (m->part_marked[parts] + m->cap - 1) / m->cap;
+    for (uint32_t t = 0, p = 0; t < k; t++) {   /* tile t begins at the marked sample of rank t cap */
+        const uint32_t want = t * m->cap;
+        while (m->part_marked[p + 1] <= want) p++;
+        size_t i = part_first(&j, p);
+        for (uint32_t rank = m->part_marked[p];; i++)
+            if (left_open(&st->terms[i]) && rank++ == want) break;
+        m->starts[t] = (uint32_t)i;
+    }
+    m->starts[k] = (uint32_t)((size_t)st->rows * st->width);
+    return k;
+}
+
+static void keys_part(void *user, uint32_t p, void *scratch)
+{
+    (void)scratch;
+    const key_job *j = (const key_job *)user;
+    hybrid_state *m = j->m;
+    const uint32_t lo = j->tile * m->cap, hi = lo + m->cap;
+    size_t i = part_first(j, p);
+    uint32_t rank = m->part_marked[p], put = 0;
+    if (i < m->starts[j->tile]) {   /* the earlier tiles' samples are no longer marked */
+        i = m->starts[j->tile];
+        rank = lo;
+    }
+    om__hkey *raw = m->tile.raw + (rank - lo);
+    for (; i < part_first(j, p + 1) && rank < hi; i++) {
+        om__lpoint pt;
+        if (!left_open(&j->st->terms[i]) || rank++ < lo) continue;
+        if (om__lspace_point(&m->ls, &j->st->samples[i], &pt)) om__hkey_put(&raw[put++], &pt, i);
+    }
+    m->part_put[p] = put;
+}
+
+/* tile_keys of `tile` into the state's tile, in parts. */
+static uint32_t keys_by_parts(hybrid_state *m, const om_strip *st, uint32_t parts, uint32_t tile)
+{
+    key_job j = {m, st, parts, tile};
+    m->lend->run_any(m->lend, keys_part, &j, parts);
+    const uint32_t lo = tile * m->cap;
+    uint32_t n = 0;
+    for (uint32_t p = 0; p < parts; p++) {
+        const uint32_t at = m->part_marked[p] > lo ? m->part_marked[p] - lo : 0;
+        if (m->part_put[p] && at != n) memmove(m->tile.raw + n, m->tile.raw + at, m->part_put[p] * sizeof *m->tile.raw);
+        n += m->part_put[p];
     }
     return n;
 }
@@ -550,21 +652,12 @@ static uint32_t tile_keys(const hybrid_state *m, const om_strip *st, uint32_t k,
 static uint32_t hybrid_pass_plan(void *state, om_strip *st)
 {
     hybrid_state *m = (hybrid_state *)state;
-    const size_t n = (size_t)st->rows * st->width;
-    uint32_t k = 0, left = 0;
-    for (size_t i = 0; i < n; i++) {
-        const om_term *t = &st->terms[i];
-        if (!(t->flags & OM_TERM_EXPOSED) || !marked(t)) continue;
-        if (left == 0) {
-            m->starts[k++] = (uint32_t)i;
-            left = m->cap;
-        }
-        left--;
-    }
-    m->starts[k] = (uint32_t)n;
+    const uint32_t want = m->lend ? 4 * m->lend->slots : 0;
+    const uint32_t parts = want < OM__HYBRID_PARTS ? want : OM__HYBRID_PARTS;
+    const uint32_t k = parts ? starts_by_parts(m, st, parts) : starts_here(m, st);
     if (!m->cands || !m->lend || k >= 2 * m->lend->slots) return m->ntiles = k;
-    for (uint32_t j = 0; j < k; j++, m->tiles++)
-        om__htile_run(&m->h, &m->tile, tile_keys(m, st, j, m->tile.raw), st, m->lend);
+    for (uint32_t t = 0; t < k; t++, m->tiles++)
+        om__htile_run(&m->h, &m->tile, keys_by_parts(m, st, parts, t), st, m->lend);
     return 0;
 }
 

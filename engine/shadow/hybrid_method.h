@@ -32,6 +32,9 @@ OM__CFG_FITS(hybrid_cfg);
 
 extern const om_method om__method_hybrid;
 
+/* Most parts of a strip the plan's scan and keys are cut into (hybrid.c). */
+#define OM__HYBRID_PARTS 64u
+
 typedef struct hybrid_state {
     const om_scene *scene;
     om__lspace ls;
@@ -49,6 +52,9 @@ typedef struct hybrid_state {
     /* The pass (OM_WITH_JOBS): where each of the current strip's tiles begins in it,
      * ntiles + 1 of them (the last: the strip's end), and room for most_tiles. */
     uint32_t *starts, ntiles, most_tiles;
+    /* The plan in parts on the lent threads (hybrid.c): each part's marked samples, then
+     * the rank of its first; each part's keys put in the current tile. */
+    uint32_t part_marked[OM__HYBRID_PARTS + 1], part_put[OM__HYBRID_PARTS];
     uint32_t lit, shadowed, uncertain, tiles;   /* with the tile's setups and tested */
 } hybrid_state;
 
