@@ -335,9 +335,11 @@ static void asm_bands(void)
  * driven directly, its tree hashed after observe and after build (use marks, benefits,
  * every cell's benefit and need, every tile, the triangle grid), on method memory
  * filled with different garbage, with the jobs lent to it run backwards
- * on 3 slots against none lent: views jumping between two places (so that nodes were
- * last used two frames before), caps that leave the free list short (observe then runs
- * a strip at a time) or not, strips of 8 rows or one. */
+ * on 3 slots against none lent: views still, jumping between two places (so that
+ * nodes were last used two frames before) or moving on each frame (jump < 0: so that
+ * some were not used in the last frame), caps that leave the free list short or not
+ * (and the last set with nodes left that observe may replace: it then runs a strip at
+ * a time), strips of 8 rows or one. */
 typedef struct lent3 {
     void *slot[3];
 } lent3;
@@ -402,7 +404,7 @@ static void asm_jobs_case(const om_scene *s, const char *set, uint32_t rows, flo
         om_light light, moving;
         om_view v;
         om_scene_at(s, 0.0f, &cam0, &light);
-        om_scene_at(s, jump * (float)(f & 1) + 0.05f * (float)f, &cam, &moving);
+        om_scene_at(s, jump < 0.0f ? -jump * (float)f : jump * (float)(f & 1) + 0.05f * (float)f, &cam, &moving);
         cam.width = W;
         cam.height = H;
         CHECK_OK(om_view_init(&v, &cam, &light, s, &d));
@@ -437,17 +439,19 @@ static void asm_jobs_tree(void)
 {
     static const char *const sets[] = {"asm.cap=300000 asm.stride=1 asm.root=256 asm.work=100000",
                                        "asm.cap=2000000 asm.stride=1 asm.root=256 asm.work=100000",
-                                       "asm.cap=200000 asm.stride=3", "asm.stride=2 asm.work=1000"};
+                                       "asm.cap=200000 asm.stride=3", "asm.stride=2 asm.work=1000",
+                                       "asm.cap=600000 asm.stride=1 asm.root=256 asm.work=10000"};
     enum { NF = 6 };
     h_scene hs;
     if (!h_scene_parse(&hs, om_scene_default_text())) return;
-    for (int k = 0; k < 4; k++)
+    for (int k = 0; k < 5; k++)
         for (uint32_t rows = 8; rows <= 72; rows += 64)
-            for (int j = 0; j < 2; j++) {
+            for (int j = 0; j < 3; j++) {
+                const float jump = j == 0 ? 0.0f : j == 1 ? 2.5f : -1.0f;
                 uint64_t a[NF][2], b[NF][2];
                 uint32_t ua = 0, ub = 0;
-                asm_jobs_case(&hs.s, sets[k], rows, j ? 2.5f : 0.0f, false, a, &ua, NF);
-                asm_jobs_case(&hs.s, sets[k], rows, j ? 2.5f : 0.0f, true, b, &ub, NF);
+                asm_jobs_case(&hs.s, sets[k], rows, jump, false, a, &ua, NF);
+                asm_jobs_case(&hs.s, sets[k], rows, jump, true, b, &ub, NF);
                 CHECK(ua > 0 && ua == ub);
                 for (int f = 0; f < NF; f++)
                     CHECK_MSG(a[f][0] == b[f][0] && a[f][1] == b[f][1],

@@ -398,6 +398,7 @@ OM_INLINE void observe_rows(om__asm_state *m, const om_strip *st, uint32_t y0, u
                 if (level == 0) {   /* the base: into the root tile */
                     if (child == OM__ASM_NONE && a) {   /* made after the bands */
                         if (!again && (!a->first[c] || a->first[c] > i + 1)) a->first[c] = (uint32_t)i + 1;
+                        if (again) a->missed[c]++;   /* none could be made: root_tile's count */
                         tm->g = again ? 255 : 254;
                         break;
                     }

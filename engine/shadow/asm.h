@@ -138,6 +138,9 @@ void om__asm_evict(om__asm_tree *t, uint32_t index);
  * node on the path to `parent`. Returns the new index, or OM__ASM_NONE when the cell
  * already has a child, the level would pass max_level, or nothing may be replaced. */
 uint32_t om__asm_make(om__asm_tree *t, uint32_t parent, uint32_t cell, uint32_t benefit);
+/* Whether om__asm_make could take a node not used in the last frame now (its first
+ * way to replace one): false when every node in the tree was. */
+bool om__asm_lru_spare(om__asm_tree *t);
 
 /* The deepest node covering (u, v), given in base texels (x right, y down, both in
  * [0, tile)); also the texel inside it. Stamps every node on the way when `stamp`. */
@@ -313,6 +316,8 @@ typedef struct om__asm_acc {
     float *need;           /* count * cells^2: each cell's largest N_required */
     uint32_t *first;       /* the base's cells: 1 + the first sample (strip index) that
                               fell in the cell while it held no root tile, else 0 */
+    uint32_t *missed;      /* the base's cells: samples that fell in the cell once no
+                              root tile could be made for it (counted with `again`) */
 } om__asm_acc;
 
 #if OM_WITH_JOBS
@@ -327,7 +332,8 @@ bool om__asm_observe_jobs(om__asm_state *m, const om_strip *st);
 /* asm.c: observe's analysis of rows [y0, y0 + rows) of the strip into `a`, reading
  * the tree only. A sample whose base cell holds no root tile goes no further: its
  * term's g is set to 254 and the cell's first sample noted. With `again`, only those
- * samples (g put back to 255), once the root tiles are made. */
+ * samples (g put back to 255), once the root tiles are made; one whose cell still has
+ * none is counted in `missed`. */
 void om__asm_observe_rows(const om__asm_state *m, const om_strip *st, uint32_t y0, uint32_t rows,
                           const om__asm_acc *a, bool again);
 /* resolve's finish, by parts of the strip; false where there are no threads. */

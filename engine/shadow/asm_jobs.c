@@ -20,7 +20,12 @@
  * replaces nothing, so no use mark decides it); they are rendered as jobs, and the
  * samples that waited are analysed by bands in them. Where the pool would run short,
  * a replacement would depend on the use marks of the samples before it: that strip is
- * analysed a strip at a time instead (asm.c), nothing of the bands kept. */
+ * analysed a strip at a time instead (asm.c), nothing of the bands kept. Unless no
+ * node may be replaced at all (every node was used in the last frame: a full pool
+ * under a still view, whose root tiles come from free nodes alone, benefit 0): then
+ * the cells of the free nodes' first samples get them, as a strip at a time, every
+ * other cell gets none, and the samples that fell in those are counted in their
+ * cells, as root_tile counts them. */
 #include "shadow.h"
 #include "asm.h"
 
@@ -35,7 +40,7 @@ extern const om_method om__method_asm;
 /* A slot's scratch, in 32-bit words from its start: slot 0's starts with the table
  * of every slot's scratch (the others leave it unused). */
 typedef struct slot_layout {
-    size_t hdr, stamp, benefit, ben, need, first, sdepth, sid, cull, gbits, words;
+    size_t hdr, stamp, benefit, ben, need, first, missed, sdepth, sid, cull, gbits, words;
 } slot_layout;
 
 static void slot_layout_of(const om__asm_layout *l, uint32_t ntris, bool lean, slot_layout *o)
@@ -54,6 +59,8 @@ static void slot_layout_of(const om__asm_layout *l, uint32_t ntris, bool lean, s
     o->need = w;
     w += count * c2;
     o->first = w;
+    w += (size_t)l->base_cells * l->base_cells;
+    o->missed = w;
     w += (size_t)l->base_cells * l->base_cells;
     o->sdepth = w;
     w += t2;
@@ -80,6 +87,7 @@ static void acc_of(const slot_layout *sl, void *scratch, om__asm_acc *a)
     a->ben = w + sl->ben;
     a->need = (float *)(void *)(w + sl->need);
     a->first = w + sl->first;
+    a->missed = w + sl->missed;
 }
 
 /* om__pass.scratch: a slot's bytes; without a state, for the default settings (the
@@ -181,6 +189,9 @@ static void merge(om__asm_state *m, const slot_layout *sl, bool keep)
 {
     om__asm_tree *t = &m->tree;
     const uint32_t count = t->lay.count, c2 = t->lay.cells * t->lay.cells;
+    const uint32_t B2 = t->lay.base_cells * t->lay.base_cells;
+    om__asm_tile base;
+    om__asm_tile_of(t, OM__ASM_ROOT, &base);
     for (uint32_t j = 0; j < m->nslot; j++) {
         om__asm_acc a;
         acc_of(sl, m->slot[j], &a);
@@ -189,6 +200,10 @@ static void merge(om__asm_state *m, const slot_layout *sl, bool keep)
             m->straddling += a.hdr[1];
         }
         a.hdr[0] = a.hdr[1] = 0;
+        for (uint32_t c = 0; c < B2; c++) {
+            if (keep) base.ben[c] += a.missed[c];
+            a.missed[c] = 0;
+        }
         for (uint32_t w = 0; w < (count + 1 + 31) / 32; w++) {
             for (uint32_t bits = keep ? a.stamp[w] : 0; bits; bits &= bits - 1) {
                 const uint32_t i = w * 32 + om__ctz32(bits);
@@ -234,10 +249,11 @@ bool om__asm_observe_jobs(om__asm_state *m, const om_strip *st)
     nb = (st->rows + j.band - 1) / j.band;
     m->lend->run(m->lend, obs_fn, &j, nb);
     /* The empty base cells samples fell in, by their first sample (an insertion sort
-     * into the candidates' memory: at most as many as free nodes, or none are kept). */
+     * into the candidates' memory, which keeps as many as there are free nodes). */
     const uint32_t B2 = t->lay.base_cells * t->lay.base_cells, free = t->pool.count - t->pool.in_use;
     uint32_t *order = (uint32_t *)(void *)m->cand, *firsts = order + free, nn = 0;
-    bool fits = true;
+    bool fits = true, left = false;   /* left: a cell that gets no root tile */
+    int spare = -1;                   /* om__asm_lru_spare, asked once */
     for (uint32_t c = 0; c < B2 && fits; c++) {
         uint32_t f = 0;
         for (uint32_t s = 0; s < m->nslot; s++) {
@@ -247,9 +263,17 @@ bool om__asm_observe_jobs(om__asm_state *m, const om_strip *st)
             a.first[c] = 0;
         }
         if (!f) continue;
-        if (nn == free) {
-            fits = false;
-            break;
+        if (nn == free) {   /* more cells than free nodes */
+            if (spare < 0) spare = om__asm_lru_spare(t);
+            if (spare) {
+                fits = false;
+                break;
+            }
+            /* Nothing may be replaced: the cells of the free nodes' first samples get
+             * them, and every other cell none, whatever order; their samples count. */
+            left = true;
+            if (nn == 0 || f > firsts[nn - 1]) continue;
+            nn--;   /* the cell of the latest first gives its place up */
         }
         uint32_t k = nn++;
         for (; k > 0 && firsts[k - 1] > f; k--) {
@@ -272,13 +296,13 @@ bool om__asm_observe_jobs(om__asm_state *m, const om_strip *st)
         return false;
     }
     merge(m, &j.sl, true);
-    if (nn == 0) return true;
+    if (nn == 0 && !left) return true;
     uint32_t nm = 0;
     for (uint32_t k = 0; k < nn; k++) {   /* each from the free list: it cannot fail */
         const uint32_t made = om__asm_make(t, OM__ASM_ROOT, order[k], 0);
         if (made != OM__ASM_NONE) order[nm++] = made;
     }
-    (void)om__asm_render_list(m, order, nm);
+    if (nm) (void)om__asm_render_list(m, order, nm);
     j.again = true;
     m->lend->run(m->lend, obs_fn, &j, nb);
     merge(m, &j.sl, true);

@@ -262,6 +262,8 @@ static uint32_t benefit_victim(om__asm_tree *t, uint32_t parent)
     return best;
 }
 
+bool om__asm_lru_spare(om__asm_tree *t) { return lru_victim(t, OM__ASM_ROOT) != OM__ASM_NONE; }
+
 uint32_t om__asm_make(om__asm_tree *t, uint32_t parent, uint32_t cell, uint32_t benefit)
 {
     om__asm_tile pt;
