@@ -682,6 +682,77 @@ static void hybrid_map_lent(void)
     }
 }
 
+/* A large tile of hybrid's irregular pass (cut into regions) on three lent slots, its
+ * sort by parts and bands of the grid's rows among the jobs, against the same tile on
+ * the calling thread: the same samples in the same order in every cell, the same
+ * cells, blocks, terms and counts. Every exposed sample of the cloud-and-bar scene
+ * is a key (more than the two regions' samples a parallel sort needs). */
+static void hybrid_tile_lent(void)
+{
+    enum { W = 320, H = 240, N = W * H };
+    h_scene hs;
+    if (!h_scene_parse(&hs, h_cloud_bar)) return;
+    const om_method *m = om_method_find("hybrid");
+    om_method_cfg c = h_cfg("hybrid", "");
+    size_t mn, full;
+    om_diag d;
+    CHECK_OK(m->bytes(&c, &hs.s, W, H, &mn, &full));
+    void *mm = calloc(1, full), *state = NULL;
+    om_arena ma;
+    om_arena_init(&ma, mm, full, "method");
+    CHECK_OK(m->init(&state, &ma, &c, &hs.s, W, H, &d));
+    om_view v;
+    CHECK_OK(h_view(&v, &hs.s, 0.0f, W, H, &d));
+    uint32_t *depth = calloc(N, sizeof *depth), *id = calloc(N, sizeof *id);
+    om_sample *smp = calloc(N, sizeof *smp);
+    om_term *terms[2] = {calloc(N, sizeof(om_term)), calloc(N, sizeof(om_term))};
+    om_target tg = {W, H, 0, H, depth, id};
+    om_strip st = {W, H, 0, H, smp, terms[0]};
+    om__eye_pass_mark(&hs.s, &v, &tg, &st, NULL);
+    memcpy(terms[1], terms[0], N * sizeof(om_term));
+    CHECK_OK(m->begin(state, &v, &d));
+    CHECK_OK(m->build(state, &d));
+    const hybrid_state *hy = (const hybrid_state *)state;
+    const size_t tb = om__htile_bytes(N, hs.s.ntris);
+    unsigned char *mem[2] = {malloc(tb + 16), malloc(tb + 16)};   /* carved from 16 bytes on */
+    om__htile t[2];
+    lent3 h = {{NULL, NULL, NULL}};
+    const om__lend l = {lent_run, lent_run, &h, 3};
+    uint32_t n = 0;
+    for (int k = 0; k < 2; k++) {
+        unsigned char *at = mem[k] + (16 - (uintptr_t)mem[k] % 16) % 16;
+        memset(at, k ? 0x5A : 0xA5, tb);
+        om__htile_carve(&t[k], at, N, hs.s.ntris);
+        n = 0;
+        for (size_t i = 0; i < N; i++) {
+            om__lpoint p;
+            if ((terms[k][i].flags & OM_TERM_EXPOSED) && om__lspace_point(&hy->ls, &smp[i], &p))
+                om__hkey_put(&t[k].raw[n++], &p, i);
+        }
+        om_strip sk = {W, H, 0, H, smp, terms[k]};
+        om__htile_run(&hy->h, &t[k], n, &sk, k ? &l : NULL);
+    }
+    const uint32_t nc = t[0].cw * t[0].ch;
+    CHECK_MSG(n >= 2 * 8192 && t[0].nreg > 1, "hybrid tile: %u samples, %u regions", n, t[0].nreg);
+    CHECK(t[0].cw == t[1].cw && t[0].ch == t[1].ch && t[0].cs == t[1].cs && t[0].nreg == t[1].nreg);
+    CHECK(!memcmp(&t[0].box, &t[1].box, sizeof t[0].box));
+    CHECK_MSG(!memcmp(t[0].smp, t[1].smp, n * sizeof *t[0].smp), "hybrid tile: sorted samples differ");
+    CHECK(!memcmp(t[0].od, t[1].od, n * sizeof *t[0].od));
+    CHECK(!memcmp(t[0].cend, t[1].cend, nc * sizeof *t[0].cend) && !memcmp(t[0].oend, t[1].oend, nc * sizeof *t[0].oend));
+    CHECK(!memcmp(t[0].bzmax, t[1].bzmax, t[0].cbw * ((t[0].ch + 3) / 4) * sizeof *t[0].bzmax));
+    CHECK(t[0].setups == t[1].setups && t[0].tested == t[1].tested && t[0].regions == t[1].regions);
+    CHECK_MSG(!memcmp(terms[0], terms[1], N * sizeof(om_term)), "hybrid tile: terms differ");
+    for (int k = 0; k < 2; k++) {
+        free(mem[k]);
+        free(terms[k]);
+    }
+    free(depth);
+    free(id);
+    free(smp);
+    free(mm);
+    h_scene_free(&hs);
+}
+
 /* ---- izb: its tiles of exposed samples as jobs (om__pass), each with a pool of its
  * own from the frame arena. The same terms, pixels and counters for any number of jobs
  * and their order, whole frames and strips, one tile or many (izb.pool); a frame arena
@@ -816,6 +887,7 @@ void suite_threads(void)
     RUN(izb_pass);
     RUN(observe_lent);
     RUN(hybrid_map_lent);
+    RUN(hybrid_tile_lent);
     RUN(settings_by_bands);
     RUN(kept_ids);
 }

@@ -287,24 +287,6 @@ static void band_rows(void *user, uint32_t b, void *scratch)
                j->list + j->start[b], j->start[b + 1] - j->start[b]);
 }
 
-/* The counts into places, on the calling thread; false when the lists do not fit
- * `room` words. */
-static bool places(build_job *j, size_t room)
-{
-    const uint32_t n = j->n;
-    uint64_t sum = 0;
-    for (uint32_t b = 0; b < n; b++) {
-        j->start[b] = (uint32_t)sum;
-        for (uint32_t p = 0; p < n; p++) {
-            const uint32_t c = j->at[(size_t)p * n + b];
-            j->at[(size_t)p * n + b] = (uint32_t)sum;
-            sum += c;
-        }
-    }
-    j->start[n] = (uint32_t)sum;
-    return sum <= room;
-}
-
 /* The map by bands, about four a thread taken as threads come free (the rows' cost
  * follows the scene); false where the tile has no room for the lists (small scenes,
  * whose build is short). */
@@ -322,7 +304,7 @@ static bool build_bands(hybrid_state *m)
     j.start = j.at + (size_t)j.n * j.n;
     j.list = j.start + j.n + 1;
     m->lend->run_any(m->lend, reach_part, &j, j.n);
-    if (!places(&j, words - table)) return false;
+    if (om__hplaces(j.at, j.n, j.n, j.start) > words - table) return false;   /* the lists do not fit */
     m->lend->run_any(m->lend, list_part, &j, j.n);
     m->lend->run_any(m->lend, band_rows, &j, j.n);
     return true;

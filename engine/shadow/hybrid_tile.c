@@ -118,32 +118,44 @@ static void fit_cells(om__htile *t, uint32_t n)
     t->cbw = (t->cw + BLOCK - 1) / BLOCK;
 }
 
+/* The bounds and farthest depth of keys [i0, i1) of q into *x (none: empty bounds). */
+static void box_of(const om__hkey *q, uint32_t i0, uint32_t i1, om__lvbox *x)
+{
+    x->lox = x->loy = INT32_MAX;
+    x->hix = x->hiy = INT32_MIN;
+    x->z = 0;
+    for (uint32_t i = i0; i < i1; i++) {
+        if (q[i].x < x->lox) x->lox = q[i].x;
+        if (q[i].x > x->hix) x->hix = q[i].x;
+        if (q[i].y < x->loy) x->loy = q[i].y;
+        if (q[i].y > x->hiy) x->hiy = q[i].y;
+        if (q[i].z > x->z) x->z = q[i].z;
+    }
+}
+
+/* A sample's cell in the grid, and its block in *b. */
+static inline uint32_t cell_of(const om__htile *t, const om__hkey *q, uint32_t *b)
+{
+    const uint32_t cx = (uint32_t)(q->x - t->ox) >> t->cs, cy = (uint32_t)(q->y - t->oy) >> t->cs;
+    *b = cy / BLOCK * t->cbw + cx / BLOCK;
+    return cy * t->cw + cx;
+}
+
 /* Sorts the tile's n samples by cell (a counting sort through cend, stable: strip
  * order within a cell), notes each block's farthest depth and clears their optical
  * depths. */
 static void sort_tile(om__htile *t, uint32_t n)
 {
-    om__lvbox *x = &t->box;
-    x->lox = x->loy = INT32_MAX;
-    x->hix = x->hiy = INT32_MIN;
-    x->z = 0;
-    for (uint32_t i = 0; i < n; i++) {
-        const om__hkey *q = &t->raw[i];
-        if (q->x < x->lox) x->lox = q->x;
-        if (q->x > x->hix) x->hix = q->x;
-        if (q->y < x->loy) x->loy = q->y;
-        if (q->y > x->hiy) x->hiy = q->y;
-        if (q->z > x->z) x->z = q->z;
-    }
+    box_of(t->raw, 0, n, &t->box);
     fit_cells(t, n);
     const size_t nc = (size_t)t->cw * t->ch;
     memset(t->bzmax, 0, (size_t)t->cbw * ((t->ch + BLOCK - 1) / BLOCK) * sizeof *t->bzmax);
     memset(t->cend, 0, nc * sizeof *t->cend);
     memset(t->od, 0, (size_t)n * sizeof *t->od);
     for (uint32_t i = 0; i < n; i++) {
+        uint32_t b;
         const om__hkey *q = &t->raw[i];
-        const uint32_t cx = (uint32_t)(q->x - t->ox) >> t->cs, cy = (uint32_t)(q->y - t->oy) >> t->cs;
-        const uint32_t c = cy * t->cw + cx, b = cy / BLOCK * t->cbw + cx / BLOCK;
+        const uint32_t c = cell_of(t, q, &b);
         t->cell[i] = c;
         t->cend[c]++;
         if (q->z > t->bzmax[b]) t->bzmax[b] = q->z;
@@ -156,6 +168,132 @@ static void sort_tile(om__htile *t, uint32_t n)
     }
     for (uint32_t i = 0; i < n; i++) t->smp[t->cend[t->cell[i]]++] = t->raw[i];   /* starts -> ends */
     memcpy(t->oend, t->cend, nc * sizeof *t->oend);   /* every sample open */
+}
+
+#if OM_WITH_JOBS
+/* ---- sort_tile on the host's threads, for a large tile run in the plan (hybrid.c):
+ * the same order. Parts of the raw samples find their bounds; then count their
+ * samples into bands of the grid's rows of blocks and copy them, in their order, to
+ * their band's place in smp; each band then sorts its samples by cell into raw and
+ * back (its cells and blocks are its own: a stable counting sort, as sort_tile's, over
+ * a range of cells). The counts and places live in the tile's `at`, unused until its
+ * candidates. */
+#define SORT_PARTS 16u
+typedef char sort_table_fits[SORT_PARTS * (SORT_PARTS + 1) + 1 <= OM__HTILE_PARTS * (OM__HTILE_REGIONS + 2) ? 1 : -1];
+
+typedef struct sort_job {
+    om__htile *t;
+    uint32_t n, parts, bands, brows;   /* brows: the grid's rows of blocks */
+    uint32_t *cnt, *start;             /* parts x bands (then places), bands + 1 */
+    om__lvbox box[SORT_PARTS];
+} sort_job;
+
+static uint32_t sort_first(const sort_job *j, uint32_t p) { return (uint32_t)((uint64_t)j->n * p / j->parts); }
+
+static uint32_t band_of(const sort_job *j, const om__hkey *q)
+{
+    const uint32_t br = ((uint32_t)(q->y - j->t->oy) >> j->t->cs) / BLOCK;
+    return (uint32_t)((((uint64_t)br + 1) * j->bands - 1) / j->brows);
+}
+
+static void box_part(void *user, uint32_t p, void *scratch)
+{
+    (void)scratch;
+    sort_job *j = (sort_job *)user;
+    box_of(j->t->raw, sort_first(j, p), sort_first(j, p + 1), &j->box[p]);
+}
+
+static void count_part(void *user, uint32_t p, void *scratch)
+{
+    (void)scratch;
+    const sort_job *j = (const sort_job *)user;
+    uint32_t *cnt = j->cnt + (size_t)p * j->bands;
+    memset(cnt, 0, j->bands * sizeof *cnt);
+    for (uint32_t i = sort_first(j, p); i < sort_first(j, p + 1); i++) cnt[band_of(j, &j->t->raw[i])]++;
+}
+
+static void move_part(void *user, uint32_t p, void *scratch)
+{
+    (void)scratch;
+    const sort_job *j = (const sort_job *)user;
+    uint32_t *at = j->cnt + (size_t)p * j->bands;
+    for (uint32_t i = sort_first(j, p); i < sort_first(j, p + 1); i++)
+        j->t->smp[at[band_of(j, &j->t->raw[i])]++] = j->t->raw[i];
+}
+
+static void sort_band(void *user, uint32_t b, void *scratch)
+{
+    (void)scratch;
+    const sort_job *j = (const sort_job *)user;
+    om__htile *t = j->t;
+    const uint32_t br0 = (uint32_t)((uint64_t)j->brows * b / j->bands), br1 = (uint32_t)((uint64_t)j->brows * (b + 1) / j->bands);
+    const uint32_t c0 = br0 * BLOCK * t->cw, c1 = (br1 * BLOCK < t->ch ? br1 * BLOCK : t->ch) * t->cw;
+    const uint32_t s0 = j->start[b], s1 = j->start[b + 1];
+    memset(t->bzmax + (size_t)br0 * t->cbw, 0, (size_t)(br1 - br0) * t->cbw * sizeof *t->bzmax);
+    memset(t->cend + c0, 0, (size_t)(c1 - c0) * sizeof *t->cend);
+    memset(t->od + s0, 0, (size_t)(s1 - s0) * sizeof *t->od);
+    for (uint32_t i = s0; i < s1; i++) {
+        uint32_t k;
+        const om__hkey *q = &t->smp[i];
+        t->cend[cell_of(t, q, &k)]++;
+        if (q->z > t->bzmax[k]) t->bzmax[k] = q->z;
+    }
+    uint32_t sum = s0;
+    for (uint32_t c = c0; c < c1; c++) {   /* counts -> starts */
+        const uint32_t k = t->cend[c];
+        t->cend[c] = sum;
+        sum += k;
+    }
+    for (uint32_t i = s0; i < s1; i++) {   /* starts -> ends */
+        uint32_t k;
+        t->raw[t->cend[cell_of(t, &t->smp[i], &k)]++] = t->smp[i];
+    }
+    memcpy(t->smp + s0, t->raw + s0, (size_t)(s1 - s0) * sizeof *t->smp);
+    memcpy(t->oend + c0, t->cend + c0, (size_t)(c1 - c0) * sizeof *t->oend);   /* every sample open */
+}
+
+static void sort_parts(om__htile *t, uint32_t n, const om__lend *l)
+{
+    sort_job j;
+    j.t = t;
+    j.n = n;
+    j.parts = 4 * l->slots < SORT_PARTS ? 4 * l->slots : SORT_PARTS;
+    l->run_any(l, box_part, &j, j.parts);
+    om__lvbox *x = &t->box;
+    *x = j.box[0];
+    for (uint32_t p = 1; p < j.parts; p++) {
+        const om__lvbox *y = &j.box[p];
+        if (y->lox < x->lox) x->lox = y->lox;
+        if (y->hix > x->hix) x->hix = y->hix;
+        if (y->loy < x->loy) x->loy = y->loy;
+        if (y->hiy > x->hiy) x->hiy = y->hiy;
+        if (y->z > x->z) x->z = y->z;
+    }
+    fit_cells(t, n);
+    j.brows = (t->ch + BLOCK - 1) / BLOCK;
+    j.bands = j.parts < j.brows ? j.parts : j.brows;
+    j.cnt = t->at;
+    j.start = t->at + (size_t)j.parts * j.bands;
+    l->run_any(l, count_part, &j, j.parts);
+    (void)om__hplaces(j.cnt, j.parts, j.bands, j.start);
+    l->run_any(l, move_part, &j, j.parts);
+    l->run_any(l, sort_band, &j, j.bands);
+}
+#endif
+
+uint64_t om__hplaces(uint32_t *cnt, uint32_t parts, uint32_t bins, uint32_t *start)
+{
+    uint64_t sum = 0;
+    for (uint32_t b = 0; b < bins; b++) {
+        start[b] = (uint32_t)sum;
+        for (uint32_t p = 0; p < parts; p++) {
+            const uint32_t c = cnt[(size_t)p * bins + b];
+            cnt[(size_t)p * bins + b] = (uint32_t)sum;
+            sum += c;
+        }
+    }
+    start[bins] = (uint32_t)sum;
+    return sum;
 }
 
 /* The cells a grid box reaches (one that meets the tile's bounds): clamped to the
@@ -380,10 +518,16 @@ static void cut_regions(om__htile *t)
  * than one, the candidates' parts (any order, or at once); the regions (any order, or
  * at once: each writes its own samples' terms); end (adds the regions' counts up in
  * their order). */
-static uint32_t tile_begin(om__htile *t, uint32_t n)
+static uint32_t tile_begin(om__htile *t, uint32_t n, const om__lend *l)
 {
     t->n = n;
+#if OM_WITH_JOBS
+    if (l && t->cand && n >= 2 * REGION_SAMPLES) sort_parts(t, n, l);
+    else sort_tile(t, n);
+#else
+    (void)l;
     sort_tile(t, n);
+#endif
     cut_regions(t);
     return t->nreg;
 }
@@ -544,7 +688,7 @@ static void run_parts(const om__lend *l, region_job *j, uint32_t n)
 
 void om__htile_run(const om__hscene *h, om__htile *t, uint32_t n, const om_strip *st, const om__lend *l)
 {
-    const uint32_t nreg = tile_begin(t, n);
+    const uint32_t nreg = tile_begin(t, n, l);
     region_job j = {h, t, st, false};
     if (nreg > 1) run_parts(l, &j, OM__HTILE_PARTS);
     j.regions = true;
