@@ -561,13 +561,15 @@ static uint32_t starts_here(hybrid_state *m, const om_strip *st)
 }
 
 /* ---- the same on the lent threads, in `parts` parts of the strip's samples (about
- * four a thread): each part counts its marked samples, and the counts say where each
- * tile begins and where each part's keys go in a tile. A part writes the keys of its
- * samples that fall in the tile, in their order, where its first one goes; a sample
- * whose projection fails (none: the bands marked it after the same projection) would
- * leave a gap, closed after. So the same keys as tile_keys, in the same order. The
- * tiles run one after another, each writing its samples' terms: a part scans from the
- * tile's start on. */
+ * sixteen a thread, up to 64, taken as threads come free: a strip's uncertain samples
+ * bunch up, and with four a thread on two threads one part held half the keys' work
+ * on the default scene): each part counts its marked samples, and the counts say
+ * where each tile begins and where each part's keys go in a tile. A part writes the
+ * keys of its samples that fall in the tile, in their order, where its first one goes;
+ * a sample whose projection fails (none: the bands marked it after the same
+ * projection) would leave a gap, closed after. So the same keys as tile_keys, in the
+ * same order. The tiles run one after another, each writing its samples' terms: a
+ * part scans from the tile's start on. */
 typedef struct key_job {
     hybrid_state *m;
     const om_strip *st;
@@ -652,7 +654,7 @@ static uint32_t keys_by_parts(hybrid_state *m, const om_strip *st, uint32_t part
 static uint32_t hybrid_pass_plan(void *state, om_strip *st)
 {
     hybrid_state *m = (hybrid_state *)state;
-    const uint32_t want = m->lend ? 4 * m->lend->slots : 0;
+    const uint32_t want = m->lend ? 16 * m->lend->slots : 0;
     const uint32_t parts = want < OM__HYBRID_PARTS ? want : OM__HYBRID_PARTS;
     const uint32_t k = parts ? starts_by_parts(m, st, parts) : starts_here(m, st);
     if (!m->cands || !m->lend || k >= 2 * m->lend->slots) return m->ntiles = k;

@@ -251,18 +251,19 @@ static uint32_t band_of(const build_job *j, uint32_t y)
 
 static uint32_t part_of(const build_job *j, uint32_t k) { return (uint32_t)((uint64_t)j->m->scene->ntris * k / j->n); }
 
-/* Part k's reach and counts. */
+/* Part k's reach and counts (on a copy of its row of the table, whose rows share
+ * cache lines, as list_part's places). */
 static void reach_part(void *user, uint32_t k, void *scratch)
 {
     (void)scratch;
     const build_job *j = (const build_job *)user;
-    uint32_t *at = j->at + (size_t)k * j->n;
-    memset(at, 0, j->n * sizeof *at);
+    uint32_t at[MOST_BANDS] = {0};
     for (uint32_t t = part_of(j, k); t < part_of(j, k + 1); t++) {
         const uint32_t r = j->reach[t] = reach_of(j->m, t);
         if (r != NONE)
             for (uint32_t b = band_of(j, r & 0xFFFFu); b <= band_of(j, r >> 16); b++) at[b]++;
     }
+    memcpy(j->at + (size_t)k * j->n, at, j->n * sizeof *at);
 }
 
 /* Part k's triangles into the bands' lists, at its places. */
@@ -270,7 +271,8 @@ static void list_part(void *user, uint32_t k, void *scratch)
 {
     (void)scratch;
     const build_job *j = (const build_job *)user;
-    uint32_t *at = j->at + (size_t)k * j->n;
+    uint32_t at[MOST_BANDS];
+    memcpy(at, j->at + (size_t)k * j->n, j->n * sizeof *at);
     for (uint32_t t = part_of(j, k); t < part_of(j, k + 1); t++) {
         const uint32_t r = j->reach[t];
         if (r != NONE)
@@ -287,12 +289,13 @@ static void band_rows(void *user, uint32_t b, void *scratch)
                j->list + j->start[b], j->start[b + 1] - j->start[b]);
 }
 
-/* The map by bands, about four a thread taken as threads come free (the rows' cost
- * follows the scene); false where the tile has no room for the lists (small scenes,
- * whose build is short). */
+/* The map by bands, about sixteen a thread (up to MOST_BANDS) taken as threads come
+ * free: the rows' cost follows the scene (with four a thread on two threads, one band
+ * held two thirds of the default scene's build). False where the tile has no room for
+ * the lists (small scenes, whose build is short). */
 static bool build_bands(hybrid_state *m)
 {
-    const uint32_t want = 4 * m->lend->slots;
+    const uint32_t want = 16 * m->lend->slots;
     build_job j;
     j.m = m;
     j.n = want < MOST_BANDS ? want : MOST_BANDS;

@@ -203,20 +203,23 @@ static void box_part(void *user, uint32_t p, void *scratch)
     box_of(j->t->raw, sort_first(j, p), sort_first(j, p + 1), &j->box[p]);
 }
 
+/* Both count and move on a copy of the part's row of the table: the rows of two parts
+ * share cache lines. */
 static void count_part(void *user, uint32_t p, void *scratch)
 {
     (void)scratch;
     const sort_job *j = (const sort_job *)user;
-    uint32_t *cnt = j->cnt + (size_t)p * j->bands;
-    memset(cnt, 0, j->bands * sizeof *cnt);
+    uint32_t cnt[SORT_PARTS] = {0};
     for (uint32_t i = sort_first(j, p); i < sort_first(j, p + 1); i++) cnt[band_of(j, &j->t->raw[i])]++;
+    memcpy(j->cnt + (size_t)p * j->bands, cnt, j->bands * sizeof *cnt);
 }
 
 static void move_part(void *user, uint32_t p, void *scratch)
 {
     (void)scratch;
     const sort_job *j = (const sort_job *)user;
-    uint32_t *at = j->cnt + (size_t)p * j->bands;
+    uint32_t at[SORT_PARTS];
+    memcpy(at, j->cnt + (size_t)p * j->bands, j->bands * sizeof *at);
     for (uint32_t i = sort_first(j, p); i < sort_first(j, p + 1); i++)
         j->t->smp[at[band_of(j, &j->t->raw[i])]++] = j->t->raw[i];
 }
@@ -257,7 +260,7 @@ static void sort_parts(om__htile *t, uint32_t n, const om__lend *l)
     sort_job j;
     j.t = t;
     j.n = n;
-    j.parts = 4 * l->slots < SORT_PARTS ? 4 * l->slots : SORT_PARTS;
+    j.parts = SORT_PARTS;   /* as many as the table holds: bands of uneven cost */
     l->run_any(l, box_part, &j, j.parts);
     om__lvbox *x = &t->box;
     *x = j.box[0];
