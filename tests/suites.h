@@ -23,6 +23,7 @@
     X(suite_hybrid) \
     X(suite_settings) \
     X(suite_threads) \
+    X(suite_lent) \
     /* end of list */
 #endif
 #define X(suite) void suite(void);
