@@ -107,11 +107,14 @@ void om__htile_carve(om__htile *t, void *mem, uint32_t cap, uint32_t cands);
  * into regions. */
 void om__htile_run(const om__hscene *h, om__htile *t, uint32_t n, const om_strip *st, const om__lend *l);
 
-/* Counts into places, for work cut into parts (rows of cnt) that each send items to
- * bins (its columns), every bin's items laid out in the bins' order and within a bin
- * in the parts' order: each count becomes where that part's first item in that bin
- * goes, start[b] where bin b begins and start[bins] the total, returned (start's
- * values are that total's low 32 bits where it is larger). */
+/* With the host's threads (the map's bands, a tile's sort): counts into places, for
+ * work cut into parts (rows of cnt) that each send items to bins (its columns), every
+ * bin's items laid out in the bins' order and within a bin in the parts' order: each
+ * count becomes where that part's first item in that bin goes, start[b] where bin b
+ * begins and start[bins] the total, returned (start's values are that total's low 32
+ * bits where it is larger). */
+#if OM_WITH_JOBS
 uint64_t om__hplaces(uint32_t *cnt, uint32_t parts, uint32_t bins, uint32_t *start);
+#endif
 
 #endif

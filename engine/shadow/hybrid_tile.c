@@ -282,7 +282,6 @@ static void sort_parts(om__htile *t, uint32_t n, const om__lend *l)
     l->run_any(l, move_part, &j, j.parts);
     l->run_any(l, sort_band, &j, j.bands);
 }
-#endif
 
 uint64_t om__hplaces(uint32_t *cnt, uint32_t parts, uint32_t bins, uint32_t *start)
 {
@@ -298,6 +297,7 @@ uint64_t om__hplaces(uint32_t *cnt, uint32_t parts, uint32_t bins, uint32_t *sta
     start[bins] = (uint32_t)sum;
     return sum;
 }
+#endif
 
 /* The cells a grid box reaches (one that meets the tile's bounds): clamped to the
  * bounds first, so the shifts are of 32 bits. */
