@@ -586,7 +586,7 @@ static void count_part(void *user, uint32_t p, void *scratch)
     (void)scratch;
     const key_job *j = (const key_job *)user;
     uint32_t c = 0;
-    for (size_t i = part_first(j, p); i < part_first(j, p + 1); i++) c += left_open(&j->st->terms[i]);
+    for (size_t i = part_first(j, p), end = part_first(j, p + 1); i < end; i++) c += left_open(&j->st->terms[i]);
     j->m->part_marked[p + 1] = c;
 }
 
@@ -617,13 +617,16 @@ static void keys_part(void *user, uint32_t p, void *scratch)
     hybrid_state *m = j->m;
     const uint32_t lo = j->tile * m->cap, hi = lo + m->cap;
     size_t i = part_first(j, p);
+    const size_t end = part_first(j, p + 1);
     uint32_t rank = m->part_marked[p], put = 0;
     if (i < m->starts[j->tile]) {   /* the earlier tiles' samples are no longer marked */
         i = m->starts[j->tile];
         rank = lo;
     }
+    m->part_put[p] = 0;
+    if (rank >= hi) return;   /* a later tile's part */
     om__hkey *raw = m->tile.raw + (rank - lo);
-    for (; i < part_first(j, p + 1) && rank < hi; i++) {
+    for (; i < end && rank < hi; i++) {
         om__lpoint pt;
         if (!left_open(&j->st->terms[i]) || rank++ < lo) continue;
         if (om__lspace_point(&m->ls, &j->st->samples[i], &pt)) om__hkey_put(&raw[put++], &pt, i);

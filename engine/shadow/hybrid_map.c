@@ -258,7 +258,7 @@ static void reach_part(void *user, uint32_t k, void *scratch)
     (void)scratch;
     const build_job *j = (const build_job *)user;
     uint32_t at[MOST_BANDS] = {0};
-    for (uint32_t t = part_of(j, k); t < part_of(j, k + 1); t++) {
+    for (uint32_t t = part_of(j, k), end = part_of(j, k + 1); t < end; t++) {
         const uint32_t r = j->reach[t] = reach_of(j->m, t);
         if (r != NONE)
             for (uint32_t b = band_of(j, r & 0xFFFFu); b <= band_of(j, r >> 16); b++) at[b]++;
@@ -273,7 +273,7 @@ static void list_part(void *user, uint32_t k, void *scratch)
     const build_job *j = (const build_job *)user;
     uint32_t at[MOST_BANDS];
     memcpy(at, j->at + (size_t)k * j->n, j->n * sizeof *at);
-    for (uint32_t t = part_of(j, k); t < part_of(j, k + 1); t++) {
+    for (uint32_t t = part_of(j, k), end = part_of(j, k + 1); t < end; t++) {
         const uint32_t r = j->reach[t];
         if (r != NONE)
             for (uint32_t b = band_of(j, r & 0xFFFFu); b <= band_of(j, r >> 16); b++) j->list[at[b]++] = t;

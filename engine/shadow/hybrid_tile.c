@@ -210,7 +210,7 @@ static void count_part(void *user, uint32_t p, void *scratch)
     (void)scratch;
     const sort_job *j = (const sort_job *)user;
     uint32_t cnt[SORT_PARTS] = {0};
-    for (uint32_t i = sort_first(j, p); i < sort_first(j, p + 1); i++) cnt[band_of(j, &j->t->raw[i])]++;
+    for (uint32_t i = sort_first(j, p), end = sort_first(j, p + 1); i < end; i++) cnt[band_of(j, &j->t->raw[i])]++;
     memcpy(j->cnt + (size_t)p * j->bands, cnt, j->bands * sizeof *cnt);
 }
 
@@ -220,7 +220,7 @@ static void move_part(void *user, uint32_t p, void *scratch)
     const sort_job *j = (const sort_job *)user;
     uint32_t at[SORT_PARTS];
     memcpy(at, j->cnt + (size_t)p * j->bands, j->bands * sizeof *at);
-    for (uint32_t i = sort_first(j, p); i < sort_first(j, p + 1); i++)
+    for (uint32_t i = sort_first(j, p), end = sort_first(j, p + 1); i < end; i++)
         j->t->smp[at[band_of(j, &j->t->raw[i])]++] = j->t->raw[i];
 }
 
