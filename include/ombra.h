@@ -408,7 +408,11 @@ typedef uint64_t (*om_clock_fn)(void *user);
  * The jobs write disjoint memory the engine carved from its arenas and take no locks:
  * the host needs no allocation and no locks beyond its own (to hand out and join the
  * jobs). Frames, masks and method counters are bit-identical whatever the thread count
- * and whatever order the jobs run in. NULL runs every job inline, in order. */
+ * and whatever order the jobs run in. NULL runs every job inline, in order. Most of a
+ * frame's calls are bands of rows in row order; a host that gives each of its threads
+ * the same contiguous share of the indices on every call, then lets a thread that
+ * finishes early take jobs from the others' ends, keeps a band's rows in one thread's
+ * caches from stage to stage (the platform's om_jobs_for does so). */
 typedef void (*om_job_fn)(void *job_user, uint32_t i);
 typedef void (*om_parallel_for_fn)(void *host, om_job_fn fn, void *job_user, uint32_t n);
 /* Optional beside the parallel-for: worker(host), called from inside a job, returns the

@@ -204,8 +204,8 @@ static void eye_rows(const frame_ctx *c, const om_target *tg, om_strip *st, bool
 }
 
 /* Whether stage sg is an eye pass that rasterizes by bands (each sets up every
- * triangle that reaches its rows): it takes bands of band_rows, heaviest first
- * (order_bands); every other stage fine bands, in row order. */
+ * triangle that reaches its rows): it takes bands of band_rows; every other stage fine
+ * bands. */
 static bool rasters(const frame_ctx *c, stage sg)
 {
     return sg == STAGE_PREPARE && c->eye && !c->half_depth && !(c->ids && c->ids_have);
@@ -286,8 +286,7 @@ static void band_job(void *user, uint32_t b)
                             (uint32_t)((uint64_t)n * (b + 1) / k));
         return;
     }
-    if (c->stage == STAGE_BUILD || c->stage == STAGE_PREPARE)   /* see order_bands */
-        b = c->slots[b].run;
+    if (c->stage == STAGE_BUILD) b = c->slots[b].run;   /* see order_bands */
     if (c->stage == STAGE_BUILD) {
         uint32_t y0 = b * c->map_band, rows = c->map_size - y0;
         c->bands->build_rows(fd->method_state, c->map_bins.rows ? &c->map_bins : NULL, y0,
@@ -353,17 +352,18 @@ static void band_job(void *user, uint32_t b)
 /* At most this many triangles' rows are read to weigh the bands (order_bands). */
 #define ORDER_SAMPLES 1024
 
-/* The order the `nb` bands of `band` rows from row y0 run in (slots[k].run): the
+/* The order the map build's `nb` bands of `band` rows run in (slots[k].run): the
  * heaviest first, weighed by the triangles whose bins' rows reach each (every
  * ntris / ORDER_SAMPLES + 1-th triangle, on the calling thread), ties in row order;
- * in row order without rows. A host hands jobs out in order, and a heavy band that
- * comes last keeps one thread busy while the others wait (a scene whose triangles
- * crowd a few rows: issue 26's random cloud); longest first is the classic cure.
- * Only the stages whose work the weights measure take this order: the eye pass
- * and the map's build; a method's resolve runs in row order (its cost follows its
- * own work, not the triangles: ref's rays at random 100K ran 3% slower ordered).
- * Which band a job runs changes when it finishes, never a pixel. */
-static void order_bands(frame_ctx *c, const uint32_t *rows, uint32_t y0, uint32_t band, uint32_t nb)
+ * in row order without rows. A heavy band that starts last keeps one thread busy while
+ * the others wait (a scene whose triangles crowd a few rows: issue 26's random cloud);
+ * longest first is the classic cure. The strip's stages run in row order instead: a
+ * host that gives each thread the same share of the indices on every call (platform's
+ * pool) then finds each band's rows in the cache of the thread that wrote them in the
+ * last stage, which the eye pass gains more from (the default scene at 1024x768: its
+ * bands took 17-20% more CPU time on two threads than on one when heaviest first, none
+ * more in row order). Which band a job runs changes when it finishes, never a pixel. */
+static void order_bands(frame_ctx *c, const uint32_t *rows, uint32_t band, uint32_t nb)
 {
     job_slot *sl = c->slots;
     for (uint32_t k = 0; k < nb; k++) {
@@ -371,12 +371,12 @@ static void order_bands(frame_ctx *c, const uint32_t *rows, uint32_t y0, uint32_
         sl[k].weight = 0;
     }
     if (!rows || nb <= c->jobs) return;
-    const uint32_t nt = c->fd->scene->ntris, step = nt / ORDER_SAMPLES + 1, y1 = y0 + band * nb;
+    const uint32_t nt = c->fd->scene->ntris, step = nt / ORDER_SAMPLES + 1, y1 = band * nb;
     for (uint32_t t = 0; t < nt; t += step) {
         uint32_t r0 = rows[t] & 0xFFFFu, r1 = rows[t] >> 16;
-        if (r0 > r1 || r1 < y0 || r0 >= y1) continue;
-        r0 = r0 < y0 ? 0 : (r0 - y0) / band;
-        r1 = r1 >= y1 ? nb - 1 : (r1 - y0) / band;
+        if (r0 > r1 || r0 >= y1) continue;
+        r0 /= band;
+        r1 = r1 >= y1 ? nb - 1 : r1 / band;
         for (uint32_t k = r0; k <= r1; k++) sl[k].weight++;
     }
     for (uint32_t k = 1; k < nb; k++) {   /* insertion sort of the runs, stable */
@@ -429,7 +429,7 @@ static void build_map(frame_ctx *c)
     c->map_band = ((c->map_size + n - 1) / n + 15) / 16 * 16;
     const uint32_t nb = (c->map_size + c->map_band - 1) / c->map_band;
     for (uint32_t j = 0; j < nb; j++) memset(c->slots[j].counts, 0, sizeof c->slots[j].counts);
-    order_bands(c, c->map_bins.rows, 0, c->map_band, nb);
+    order_bands(c, c->map_bins.rows, c->map_band, nb);
     run_stage(c, STAGE_BUILD, nb);
     uint32_t sum[8] = {0};
     for (uint32_t j = 0; j < nb; j++)
@@ -575,8 +575,6 @@ static void prepare(frame_ctx *c, bool eye, bool mark, om_frame_stats *fs)
             run_stage(c, STAGE_EYE_HALF, c->eye_parts);
             run_bands(c, STAGE_EYE_MERGE);
         }
-        order_bands(c, rasters(c, STAGE_PREPARE) && c->bins ? c->bins->rows : NULL, c->strip.y0,
-                    stage_rows(c, STAGE_PREPARE), stage_bands(c, STAGE_PREPARE));
         run_bands(c, STAGE_PREPARE);
     } else {
         if (eye) eye_rows(c, &c->tg, &c->strip, mark);
