@@ -711,8 +711,10 @@ om_status om_render_frame(const om_frame_desc *fd, om_arena *fa, om_frame_stats 
     }
     if (single && OM_WITH_JOBS && c.jobs == 2 && (uint64_t)s->nverts * HALVES_PIXELS > n) {
         /* the second half's depth and ids in the samples (8 bytes of a sample's 32),
-         * which the eye pass writes once the halves are merged */
-        c.half_depth = (uint32_t *)ps;
+         * which the eye pass writes once the halves are merged: in the last quarter,
+         * the samples of the last rows, which the thread that draws the second half
+         * resolves where each thread has its own chunk of the bands (om_jobs_for) */
+        c.half_depth = (uint32_t *)ps + n * (sizeof(om_sample) / sizeof(uint32_t) - 2);
         c.half_id = c.half_depth + n;
         c.eye_parts = fd->worker && fd->threads == 2 ? EYE_PARTS : 2;
     } else if (single && OM_WITH_JOBS && c.jobs > 1) {
