@@ -411,7 +411,7 @@ typedef uint64_t (*om_clock_fn)(void *user);
  * and whatever order the jobs run in. NULL runs every job inline, in order. Most of a
  * frame's calls are bands of rows in row order; a host that gives each of its threads
  * the same contiguous share of the indices on every call, then lets a thread that
- * finishes early take jobs from the others' ends, keeps a band's rows in one thread's
+ * finishes early take the others' next jobs, keeps a band's rows in one thread's
  * caches from stage to stage (the platform's om_jobs_for does so). */
 typedef void (*om_job_fn)(void *job_user, uint32_t i);
 typedef void (*om_parallel_for_fn)(void *host, om_job_fn fn, void *job_user, uint32_t n);
