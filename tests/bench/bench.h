@@ -58,6 +58,7 @@ int bench_run_hooked(const bscene *b, const char *method, const om_method_cfg *c
     X(bench_spsm) \
     X(bench_hybrid) \
     X(bench_threads) \
+    X(bench_calls) \
     X(bench_serial) \
     /* end of list */
 #define X(name) void name(void);
