@@ -11,7 +11,7 @@
  * frame) in its own caches. Handed out in one queue, a band's samples were written
  * by one thread and shaded by the other about half the time: on the 2-CPU machine the
  * eye pass's bands took 10-20% more CPU time on two threads than on one, and 0-6%
- * this way (issue 26; tools' per-call profile at 1024x768). The next job, not the
+ * this way (issue 26; `build/bench calls`, 1024x768). The next job, not the
  * last: the chunks' remainder then runs in index order, as from one queue, so jobs of
  * uneven cost end as they would there (izb's tiles on the default scene, the heavy ones
  * first on screen: 0.96-0.99 of the two CPUs' ideal from one queue, 0.87-0.90 taking
@@ -50,8 +50,9 @@ struct om_jobs {
     pthread_cond_t go, done;
     pthread_t *workers;
     uint32_t nworkers;
-    /* the current call: fn(user, i) for i in [next, n); `busy` workers are inside it.
-     * call, busy and quit are written under mu and read by spinners without it. */
+    /* the current call: fn(user, i) for the i left in the threads' chunks; `busy`
+     * workers are inside it. call, busy and quit are written under mu and read by
+     * spinners without it. */
     om_job_fn fn;
     void *user;
     uint32_t left, busy;       /* jobs not yet begun; workers inside the call */

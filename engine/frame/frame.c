@@ -48,7 +48,7 @@ typedef struct job_slot {
     uint32_t counts[8];
     void *scratch;
     size_t dirty;   /* bytes of scratch its first job zeroes (a pass slot: band_job) */
-    uint32_t run;    /* the band that job k of a stage runs is slots[k].run (order_bands) */
+    uint32_t run;    /* the band that job k of the map build runs (order_bands) */
     uint32_t weight; /* order_bands' estimate of band k's work */
 } job_slot;
 
@@ -286,8 +286,8 @@ static void band_job(void *user, uint32_t b)
                             (uint32_t)((uint64_t)n * (b + 1) / k));
         return;
     }
-    if (c->stage == STAGE_BUILD) b = c->slots[b].run;   /* see order_bands */
     if (c->stage == STAGE_BUILD) {
+        b = c->slots[b].run;   /* see order_bands */
         uint32_t y0 = b * c->map_band, rows = c->map_size - y0;
         c->bands->build_rows(fd->method_state, c->map_bins.rows ? &c->map_bins : NULL, y0,
                              rows < c->map_band ? rows : c->map_band, c->slots[b].counts);
