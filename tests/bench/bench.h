@@ -47,6 +47,13 @@ int bench_run_hooked(const bscene *b, const char *method, const om_method_cfg *c
                      uint32_t H, float t, uint8_t *mask, mrun *out,
                      void (*hook)(void *state, mrun *out));
 
+/* Whether the calling thread can be pinned to CPU 0 and to CPU 1 (Linux, two CPUs
+ * online); it records the thread's CPUs for bench_pin(-1), so call it before pinning. */
+bool bench_pin_two(void);
+/* Pins the calling thread to `cpu`, or gives it back the CPUs bench_pin_two found
+ * with cpu < 0; false where it cannot. */
+bool bench_pin(int cpu);
+
 #define OM_BENCHES \
     X(bench_raster) \
     X(bench_raster_sweep) \

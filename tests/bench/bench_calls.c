@@ -11,14 +11,6 @@
  * from a thread left waiting. Medians over the rounds; each timed frame follows an
  * untimed one of its kind. A call that one thread skips (the halves' merge: one thread
  * draws every part into one target) reads 0 inline. */
-#if defined(__linux__)
-#define _GNU_SOURCE   /* pthread_setaffinity_np */
-#include <pthread.h>
-#include <sched.h>
-#define CAN_PIN 1
-#else
-#define CAN_PIN 0
-#endif
 #include "bench.h"
 
 #include <string.h>
@@ -80,20 +72,6 @@ static uint32_t rec_worker(void *h)
     return r->pool ? om_jobs_worker(r->pool) : 0;
 }
 
-#if CAN_PIN
-static cpu_set_t all_cpus;
-
-static int pin(int cpu)
-{
-    cpu_set_t m = all_cpus;
-    if (cpu >= 0) {
-        CPU_ZERO(&m);
-        CPU_SET(cpu, &m);
-    }
-    return pthread_setaffinity_np(pthread_self(), sizeof m, &m) == 0;
-}
-#endif
-
 /* Per kind (0, 1: inline on CPU 0, 1; 2: two threads), per call, per round. */
 typedef struct call_ms {
     double gap[3][MAX_CALLS][ROUNDS], sum[3][MAX_CALLS][ROUNDS], wall[MAX_CALLS][ROUNDS];
@@ -130,9 +108,10 @@ static void one_method(const bscene *b, const char *name, om_jobs *pool, bool pi
         for (int q = 0; q < kinds; q++) {
             int k = (q + (p < 0 ? 0 : p)) % kinds;
             if (!pinned && k == 1) k = 2;
-#if CAN_PIN
-            if (pinned) pin(k == 2 ? -1 : k);
-#endif
+            if (pinned && !bench_pin(k == 2 ? -1 : k)) {
+                printf("%-12s %-7s (a thread would not be pinned)\n", b->name, name);
+                goto out;
+            }
             r->pool = k == 2 ? pool : NULL;
             for (int rep = 0; rep < 2; rep++) {   /* the first settles */
                 om_arena fa;
@@ -186,9 +165,7 @@ static void one_method(const bscene *b, const char *name, om_jobs *pool, bool pi
         else printf("    -     -\n");
     }
 out:
-#if CAN_PIN
-    if (pinned) pin(-1);
-#endif
+    if (pinned) bench_pin(-1);
     free(mem);
     free(fmem);
     free(px);
@@ -198,11 +175,7 @@ void bench_calls(void)
 {
     om_jobs *pool = NULL;
     om_diag d;
-    bool pinned = false;
-#if CAN_PIN
-    pinned = om_cpus_online() >= 2 && pthread_getaffinity_np(pthread_self(), sizeof all_cpus, &all_cpus) == 0 &&
-             CPU_ISSET(0, &all_cpus) && CPU_ISSET(1, &all_cpus);
-#endif
+    const bool pinned = bench_pin_two();
     if (om_jobs_start(&pool, 2, &d) != OM_OK) {   /* before any pinning: its worker takes every CPU */
         printf("calls: no pool of two (%s)\n", d.msg);
         return;

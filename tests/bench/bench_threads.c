@@ -18,36 +18,12 @@
  * next one there), so each timed frame follows an untimed one of its kind, as a host
  * that renders frame after frame would run it. Every frame is checked to be the bits
  * of the first. The load average is printed before and after. */
-#if defined(__linux__)
-#define _GNU_SOURCE   /* pthread_setaffinity_np */
-#include <pthread.h>
-#include <sched.h>
-#define CAN_PIN 1
-#else
-#define CAN_PIN 0
-#endif
 #include "bench.h"
 
 #include <string.h>
 
 #define ROUNDS 15
 #define KINDS 4   /* one thread (any CPU), two threads, one thread on CPU 0, on CPU 1 */
-
-#if CAN_PIN
-static cpu_set_t all_cpus;   /* the main thread's CPUs as the program started */
-
-/* Pins the calling thread to `cpu`, or gives it every CPU it had with cpu < 0. */
-static int pin(int cpu)
-{
-    cpu_set_t m = all_cpus;
-    if (cpu >= 0) {
-        if (!CPU_ISSET(cpu, &all_cpus)) return 0;
-        CPU_ZERO(&m);
-        CPU_SET(cpu, &m);
-    }
-    return pthread_setaffinity_np(pthread_self(), sizeof m, &m) == 0;
-}
-#endif
 
 static void print_load(const char *when)
 {
@@ -124,12 +100,10 @@ static void one_method(const bscene *b, const char *name, om_jobs *jobs, bool pi
         for (int q = 0; q < kinds; q++) {
             const int k = (q + (p < 0 ? 0 : p)) % kinds;
             double a, e;
-#if CAN_PIN
-            if (pinned && !pin(k >= 2 ? k - 2 : -1)) {
+            if (pinned && !bench_pin(k >= 2 ? k - 2 : -1)) {
                 printf("%-12s %-7s (a thread would not be pinned)\n", b->name, name);
                 goto out;
             }
-#endif
             if (frame(b, &t, jobs, k, &a, &e) || frame(b, &t, jobs, k, &a, &e)) goto out;   /* the first settles */
             const uint64_t h = om_hash(0, px, (size_t)W * H * 3);
             if (p < 0 && q == 0) first = h;
@@ -155,9 +129,7 @@ static void one_method(const bscene *b, const char *name, om_jobs *jobs, bool pi
     }
     printf("%s\n", same ? "" : "  FRAMES DIFFER");
 out:
-#if CAN_PIN
-    if (pinned) pin(-1);
-#endif
+    if (pinned) bench_pin(-1);
     free(t.mem);
     free(t.fmem);
     free(px);
@@ -167,11 +139,7 @@ void bench_threads(void)
 {
     om_jobs *jobs = NULL;
     om_diag d;
-    bool pinned = false;
-#if CAN_PIN
-    pinned = om_cpus_online() >= 2 && pthread_getaffinity_np(pthread_self(), sizeof all_cpus, &all_cpus) == 0 &&
-             CPU_ISSET(0, &all_cpus) && CPU_ISSET(1, &all_cpus);
-#endif
+    const bool pinned = bench_pin_two();
     if (om_jobs_start(&jobs, 2, &d) != OM_OK) {   /* before any pinning: its worker takes every CPU */
         printf("threads: no pool of two (%s)\n", d.msg);
         return;
