@@ -47,6 +47,24 @@ int bench_run_hooked(const bscene *b, const char *method, const om_method_cfg *c
                      uint32_t H, float t, uint8_t *mask, mrun *out,
                      void (*hook)(void *state, mrun *out));
 
+/* A method at its defaults on scene b at W x H, ready for frame after frame: its state
+ * in a heap arena, a frame arena with room for `threads` jobs (zeroed, so resident as a
+ * host's arenas are), an RGB888 framebuffer and default shading. */
+typedef struct bsetup {
+    const om_method *m;
+    void *state, *mem, *fmem;
+    size_t fbytes;
+    om_view v;
+    om_framebuffer fb;
+    om_shade_cfg shade;
+} bsetup;
+/* Non-zero where it cannot (after bench_teardown of what it made). */
+int bench_setup(bsetup *t, const bscene *b, const char *name, uint32_t W, uint32_t H, uint32_t threads);
+void bench_teardown(bsetup *t);
+/* A frame of t on one thread: *fd filled but for the parallel-for, and *fa over t's
+ * frame arena. */
+void bench_frame_desc(bsetup *t, const bscene *b, om_frame_desc *fd, om_arena *fa);
+
 /* Whether the calling thread can be pinned to CPU 0 and to CPU 1 (Linux, two CPUs
  * online); it records the thread's CPUs for bench_pin(-1), so call it before pinning. */
 bool bench_pin_two(void);

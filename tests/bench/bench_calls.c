@@ -81,27 +81,9 @@ typedef struct call_ms {
 static void one_method(const bscene *b, const char *name, om_jobs *pool, bool pinned, rec_host *r, call_ms *cm)
 {
     const uint32_t W = 1024, H = 768;
-    const om_method *m = om_method_find(name);
-    om_method_cfg cfg;
-    om_method_cfg_default(&cfg, m);
-    om_view v;
+    bsetup bs;
     om_diag d;
-    size_t mn, full;
-    void *state, *mem = NULL, *fmem = NULL;
-    uint8_t *px = NULL;
-    if (bench_view(b, W, H, 0, &v) || m->bytes(&cfg, &b->s, W, H, &mn, &full)) return;
-    const size_t fbytes = om_frame_bytes_scene(&b->s, W, H) + om_frame_bytes_jobs(m, &b->s, 2);
-    mem = malloc(full);
-    fmem = malloc(fbytes);
-    px = malloc((size_t)W * H * 3);
-    om_arena ma;
-    if (!mem || !fmem || !px) goto out;
-    memset(fmem, 0, fbytes);
-    om_arena_init(&ma, mem, full, "method");
-    if (m->init(&state, &ma, &cfg, &b->s, W, H, &d) != OM_OK) goto out;
-    om_framebuffer fb = {OM_RGB888, W, H, (size_t)W * 3, px};
-    om_shade_cfg shade;
-    om_shade_cfg_default(&shade);
+    if (bench_setup(&bs, b, name, W, H, 2)) return;
     uint32_t ncalls = 0;
     const int kinds = pinned ? 3 : 2;   /* unpinned: inline (as kind 0) and two threads */
     for (int p = -1; p < ROUNDS; p++)
@@ -115,11 +97,8 @@ static void one_method(const bscene *b, const char *name, om_jobs *pool, bool pi
             r->pool = k == 2 ? pool : NULL;
             for (int rep = 0; rep < 2; rep++) {   /* the first settles */
                 om_arena fa;
-                om_arena_init(&fa, fmem, fbytes, "frame");
                 om_frame_desc fd;
-                memset(&fd, 0, sizeof fd);
-                fd.scene = &b->s; fd.view = &v; fd.method = m; fd.method_state = state;
-                fd.shade = &shade; fd.fb = &fb; fd.clock = om_clock_ns;
+                bench_frame_desc(&bs, b, &fd, &fa);
                 fd.parallel_for = rec_for; fd.parallel_user = r; fd.worker = rec_worker; fd.threads = 2;
                 r->ncalls = 0;
                 r->t0 = om_clock_ns(NULL);
@@ -166,9 +145,7 @@ static void one_method(const bscene *b, const char *name, om_jobs *pool, bool pi
     }
 out:
     if (pinned) bench_pin(-1);
-    free(mem);
-    free(fmem);
-    free(px);
+    bench_teardown(&bs);
 }
 
 void bench_calls(void)

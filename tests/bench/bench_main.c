@@ -99,6 +99,50 @@ int bench_view(const bscene *b, uint32_t W, uint32_t H, float t, om_view *v)
     return om_view_init(v, &cam, &light, &b->s, &d) != OM_OK;
 }
 
+int bench_setup(bsetup *t, const bscene *b, const char *name, uint32_t W, uint32_t H, uint32_t threads)
+{
+    memset(t, 0, sizeof *t);
+    t->m = om_method_find(name);
+    om_method_cfg c;
+    om_diag d;
+    size_t mn, full;
+    if (!t->m) return 1;
+    om_method_cfg_default(&c, t->m);
+    if (bench_view(b, W, H, 0, &t->v) || t->m->bytes(&c, &b->s, W, H, &mn, &full)) return 1;
+    t->fbytes = om_frame_bytes_scene(&b->s, W, H) + om_frame_bytes_jobs(t->m, &b->s, threads);
+    t->mem = malloc(full);
+    t->fmem = malloc(t->fbytes);
+    uint8_t *px = malloc((size_t)W * H * 3);
+    t->fb = (om_framebuffer){OM_RGB888, W, H, (size_t)W * 3, px};
+    om_shade_cfg_default(&t->shade);
+    om_arena ma;
+    if (!t->mem || !t->fmem || !px) goto fail;
+    memset(t->fmem, 0, t->fbytes);
+    om_arena_init(&ma, t->mem, full, "method");
+    if (t->m->init(&t->state, &ma, &c, &b->s, W, H, &d) == OM_OK) return 0;
+    fprintf(stderr, "bench: %s %s: %s\n", b->name, name, d.msg);
+fail:
+    bench_teardown(t);
+    return 1;
+}
+
+void bench_teardown(bsetup *t)
+{
+    free(t->mem);
+    free(t->fmem);
+    free(t->fb.pixels);
+    t->mem = t->fmem = NULL;
+    t->fb.pixels = NULL;
+}
+
+void bench_frame_desc(bsetup *t, const bscene *b, om_frame_desc *fd, om_arena *fa)
+{
+    om_arena_init(fa, t->fmem, t->fbytes, "frame");
+    memset(fd, 0, sizeof *fd);
+    fd->scene = &b->s; fd->view = &t->v; fd->method = t->m; fd->method_state = t->state;
+    fd->shade = &t->shade; fd->fb = &t->fb; fd->clock = om_clock_ns;
+}
+
 int bench_run(const bscene *b, const char *name, const om_method_cfg *cfg, uint32_t W,
               uint32_t H, float t, uint8_t *mask, mrun *out)
 {

@@ -58,17 +58,11 @@ static uint32_t loop_worker(void *host)
 }
 
 /* One frame on `threads` (1: inline) into fb: its time, and the tally. */
-static int frame(const bscene *b, const om_method *m, void *state, const om_view *v, om_framebuffer *fb,
-                 void *fmem, size_t fbytes, uint32_t threads, double *ms, tally *t)
+static int frame(const bscene *b, bsetup *bs, uint32_t threads, double *ms, tally *t)
 {
     om_arena fa;
-    om_arena_init(&fa, fmem, fbytes, "frame");
-    om_shade_cfg shade;
-    om_shade_cfg_default(&shade);
     om_frame_desc fd;
-    memset(&fd, 0, sizeof fd);
-    fd.scene = &b->s; fd.view = v; fd.method = m; fd.method_state = state;
-    fd.shade = &shade; fd.fb = fb; fd.clock = om_clock_ns;
+    bench_frame_desc(bs, b, &fd, &fa);
     memset(t, 0, sizeof *t);
     t->threads = threads;
     if (threads > 1) {
@@ -81,7 +75,7 @@ static int frame(const bscene *b, const om_method *m, void *state, const om_view
     om_diag d;
     const uint64_t t0 = om_clock_ns(NULL);
     if (om_render_frame(&fd, &fa, &fs, &d) != OM_OK) {
-        fprintf(stderr, "bench: %s %s: %s\n", b->name, m->name, d.msg);
+        fprintf(stderr, "bench: %s %s: %s\n", b->name, bs->m->name, d.msg);
         return 1;
     }
     *ms = (double)(om_clock_ns(NULL) - t0) / 1e6;
@@ -91,22 +85,9 @@ static int frame(const bscene *b, const om_method *m, void *state, const om_view
 static void one_method(const bscene *b, const char *name)
 {
     const uint32_t W = 1024, H = 768;
-    const om_method *m = om_method_find(name);
-    om_method_cfg c;
-    om_method_cfg_default(&c, m);
-    om_view v;
-    size_t mn, full;
-    if (bench_view(b, W, H, 0, &v) || m->bytes(&c, &b->s, W, H, &mn, &full)) return;
-    const size_t fbytes = om_frame_bytes_scene(&b->s, W, H) + om_frame_bytes_jobs(m, &b->s, 16);
-    void *mem = malloc(full), *fmem = malloc(fbytes), *state = NULL;
-    uint8_t *px = malloc((size_t)W * H * 3);
-    om_arena ma;
-    om_diag d;
-    if (!mem || !fmem || !px) goto out;
-    memset(fmem, 0, fbytes);
-    om_arena_init(&ma, mem, full, "method");
-    if (m->init(&state, &ma, &c, &b->s, W, H, &d) != OM_OK) goto out;
-    om_framebuffer fb = {OM_RGB888, W, H, (size_t)W * 3, px};
+    bsetup bs;
+    if (bench_setup(&bs, b, name, W, H, 16)) return;
+    const uint8_t *px = bs.fb.pixels;
     /* one: the one-thread frame; per count: serial and work against it, the estimates */
     double one[ROUNDS], serial[NCOUNTS][ROUNDS], work[NCOUNTS][ROUNDS], amdahl[NCOUNTS][ROUNDS],
         jobs[NCOUNTS][ROUNDS];
@@ -116,7 +97,7 @@ static void one_method(const bscene *b, const char *name)
     for (double ms; settle < SETTLE && first != last; settle++) {
         tally t;
         last = first;
-        if (frame(b, m, state, &v, &fb, fmem, fbytes, 1, &ms, &t)) goto out;
+        if (frame(b, &bs, 1, &ms, &t)) goto out;
         first = om_hash(0, px, (size_t)W * H * 3);
     }
     bool same = first == last;
@@ -126,7 +107,7 @@ static void one_method(const bscene *b, const char *name)
             const uint32_t n = k ? counts[k - 1] : 1;
             double ms;
             tally t;
-            if (frame(b, m, state, &v, &fb, fmem, fbytes, n, &ms, &t)) goto out;
+            if (frame(b, &bs, n, &ms, &t)) goto out;
             const uint64_t h = om_hash(0, px, (size_t)W * H * 3);
             same = same && h == first;
             if (p < 0) continue;
@@ -156,9 +137,7 @@ static void one_method(const bscene *b, const char *name)
     if (settle > 2) printf("  (settled at frame %d)", settle);
     printf("%s\n", same ? "" : first == last ? "  FRAMES DIFFER" : "  (frames did not settle)");
 out:
-    free(mem);
-    free(fmem);
-    free(px);
+    bench_teardown(&bs);
 }
 
 void bench_serial(void)

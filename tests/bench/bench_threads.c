@@ -33,24 +33,12 @@ static void print_load(const char *when)
     if (f) fclose(f);
 }
 
-typedef struct tsetup {
-    const om_method *m;
-    void *state, *mem, *fmem;
-    size_t fbytes;
-    om_view v;
-    om_framebuffer fb;
-    om_shade_cfg shade;
-} tsetup;
-
 /* One frame of kind k (see KINDS) into t->fb: its wall time and eye pass in ms. */
-static int frame(const bscene *b, tsetup *t, om_jobs *jobs, int k, double *ms, double *eye)
+static int frame(const bscene *b, bsetup *t, om_jobs *jobs, int k, double *ms, double *eye)
 {
     om_arena fa;
-    om_arena_init(&fa, t->fmem, t->fbytes, "frame");
     om_frame_desc fd;
-    memset(&fd, 0, sizeof fd);
-    fd.scene = &b->s; fd.view = &t->v; fd.method = t->m; fd.method_state = t->state;
-    fd.shade = &t->shade; fd.fb = &t->fb; fd.clock = om_clock_ns;
+    bench_frame_desc(t, b, &fd, &fa);
     if (k == 1) {
         fd.parallel_for = om_jobs_for;
         fd.parallel_user = jobs;
@@ -72,26 +60,10 @@ static int frame(const bscene *b, tsetup *t, om_jobs *jobs, int k, double *ms, d
 static void one_method(const bscene *b, const char *name, om_jobs *jobs, bool pinned)
 {
     const uint32_t W = 1024, H = 768;
-    tsetup t;
-    memset(&t, 0, sizeof t);
-    t.m = om_method_find(name);
-    om_method_cfg c;
-    om_method_cfg_default(&c, t.m);
-    om_diag d;
-    size_t mn, full;
-    if (bench_view(b, W, H, 0, &t.v) || t.m->bytes(&c, &b->s, W, H, &mn, &full)) return;
+    bsetup t;
     /* one arena for both counts: room for two threads' scratch, which one leaves alone */
-    t.fbytes = om_frame_bytes_scene(&b->s, W, H) + om_frame_bytes_jobs(t.m, &b->s, 2);
-    t.mem = malloc(full);
-    t.fmem = malloc(t.fbytes);
-    uint8_t *px = malloc((size_t)W * H * 3);
-    om_arena ma;
-    if (!t.mem || !t.fmem || !px) goto out;
-    memset(t.fmem, 0, t.fbytes);   /* resident, as a host's arenas are */
-    om_arena_init(&ma, t.mem, full, "method");
-    if (t.m->init(&t.state, &ma, &c, &b->s, W, H, &d) != OM_OK) goto out;
-    t.fb = (om_framebuffer){OM_RGB888, W, H, (size_t)W * 3, px};
-    om_shade_cfg_default(&t.shade);
+    if (bench_setup(&t, b, name, W, H, 2)) return;
+    const uint8_t *px = t.fb.pixels;
     const int kinds = pinned ? KINDS : 2;
     double ms[KINDS][ROUNDS], eye[KINDS][ROUNDS];
     uint64_t first = 0;
@@ -130,9 +102,7 @@ static void one_method(const bscene *b, const char *name, om_jobs *jobs, bool pi
     printf("%s\n", same ? "" : "  FRAMES DIFFER");
 out:
     if (pinned) bench_pin(-1);
-    free(t.mem);
-    free(t.fmem);
-    free(px);
+    bench_teardown(&t);
 }
 
 void bench_threads(void)
