@@ -196,6 +196,17 @@ static void build_rows(hybrid_state *m, uint32_t row0, uint32_t row1, const uint
     const om_scene *s = m->scene;
     for (uint32_t i = 0; i < n; i++) {
         const uint32_t t = tris ? tris[i] : i;
+#if OM_WITH_JOBS && (defined(__GNUC__) || defined(__clang__))
+        /* A band's list skips through the scene, and its triangles' projected vertices
+         * were written by every thread's parts of the set-up: ask for the next ones'
+         * early (a hint: no effect on what is computed). Random 100K on two threads:
+         * the bands took 4.6 ms without, as long as one thread took for them all. */
+        if (tris && m->ls.verts && i + 8 < n) {
+            const uint32_t *nx = s->idx + (size_t)tris[i + 8] * 3;
+            for (int k = 0; k < 3; k++) __builtin_prefetch(&m->ls.verts[nx[k]]);
+            if (i + 16 < n) __builtin_prefetch(s->idx + (size_t)tris[i + 16] * 3);
+        }
+#endif
         om__ltri lt;
         if (add_small(m, t, row0, row1) || !om__lspace_tri(&m->ls, t, &lt)) continue;
         bool cover = lt.n == 1 && om__odepth_opaque(&m->mat_od[s->tri_mat[t]]);
