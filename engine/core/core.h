@@ -187,8 +187,9 @@ double om__exp2(double x);
  * store would otherwise wait for the other cores' copies to be dropped: random 100K's
  * light bins took twice the CPU time on two threads that they took on one. x86 needs
  * its own instruction: the compilers' write hint is a read prefetch there unless the
- * build targets PREFETCHW, which AMD's x86-64 CPUs run, and Intel's since Core 2
- * (before Broadwell as a no-op). It changes no result. */
+ * build targets PREFETCHW, which AMD's x86-64 CPUs and Intel's since Broadwell list
+ * (CPUID's PRFCHW); older Intel ones are said to take it as a no-op, which this
+ * project has not run. It changes no result. */
 #if (defined(__GNUC__) || defined(__clang__)) && (defined(__x86_64__) || defined(__i386__))
 #define OM_PREFETCH_WRITE(p) __asm__("prefetchw %0" : : "m"(*(const char *)(p)))
 #elif defined(__GNUC__) || defined(__clang__)
