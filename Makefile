@@ -26,7 +26,7 @@ LDLIBS  = -lm
 # library needs none (the embedding examples link without it).
 PTHREAD = -pthread
 
-ENGINE_SRC   = $(sort $(wildcard engine/*/*.c))
+ENGINE_SRC   = $(sort $(wildcard engine/*/*.c engine/*/*/*.c))
 PLATFORM_SRC = $(sort $(wildcard platform/*.c))
 TOOL_SRC     = $(sort $(wildcard tools/*.c))
 TEST_SRC     = $(sort $(wildcard tests/*.c))
@@ -42,7 +42,7 @@ all: $(O)/ombra
 # V=1 shows the full compiler lines.
 Q = $(if $(V),,@)
 
-$(O)/%.o: %.c $(wildcard include/*.h engine/*/*.h platform/*.h tools/*.h tests/*.h)
+$(O)/%.o: %.c $(wildcard include/*.h engine/*/*.h engine/*/*/*.h platform/*.h tools/*.h tests/*.h)
 	@mkdir -p $(dir $@)
 	@$(if $(V),,echo "  CC $(O)/$<")
 	$(Q)$(CC) $(CFLAGS_ALL) -c $< -o $@
@@ -112,7 +112,7 @@ $(O)/embed-render-sized: tests/embed/render_sized.c $(O)/libombra.a include/ombr
 ONLY_SM = -DOM_WITH_NONE=0 -DOM_WITH_REF=0 -DOM_WITH_ASM=0 -DOM_WITH_RTW=0 -DOM_WITH_SPSM=0 \
           -DOM_WITH_IZB=0 -DOM_WITH_HYBRID=0
 $(O)/embed-only-sm: tests/embed/render_once.c engine/shadow/registry.c $(O)/libombra.a \
-                    include/ombra.h $(wildcard engine/*/*.h)
+                    include/ombra.h $(wildcard engine/*/*.h engine/*/*/*.h)
 	$(Q)$(CC) $(CFLAGS_ALL) $(ONLY_SM) -o $@ $(filter %.c %.a,$^) $(LDLIBS)
 
 # The benchmark, stress and stability programs are built (not run), so a change that

@@ -8,7 +8,7 @@
 #include "test.h"
 #include "harness.h"
 #include "../engine/shadow/rtw.h"
-#include "../engine/shadow/occlude.h"
+#include "../engine/shadow/common/occlude.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -4,9 +4,9 @@
  * method's kept state against a fresh one. */
 #include "test.h"
 #include "harness.h"
-#include "../engine/shadow/occlude.h"
+#include "../engine/shadow/common/occlude.h"
 #include "../engine/frame/frame.h"
-#include "../engine/shadow/smlookup.h"
+#include "../engine/shadow/common/smlookup.h"
 #include "../engine/shadow/ref_light.h"
 
 #include <math.h>

@@ -9,7 +9,7 @@
  * (ref_light.h), over packets of neighbouring samples: the same filter's answer for
  * the triangles that matter, in fewer steps. */
 #include "shadow.h"
-#include "occlude.h"
+#include "common/occlude.h"
 #include "bvh.h"
 #include "ref_light.h"
 

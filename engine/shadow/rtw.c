@@ -18,7 +18,7 @@
  * buffers. */
 #include "shadow.h"
 #include "rtw.h"
-#include "occlude.h"   /* OM_LIGHT_GRID */
+#include "common/occlude.h"   /* OM_LIGHT_GRID */
 
 OM__CFG_FITS(om__rtw_cfg);
 extern const om_method om__method_rtw;

@@ -6,7 +6,7 @@
  * depth minus the bias is beyond the stored depth; the bias rules and PCF live in
  * smlookup.c, shared with the RTW map. */
 #include "shadow.h"
-#include "smlookup.h"
+#include "common/smlookup.h"
 
 /* sm's configuration: what its settings (at the end of this file) set. */
 typedef struct sm_cfg {

@@ -22,7 +22,7 @@ if [ "${1:-}" != --one ]; then   # (--one: one build, run by this script in para
         >"$out/stab_scene.h"
 fi
 
-ENGINE=$(ls engine/*/*.c | tr '\n' ' ')
+ENGINE=$(find engine -name '*.c' | sort | tr '\n' ' ')
 WARN="-std=c99 -Wall -Wextra -Wpedantic -Werror -Iinclude -I$out"
 # What the Makefile passes gcc (clang has no such flag): see its DETERM.
 GX=-fexcess-precision=standard
@@ -385,13 +385,14 @@ if command -v arm-none-eabi-gcc >/dev/null 2>&1; then
         fi
     done
     echo "cross: .text bytes for Cortex-M4 at -Os:"
-    for part in core raster scene frame measure shadow/occlude shadow/bvh shadow/smlookup shadow/registry \
-                $(ls engine/shadow/*.c | sed -n 's|engine/shadow/\([a-z]*\)\.c|\1|p' | \
-                  grep -v -x -e occlude -e bvh -e registry -e smlookup -e asm_tree -e rtw_warp -e spsm_texel -e spsm_outline); do
+    # A part: a folder of the engine, the shadow methods' shared folder, the registry,
+    # and each method's folder (named by the method, as m4.csv names it).
+    for part in core raster scene frame measure shadow/common shadow/registry \
+                $(ls -d engine/shadow/*/ | sed 's|engine/shadow/\([a-z]*\)/|\1|' | grep -v -x common); do
         case $part in
-            core|raster|scene|frame|measure) files=$(ls engine/$part/*.c) ;;
-            shadow/*) files=engine/$part.c ;;
-            *) files=$(ls engine/shadow/$part.c engine/shadow/${part}_*.c 2>/dev/null) ;;
+            core|raster|scene|frame|measure|shadow/common) files=$(ls engine/$part/*.c) ;;
+            shadow/registry) files=engine/$part.c ;;
+            *) files=$(ls engine/shadow/$part/*.c) ;;
         esac
         total=0
         for f in $files; do

@@ -8,7 +8,7 @@ cd "$(dirname "$0")/../.."
 secs=${FUZZ_SECONDS:-60}
 out=build/fuzz
 mkdir -p "$out"
-SRC="$(ls engine/*/*.c | tr '\n' ' ')"
+SRC="$(find engine -name '*.c' | sort | tr '\n' ' ')"
 FLAGS="-std=c99 -g -O1 -ffp-contract=off -Iinclude -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all"
 status=0
 for t in scene obj render; do

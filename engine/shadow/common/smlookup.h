@@ -11,7 +11,7 @@
 #ifndef OM_SMLOOKUP_H
 #define OM_SMLOOKUP_H
 
-#include "../frame/frame.h"
+#include "../../frame/frame.h"
 
 /* A warped map's coordinate mapping (rtw.h): one 1-D table per axis of n + 1
  * fixed-point super-cell edge positions, 1.0 = OM_RTW_ONE, interpolated linearly. */

@@ -47,7 +47,7 @@
 #ifndef OM_OCCLUDE_H
 #define OM_OCCLUDE_H
 
-#include "../frame/frame.h"
+#include "../../frame/frame.h"
 
 #define OM_LIGHT_GRID 8192u
 
