@@ -1,7 +1,7 @@
 /* none.c — the method with no occluders: every exposed sample is lit. It is the
  * smallest complete example of the method interface, and the lit rule's (a) and (b)
  * alone (facing the light, inside its frustum) decide its image. */
-#include "shadow.h"
+#include "../shadow.h"
 
 typedef struct none_state { uint32_t frames; } none_state;
 
