@@ -5,8 +5,8 @@
  * along its normal by `normal_offset` texels, is shadowed in a texel when its light
  * depth minus the bias is beyond the stored depth; the bias rules and PCF live in
  * smlookup.c, shared with the RTW map. */
-#include "shadow.h"
-#include "common/smlookup.h"
+#include "../shadow.h"
+#include "../common/smlookup.h"
 
 /* sm's configuration: what its settings (at the end of this file) set. */
 typedef struct sm_cfg {
