@@ -7,7 +7,7 @@
 #include "../engine/shadow/common/occlude.h"
 #include "../engine/frame/frame.h"
 #include "../engine/shadow/common/smlookup.h"
-#include "../engine/shadow/ref_light.h"
+#include "../engine/shadow/ref/ref_light.h"
 
 #include <math.h>
 #include <stdlib.h>

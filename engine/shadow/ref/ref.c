@@ -8,8 +8,8 @@
  * predicate decides. With the memory for it, the walk runs on the light's grid instead
  * (ref_light.h), over packets of neighbouring samples: the same filter's answer for
  * the triangles that matter, in fewer steps. */
-#include "shadow.h"
-#include "common/occlude.h"
+#include "../shadow.h"
+#include "../common/occlude.h"
 #include "bvh.h"
 #include "ref_light.h"
 

@@ -7,7 +7,7 @@
 #ifndef OM_BVH_H
 #define OM_BVH_H
 
-#include "../core/core.h"
+#include "../../core/core.h"
 
 
 /* A box on the light's grid (ref_light.h): the grid bounds and nearest light depth

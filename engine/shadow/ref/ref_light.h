@@ -15,7 +15,7 @@
 #ifndef OM_REF_LIGHT_H
 #define OM_REF_LIGHT_H
 
-#include "common/occlude.h"
+#include "../common/occlude.h"
 #include "bvh.h"
 
 /* A grid box and nearest depth; a triangle with a vertex that needs clipping has an
