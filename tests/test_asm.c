@@ -7,7 +7,7 @@
 #include "test.h"
 #include "harness.h"
 #include "../engine/shadow/shadow.h"
-#include "../engine/shadow/asm.h"
+#include "../engine/shadow/asm/asm.h"
 
 #include <stdlib.h>
 #include <math.h>

@@ -5,7 +5,7 @@
  * tiles), which whole frames (test_threads.c) would not all show. */
 #include "test.h"
 #include "harness.h"
-#include "../engine/shadow/asm.h"
+#include "../engine/shadow/asm/asm.h"
 #include "../engine/shadow/rtw.h"
 #include "../engine/shadow/spsm_method.h"
 #include "../engine/shadow/hybrid_method.h"

@@ -6,7 +6,7 @@
 #include "test.h"
 #include "harness.h"
 #include "../platform/platform.h"
-#include "../engine/shadow/asm.h"
+#include "../engine/shadow/asm/asm.h"
 
 #include <stdio.h>
 #include <stdlib.h>

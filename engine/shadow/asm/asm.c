@@ -39,7 +39,7 @@
  * Bias: the constant and slope-scaled bias of the conventional map (cfg bias_const,
  * bias_slope in texels of the node the sample is tested in); the paper notes the ID
  * test does not remove the bias problem. pcf and normal_offset do not apply. */
-#include "shadow.h"
+#include "../shadow.h"
 #include "asm.h"
 
 #include <float.h>
