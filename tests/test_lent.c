@@ -6,7 +6,7 @@
 #include "test.h"
 #include "harness.h"
 #include "../engine/shadow/asm/asm.h"
-#include "../engine/shadow/rtw.h"
+#include "../engine/shadow/rtw/rtw.h"
 #include "../engine/shadow/spsm_method.h"
 #include "../engine/shadow/hybrid_method.h"
 

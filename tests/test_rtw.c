@@ -7,7 +7,7 @@
  * agreeing with the double arithmetic they stand for. */
 #include "test.h"
 #include "harness.h"
-#include "../engine/shadow/rtw.h"
+#include "../engine/shadow/rtw/rtw.h"
 #include "../engine/shadow/common/occlude.h"
 
 #include <math.h>

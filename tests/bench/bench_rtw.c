@@ -7,7 +7,7 @@
  * resolution and the triangles drawn; plus the 512 map with hybrid analysis and the
  * shadow-edge function. */
 #include "bench.h"
-#include "../../engine/shadow/rtw.h"
+#include "../../engine/shadow/rtw/rtw.h"
 
 #include <string.h>
 

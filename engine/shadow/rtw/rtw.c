@@ -16,9 +16,9 @@
  *            in float here where that gives the same bits)
  * All state lives in the method's arena; nothing persists between frames but the
  * buffers. */
-#include "shadow.h"
+#include "../shadow.h"
 #include "rtw.h"
-#include "common/occlude.h"   /* OM_LIGHT_GRID */
+#include "../common/occlude.h"   /* OM_LIGHT_GRID */
 
 OM__CFG_FITS(om__rtw_cfg);
 extern const om_method om__method_rtw;

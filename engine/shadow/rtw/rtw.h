@@ -20,7 +20,7 @@
 #ifndef OM_RTW_H
 #define OM_RTW_H
 
-#include "common/smlookup.h"
+#include "../common/smlookup.h"
 
 #define OM_RTW_ALPHA 0.001f        /* shadow-edge function away from edges (section 5.3) */
 #define OM_RTW_BETA 2.0f           /* surface-normal bonus (section 5.4) */
