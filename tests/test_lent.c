@@ -7,7 +7,7 @@
 #include "harness.h"
 #include "../engine/shadow/asm/asm.h"
 #include "../engine/shadow/rtw/rtw.h"
-#include "../engine/shadow/spsm_method.h"
+#include "../engine/shadow/spsm/spsm_method.h"
 #include "../engine/shadow/hybrid_method.h"
 
 #include <stdlib.h>

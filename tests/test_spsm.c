@@ -6,8 +6,8 @@
  * the shared routine; the build's plane without double against the double one. */
 #include "test.h"
 #include "harness.h"
-#include "../engine/shadow/spsm.h"
-#include "../engine/shadow/spsm_lookup.h"
+#include "../engine/shadow/spsm/spsm.h"
+#include "../engine/shadow/spsm/spsm_lookup.h"
 
 #include <math.h>
 #include <stdlib.h>

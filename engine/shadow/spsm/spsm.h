@@ -10,7 +10,7 @@
 #ifndef OM_SPSM_H
 #define OM_SPSM_H
 
-#include "../frame/frame.h"
+#include "../../frame/frame.h"
 
 /* One texel, exactly 16 bytes (checked below). vx/vy: the nearest triangle's three
  * vertices as offsets from the texel centre in the 16-bit "o16" code; z: depth of the
