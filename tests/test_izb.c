@@ -8,7 +8,7 @@
  * at once, and a tile that walks only its own gives the same terms and counts. */
 #include "test.h"
 #include "harness.h"
-#include "../engine/shadow/izb.h"
+#include "../engine/shadow/izb/izb.h"
 
 #include <stdlib.h>
 

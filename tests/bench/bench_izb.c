@@ -8,7 +8,7 @@
  * that two threads would run as izb's pass hands tiles out (slot k % 2, each odd pair
  * the other way round), the bound that the tiles put on a frame's speed-up on two threads. */
 #include "bench.h"
-#include "../../engine/shadow/izb.h"
+#include "../../engine/shadow/izb/izb.h"
 
 static void table_row(const bscene *b, uint32_t W, uint32_t H)
 {

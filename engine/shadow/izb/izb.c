@@ -16,7 +16,7 @@
  * consecutive samples, each with its own BSP — memory stays fixed whatever the image
  * size. The tie rule, depth test and transmittance are the reference's own, so the
  * result equals the reference exactly, whatever the tiling. */
-#include "shadow.h"
+#include "../shadow.h"
 #include "izb.h"
 
 extern const om_method om__method_izb;

@@ -26,7 +26,7 @@
 #ifndef OM_LGRID_H
 #define OM_LGRID_H
 
-#include "common/occlude.h"
+#include "../common/occlude.h"
 
 /* Most cells a triangle is listed in; a larger one is wide. */
 #define LGRID_MOST 16u
