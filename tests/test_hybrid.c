@@ -5,7 +5,7 @@
  * reference says, checked one by one. */
 #include "test.h"
 #include "harness.h"
-#include "../engine/shadow/hybrid.h"
+#include "../engine/shadow/hybrid/hybrid.h"
 
 #include <stdlib.h>
 

@@ -8,7 +8,7 @@
 #include "../engine/shadow/asm/asm.h"
 #include "../engine/shadow/rtw/rtw.h"
 #include "../engine/shadow/spsm/spsm_method.h"
-#include "../engine/shadow/hybrid_method.h"
+#include "../engine/shadow/hybrid/hybrid_method.h"
 
 #include <stdlib.h>
 

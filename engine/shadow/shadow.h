@@ -32,4 +32,10 @@ om_status om__method_cfg_of(const om_method_cfg *c, const om_method *m, void *ou
 #define OM__SET_PCF(T) \
     OM__SETTING(T, pcf, "pcf", OM_SETTING_U32, 1, 9, 1, "k x k percentage-closer filtering, 1 = off")
 
+/* The pool of an irregular z-buffer, for izb and hybrid, whose struct T holds it at `f`
+ * (a field designator). */
+#define OM__SET_IZB_POOL(T, f) \
+    OM__SETTING(T, f, "izb.pool", OM_SETTING_U32, 0, 1e9, 0, \
+                "samples the pool holds, 0 = izb: n^2/2^20 for n triangles, 32768 to the frame; hybrid: the frame, at most 2 a triangle (32768..262144)")
+
 #endif

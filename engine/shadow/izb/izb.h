@@ -72,13 +72,10 @@ typedef struct om__izb_cfg {
                               auto_pool), hybrid the frame, at most 2 a triangle */
 } om__izb_cfg;
 
-/* Their entries in the settings of a method whose struct T holds them at `f` (a field
- * designator: izb_leaf, or part.izb_leaf). */
+/* Its entry in the settings of a method whose struct T holds it at `f` (a field
+ * designator: izb_leaf, or part.izb_leaf); izb.pool's is shadow.h's. */
 #define OM__SET_IZB_LEAF(T, f) \
     OM__SETTING(T, f, "izb.leaf", OM_SETTING_U32, 1, 65536, 64, "most samples in a BSP leaf (the paper: 64)")
-#define OM__SET_IZB_POOL(T, f) \
-    OM__SETTING(T, f, "izb.pool", OM_SETTING_U32, 0, 1e9, 0, \
-                "samples the pool holds, 0 = izb: n^2/2^20 for n triangles, 32768 to the frame; hybrid: the frame, at most 2 a triangle (32768..262144)")
 
 /* The Z-order (Morton) code of a key: x and y relative to the tile's corner, shifted
  * to izb.c's ZBITS bits each, bits interleaved (the build sorts and splits by it, the

@@ -4,7 +4,7 @@
 #ifndef OM_HYBRID_H
 #define OM_HYBRID_H
 
-#include "common/occlude.h"
+#include "../common/occlude.h"
 
 /* Classifies a sample of the current frame (after the method's build) by the map
  * alone: 1 certainly lit, 2 certainly shadowed (t set to 0), 0 uncertain. */
