@@ -271,7 +271,7 @@ uint32_t om_format_bpp(om_format f);   /* bytes per pixel */
 
 /* ---------------------------------------------------------------- methods */
 
-/* Settings belong to their method: each method lists its own (om_method.settings) over
+/* Settings belong to their method: each method lists its own (om_method_setting_at) over
  * a configuration struct private to its file, so adding a setting changes that file
  * alone. A host holds one method's values in an om_method_cfg and sets them by name. */
 typedef enum om_setting_kind {
@@ -294,14 +294,18 @@ typedef struct om_setting {
  * compile). */
 #define OM_METHOD_CFG_BYTES 128
 
-struct om_method;
+/* The methods built in (om_method_at). Each can be left out when the engine is
+ * compiled: -DOM_WITH_SPSM=0 (likewise OM_WITH_NONE, _REF, _SM, _ASM, _RTW, _IZB,
+ * _HYBRID; engine/core/config.h lists every switch) drops it from the list, so a
+ * program linked against the library carries none of its code. */
+typedef struct om_method om_method;
 
 /* One method's settings, by value: plain memory the host keeps where it likes (the
  * stack, a static) and copies freely. Made by om_method_cfg_default for a method,
  * changed by om_method_cfg_set, read by that method's bytes and init (a method with
  * settings refuses a configuration made for another one: OM_E_INVALID). */
 typedef struct om_method_cfg {
-    const struct om_method *method;   /* whose settings these are; NULL: none */
+    const om_method *method;   /* whose settings these are; NULL: none */
     union {                /* private: the method's configuration struct */
         unsigned char bytes[OM_METHOD_CFG_BYTES];
         uint64_t align_u64;
@@ -310,7 +314,7 @@ typedef struct om_method_cfg {
 } om_method_cfg;
 
 /* The defaults of method m (m may be NULL: an empty configuration no method takes). */
-void om_method_cfg_default(om_method_cfg *c, const struct om_method *m);
+void om_method_cfg_default(om_method_cfg *c, const om_method *m);
 /* Sets a setting of c's method by name: OM_E_NOTFOUND when the method has no such
  * setting, OM_E_RANGE outside [min, max] or not whole for a whole-number setting. */
 om_status om_method_cfg_set(om_method_cfg *c, const char *name, double value, om_diag *d);
@@ -318,7 +322,7 @@ om_status om_method_cfg_set(om_method_cfg *c, const char *name, double value, om
 om_status om_method_cfg_get(const om_method_cfg *c, const char *name, double *value);
 /* m's defaults with the value of every setting of `from` (may be NULL) that m takes
  * too: to compare methods at the same "map", say. `from` may be c's own storage. */
-void om_method_cfg_from(om_method_cfg *c, const struct om_method *m, const om_method_cfg *from);
+void om_method_cfg_from(om_method_cfg *c, const om_method *m, const om_method_cfg *from);
 
 typedef struct om_method_stats {
     size_t bytes_used;     /* arena bytes held by the method this frame (peak) */
@@ -333,47 +337,37 @@ enum {
                                  triangle count compare these) */
 };
 
-/* A shadow method: a small table of functions behind one interface. A frame runs
- *   begin -> [observe for every strip, if OBSERVES] -> build -> resolve for every strip
- * and state persists across frames (progressive methods refine it). */
-typedef struct om_method {
-    const char *name;
-    const char *summary;
-    unsigned flags;
-    /* Bytes the method's arena needs for this configuration, scene and image size:
-     * the least it can work with, and the size it is meant to run at (`full`): one
-     * pass for every method but izb, whose full is its default pool (it tiles where
-     * the scene has few triangles for its samples, which is faster there). */
-    om_status (*bytes)(const om_method_cfg *c, const om_scene *s, uint32_t width,
-                       uint32_t height, size_t *min, size_t *full);
-    /* Creates the state in `a`; the method keeps `a` for per-frame scratch. */
-    om_status (*init)(void **state, om_arena *a, const om_method_cfg *c,
-                      const om_scene *s, uint32_t width, uint32_t height, om_diag *d);
-    om_status (*begin)(void *state, const om_view *v, om_diag *d);
-    om_status (*observe)(void *state, const om_strip *st, om_diag *d);
-    om_status (*build)(void *state, om_diag *d);
-    /* Writes st->terms for every sample of the strip (background samples get 255). */
-    om_status (*resolve)(void *state, om_strip *st, om_diag *d);
-    void (*stats)(const void *state, om_method_stats *out);
-    /* May be NULL. For an OBSERVES method: whether this state observes at all (its
-     * configuration may not need the samples first); when not, the frame skips the
-     * observe pass and, with strips, the eye pass it would run again for it. */
-    bool (*observes)(const void *state);
-    /* Its settings, and the size of the configuration they lie in. */
-    const om_setting *settings;
-    uint32_t nsettings;
-    size_t cfg_bytes;
-} om_method;
-
-/* The methods built in. Each can be left out when the engine is compiled:
- * -DOM_WITH_SPSM=0 (likewise OM_WITH_NONE, _REF, _SM, _ASM, _RTW, _IZB, _HYBRID; 0 or 1,
- * all 1 by default) drops it from this list, so a program linked against the library
- * carries none of its code. */
+/* A shadow method, opaque: found by name (om_method_find) or index (om_method_at),
+ * read through the functions below. A frame runs its stages (om_render_frame); a host
+ * asks it for its arena's size and creates its state. */
 size_t om_method_count(void);
 const om_method *om_method_at(size_t i);
 const om_method *om_method_find(const char *name);
+/* Its name ("sm") and a one-line summary; "" for NULL. */
+const char *om_method_name(const om_method *m);
+const char *om_method_summary(const om_method *m);
+/* OM_METHOD_OBSERVES and OM_METHOD_EXACT; 0 for NULL. */
+unsigned om_method_flags(const om_method *m);
+/* Its settings: om_method_nsettings(m) of them, setting i at om_method_setting_at (NULL
+ * past the end or for NULL). */
+uint32_t om_method_nsettings(const om_method *m);
+const om_setting *om_method_setting_at(const om_method *m, uint32_t i);
 /* A setting of method m by name; NULL when m has none of that name. */
 const om_setting *om_method_setting(const om_method *m, const char *name);
+/* Bytes m's arena needs for configuration c (made for m), scene s and a width x height
+ * image: the least it can work with (*min), and the size it is meant to run at
+ * (*full): one pass for every method but izb, whose full is its default pool (it tiles
+ * where the scene has few triangles for its samples, which is faster there).
+ * OM_E_INVALID for a NULL argument or a configuration made for another method. */
+om_status om_method_bytes(const om_method *m, const om_method_cfg *c, const om_scene *s, uint32_t width,
+                          uint32_t height, size_t *min, size_t *full);
+/* Creates m's state in arena a (at least *min bytes of om_method_bytes); the method
+ * keeps `a` for its per-frame scratch, so the arena is the method's until the host is
+ * done with the state. *state is NULL on failure. */
+om_status om_method_init(const om_method *m, void **state, om_arena *a, const om_method_cfg *c,
+                         const om_scene *s, uint32_t width, uint32_t height, om_diag *d);
+/* The state's counters and bytes after a frame (zeros for NULL). */
+void om_method_get_stats(const om_method *m, const void *state, om_method_stats *out);
 
 /* ---------------------------------------------------------------- rendering */
 
@@ -464,7 +458,7 @@ size_t om_frame_bytes_scene(const om_scene *s, uint32_t width, uint32_t strip_ro
  * jobs' scratch, but for one on two jobs whose scene has more than one vertex for
  * every 8 pixels: its eye pass splits the triangles in halves instead, with no more
  * memory (DESIGN.md). */
-size_t om_frame_bytes_jobs(const struct om_method *m, const om_scene *s, uint32_t threads);
+size_t om_frame_bytes_jobs(const om_method *m, const om_scene *s, uint32_t threads);
 /* What the frame arena may hold beyond those so that a frame through strips keeps the
  * triangle under every pixel of a width x height image from its first eye pass (2
  * bytes a pixel where s has fewer than 65535 triangles, else 4). A frame that passes

@@ -115,7 +115,7 @@ om_status h_render_in(const om_scene *s, const char *name, const om_method_cfg *
     om_method_cfg_from(&c, m, cfg);
     size_t mn, full;
     const uint32_t W = v.cam.width, H = v.cam.height;
-    if ((st = m->bytes(&c, s, W, H, &mn, &full))) return st;
+    if ((st = om_method_bytes(m, &c, s, W, H, &mn, &full))) return st;
     if (method_bytes) full = method_bytes;
     uint32_t rows = strip_rows ? strip_rows : H;
     size_t fbytes = om_frame_bytes_scene(s, W, rows);
@@ -124,7 +124,7 @@ om_status h_render_in(const om_scene *s, const char *name, const om_method_cfg *
     om_arena_init(&ma, mm, full, "method");
     om_arena_init(&fa, fm, fbytes, "frame");
     void *state;
-    st = m->init(&state, &ma, &c, s, W, H, &d);
+    st = om_method_init(m, &state, &ma, &c, s, W, H, &d);
     if (st == OM_OK) {
         om_framebuffer fb = {OM_RGB888, W, rows, (size_t)W * 3, (uint8_t *)px};
         om_shade_cfg shade;

@@ -6,7 +6,7 @@
  * minimum, and bit-identical frames (strips included). */
 #include "test.h"
 #include "harness.h"
-#include "../engine/shadow/shadow.h"
+#include "../engine/shadow/method.h"
 #include "../engine/shadow/asm/asm.h"
 
 #include <stdlib.h>
@@ -48,7 +48,7 @@ static bool arun_init(arun *r, const om_scene *s, const om_method_cfg *c, uint32
     r->W = W;
     r->H = H;
     if (!r->m) { CHECK_MSG(0, "asm is not registered"); return false; }
-    CHECK_OK(r->m->bytes(c, s, W, H, &mn, &full));
+    CHECK_OK(om_method_bytes(r->m, c, s, W, H, &mn, &full));
     CHECK(mn <= full);
     if (lean) full = mn;
     r->bytes = full;
@@ -57,7 +57,7 @@ static bool arun_init(arun *r, const om_scene *s, const om_method_cfg *c, uint32
     r->px = malloc((size_t)W * H * 3);
     om_arena a;
     om_arena_init(&a, r->mem, full, "method");
-    om_status st = r->m->init(&r->state, &a, c, s, W, H, &d);
+    om_status st = om_method_init(r->m, &r->state, &a, c, s, W, H, &d);
     CHECK_MSG(st == OM_OK, "asm init: %s", d.msg);
     CHECK(a.peak <= full);
     return st == OM_OK;
@@ -109,7 +109,7 @@ static om_status arun_frame(arun *r, float t, float tl, uint32_t strip, uint8_t 
     fd.on_strip = agrab_strip; fd.user = &g;
     st = om_render_frame(&fd, &fa, NULL, &d);
     if (st) fprintf(stderr, "  (asm frame: %s)\n", d.msg);
-    if (ms) r->m->stats(r->state, ms);
+    if (ms) om_method_get_stats(r->m, r->state, ms);
     return st;
 }
 
@@ -294,12 +294,12 @@ static void budgets_name_minimum(void)
     /* a cap below one root node (and one child) */
     CHECK_OK(om_method_cfg_set(&c, "asm.cap", l.min_cap - 1, NULL));
     size_t mn, full;
-    CHECK_OK(m->bytes(&c, &hs.s, 160, 120, &mn, &full));
+    CHECK_OK(om_method_bytes(m, &c, &hs.s, 160, 120, &mn, &full));
     void *buf = malloc(full), *state;
     om_arena a;
     om_diag d;
     om_arena_init(&a, buf, full, "method");
-    CHECK(m->init(&state, &a, &c, &hs.s, 160, 120, &d) == OM_E_BUDGET);
+    CHECK(om_method_init(m, &state, &a, &c, &hs.s, 160, 120, &d) == OM_E_BUDGET);
     char num[32];
     snprintf(num, sizeof num, "%llu", (unsigned long long)l.min_cap);
     CHECK_MSG(strstr(d.msg, num) != NULL, "'%s' does not name %s", d.msg, num);
@@ -308,17 +308,17 @@ static void budgets_name_minimum(void)
     /* the smallest cap works; an arena below the minimum names the minimum, which the
      * lean mode needs: the cap and a tile of scratch, nothing per vertex or triangle */
     CHECK_OK(om_method_cfg_set(&c, "asm.cap", l.min_cap, NULL));
-    CHECK_OK(m->bytes(&c, &hs.s, 160, 120, &mn, &full));
+    CHECK_OK(om_method_bytes(m, &c, &hs.s, 160, 120, &mn, &full));
     CHECK(mn < full);
     CHECK(mn < l.arena_bytes + 64 * 1024);
     unsigned char *g = malloc(mn + 64);
     memset(g, 0xA5, mn + 64);
     om_arena_init(&a, g + 32, mn - 1, "method");
-    CHECK(m->init(&state, &a, &c, &hs.s, 160, 120, &d) == OM_E_BUDGET);
+    CHECK(om_method_init(m, &state, &a, &c, &hs.s, 160, 120, &d) == OM_E_BUDGET);
     snprintf(num, sizeof num, "%zu", mn);
     CHECK_MSG(strstr(d.msg, num) != NULL, "'%s' does not name %s", d.msg, num);
     om_arena_init(&a, g + 32, mn, "method");
-    CHECK_OK(m->init(&state, &a, &c, &hs.s, 160, 120, &d));
+    CHECK_OK(om_method_init(m, &state, &a, &c, &hs.s, 160, 120, &d));
     CHECK(a.peak <= mn);
     int guard = 0;
     for (int i = 0; i < 32; i++) guard += g[i] != 0xA5 || g[32 + mn + i] != 0xA5;

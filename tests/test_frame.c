@@ -4,7 +4,7 @@
  * depend on the parser. */
 #include "test.h"
 #include "harness.h"
-#include "../engine/frame/frame.h"
+#include "../engine/shadow/method.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -73,7 +73,7 @@ static om_status render(const om_scene *s, const om_light *light, uint32_t strip
     om_arena_init(&ma, method_mem, sizeof method_mem, "method");
     om_arena_init(&fa, frame_mem, frame_size, "frame");
     void *state;
-    om_status st = m->init(&state, &ma, &cfg, s, v.cam.width, v.cam.height, &d);
+    om_status st = om_method_init(m, &state, &ma, &cfg, s, v.cam.width, v.cam.height, &d);
     if (st) return st;
     static unsigned char strip_pix[80 * 60 * 3];
     om_framebuffer fb = {f, v.cam.width, strip ? strip : v.cam.height,
@@ -223,7 +223,7 @@ static void frame_budget(void)
     om_arena_init(&ma, method_mem, sizeof method_mem, "method");
     om_method_cfg cfg;
     om_method_cfg_default(&cfg, m);
-    CHECK_OK(m->init(&state, &ma, &cfg, &s, 80, 60, NULL));
+    CHECK_OK(om_method_init(m, &state, &ma, &cfg, &s, 80, 60, NULL));
     static unsigned char pix[80 * 3 * 4];
     om_framebuffer fb = {OM_RGB888, 80, 4, 240, pix};
     om_shade_cfg shade;
@@ -293,7 +293,7 @@ static void registry(void)
     CHECK(om_method_find(NULL) == NULL);
     for (size_t i = 0; i < om_method_count(); i++) {
         const om_method *m = om_method_at(i);
-        CHECK(m->name && m->summary && m->bytes && m->init && m->begin && m->observe &&
+        CHECK(om_method_name(m) && om_method_summary(m) && m->bytes && m->init && m->begin && m->observe &&
               m->build && m->resolve && m->stats);
     }
 }

@@ -243,7 +243,7 @@ static void hiz_methods_same_without_room(void)
         const om_method *m = om_method_find(names[k]);
         om_method_cfg cfg = h_cfg(names[k], "map=512");
         size_t mn = 0, full = 0;
-        CHECK_OK(m->bytes(&cfg, &hs.s, FW, FH, &mn, &full));
+        CHECK_OK(om_method_bytes(m, &cfg, &hs.s, FW, FH, &mn, &full));
         CHECK(full >= mn + om__hiz_words(512, 512) * 4);
         static uint8_t a[FW * FH], b[FW * FH];
         static om_term ta[FW * FH], tb[FW * FH];

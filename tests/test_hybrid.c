@@ -37,13 +37,13 @@ static uint32_t certain_agree(const om_scene *s, const om_method_cfg *c, const c
     om_diag d;
     CHECK_OK(h_view(&v, s, 0, W, H, &d));
     size_t mn, full;
-    CHECK_OK(m->bytes(c, s, W, H, &mn, &full));
+    CHECK_OK(om_method_bytes(m, c, s, W, H, &mn, &full));
     void *mem = malloc(least ? mn : full), *state;
     om_arena a;
     om_arena_init(&a, mem, least ? mn : full, "method");
     uint32_t decided = 0, wrong = 0, answers[3] = {0, 0, 0};
     bool ran = false;
-    if (m->init(&state, &a, c, s, W, H, &d) == OM_OK && m->begin(state, &v, &d) == OM_OK &&
+    if (om_method_init(m, &state, &a, c, s, W, H, &d) == OM_OK && m->begin(state, &v, &d) == OM_OK &&
         m->build(state, &d) == OM_OK) {
         ran = true;
         const om__lspace *ls = om__hybrid_lspace(state);
@@ -74,7 +74,7 @@ static uint32_t certain_agree(const om_scene *s, const om_method_cfg *c, const c
         om_strip st = {W, H, 0, H, smp, terms};
         om_method_stats ms;
         CHECK_OK(m->resolve(state, &st, &d));
-        m->stats(state, &ms);
+        om_method_get_stats(m, state, &ms);
         for (int k = 0; k < 3; k++)
             CHECK_MSG(ms.counters[k] == answers[k], "%s: resolve's %s %u, the map's %u", what,
                       ms.counter_names[k], (unsigned)ms.counters[k], answers[k]);
@@ -116,7 +116,7 @@ static void equals_ref(const char *text, const char *what, double least_certain)
     CHECK_MSG(term_diff() == 0, "%s, strips: %d samples differ", what, term_diff());
     const om_method *m = om_method_find("hybrid");
     size_t mn, full;
-    CHECK_OK(m->bytes(&c, &hs.s, W, H, &mn, &full));
+    CHECK_OK(om_method_bytes(m, &c, &hs.s, W, H, &mn, &full));
     CHECK_OK(h_render_in(&hs.s, "hybrid", &c, W, H, 0, 0, mn, NULL, hyb_t, NULL));
     CHECK_MSG(term_diff() == 0, "%s, minimum budget: %d samples differ", what, term_diff());
     h_scene_free(&hs);
@@ -137,7 +137,7 @@ static void hybrid_regions_equal_ref(void)
     om_method_cfg c;
     om_method_cfg_default(&c, m);
     size_t mn, full;
-    CHECK_OK(m->bytes(&c, &hs.s, RW, RH, &mn, &full));
+    CHECK_OK(om_method_bytes(m, &c, &hs.s, RW, RH, &mn, &full));
     CHECK_OK(h_render(&hs.s, "ref", NULL, RW, RH, 0, 0, NULL, ref, NULL));
     for (int least = 0; least < 2; least++) {
         CHECK_OK(h_render_in(&hs.s, "hybrid", &c, RW, RH, 0, 0, least ? mn : full, NULL, hyb, NULL));

@@ -105,7 +105,7 @@ static void budgets(void)
     om_method_cfg c;
     om_method_cfg_default(&c, om_method_find("izb"));
     size_t mn, full;
-    CHECK_OK(m->bytes(&c, &hs.s, W, H, &mn, &full));
+    CHECK_OK(om_method_bytes(m, &c, &hs.s, W, H, &mn, &full));
     CHECK(mn < full);
     /* below the minimum: a budget error naming it */
     unsigned char *buf = malloc(full + 64);
@@ -113,7 +113,7 @@ static void budgets(void)
     om_arena_init(&a, buf, mn - 1, "method");
     void *state;
     om_diag d;
-    CHECK(m->init(&state, &a, &c, &hs.s, W, H, &d) == OM_E_BUDGET);
+    CHECK(om_method_init(m, &state, &a, &c, &hs.s, W, H, &d) == OM_E_BUDGET);
     char num[32];
     snprintf(num, sizeof num, "%zu", mn);
     CHECK_MSG(strstr(d.msg, num) != NULL, "'%s' does not name %s", d.msg, num);
@@ -129,7 +129,7 @@ static void budgets(void)
         om_arena ma, fa;
         om_arena_init(&ma, mem, sizes[k], "method");
         om_arena_init(&fa, fmem, om_frame_bytes(W, H), "frame");
-        CHECK_OK(m->init(&state, &ma, &c, &hs.s, W, H, &d));
+        CHECK_OK(om_method_init(m, &state, &ma, &c, &hs.s, W, H, &d));
         CHECK(ma.peak <= sizes[k]);
         om_framebuffer fb = {OM_RGB888, W, H, W * 3, px};
         om_shade_cfg shade;
@@ -138,7 +138,7 @@ static void budgets(void)
         /* capture terms through the strip callback of the harness' kind */
         CHECK_OK(om_render_frame(&fd, &fa, NULL, &d));
         om_method_stats ms;
-        m->stats(state, &ms);
+        om_method_get_stats(m, state, &ms);
         uint32_t tiles = ms.counters[5];
         if (k == 0) CHECK_MSG(tiles > 10, "minimum budget: %u tiles", tiles);
         if (k == 2) CHECK_EQ_U(tiles, 1);
@@ -167,8 +167,8 @@ static void default_pool(void)
     om_method_cfg_default(&one, m);
     CHECK_OK(om_method_cfg_set(&one, "izb.pool", W2 * H2, NULL));
     size_t mn, full, full_one;
-    CHECK_OK(m->bytes(&c, &hs.s, W2, H2, &mn, &full));
-    CHECK_OK(m->bytes(&one, &hs.s, W2, H2, &mn, &full_one));
+    CHECK_OK(om_method_bytes(m, &c, &hs.s, W2, H2, &mn, &full));
+    CHECK_OK(om_method_bytes(m, &one, &hs.s, W2, H2, &mn, &full_one));
     CHECK_MSG(full < full_one / 2, "default pool %zu bytes, one pass %zu", full, full_one);
     om_term *rt = malloc(sizeof *rt * W2 * H2), *zt = malloc(sizeof *zt * W2 * H2);
     CHECK_OK(h_render(&hs.s, "ref", NULL, W2, H2, 0, 0, NULL, rt, NULL));
@@ -190,14 +190,14 @@ static void default_pool(void)
         om_diag d;
         void *state;
         CHECK_OK(h_view(&v, &hs.s, 0, W2, H2, NULL));
-        CHECK_OK(m->init(&state, &ma, ck, &hs.s, W2, H2, &d));
+        CHECK_OK(om_method_init(m, &state, &ma, ck, &hs.s, W2, H2, &d));
         om_framebuffer fb = {OM_RGB888, W2, H2, W2 * 3, px};
         om_shade_cfg shade;
         om_frame_desc fd;
         h_frame_desc(&fd, &shade, &hs.s, &v, m, state, &fb, 0);
         CHECK_OK(om_render_frame(&fd, &fa, NULL, &d));
         om_method_stats ms;
-        m->stats(state, &ms);
+        om_method_get_stats(m, state, &ms);
         tiles[k] = ms.counters[5];
         free(mem);
         free(fmem);
@@ -385,7 +385,7 @@ static izb_run izb_frame(const om_scene *s, const char *pool, size_t bytes, uint
     om_arena ma, fa;
     om_arena_init(&ma, mem, bytes, "method");
     om_arena_init(&fa, fmem, fbytes, "frame");
-    CHECK_OK(m->init(&state, &ma, &c, s, W, H, &d));
+    CHECK_OK(om_method_init(m, &state, &ma, &c, s, W, H, &d));
     om_framebuffer fb = {OM_RGB888, W, H, W * 3, px};
     om_shade_cfg shade;
     om_shade_cfg_default(&shade);
@@ -395,7 +395,7 @@ static izb_run izb_frame(const om_scene *s, const char *pool, size_t bytes, uint
     fd.fb = &fb; fd.strip_rows = rows; fd.on_strip = hash_strip; fd.user = &r.hash;
     CHECK_OK(om_render_frame(&fd, &fa, NULL, &d));
     om_method_stats ms;
-    m->stats(state, &ms);
+    om_method_get_stats(m, state, &ms);
     for (uint32_t k = 0; k < ms.ncounters && k < 8; k++) r.counters[k] = (uint32_t)ms.counters[k];
     const om__izb *z = (const om__izb *)state;
     r.grid = z->grid ? z->grid->ready : 2;
@@ -430,7 +430,7 @@ static void grid_same_walk(void)
             const char *pool = pi ? "izb.pool=1500" : "izb.pool=0";
             om_method_cfg c = h_cfg("izb", pool);
             size_t mn, full;
-            CHECK_OK(m->bytes(&c, &hs.s, W, H, &mn, &full));
+            CHECK_OK(om_method_bytes(m, &c, &hs.s, W, H, &mn, &full));
             for (uint32_t rows = 0; rows <= 16; rows += 16) {
                 izb_run a = izb_frame(&hs.s, pool, full, rows),
                         b = izb_frame(&hs.s, pool, full - om__lgrid_bytes(&hs.s) / 2, rows);

@@ -62,11 +62,11 @@ static void asm_jobs_case(const om_scene *s, const char *set, uint32_t rows, flo
 {
     enum { W = 96, H = 72 };
     const om_method *m = om_method_find("asm");
-    const om__pass *ps = om__method_pass(m);
+    const om__pass *ps = m->pass;
     om_method_cfg c = h_cfg("asm", set);
     size_t mn, full;
     om_diag d;
-    CHECK_OK(m->bytes(&c, s, W, H, &mn, &full));
+    CHECK_OK(om_method_bytes(m, &c, s, W, H, &mn, &full));
     void *mm = malloc(full), *state = NULL;
     memset(mm, lend ? 0x5A : 0xA5, full);   /* what init leaves unwritten differs between the two */
     uint32_t *depth = calloc((size_t)W * H, sizeof *depth), *id = calloc((size_t)W * H, sizeof *id);
@@ -74,7 +74,7 @@ static void asm_jobs_case(const om_scene *s, const char *set, uint32_t rows, flo
     om_term *terms = calloc((size_t)W * H, sizeof *terms), *kept = calloc((size_t)W * H, sizeof *terms);
     om_arena ma;
     om_arena_init(&ma, mm, full, "method");
-    CHECK_OK(m->init(&state, &ma, &c, s, W, H, &d));
+    CHECK_OK(om_method_init(m, &state, &ma, &c, s, W, H, &d));
     CHECK(ps && ps->lend);
     lent3 h;
     const size_t sb = ps->scratch(state, s);
@@ -157,20 +157,20 @@ static void observe_lent(void)
     static const char *const sets[][2] = {{"rtw", "map=256"}, {"spsm", "map=256 spsm.records=2"}};
     for (int i = 0; i < 2; i++) {
         const om_method *m = om_method_find(sets[i][0]);
-        const om__pass *ps = om__method_pass(m);
+        const om__pass *ps = m->pass;
         CHECK(ps && ps->lend && !ps->job);
         if (!ps) continue;
         om_method_cfg c = h_cfg(sets[i][0], sets[i][1]);
         size_t mn, full;
         om_diag d;
-        CHECK_OK(m->bytes(&c, &hs.s, W, H, &mn, &full));
+        CHECK_OK(om_method_bytes(m, &c, &hs.s, W, H, &mn, &full));
         uint64_t hash[2][2] = {{0}};
         for (int lend = 0; lend < 2; lend++)
             for (uint32_t rows = 8; rows <= H; rows += H - 8) {
                 void *mm = calloc(1, full), *state = NULL;
                 om_arena ma;
                 om_arena_init(&ma, mm, full, "method");
-                CHECK_OK(m->init(&state, &ma, &c, &hs.s, W, H, &d));
+                CHECK_OK(om_method_init(m, &state, &ma, &c, &hs.s, W, H, &d));
                 lent3 h;
                 const size_t sb = ps->scratch(state, &hs.s);
                 CHECK(sb > 0);
@@ -188,7 +188,7 @@ static void observe_lent(void)
                     CHECK_OK(m->observe(state, &sub, &d));
                 }
                 const om__lent *lt = i ? &((const om__spsm_state *)state)->lent : &((const om__rtw *)state)->lent;
-                CHECK_MSG(lt->used == (lend == 1), "%s: bands %s", m->name, lend ? "did not run" : "ran unlent");
+                CHECK_MSG(lt->used == (lend == 1), "%s: bands %s", om_method_name(m), lend ? "did not run" : "ran unlent");
                 CHECK_OK(m->build(state, &d));
                 if (i == 0) {
                     const om__rtw *r = (const om__rtw *)state;
@@ -202,7 +202,7 @@ static void observe_lent(void)
                 for (int k = 0; k < 3; k++) free(h.slot[k]);
                 free(mm);
             }
-        CHECK_MSG(hash[1][0] == hash[0][0] && hash[1][1] == hash[0][1], "%s: lent observe differs", m->name);
+        CHECK_MSG(hash[1][0] == hash[0][0] && hash[1][1] == hash[0][1], "%s: lent observe differs", om_method_name(m));
     }
     free(depth);
     free(id);
@@ -226,7 +226,7 @@ static void hybrid_map_lent(void)
     const char *const scenes[] = {om_scene_default_text(), clipped};
     static const char *const sets[] = {"hybrid.map=256", "hybrid.map=100", "hybrid.map=5"};
     const om_method *m = om_method_find("hybrid");
-    const om__pass *ps = om__method_pass(m);
+    const om__pass *ps = m->pass;
     CHECK(ps && ps->lend);
     for (int sc = 0; sc < 2 && ps; sc++) {
         h_scene hs;
@@ -235,14 +235,14 @@ static void hybrid_map_lent(void)
             om_method_cfg c = h_cfg("hybrid", sets[i]);
             size_t mn, full;
             om_diag d;
-            CHECK_OK(m->bytes(&c, &hs.s, W, H, &mn, &full));
+            CHECK_OK(om_method_bytes(m, &c, &hs.s, W, H, &mn, &full));
             uint64_t hash[2] = {0, 0};
             uint32_t clips = 0;
             for (int lend = 0; lend < 2; lend++) {
                 void *mm = calloc(1, full), *state = NULL;
                 om_arena ma;
                 om_arena_init(&ma, mm, full, "method");
-                CHECK_OK(m->init(&state, &ma, &c, &hs.s, W, H, &d));
+                CHECK_OK(om_method_init(m, &state, &ma, &c, &hs.s, W, H, &d));
                 const hybrid_state *hy = (const hybrid_state *)state;
                 CHECK_MSG(hy->cands == hs.s.ntris, "hybrid: no room for the bands' reach");
                 lent3 h = {{NULL, NULL, NULL}};
@@ -278,11 +278,11 @@ static void hybrid_tile_lent(void)
     om_method_cfg c = h_cfg("hybrid", "");
     size_t mn, full;
     om_diag d;
-    CHECK_OK(m->bytes(&c, &hs.s, W, H, &mn, &full));
+    CHECK_OK(om_method_bytes(m, &c, &hs.s, W, H, &mn, &full));
     void *mm = calloc(1, full), *state = NULL;
     om_arena ma;
     om_arena_init(&ma, mm, full, "method");
-    CHECK_OK(m->init(&state, &ma, &c, &hs.s, W, H, &d));
+    CHECK_OK(om_method_init(m, &state, &ma, &c, &hs.s, W, H, &d));
     om_view v;
     CHECK_OK(h_view(&v, &hs.s, 0.0f, W, H, &d));
     uint32_t *depth = calloc(N, sizeof *depth), *id = calloc(N, sizeof *id);

@@ -64,9 +64,9 @@ static void failure_injection(void)
     static unsigned char fmem[W * 9 * 52];   /* 44 bytes a pixel, and room for the bins */
     for (size_t k = 0; k < om_method_count(); k++) {
         f.m = om_method_at(k);
-        f.cfg = h_cfg(f.m->name, SMALL);
+        f.cfg = h_cfg(om_method_name(f.m), SMALL);
         size_t mn, full;
-        CHECK_OK(f.m->bytes(&f.cfg, &hs.s, W, H, &mn, &full));
+        CHECK_OK(om_method_bytes(f.m, &f.cfg, &hs.s, W, H, &mn, &full));
         unsigned char *mem = malloc(full);
         om_arena ma, fa;
         void *state;
@@ -74,7 +74,7 @@ static void failure_injection(void)
         /* undisturbed: two frames (progressive methods may change between them) */
         om_arena_init(&ma, mem, full, "method");
         om_arena_init(&fa, fmem, sizeof fmem, "frame");
-        CHECK_OK(f.m->init(&state, &ma, &f.cfg, &hs.s, W, H, NULL));
+        CHECK_OK(om_method_init(f.m, &state, &ma, &f.cfg, &hs.s, W, H, NULL));
         CHECK_OK(frame(&f, state, &fa, good));
         uint32_t method_carves = ma.carves, frame_carves = fa.carves;
         CHECK_OK(frame(&f, state, &fa, good));
@@ -83,25 +83,25 @@ static void failure_injection(void)
          * vertices (carves that may fail: the strips then walk every triangle, or clip
          * every vertex, for the same pixels) */
         CHECK_MSG(method_carves >= 1 && frame_carves == 6, "%s: %u method and %u frame carves",
-                  f.m->name, method_carves, frame_carves);
+                  om_method_name(f.m), method_carves, frame_carves);
         int bad = 0;
         for (uint32_t n = 1; n <= method_carves + frame_carves; n++) {
             om_arena_init(&ma, mem, full, "method");
             om_arena_init(&fa, fmem, sizeof fmem, "frame");
             if (n <= method_carves) ma.fail_at = n;
             else fa.fail_at = n - method_carves;
-            om_status st = f.m->init(&state, &ma, &f.cfg, &hs.s, W, H, NULL);
+            om_status st = om_method_init(f.m, &state, &ma, &f.cfg, &hs.s, W, H, NULL);
             if (st != OM_OK) {
                 if (st != OM_E_BUDGET) bad++;
                 /* init failed: a fresh init with the carve counter past the failure */
                 om_arena_init(&ma, mem, full, "method");
-                CHECK_OK(f.m->init(&state, &ma, &f.cfg, &hs.s, W, H, NULL));
+                CHECK_OK(om_method_init(f.m, &state, &ma, &f.cfg, &hs.s, W, H, NULL));
             }
             st = frame(&f, state, &fa, got);
             if (st != OM_OK && st != OM_E_BUDGET) bad++;
             if (frame(&f, state, &fa, got) != OM_OK || memcmp(got, good, sizeof got) != 0) bad++;
         }
-        CHECK_MSG(bad == 0, "%s: %d injected failures went wrong (of %u carves)", f.m->name, bad,
+        CHECK_MSG(bad == 0, "%s: %d injected failures went wrong (of %u carves)", om_method_name(f.m), bad,
                   method_carves + frame_carves);
         free(mem);
     }
@@ -153,9 +153,9 @@ static void every_method_survives(const om_scene *s, const char *what)
 {
     static uint8_t mask[W * H];
     for (size_t k = 0; k < om_method_count(); k++) {
-        om_method_cfg c = h_cfg(om_method_at(k)->name, SMALL);
-        om_status st = h_render(s, om_method_at(k)->name, &c, W, H, 0, 7, mask, NULL, NULL);
-        CHECK_MSG(st == OM_OK, "%s: %s gave %s", what, om_method_at(k)->name, om_status_str(st));
+        om_method_cfg c = h_cfg(om_method_name(om_method_at(k)), SMALL);
+        om_status st = h_render(s, om_method_name(om_method_at(k)), &c, W, H, 0, 7, mask, NULL, NULL);
+        CHECK_MSG(st == OM_OK, "%s: %s gave %s", what, om_method_name(om_method_at(k)), om_status_str(st));
     }
 }
 
@@ -223,8 +223,8 @@ static void pathological_views(void)
     cam.width = cam.height = 8193;
     CHECK(om_view_init(&v, &cam, &s.light, &s, &d) == OM_E_INVALID);
     for (size_t k = 0; k < om_method_count(); k++) {
-        om_method_cfg c = h_cfg(om_method_at(k)->name, SMALL);
-        CHECK_OK(h_render(&s, om_method_at(k)->name, &c, 1, 1, 0, 0, mask, NULL, NULL));
+        om_method_cfg c = h_cfg(om_method_name(om_method_at(k)), SMALL);
+        CHECK_OK(h_render(&s, om_method_name(om_method_at(k)), &c, 1, 1, 0, 0, mask, NULL, NULL));
     }
 }
 
@@ -244,13 +244,13 @@ static void largest_image(void)
         om_view v;
         CHECK_OK(om_view_init(&v, &cam, &s.light, &s, NULL));
         size_t mn, full, fbytes = om_frame_bytes(8192, 64);
-        CHECK_OK(m->bytes(&c, &s, 8192, 8192, &mn, &full));
+        CHECK_OK(om_method_bytes(m, &c, &s, 8192, 8192, &mn, &full));
         void *mem = malloc(full), *fmem = malloc(fbytes), *px = malloc(8192 * 64 * 2);
         om_arena ma, fa;
         om_arena_init(&ma, mem, full, "method");
         om_arena_init(&fa, fmem, fbytes, "frame");
         void *state;
-        CHECK_OK(m->init(&state, &ma, &c, &s, 8192, 8192, NULL));
+        CHECK_OK(om_method_init(m, &state, &ma, &c, &s, 8192, 8192, NULL));
         om_shade_cfg shade;
         om_framebuffer fb = {OM_RGB565, 8192, 64, 8192 * 2, px};
         om_frame_desc fd;

@@ -171,7 +171,7 @@ static om_status run_rtw(const om_scene *s, const om_method_cfg *c, uint32_t w, 
     const om_method *m = om_method_find("rtw");
     size_t mn, full;
     if (!m) return OM_E_NOTFOUND;
-    if ((st = m->bytes(c, s, w, h, &mn, &full))) return st;
+    if ((st = om_method_bytes(m, c, s, w, h, &mn, &full))) return st;
     uint32_t rows = strip ? strip : h;
     void *mm = malloc(full), *fm = malloc(om_frame_bytes(w, rows)), *px = malloc((size_t)w * rows * 3);
     om_arena ma, fa;
@@ -179,7 +179,7 @@ static om_status run_rtw(const om_scene *s, const om_method_cfg *c, uint32_t w, 
     om_arena_init(&fa, fm, om_frame_bytes(w, rows), "frame");
     void *state;
     om_diag d;
-    st = m->init(&state, &ma, c, s, w, h, &d);
+    st = om_method_init(m, &state, &ma, c, s, w, h, &d);
     if (st == OM_OK) {
         om_framebuffer fb = {OM_RGB888, w, rows, (size_t)w * 3, (uint8_t *)px};
         om_shade_cfg shade;
@@ -462,7 +462,7 @@ static void budget_and_determinism(void)
         CHECK_OK(om_method_cfg_set(&c, "rtw.importance", 64, NULL));
         CHECK_OK(om_method_cfg_set(&c, "rtw.analysis", analysis, NULL));
         size_t mn, full;
-        CHECK_OK(m->bytes(&c, &hs.s, w, h, &mn, &full));
+        CHECK_OK(om_method_bytes(m, &c, &hs.s, w, h, &mn, &full));
         CHECK(mn < full && mn >= 256 * 256 * 4);
         unsigned char *buf = malloc(mn + 64);
         memset(buf, 0xC3, mn + 64);
@@ -470,7 +470,7 @@ static void budget_and_determinism(void)
         om_arena_init(&a, buf + 32, mn - 1, "method");
         void *state;
         om_diag d;
-        CHECK(m->init(&state, &a, &c, &hs.s, w, h, &d) == OM_E_BUDGET);
+        CHECK(om_method_init(m, &state, &a, &c, &hs.s, w, h, &d) == OM_E_BUDGET);
         CHECK_EQ_U(a.used, 0);
         char num[32];
         snprintf(num, sizeof num, "%zu", mn);
@@ -510,7 +510,7 @@ static void budget_and_determinism(void)
     om_arena_init(&a, small, sizeof small, "method");
     om_method_cfg other;
     om_method_cfg_default(&other, om_method_find("sm"));
-    CHECK(m->init(&state, &a, &other, &hs.s, w, h, NULL) == OM_E_INVALID);
+    CHECK(om_method_init(m, &state, &a, &other, &hs.s, w, h, NULL) == OM_E_INVALID);
     h_scene_free(&hs);
 }
 
@@ -577,10 +577,10 @@ static void importance_follows_small_maps(void)
         CHECK(om_method_cfg_get(&c, "rtw.importance", &side) == OM_OK && side == 0);
         CHECK_OK(om_method_cfg_set(&c, "map", maps[i], NULL));
         size_t mn0, full0, mn1, full1;
-        CHECK_OK(m->bytes(&c, &hs.s, w, h, &mn0, &full0));
+        CHECK_OK(om_method_bytes(m, &c, &hs.s, w, h, &mn0, &full0));
         if (maps[i] <= 128) CHECK_OK(run_rtw(&hs.s, &c, w, h, 0, pcf_terms[0], NULL, NULL));
         CHECK_OK(om_method_cfg_set(&c, "rtw.importance", sides[i], NULL));
-        CHECK_OK(m->bytes(&c, &hs.s, w, h, &mn1, &full1));
+        CHECK_OK(om_method_bytes(m, &c, &hs.s, w, h, &mn1, &full1));
         CHECK_MSG(mn0 == mn1, "map %u: %zu bytes by default, %zu with importance %u", maps[i], mn0, mn1, sides[i]);
         if (maps[i] <= 128) {
             CHECK_OK(run_rtw(&hs.s, &c, w, h, 0, pcf_terms[1], NULL, NULL));

@@ -4,6 +4,7 @@
  * refused, and om_method_cfg_from carries only what two methods share. */
 #include "test.h"
 #include "harness.h"
+#include "../engine/shadow/method.h"   /* the tables themselves (cfg_bytes) */
 
 #include <math.h>
 
@@ -13,29 +14,29 @@ static void tables_are_sound(void)
 {
     for (size_t k = 0; k < om_method_count(); k++) {
         const om_method *m = om_method_at(k);
-        CHECK_MSG(m->cfg_bytes <= OM_METHOD_CFG_BYTES, "%s: %zu bytes", m->name, m->cfg_bytes);
-        CHECK_MSG((m->nsettings == 0) == (m->cfg_bytes == 0), "%s: %u settings in %zu bytes", m->name,
-                  m->nsettings, m->cfg_bytes);
-        for (uint32_t i = 0; i < m->nsettings; i++) {
-            const om_setting *f = &m->settings[i];
+        CHECK_MSG(m->cfg_bytes <= OM_METHOD_CFG_BYTES, "%s: %zu bytes", om_method_name(m), m->cfg_bytes);
+        CHECK_MSG((om_method_nsettings(m) == 0) == (m->cfg_bytes == 0), "%s: %u settings in %zu bytes", om_method_name(m),
+                  om_method_nsettings(m), m->cfg_bytes);
+        for (uint32_t i = 0; i < om_method_nsettings(m); i++) {
+            const om_setting *f = om_method_setting_at(m, i);
             size_t n = kind_bytes(f->kind);
-            CHECK_MSG(f->name[0] && f->doc[0] && !strchr(f->doc, '\n'), "%s: setting %u", m->name, i);
-            CHECK_MSG(f->offset % n == 0 && f->offset + n <= m->cfg_bytes, "%s %s at %zu", m->name,
+            CHECK_MSG(f->name[0] && f->doc[0] && !strchr(f->doc, '\n'), "%s: setting %u", om_method_name(m), i);
+            CHECK_MSG(f->offset % n == 0 && f->offset + n <= m->cfg_bytes, "%s %s at %zu", om_method_name(m),
                       f->name, f->offset);
-            CHECK_MSG(f->min <= f->def && f->def <= f->max, "%s %s: default %g outside %g..%g", m->name,
+            CHECK_MSG(f->min <= f->def && f->def <= f->max, "%s %s: default %g outside %g..%g", om_method_name(m),
                       f->name, f->def, f->min, f->max);
-            CHECK_MSG(om_method_setting(m, f->name) == f, "%s: %s named twice", m->name, f->name);
+            CHECK_MSG(om_method_setting(m, f->name) == f, "%s: %s named twice", om_method_name(m), f->name);
             /* METHOD.NAME is that method's own: it takes it (hybrid takes izb's too) */
             const char *dot = strchr(f->name, '.');
             for (size_t j = 0; dot && j < om_method_count(); j++) {
                 const om_method *o = om_method_at(j);
-                bool own = strlen(o->name) == (size_t)(dot - f->name) && !strncmp(o->name, f->name, (size_t)(dot - f->name));
-                if (own) CHECK_MSG(om_method_setting(o, f->name) != NULL, "%s is not %s's", f->name, o->name);
+                bool own = strlen(om_method_name(o)) == (size_t)(dot - f->name) && !strncmp(om_method_name(o), f->name, (size_t)(dot - f->name));
+                if (own) CHECK_MSG(om_method_setting(o, f->name) != NULL, "%s is not %s's", f->name, om_method_name(o));
             }
             for (uint32_t j = 0; j < i; j++) {
-                const om_setting *g = &m->settings[j];
+                const om_setting *g = om_method_setting_at(m, j);
                 CHECK_MSG(f->offset >= g->offset + kind_bytes(g->kind) || g->offset >= f->offset + n,
-                          "%s: %s and %s overlap", m->name, f->name, g->name);
+                          "%s: %s and %s overlap", om_method_name(m), f->name, g->name);
             }
         }
     }
@@ -48,8 +49,8 @@ static void defaults_and_ranges(void)
         om_method_cfg c;
         om_method_cfg_default(&c, m);
         CHECK(c.method == m);
-        for (uint32_t i = 0; i < m->nsettings; i++) {
-            const om_setting *f = &m->settings[i];
+        for (uint32_t i = 0; i < om_method_nsettings(m); i++) {
+            const om_setting *f = om_method_setting_at(m, i);
             const bool whole = f->kind != OM_SETTING_F32;
             double v = -1, want = whole ? f->def : (double)(float)f->def;
             CHECK(om_method_cfg_get(&c, f->name, &v) == OM_OK && v == want);
@@ -99,7 +100,7 @@ static void carried_across(void)
     om_method_cfg_default(&none, NULL);
     CHECK(om_method_cfg_set(&none, "map", 512, NULL) == OM_E_NOTFOUND);
     size_t mn, full;
-    CHECK(om_method_find("sm")->bytes(&none, NULL, 16, 16, &mn, &full) == OM_E_INVALID);
+    CHECK(om_method_bytes(om_method_find("sm"), &none, NULL, 16, 16, &mn, &full) == OM_E_INVALID);
 }
 
 void suite_settings(void)

@@ -451,7 +451,7 @@ static void methods_agree_on_samples(void)
     if (!h_scene_parse(&hs, default_scene())) return;
     CHECK_OK(h_render(&hs.s, "ref", NULL, W, H, 0, 0, mask, NULL, NULL));
     for (size_t i = 0; i < om_method_count(); i++) {
-        CHECK_OK(h_render(&hs.s, om_method_at(i)->name, NULL, W, H, 0, 7, mask2, NULL, NULL));
+        CHECK_OK(h_render(&hs.s, om_method_name(om_method_at(i)), NULL, W, H, 0, 7, mask2, NULL, NULL));
         om_metrics m;
         om_compare_masks(mask, mask2, W, H, &m);
         CHECK_EQ_U(m.mismatched_bg, 0);
@@ -471,19 +471,19 @@ static void budgets_name_the_minimum(void)
         const om_method *m = om_method_find(names[k]);
         om_method_cfg c = h_cfg(names[k], "map=256");
         size_t mn, full;
-        CHECK_OK(m->bytes(&c, &hs.s, W, H, &mn, &full));
+        CHECK_OK(om_method_bytes(m, &c, &hs.s, W, H, &mn, &full));
         unsigned char *buf = malloc(mn + 64);
         memset(buf, 0xC3, mn + 64);
         om_arena a;
         om_arena_init(&a, buf + 32, mn / 2, "method");
         void *state;
         om_diag d;
-        CHECK(m->init(&state, &a, &c, &hs.s, W, H, &d) == OM_E_BUDGET);
+        CHECK(om_method_init(m, &state, &a, &c, &hs.s, W, H, &d) == OM_E_BUDGET);
         char num[32];
         snprintf(num, sizeof num, "%zu", mn);
         CHECK_MSG(strstr(d.msg, num) != NULL, "%s: '%s' does not name %s", names[k], d.msg, num);
         om_arena_init(&a, buf + 32, mn, "method");
-        CHECK_OK(m->init(&state, &a, &c, &hs.s, W, H, &d));
+        CHECK_OK(om_method_init(m, &state, &a, &c, &hs.s, W, H, &d));
         CHECK(a.peak <= mn);
         int guard = 0;
         for (int i = 0; i < 32; i++) guard += buf[i] != 0xC3 || buf[32 + mn + i] != 0xC3;
@@ -509,7 +509,7 @@ static void odd_lights(void)
         h_scene hs;
         if (!h_scene_parse(&hs, text)) return;
         for (size_t i = 0; i < om_method_count(); i++)
-            CHECK_OK(h_render(&hs.s, om_method_at(i)->name, NULL, 0, 0, 0, 0, mask, NULL, NULL));
+            CHECK_OK(h_render(&hs.s, om_method_name(om_method_at(i)), NULL, 0, 0, 0, 0, mask, NULL, NULL));
         h_scene_free(&hs);
     }
 }
@@ -527,7 +527,7 @@ static void ref_small_equals_fast(void)
     om_method_cfg c;
     om_method_cfg_default(&c, m);
     size_t mn, full;
-    CHECK_OK(m->bytes(&c, &hs.s, W, H, &mn, &full));
+    CHECK_OK(om_method_bytes(m, &c, &hs.s, W, H, &mn, &full));
     CHECK(mn < full / 4);
     om_view v;
     CHECK_OK(h_view(&v, &hs.s, 0, W, H, NULL));
@@ -538,7 +538,7 @@ static void ref_small_equals_fast(void)
         om_arena_init(&ma, mem, size, "method");
         om_arena_init(&fa, fmem, om_frame_bytes(W, H), "frame");
         void *state;
-        CHECK_OK(m->init(&state, &ma, &c, &hs.s, W, H, NULL));
+        CHECK_OK(om_method_init(m, &state, &ma, &c, &hs.s, W, H, NULL));
         om_framebuffer fb = {OM_RGB888, W, H, W * 3, px};
         om_shade_cfg shade;
         om_frame_desc fd;
@@ -551,7 +551,7 @@ static void ref_small_equals_fast(void)
         CHECK_OK(om_render_frame(&fd, &fa, NULL, NULL));
         CHECK(!memcmp(fast, small, sizeof fast));
         om_method_stats ms;
-        m->stats(state, &ms);
+        om_method_get_stats(m, state, &ms);
         CHECK(ma.peak <= size);
         if (k) CHECK(ms.bytes_used > mn && ms.bytes_used < full / 2);   /* the middle mode */
         else CHECK(ma.peak <= mn);
@@ -705,16 +705,16 @@ static void kept_state_case(const char *text, float t1)
     static uint8_t px[W * 16 * 3];
     for (size_t mi = 0; mi < om_method_count(); mi++) {
         const om_method *m = om_method_at(mi);
-        if (!strcmp(m->name, "asm")) continue;
+        if (!strcmp(om_method_name(m), "asm")) continue;
         uint64_t h[2];
         for (int fresh = 0; fresh < 2; fresh++) {
-            om_method_cfg c = h_cfg(m->name, "map=256");
+            om_method_cfg c = h_cfg(om_method_name(m), "map=256");
             size_t mn, full;
-            CHECK_OK(m->bytes(&c, &hs.s, W, H, &mn, &full));
+            CHECK_OK(om_method_bytes(m, &c, &hs.s, W, H, &mn, &full));
             void *mm = malloc(full), *state = NULL;
             om_arena ma, fa;
             om_arena_init(&ma, mm, full, "method");
-            CHECK_OK(m->init(&state, &ma, &c, &hs.s, W, H, NULL));
+            CHECK_OK(om_method_init(m, &state, &ma, &c, &hs.s, W, H, NULL));
             for (int f = fresh; f < 2; f++) {
                 om_view v;
                 CHECK_OK(h_view(&v, &hs.s, f ? t1 : 0.0f, W, H, NULL));
@@ -730,7 +730,7 @@ static void kept_state_case(const char *text, float t1)
             h[fresh] = kept_hash;
             free(mm);
         }
-        CHECK_MSG(h[0] == h[1], "%s: a kept state's frame at t %g is not a fresh one's", m->name, t1);
+        CHECK_MSG(h[0] == h[1], "%s: a kept state's frame at t %g is not a fresh one's", om_method_name(m), t1);
     }
     h_scene_free(&hs);
 }

@@ -430,18 +430,18 @@ static void marks_only_when_they_pay(void)
         om_method_cfg_default(&c, om_method_find("spsm"));
         CHECK_OK(om_method_cfg_set(&c, "map", map, NULL));
         size_t mn, full;
-        CHECK_OK(m->bytes(&c, &hs.s, 160, 120, &mn, &full));
+        CHECK_OK(om_method_bytes(m, &c, &hs.s, 160, 120, &mn, &full));
         CHECK(full <= sizeof mem);
         if (full > sizeof mem) break;
         om_arena a;
         om_arena_init(&a, mem, full, "method");
         void *state;
         om_diag d;
-        CHECK_OK(m->init(&state, &a, &c, &hs.s, 160, 120, &d));
+        CHECK_OK(om_method_init(m, &state, &a, &c, &hs.s, 160, 120, &d));
         om_frame_stats fs;
         spsm_frames(&hs.s, state, 30, 1, &fs);
         om_method_stats s;
-        m->stats(state, &s);
+        om_method_get_stats(m, state, &s);
         const bool marks = map == 1024;
         CHECK_EQ_U(fs.strips, 4);
         CHECK_MSG(fs.eye_passes == (marks ? 8u : 4u), "map %u: %u eye passes", map, fs.eye_passes);
@@ -486,7 +486,7 @@ static void stats_and_budget(void)
     om_method_cfg_default(&c, om_method_find("spsm"));
     CHECK_OK(om_method_cfg_set(&c, "map", 300, NULL));
     size_t mn, full;
-    CHECK_OK(m->bytes(&c, &hs.s, 160, 120, &mn, &full));
+    CHECK_OK(om_method_bytes(m, &c, &hs.s, 160, 120, &mn, &full));
     CHECK(mn == full && mn >= (size_t)300 * 300 * 24);
     unsigned char *buf = malloc(mn + 64);
     memset(buf, 0xC3, mn + 64);
@@ -494,12 +494,12 @@ static void stats_and_budget(void)
     om_arena_init(&a, buf + 32, mn - 1, "method");
     void *state;
     om_diag d;
-    CHECK(m->init(&state, &a, &c, &hs.s, 160, 120, &d) == OM_E_BUDGET);
+    CHECK(om_method_init(m, &state, &a, &c, &hs.s, 160, 120, &d) == OM_E_BUDGET);
     char num[32];
     snprintf(num, sizeof num, "%zu", mn);
     CHECK_MSG(strstr(d.msg, num) != NULL, "'%s' does not name %s", d.msg, num);
     om_arena_init(&a, buf + 32, mn, "method");
-    CHECK_OK(m->init(&state, &a, &c, &hs.s, 160, 120, &d));
+    CHECK_OK(om_method_init(m, &state, &a, &c, &hs.s, 160, 120, &d));
     om_frame_stats fs;
     spsm_frames(&hs.s, state, 0, 2, &fs);
     CHECK(a.peak <= mn);
@@ -507,7 +507,7 @@ static void stats_and_budget(void)
     for (int i = 0; i < 32; i++) guard += buf[i] != 0xC3 || buf[32 + mn + i] != 0xC3;
     CHECK_EQ_U(guard, 0);
     om_method_stats s;
-    m->stats(state, &s);
+    om_method_get_stats(m, state, &s);
     CHECK(s.ncounters >= 4);
     CHECK_MSG(s.counters[1] + s.counters[2] + s.counters[3] == s.counters[0],
               "lit %u + shadowed %u + uncertain %u != %u", s.counters[1], s.counters[2], s.counters[3],
@@ -530,16 +530,16 @@ static void stats_and_budget(void)
     /* a configuration made for another method is refused by bytes and init */
     om_method_cfg other;
     om_method_cfg_default(&other, om_method_find("rtw"));
-    CHECK(m->bytes(&other, &hs.s, 160, 120, &mn, &full) == OM_E_INVALID);
+    CHECK(om_method_bytes(m, &other, &hs.s, 160, 120, &mn, &full) == OM_E_INVALID);
     om_arena_init(&a, buf + 32, mn, "method");
-    CHECK(m->init(&state, &a, &other, &hs.s, 160, 120, &d) == OM_E_INVALID);
+    CHECK(om_method_init(m, &state, &a, &other, &hs.s, 160, 120, &d) == OM_E_INVALID);
     CHECK_MSG(strstr(d.msg, "made for rtw") != NULL, "%s", d.msg);
     /* the fine plain map: 16 bytes per texel and half a bit for its needs */
     size_t mn1, full1;
     CHECK_OK(om_method_cfg_set(&c, "spsm.fine", 0, NULL));
-    CHECK_OK(m->bytes(&c, &hs.s, 160, 120, &mn, &full));
+    CHECK_OK(om_method_bytes(m, &c, &hs.s, 160, 120, &mn, &full));
     CHECK_OK(om_method_cfg_set(&c, "spsm.fine", 1, NULL));
-    CHECK_OK(m->bytes(&c, &hs.s, 160, 120, &mn1, &full1));
+    CHECK_OK(om_method_bytes(m, &c, &hs.s, 160, 120, &mn1, &full1));
     CHECK_MSG(mn1 - mn >= 64u * 64u * 16u + 128u * 128u / 8u && mn1 - mn <= 64u * 64u * 16u + 128u * 128u / 8u + 64u,
               "fine adds %zu bytes", mn1 - mn);
     free(buf);

@@ -106,9 +106,9 @@ static frame_out render_on(const om_scene *s, const om_method *m, const char *se
     om_view v;
     om_diag d;
     if ((o.st = h_view(&v, s, 0, W, H, &d))) return o;
-    om_method_cfg c = h_cfg(m->name, set);
+    om_method_cfg c = h_cfg(om_method_name(m), set);
     size_t mn, full;
-    if ((o.st = m->bytes(&c, s, W, H, &mn, &full))) return o;
+    if ((o.st = om_method_bytes(m, &c, s, W, H, &mn, &full))) return o;
     uint32_t r = rows ? rows : H;
     size_t fbytes = (bins ? om_frame_bytes_scene(s, W, r) : om_frame_bytes(W, r)) + job_bytes;
     void *mm = malloc(full), *fm = malloc(fbytes), *px = malloc((size_t)W * r * 3);
@@ -120,7 +120,7 @@ static frame_out render_on(const om_scene *s, const om_method *m, const char *se
     om_arena_init(&ma, mm, full, "method");
     om_arena_init(&fa, fm, fbytes, "frame");
     void *state;
-    if ((o.st = m->init(&state, &ma, &c, s, W, H, &d)) == OM_OK) {
+    if ((o.st = om_method_init(m, &state, &ma, &c, s, W, H, &d)) == OM_OK) {
         om_framebuffer fb = {OM_RGB888, W, r, (size_t)W * 3, (uint8_t *)px};
         om_shade_cfg shade;
         om_frame_desc fd;
@@ -132,7 +132,7 @@ static frame_out render_on(const om_scene *s, const om_method *m, const char *se
         o.st = om_render_frame(&fd, &fa, &fs, &d);
         o.jobs = fs.jobs;
         o.peak = fs.frame_peak;
-        m->stats(state, &o.ms);
+        om_method_get_stats(m, state, &o.ms);
     }
     free(mm);
     free(fm);
@@ -179,16 +179,16 @@ static void same_bits(void)
             const om_method *m = om_method_at(mi);
             for (uint32_t rows = 0; rows <= 40; rows += 40) {
                 frame_out one = render(&hs.s, m, 120, 90, rows, NULL, NULL, 1, 0, true);
-                CHECK_MSG(one.st == OM_OK && one.jobs == 1, "%s: inline frame", m->name);
+                CHECK_MSG(one.st == OM_OK && one.jobs == 1, "%s: inline frame", om_method_name(m));
                 for (int k = 0; k < 7; k++) {
                     uint32_t n = k < 6 ? threads[k] : 5;
                     frame_out o = k < 6 ? render(&hs.s, m, 120, 90, rows, om_jobs_for, pools[k], n, om_frame_bytes_jobs(m, &hs.s, n), true)
                                         : render(&hs.s, m, 120, 90, rows, backwards, NULL, n, om_frame_bytes_jobs(m, &hs.s, n), true);
-                    CHECK_MSG(o.st == OM_OK && o.jobs == n, "%s: %u jobs ran %u", m->name, n, o.jobs);
+                    CHECK_MSG(o.st == OM_OK && o.jobs == n, "%s: %u jobs ran %u", om_method_name(m), n, o.jobs);
                     CHECK_MSG(o.hash == one.hash, "%s light %d strips %u: %u threads%s change the frame",
-                              m->name, li, rows, n, k < 6 ? "" : " backwards");
+                              om_method_name(m), li, rows, n, k < 6 ? "" : " backwards");
                     CHECK_MSG(!memcmp(o.ms.counters, one.ms.counters, sizeof o.ms.counters),
-                              "%s: %u threads change the counters", m->name, n);
+                              "%s: %u threads change the counters", om_method_name(m), n);
                 }
             }
         }
@@ -283,15 +283,15 @@ static void asm_frames(const om_scene *s, uint32_t rows, om_parallel_for_fn pf, 
     om_method_cfg c = h_cfg("asm", set);
     size_t mn, full;
     om_diag d;
-    CHECK_OK(m->bytes(&c, s, W, H, &mn, &full));
+    CHECK_OK(om_method_bytes(m, &c, s, W, H, &mn, &full));
     const uint32_t r = rows ? rows : H;
     void *mm = malloc(full), *px = malloc((size_t)W * r * 3), *state = NULL;
     om_arena ma, fa;
     om_arena_init(&ma, mm, full, "method");
-    CHECK_OK(m->init(&state, &ma, &c, s, W, H, &d));
+    CHECK_OK(om_method_init(m, &state, &ma, &c, s, W, H, &d));
     /* om_frame_bytes_jobs is for the default settings; a larger tree's jobs need more */
     const bool big_tree = strstr(set, "asm.tile=4") != NULL;
-    const size_t big = state && threads > 1 && big_tree ? threads * (om__method_pass(m)->scratch(state, s) + 64) : 0;
+    const size_t big = state && threads > 1 && big_tree ? threads * (m->pass->scratch(state, s) + 64) : 0;
     const size_t fbytes = om_frame_bytes_scene(s, W, r) + om_frame_bytes_jobs(m, s, threads) + big;
     void *fm = malloc(fbytes);
     for (int f = 0; f < nframes && state; f++) {
@@ -315,7 +315,7 @@ static void asm_frames(const om_scene *s, uint32_t rows, om_parallel_for_fn pf, 
         CHECK_OK(om_render_frame(&fd, &fa, &fs, &d));
         CHECK_MSG(fs.jobs == (pf ? threads : 1), "asm: %u jobs ran %u", threads, fs.jobs);
         om_method_stats ms;
-        m->stats(state, &ms);
+        om_method_get_stats(m, state, &ms);
         memcpy(counters[f], ms.counters, sizeof counters[f]);
         /* and the tree: every node's place and use stamp */
         const om__asm_tree *t = om__asm_tree_of(state);
@@ -534,16 +534,16 @@ static void settings_by_bands(void)
         const om_method *m = om_method_find(sets[i][0]);
         for (uint32_t rows = 0; rows <= 40; rows += 40) {
             frame_out one = render_set(&hs.s, m, sets[i][1], 96, 72, rows, NULL, NULL, 1, 0, true);
-            CHECK_MSG(one.st == OM_OK, "%s %s: inline frame", m->name, sets[i][1]);
+            CHECK_MSG(one.st == OM_OK, "%s %s: inline frame", om_method_name(m), sets[i][1]);
             for (uint32_t n = 2; n <= 5; n += 3)
                 for (int lean = 0; lean < (rows ? 1 : 2); lean++) {   /* strips' bins come first */
                     frame_out o = render_set(&hs.s, m, sets[i][1], 96, 72, rows, backwards, NULL, n,
                                              om_frame_bytes_jobs(m, lean ? NULL : &hs.s, n), !lean);
-                    CHECK_MSG(o.st == OM_OK && o.jobs == n, "%s %s strips %u%s: %u jobs ran %u", m->name, sets[i][1], rows, lean ? " lean" : "", n, o.jobs);
-                    CHECK_MSG(o.hash == one.hash, "%s %s strips %u: %u bands%s change the frame", m->name,
+                    CHECK_MSG(o.st == OM_OK && o.jobs == n, "%s %s strips %u%s: %u jobs ran %u", om_method_name(m), sets[i][1], rows, lean ? " lean" : "", n, o.jobs);
+                    CHECK_MSG(o.hash == one.hash, "%s %s strips %u: %u bands%s change the frame", om_method_name(m),
                               sets[i][1], rows, n, lean ? " without bins" : "");
                     CHECK_MSG(!memcmp(o.ms.counters, one.ms.counters, sizeof o.ms.counters),
-                              "%s %s strips %u: %u bands change the counters", m->name, sets[i][1], rows, n);
+                              "%s %s strips %u: %u bands change the counters", om_method_name(m), sets[i][1], rows, n);
                 }
         }
     }
@@ -573,11 +573,11 @@ static void kept_ids(void)
                     frame_out a = render(&hs.s, m, 120, 90, rows, pf, NULL, n, jb, true);
                     frame_out b = render(&hs.s, m, 120, 90, rows, pf, NULL, n, jb + ids, true);
                     CHECK_MSG(a.st == OM_OK && b.st == OM_OK && a.hash == b.hash,
-                              "%s light %d strips %u threads %u: kept ids change the frame", m->name, li, rows, n);
+                              "%s light %d strips %u threads %u: kept ids change the frame", om_method_name(m), li, rows, n);
                     CHECK_MSG(!memcmp(a.ms.counters, b.ms.counters, sizeof a.ms.counters),
-                              "%s: kept ids change the counters", m->name);
+                              "%s: kept ids change the counters", om_method_name(m));
                     CHECK_MSG(twice ? b.peak >= a.peak + 120 * 90 * 2 : b.peak == a.peak,
-                              "%s light %d: ids carved %s", m->name, li, twice ? "not" : "needlessly");
+                              "%s light %d: ids carved %s", om_method_name(m), li, twice ? "not" : "needlessly");
                 }
         }
         h_scene_free(&hs);

@@ -130,7 +130,7 @@ om_status cli_measure_strips(const om_method *m, const om_method_cfg *cfg, const
 {
     uint32_t W = v->cam.width, H = v->cam.height;
     size_t mn, full;
-    om_status st = m->bytes(cfg, &cs->scene, W, H, &mn, &full);
+    om_status st = om_method_bytes(m, cfg, &cs->scene, W, H, &mn, &full);
     if (st) return st;
     /* threads: each job's scratch, and the bins the bands of a whole frame use */
     if (cli_threads() > 1) {
@@ -150,7 +150,7 @@ om_status cli_measure_strips(const om_method *m, const om_method_cfg *cfg, const
     if (runs > 16) runs = 16;
     /* init is a stage of its own: a user pays it whenever the scene changes */
     uint64_t t0 = om_clock_ns(NULL);
-    st = m->init(&state, &ma, cfg, &cs->scene, W, H, d);
+    st = om_method_init(m, &state, &ma, cfg, &cs->scene, W, H, d);
     p->init = (double)(om_clock_ns(NULL) - t0) / 1e6;
     p->w = W;
     p->h = H;
@@ -190,7 +190,7 @@ om_status cli_measure_strips(const om_method *m, const om_method_cfg *cfg, const
         p->shade = median(t[4], runs);
         p->bytes = ma.peak;
         om_method_stats ms;
-        m->stats(state, &ms);
+        om_method_get_stats(m, state, &ms);
         size_t n = 0;
         p->stats[0] = '\0';
         for (uint32_t k = 0; k < ms.ncounters && n + 1 < sizeof p->stats; k++) {
@@ -221,7 +221,7 @@ static const struct { const char *method, *sweep; } sweeps[] = {
 const char *cli_sweep(const om_method *m)
 {
     for (size_t i = 0; m && i < sizeof sweeps / sizeof sweeps[0]; i++)
-        if (!strcmp(sweeps[i].method, m->name)) return sweeps[i].sweep;
+        if (!strcmp(sweeps[i].method, om_method_name(m))) return sweeps[i].sweep;
     return NULL;
 }
 
@@ -341,7 +341,7 @@ static bool chart(om_out *o, const svg_chart *c, const cli_point *pts, int n, co
         size_t np = 0;
         for (int i = 0; i < n && np < 64; i++) {
             const cli_point *p = &pts[i];
-            if (!p->ok || strcmp(p->method, m->name) || strcmp(p->scene, scene)) continue;
+            if (!p->ok || strcmp(p->method, om_method_name(m)) || strcmp(p->scene, scene)) continue;
             double first = xkind == 2 ? p->init : 0;
             xs[ns][np] = xkind == 1 ? (double)p->bytes : first + p->total;
             lo[ns][np] = first + p->tmin;
@@ -352,7 +352,7 @@ static bool chart(om_out *o, const svg_chart *c, const cli_point *pts, int n, co
             np++;
         }
         if (!np) continue;
-        s[ns].name = m->name;
+        s[ns].name = om_method_name(m);
         s[ns].x = xs[ns];
         s[ns].y = ys[ns];
         s[ns].n = np;
@@ -641,7 +641,7 @@ static int scaling(const char *cmd, char **names, size_t nn, const uint32_t *sw,
         bool have_eye = false;
         for (size_t k = 0; k < om_method_count() && st == OM_OK && !rc; k++) {
             const om_method *m = om_method_at(k);
-            if ((cli_sweep(m) && !cli_sweep(m)[0]) || !in_list(methods, m->name)) continue;
+            if ((cli_sweep(m) && !cli_sweep(m)[0]) || !in_list(methods, om_method_name(m))) continue;
             om_method_cfg cfg;
             om_method_cfg_default(&cfg, m);
             scale_row r;
@@ -660,7 +660,7 @@ static int scaling(const char *cmd, char **names, size_t nn, const uint32_t *sw,
                     }
                 }
             if (st != OM_OK || rc) break;
-            scale_print(cli_base_name(names[si]), m->name, &r, nc);
+            scale_print(cli_base_name(names[si]), om_method_name(m), &r, nc);
             fflush(stdout);
             have_eye = true;
         }
@@ -731,7 +731,7 @@ int cmd_bench(int argc, char **argv)
         const om_method *m = om_method_at(k);
         char tmp[64][96];
         if (cli_sweep(m) && !cli_sweep(m)[0]) continue;
-        if (in_list(methods, m->name)) total += expand(cli_sweep(m), tmp, 64) * (int)nn;
+        if (in_list(methods, om_method_name(m))) total += expand(cli_sweep(m), tmp, 64) * (int)nn;
     }
     /* Any scene that does not load, view or measure fails the run: nothing is written. */
     for (size_t si = 0; si < nn && !rc; si++) {
@@ -758,14 +758,14 @@ int cmd_bench(int argc, char **argv)
         if (st != OM_OK) rc = cli_error(name, &d, st);
         for (size_t k = 0; k < om_method_count() && np < MAXP && !rc; k++) {
             const om_method *m = om_method_at(k);
-            if ((cli_sweep(m) && !cli_sweep(m)[0]) || !in_list(methods, m->name)) continue;
+            if ((cli_sweep(m) && !cli_sweep(m)[0]) || !in_list(methods, om_method_name(m))) continue;
             char settings[64][96];
             int ns = expand(cli_sweep(m), settings, 64);
             if (ns == 0) { settings[0][0] = 0; ns = 1; }
             for (int j = 0; j < ns && np < MAXP; j++) {
                 cli_point *p = &pts[np];
                 p->scene = name;
-                snprintf(p->method, sizeof p->method, "%s", m->name);
+                snprintf(p->method, sizeof p->method, "%s", om_method_name(m));
                 const char *label = settings[j][0] ? settings[j] : "defaults";
                 size_t ll = strlen(label) < sizeof p->setting ? strlen(label) : sizeof p->setting - 1;
                 memcpy(p->setting, label, ll);
@@ -777,7 +777,7 @@ int cmd_bench(int argc, char **argv)
                 st = cli_measure(m, &cfg, &cs, &v, (int)runs, mask, NULL, p, &d);
                 if (st) {
                     /* a point a method cannot run (its memory, say) is left out, said */
-                    fprintf(stderr, "\nombra: %s %s on %s: %s\n", m->name, p->setting, name, d.msg);
+                    fprintf(stderr, "\nombra: %s %s on %s: %s\n", om_method_name(m), p->setting, name, d.msg);
                     continue;
                 }
                 om_compare_masks(ref, mask, W, H, &p->m);
@@ -799,8 +799,8 @@ int cmd_bench(int argc, char **argv)
     const char *tnames[16];
     for (size_t k = 0; tri_sweep && !rc && k < om_method_count() && ntri < 16; k++) {
         const om_method *m = om_method_at(k);
-        if (!(m->flags & OM_METHOD_EXACT)) continue;
-        tnames[ntri] = m->name;
+        if (!(om_method_flags(m) & OM_METHOD_EXACT)) continue;
+        tnames[ntri] = om_method_name(m);
         for (int j = 0; j < 4 && !rc; j++) {
             om_diag d;
             memset(&d, 0, sizeof d);
@@ -814,7 +814,7 @@ int cmd_bench(int argc, char **argv)
                 cli_point p;
                 memset(&p, 0, sizeof p);
                 p.scene = counts[j];
-                snprintf(p.method, sizeof p.method, "%s", m->name);
+                snprintf(p.method, sizeof p.method, "%s", om_method_name(m));
                 snprintf(p.setting, sizeof p.setting, "triangle sweep");
                 progress(j + 1, 4, &p);
                 if (!(tmask = malloc((size_t)v.cam.width * v.cam.height))) st = cli_oom(&d);
@@ -822,7 +822,7 @@ int cmd_bench(int argc, char **argv)
                 if (st == OM_OK) {
                     ty[ntri][tn[ntri]++] = p.init + p.total;
                     printf("%-12s %-5s triangle sweep: init %.2f ms, frame %.2f ms\n", counts[j],
-                           m->name, p.init, p.total);
+                           om_method_name(m), p.init, p.total);
                 }
             }
             if (st != OM_OK) rc = cli_error(counts[j], &d, st);

@@ -56,13 +56,13 @@ int cli_unknown_method(const char *cmd, const char *option, const char *name)
     const char *best = NULL;
     size_t bd = 3;   /* suggest only a name at most two edits away */
     for (size_t i = 0; i < om_method_count(); i++) {
-        size_t dd = distance(name, om_method_at(i)->name);
-        if (dd < bd) { bd = dd; best = om_method_at(i)->name; }
+        size_t dd = distance(name, om_method_name(om_method_at(i)));
+        if (dd < bd) { bd = dd; best = om_method_name(om_method_at(i)); }
     }
     fprintf(stderr, "ombra %s: %s: unknown method '%s'", cmd, option, name);
     if (best) fprintf(stderr, "; did you mean '%s'?", best);
     fprintf(stderr, "\nmethods:");
-    for (size_t i = 0; i < om_method_count(); i++) fprintf(stderr, " %s", om_method_at(i)->name);
+    for (size_t i = 0; i < om_method_count(); i++) fprintf(stderr, " %s", om_method_name(om_method_at(i)));
     fprintf(stderr, " (see 'ombra methods')\n");
     return 2;
 }
@@ -70,8 +70,8 @@ int cli_unknown_method(const char *cmd, const char *option, const char *name)
 void cli_method_hint(const om_method *m, char *buf, size_t n)
 {
     /* The first of its settings that sizes its memory: the map, bytes, a pool. */
-    for (uint32_t i = 0; i < m->nsettings; i++) {
-        const om_setting *f = &m->settings[i];
+    for (uint32_t i = 0; i < om_method_nsettings(m); i++) {
+        const om_setting *f = om_method_setting_at(m, i);
         if (!strcmp(f->name, "map") || strstr(f->doc, "bytes") || strstr(f->doc, "pool")) {
             snprintf(buf, n, ", or ask the method for less (--set %s=N: %s)", f->name, f->doc);
             return;
@@ -305,7 +305,7 @@ bool cli_cfg(const om_method *m, const cli_settings *s, om_method_cfg *c, const 
         double v;
         if (!split(s->item[i], name, sizeof name, &v)) return false;
         if (!om_method_setting(m, name)) {
-            if (note) fprintf(stderr, "ombra %s: %s takes no setting '%s' (ignored)\n", note, m->name, name);
+            if (note) fprintf(stderr, "ombra %s: %s takes no setting '%s' (ignored)\n", note, om_method_name(m), name);
             continue;
         }
         if (!cli_set(c, s->item[i])) return false;

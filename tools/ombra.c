@@ -49,7 +49,7 @@ static void format_value(const om_setting *f, char *buf, size_t n)
 /* Whether setting i of method k is the first of that name (several methods take "map"). */
 static bool first_of_name(size_t k, uint32_t i)
 {
-    const char *name = om_method_at(k)->settings[i].name;
+    const char *name = om_method_setting_at(om_method_at(k), i)->name;
     for (size_t j = 0; j < k; j++)
         if (om_method_setting(om_method_at(j), name)) return false;
     return true;
@@ -61,10 +61,10 @@ static int list_methods(void)
     char v[32];
     for (size_t k = 0; k < om_method_count(); k++) {
         const om_method *m = om_method_at(k);
-        printf("%-6s %s\n", m->name, m->summary);
-        for (uint32_t i = 0; i < m->nsettings; i++) {
-            format_value(&m->settings[i], v, sizeof v);
-            if (strlen(m->settings[i].name) > wn) wn = strlen(m->settings[i].name);
+        printf("%-6s %s\n", om_method_name(m), om_method_summary(m));
+        for (uint32_t i = 0; i < om_method_nsettings(m); i++) {
+            format_value(om_method_setting_at(m, i), v, sizeof v);
+            if (strlen(om_method_setting_at(m, i)->name) > wn) wn = strlen(om_method_setting_at(m, i)->name);
             if (strlen(v) > wv) wv = strlen(v);
         }
     }
@@ -72,14 +72,14 @@ static int list_methods(void)
     printf("\nsettings (--set NAME=VALUE):\n");
     for (size_t k = 0; k < om_method_count(); k++) {
         const om_method *m = om_method_at(k);
-        for (uint32_t i = 0; i < m->nsettings; i++) {
-            const om_setting *f = &m->settings[i];
+        for (uint32_t i = 0; i < om_method_nsettings(m); i++) {
+            const om_setting *f = om_method_setting_at(m, i);
             if (!first_of_name(k, i)) continue;
             format_value(f, v, sizeof v);
             printf("  %-*s  %-*s  %s (", (int)wn, f->name, (int)wv, v, f->doc);
             for (size_t j = k, sep = 0; j < om_method_count(); j++)
                 if (om_method_setting(om_method_at(j), f->name))
-                    printf("%s%s", sep++ ? ", " : "", om_method_at(j)->name);
+                    printf("%s%s", sep++ ? ", " : "", om_method_name(om_method_at(j)));
             printf(")\n");
         }
     }

@@ -54,7 +54,7 @@ static om_status run_init(run *r, const cli_scene *cs, uint32_t W, uint32_t H, o
     if (!r->mem) return cli_oom(d);
     om_arena_init(&r->arena, r->mem, r->given, "method");
     uint64_t t0 = om_clock_ns(NULL);
-    st = r->m->init(&r->state, &r->arena, &r->cfg, &cs->scene, W, H, d);
+    st = om_method_init(r->m, &r->state, &r->arena, &r->cfg, &cs->scene, W, H, d);
     r->ns_init = om_clock_ns(NULL) - t0;
     return st;
 }
@@ -95,7 +95,7 @@ static om_status run_frame(run *r, const cli_scene *cs, const om_view *v, uint32
     /* Strips of a frame that passes over the image more than once: room to keep the
      * first pass's triangle ids, so the scene is rasterized once (om_frame_bytes_ids) */
     if (jobs && rows < v->cam.height &&
-        ((r->m->flags & OM_METHOD_OBSERVES) || v->light.kind == OM_LIGHT_DIRECTIONAL))
+        ((om_method_flags(r->m) & OM_METHOD_OBSERVES) || v->light.kind == OM_LIGHT_DIRECTIONAL))
         *frame_bytes += om_frame_bytes_ids(&cs->scene, W, v->cam.height);
     void *frame_mem = malloc(*frame_bytes);
     om_framebuffer fb;
@@ -260,7 +260,7 @@ int cmd_render(int argc, char **argv)
     memset(&diff_out, 0, sizeof diff_out);
     if ((st = om_view_init(&view, &cam, &light, &cs.scene, &d)) != OM_OK) { rc = cli_error(where, &d, st); goto out; }
     const uint32_t W = cam.width, H = cam.height;
-    if ((st = main_run.m->bytes(&main_run.cfg, &cs.scene, W, H, &main_run.min, &main_run.full)) != OM_OK) {
+    if ((st = om_method_bytes(main_run.m, &main_run.cfg, &cs.scene, W, H, &main_run.min, &main_run.full)) != OM_OK) {
         rc = cli_error(mname, &d, st);
         goto out;
     }
@@ -307,7 +307,7 @@ int cmd_render(int argc, char **argv)
     if ((st = run_init(&main_run, &cs, W, H, &d)) != OM_OK) { rc = cli_error(mname, &d, st); goto out; }
     if (against) {
         /* The reference is a measuring instrument: it gets what it needs, outside --budget. */
-        if ((st = ref_run.m->bytes(&ref_run.cfg, &cs.scene, W, H, &ref_run.min, &ref_run.full)) != OM_OK ||
+        if ((st = om_method_bytes(ref_run.m, &ref_run.cfg, &cs.scene, W, H, &ref_run.min, &ref_run.full)) != OM_OK ||
             (ref_run.given = ref_run.full, st = run_init(&ref_run, &cs, W, H, &d)) != OM_OK) {
             rc = cli_error(against, &d, st);
             goto out;
@@ -353,7 +353,7 @@ int cmd_render(int argc, char **argv)
     }
     if (!quiet) {
         om_method_stats ms;
-        main_run.m->stats(main_run.state, &ms);
+        om_method_get_stats(main_run.m, main_run.state, &ms);
         fprintf(info, "%s: %ux%u, %u triangles, method %s, %u strip(s) of %u rows, %u thread(s)\n",
                 where, W, H, cs.scene.ntris, mname, fs.strips, rows, fs.jobs);
         fprintf(info, "time: total %.2f ms (init %.2f, eye %.2f x%u, observe %.2f, build %.2f, "
@@ -434,9 +434,9 @@ int cmd_info(int argc, char **argv)
         size_t mn, full;
         om_method_cfg cfg;
         if (!cli_cfg(m, &settings, &cfg, NULL)) { cli_scene_free(&cs); return 2; }
-        st = m->bytes(&cfg, s, W, H, &mn, &full);
-        if (st == OM_OK) printf("  %-6s min %zu, full %zu\n", m->name, mn, full);
-        else printf("  %-6s %s\n", m->name, om_status_str(st));
+        st = om_method_bytes(m, &cfg, s, W, H, &mn, &full);
+        if (st == OM_OK) printf("  %-6s min %zu, full %zu\n", om_method_name(m), mn, full);
+        else printf("  %-6s %s\n", om_method_name(m), om_status_str(st));
     }
     cli_scene_free(&cs);
     return 0;

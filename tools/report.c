@@ -115,7 +115,7 @@ static int scene_crops(FILE *f, const char *name, uint32_t w, uint32_t h)
     for (size_t k = 0; k < om_method_count() && nm < 16; k++) {
         const om_method *m = om_method_at(k);
         const char *sw = cli_sweep(m);
-        if ((sw && !sw[0]) || !strcmp(m->name, "ref")) continue;
+        if ((sw && !sw[0]) || !strcmp(om_method_name(m), "ref")) continue;
         if (!(masks[nm] = malloc(n))) continue;
         om_method_cfg_default(&cfg, m);
         if (cli_measure(m, &cfg, &cs, &v, 1, masks[nm], NULL, &p, &d) == OM_OK) ms[nm++] = m;
@@ -159,12 +159,12 @@ static int scene_crops(FILE *f, const char *name, uint32_t w, uint32_t h)
         om_compare_masks(ref, masks[k], W, H, &mt);
         fprintf(f, "<figure>");
         report_mask_rgb(masks[k], W, bx, by, crop, rgb);
-        report_img(f, rgb, crop, crop, ZOOM, ms[k]->name);
-        fprintf(f, "<figcaption>%s mask</figcaption></figure>\n<figure>", ms[k]->name);
+        report_img(f, rgb, crop, crop, ZOOM, om_method_name(ms[k]));
+        fprintf(f, "<figcaption>%s mask</figcaption></figure>\n<figure>", om_method_name(ms[k]));
         om_diff_image(ref, masks[k], W, H, dm);
         report_crop_rgb(dm, W, bx, by, crop, rgb);
         report_img(f, rgb, crop, crop, ZOOM, "difference");
-        fprintf(f, "<figcaption>%s: %.3f%% wrong</figcaption></figure>\n", ms[k]->name,
+        fprintf(f, "<figcaption>%s: %.3f%% wrong</figcaption></figure>\n", om_method_name(ms[k]),
                 100.0 * (1.0 - om_metrics_match(&mt)));
         free(masks[k]);
     }

@@ -72,7 +72,7 @@ static bool fit(const om_method *m, const char *setting, const cli_scene *cs, ui
     om_method_cfg cfg;
     size_t mn, full;
     *need = SIZE_MAX;
-    if (!configure(m, setting, &cfg) || m->bytes(&cfg, &cs->scene, W, H, &mn, &full) != OM_OK) return false;
+    if (!configure(m, setting, &cfg) || om_method_bytes(m, &cfg, &cs->scene, W, H, &mn, &full) != OM_OK) return false;
     uint32_t lo = W <= 160 ? 1 : H < MIN_ROWS ? H : MIN_ROWS;
     size_t base = cs->bytes + full;
     *need = base + om_frame_bytes(W, lo);

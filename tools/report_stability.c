@@ -81,7 +81,7 @@ static om_status path(const om_scene *s, const om_method *m, const om_method_cfg
                       int last, uint8_t *prev, uint8_t *cur, uint8_t *rgb, om_diag *d)
 {
     size_t mn, full, fbytes = om_frame_bytes(SW, SH);
-    om_status st = m->bytes(cfg, s, SW, SH, &mn, &full);
+    om_status st = om_method_bytes(m, cfg, s, SW, SH, &mn, &full);
     if (st) return st;
     void *mem = malloc(full ? full : 1), *fmem = malloc(fbytes), *px = malloc((size_t)SW * SH * 3);
     if (!mem || !fmem || !px) { free(mem); free(fmem); free(px); return cli_oom(d); }
@@ -89,7 +89,7 @@ static om_status path(const om_scene *s, const om_method *m, const om_method_cfg
     om_arena_init(&ma, mem, full, "method");
     om_arena_init(&fa, fmem, fbytes, "frame");
     void *state;
-    st = m->init(&state, &ma, cfg, s, SW, SH, d);
+    st = om_method_init(m, &state, &ma, cfg, s, SW, SH, d);
     float tend = 0;
     if (s->ncam_keys) tend = s->cam_keys[s->ncam_keys - 1].t;
     if (s->nlight_keys && s->light_keys[s->nlight_keys - 1].t > tend) tend = s->light_keys[s->nlight_keys - 1].t;

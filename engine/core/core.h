@@ -5,6 +5,7 @@
 #define OM_CORE_H
 
 #include "ombra.h"
+#include "config.h"
 
 #include <float.h>
 #include <math.h>
@@ -157,21 +158,8 @@ double om__log2(double x);     /* x > 0 */
 double om__exp2(double x);
 #define OM_PI 3.14159265358979323846
 
-/* OM_FAST_FLOAT: 1 where a double operation is a library routine and a float one is
- * cheaper (32-bit ARM without a double FPU: the Cortex-M4F's is single precision, the
- * M0 and M3 have none; RISC-V without D). asm, rtw, spsm and hybrid then decide in
- * float first, with an error bound, and fall back to double only where the bound
- * leaves the answer open: the same answers and frames (proven at each, and tested).
- * Where double is hardware the bounds only cost, so it is 0; a build may set it
- * either way (make test builds one of its four with 1). */
-#ifndef OM_FAST_FLOAT
-#if (defined(__arm__) && !(defined(__ARM_FP) && (__ARM_FP & 8))) || \
-    (defined(__riscv) && !(defined(__riscv_flen) && __riscv_flen >= 64))
-#define OM_FAST_FLOAT 1
-#else
-#define OM_FAST_FLOAT 0
-#endif
-#endif
+/* OM_FAST_FLOAT (config.h) picks the float-first paths of a CPU without double
+ * hardware. */
 
 /* A cold path kept out of its caller, so that the hot path stays small enough to be
  * inlined where it runs (a hint; GCC and Clang only). */

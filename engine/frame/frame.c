@@ -29,7 +29,7 @@
  * that runs a job, the parts are many and each goes to its thread's target, so a
  * thread that runs slower takes fewer; else they are the halves. More jobs would each
  * need such a target and a merge; they take the bins. */
-#include "frame.h"
+#include "../shadow/method.h"
 
 /* Bands per thread: a strip (or a map) is cut into at most this many bands a thread,
  * and the host's parallel-for hands them out, so a thread that the system stalls holds
@@ -79,8 +79,8 @@ static size_t band_job_bytes(const om__bands *b)
 size_t om_frame_bytes_jobs(const om_method *m, const om_scene *s, uint32_t threads)
 {
     if (!OM_WITH_JOBS || threads <= 1) return 0;
-    const om__bands *b = m ? om__method_bands(m) : NULL;
-    const om__pass *p = m ? om__method_pass(m) : NULL;
+    const om__bands *b = m ? m->bands : NULL;
+    const om__pass *p = m ? m->pass : NULL;
     return (size_t)threads * (band_job_bytes(b) + (p ? pass_slot_bytes(p->scratch(NULL, s)) : 0)) +
            map_bins_bytes(b, s);
 }
@@ -616,8 +616,8 @@ static void carve_jobs(frame_ctx *c, om_arena *fa, size_t keep)
     const om_frame_desc *fd = c->fd;
     c->jobs = 1;
     if (!OM_WITH_JOBS || !fd->parallel_for || fd->threads <= 1) return;
-    const om__bands *b = om__method_bands(fd->method);
-    const om__pass *ps = om__method_pass(fd->method);
+    const om__bands *b = fd->method->bands;
+    const om__pass *ps = fd->method->pass;
     size_t per = band_job_bytes(b), pscratch = 0, pslot = 0;
     size_t left = om_arena_left(fa), room = left > keep ? left - keep : 0, fit = room / per;
     if (ps) {
@@ -716,7 +716,7 @@ om_status om_render_frame(const om_frame_desc *fd, om_arena *fa, om_frame_stats 
     /* The jobs, keeping beside them the bins they use when two jobs fit as well: one
      * strip's bands want the camera's, a map built by bands the light's. */
     {
-        const om__bands *b = om__method_bands(m);
+        const om__bands *b = m->bands;
         size_t keep = (single ? bins_bytes(s) : 0) + map_bins_bytes(b, s);
         carve_jobs(&c, fa, om_arena_left(fa) >= keep + om_frame_bytes_jobs(m, NULL, 2) ? keep : 0);
     }

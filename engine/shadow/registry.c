@@ -1,37 +1,11 @@
-/* registry.c — every shadow method by name, and settings by name. Adding a method is
- * its own file plus one line of METHODS; its settings and their defaults live in its
- * file (om_method.settings), so every tool, chart and test finds both through here. */
-#include "shadow.h"
+/* registry.c — every shadow method by name, the functions a host reads a method
+ * through, and settings by name. Adding a method is its own folder plus one line of
+ * METHODS; its settings and their defaults live in its files (struct om_method,
+ * method.h), so every tool, chart and test finds both through here. */
+#include "method.h"
 
-/* Compile-time selection (ombra.h): a method left out is not named below, so the
- * linker takes none of its files from the library. */
-#ifndef OM_WITH_NONE
-#define OM_WITH_NONE 1
-#endif
-#ifndef OM_WITH_REF
-#define OM_WITH_REF 1
-#endif
-#ifndef OM_WITH_SM
-#define OM_WITH_SM 1
-#endif
-#ifndef OM_WITH_ASM
-#define OM_WITH_ASM 1
-#endif
-#ifndef OM_WITH_RTW
-#define OM_WITH_RTW 1
-#endif
-#ifndef OM_WITH_SPSM
-#define OM_WITH_SPSM 1
-#endif
-#ifndef OM_WITH_IZB
-#define OM_WITH_IZB 1
-#endif
-#ifndef OM_WITH_HYBRID
-#define OM_WITH_HYBRID 1
-#endif
-
-/* One line a method, in the order tools list them: X(name, 1) builds it in always,
- * X(name, OM_WITH_NAME) lets a firmware leave it out (with its default above). */
+/* One line a method, in the order tools list them: X(name, OM_WITH_NAME) builds it in
+ * where its switch is 1 (config.h), so that a firmware may leave it out. */
 #define METHODS(X)           \
     X(none, OM_WITH_NONE)    \
     X(ref, OM_WITH_REF)      \
@@ -54,64 +28,47 @@ METHODS(DECLARE)
 
 static const om_method *const methods[] = {METHODS(ENTRY) NULL};
 
-/* The methods whose resolve runs by bands on the host's threads (frame.h, om__bands):
- * those whose resolve only reads the state once it is built (spsm's window of decoded
- * texels is the band's own; hybrid: its map lookup by bands, its irregular pass after
- * them; asm: its leaf cache is the band's own, the use stamps put on the tree after
- * them). izb (per-strip lists in the state) resolves a strip at a time. */
-#define BANDED(X)            \
-    X(none, OM_WITH_NONE)    \
-    X(ref, OM_WITH_REF)      \
-    X(sm, OM_WITH_SM)        \
-    X(rtw, OM_WITH_RTW)      \
-    X(hybrid, OM_WITH_HYBRID) \
-    X(spsm, OM_WITH_SPSM)    \
-    X(asm, OM_WITH_ASM)
-
-#define DECLARE_BANDS(m, on) extern const om__bands om__bands_##m;
-BANDED(DECLARE_BANDS)
-
-#define BANDS_1(m) if (m_ == &om__method_##m) return &om__bands_##m;
-#define BANDS_0(m)
-#define BANDS(m, on) CAT(BANDS_, on)(m)
-
-const om__bands *om__method_bands(const om_method *m_)
-{
-    if (!OM_WITH_JOBS) return NULL;   /* (frame.h) none linked */
-    BANDED(BANDS)
-    (void)m_;
-    return NULL;
-}
-
-/* The methods with a pass of jobs of their own (frame.h, om__pass): izb's tiles, ref's
- * per-frame vertex projection (its begin; its bands resolve), asm, which lends the
- * threads to its analysis and tile renders (asm_jobs.c), rtw and spsm, which lend them
- * to their observe (rtw_jobs.c, spsm_observe.c), and hybrid's tiles of uncertain
- * samples. */
-#define PASSED(X) \
-    X(izb, OM_WITH_IZB) X(ref, OM_WITH_REF) X(asm, OM_WITH_ASM) X(rtw, OM_WITH_RTW) X(spsm, OM_WITH_SPSM) \
-    X(hybrid, OM_WITH_HYBRID)
-
-#define DECLARE_PASS(m, on) extern const om__pass om__pass_##m;
-PASSED(DECLARE_PASS)
-
-#define PASS_1(m) if (m_ == &om__method_##m) return &om__pass_##m;
-#define PASS_0(m)
-#define PASS(m, on) CAT(PASS_, on)(m)
-
-const om__pass *om__method_pass(const om_method *m_)
-{
-    if (!OM_WITH_JOBS) return NULL;
-    PASSED(PASS)
-    (void)m_;
-    return NULL;
-}
-
 size_t om_method_count(void) { return sizeof methods / sizeof methods[0] - 1; }
 
 const om_method *om_method_at(size_t i)
 {
     return i < om_method_count() ? methods[i] : NULL;
+}
+
+const char *om_method_name(const om_method *m) { return m ? m->name : ""; }
+const char *om_method_summary(const om_method *m) { return m ? m->summary : ""; }
+unsigned om_method_flags(const om_method *m) { return m ? m->flags : 0u; }
+uint32_t om_method_nsettings(const om_method *m) { return m ? m->nsettings : 0u; }
+
+const om_setting *om_method_setting_at(const om_method *m, uint32_t i)
+{
+    return m && i < m->nsettings ? &m->settings[i] : NULL;
+}
+
+om_status om_method_bytes(const om_method *m, const om_method_cfg *c, const om_scene *s, uint32_t width,
+                          uint32_t height, size_t *min, size_t *full)
+{
+    if (!m || !c || !s || !min || !full) return OM_E_INVALID;
+    return m->bytes(c, s, width, height, min, full);
+}
+
+om_status om_method_init(const om_method *m, void **state, om_arena *a, const om_method_cfg *c,
+                         const om_scene *s, uint32_t width, uint32_t height, om_diag *d)
+{
+    if (state) *state = NULL;
+    if (!m || !state || !a || !c || !s)
+        return om__fail(d, OM_E_INVALID, "om_method_init needs a method, a state pointer, an arena, a configuration and a scene");
+    return m->init(state, a, c, s, width, height, d);
+}
+
+void om_method_get_stats(const om_method *m, const void *state, om_method_stats *out)
+{
+    if (!out) return;
+    if (!m || !state) {
+        memset(out, 0, sizeof *out);
+        return;
+    }
+    m->stats(state, out);
 }
 
 static bool same_name(const char *a, const char *b)

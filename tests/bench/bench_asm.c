@@ -27,10 +27,10 @@ static int brun_init(brun *r, const bscene *b, const char *name, const om_method
     r->m = om_method_find(name);
     om_method_cfg mc;
     om_method_cfg_from(&mc, r->m, c);   /* asm's cfg gives sm its bias */
-    if (!r->m || r->m->bytes(&mc, &b->s, W, H, &mn, &full)) return 1;
+    if (!r->m || om_method_bytes(r->m, &mc, &b->s, W, H, &mn, &full)) return 1;
     r->mem = malloc(full);
     om_arena_init(&a, r->mem, full, "method");
-    if (r->m->init(&r->state, &a, &mc, &b->s, W, H, &d)) {
+    if (om_method_init(r->m, &r->state, &a, &mc, &b->s, W, H, &d)) {
         fprintf(stderr, "bench: %s: %s\n", name, d.msg);
         return 1;
     }
@@ -72,10 +72,10 @@ static int bframe(brun *r, const bscene *b, const om_camera *cam, const om_light
     fd.scene = &b->s; fd.view = &v; fd.method = r->m; fd.method_state = r->state; fd.shade = &shade;
     fd.fb = &fb; fd.on_strip = bgrab_strip; fd.user = &g; fd.clock = om_clock_ns;
     if (om_render_frame(&fd, &fa, fs, &d)) {
-        fprintf(stderr, "bench: %s: %s\n", r->m->name, d.msg);
+        fprintf(stderr, "bench: %s: %s\n", om_method_name(r->m), d.msg);
         return 1;
     }
-    r->m->stats(r->state, ms);
+    om_method_get_stats(r->m, r->state, ms);
     return 0;
 }
 

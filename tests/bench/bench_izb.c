@@ -9,6 +9,7 @@
  * the other way round), the bound that the tiles put on a frame's speed-up on two threads. */
 #include "bench.h"
 #include "../../engine/shadow/izb/izb.h"
+#include "../../engine/shadow/method.h"
 
 static void table_row(const bscene *b, uint32_t W, uint32_t H)
 {
@@ -18,7 +19,7 @@ static void table_row(const bscene *b, uint32_t W, uint32_t H)
     om_view v;
     om_diag d;
     size_t mn, full, n = (size_t)W * H;
-    if (bench_view(b, W, H, 0, &v) || m->bytes(&cfg, &b->s, W, H, &mn, &full)) return;
+    if (bench_view(b, W, H, 0, &v) || om_method_bytes(m, &cfg, &b->s, W, H, &mn, &full)) return;
     void *mem = malloc(full);
     om_target tg = {W, H, 0, H, malloc(n * 4), malloc(n * 4)};
     om_strip st = {W, H, 0, H, malloc(n * sizeof(om_sample)), malloc(n * sizeof(om_term))};
@@ -34,7 +35,7 @@ static void table_row(const bscene *b, uint32_t W, uint32_t H)
         om_arena_init(&a, mem, full, "method");
         void *state;
         uint64_t ti0 = om_clock_ns(NULL);
-        if (m->init(&state, &a, &cfg, &b->s, W, H, &d)) return;
+        if (om_method_init(m, &state, &a, &cfg, &b->s, W, H, &d)) return;
         ti[r] = (double)(om_clock_ns(NULL) - ti0) / 1e6;
         if (m->begin(state, &v, &d)) return;
         om__izb *z = (om__izb *)state;

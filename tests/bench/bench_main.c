@@ -108,7 +108,7 @@ int bench_setup(bsetup *t, const bscene *b, const char *name, uint32_t W, uint32
     size_t mn, full;
     if (!t->m) return 1;
     om_method_cfg_default(&c, t->m);
-    if (bench_view(b, W, H, 0, &t->v) || t->m->bytes(&c, &b->s, W, H, &mn, &full)) return 1;
+    if (bench_view(b, W, H, 0, &t->v) || om_method_bytes(t->m, &c, &b->s, W, H, &mn, &full)) return 1;
     t->fbytes = om_frame_bytes_scene(&b->s, W, H) + om_frame_bytes_jobs(t->m, &b->s, threads);
     t->mem = malloc(full);
     t->fmem = malloc(t->fbytes);
@@ -119,7 +119,7 @@ int bench_setup(bsetup *t, const bscene *b, const char *name, uint32_t W, uint32
     if (!t->mem || !t->fmem || !px) goto fail;
     memset(t->fmem, 0, t->fbytes);
     om_arena_init(&ma, t->mem, full, "method");
-    if (t->m->init(&t->state, &ma, &c, &b->s, W, H, &d) == OM_OK) return 0;
+    if (om_method_init(t->m, &t->state, &ma, &c, &b->s, W, H, &d) == OM_OK) return 0;
     fprintf(stderr, "bench: %s %s: %s\n", b->name, name, d.msg);
 fail:
     bench_teardown(t);
@@ -160,7 +160,7 @@ int bench_run_hooked(const bscene *b, const char *name, const om_method_cfg *cfg
     om_diag d;
     size_t mn, full;
     memset(out, 0, sizeof *out);
-    if (!m || bench_view(b, W, H, t, &v) || m->bytes(&c, &b->s, W, H, &mn, &full)) {
+    if (!m || bench_view(b, W, H, t, &v) || om_method_bytes(m, &c, &b->s, W, H, &mn, &full)) {
         fprintf(stderr, "bench: cannot set up %s\n", name);
         return 1;
     }
@@ -175,7 +175,7 @@ int bench_run_hooked(const bscene *b, const char *name, const om_method_cfg *cfg
     om_arena_init(&fa, fmem, om_frame_bytes(W, H), "frame");
     void *state;
     uint64_t t0 = om_clock_ns(NULL);
-    om_status st = m->init(&state, &ma, &c, &b->s, W, H, &d);
+    om_status st = om_method_init(m, &state, &ma, &c, &b->s, W, H, &d);
     out->init_ms = (double)(om_clock_ns(NULL) - t0) / 1e6;
     if (st == OM_OK) {
         om_framebuffer fb = {OM_RGB888, W, H, (size_t)W * 3, (uint8_t *)px};
@@ -193,7 +193,7 @@ int bench_run_hooked(const bscene *b, const char *name, const om_method_cfg *cfg
         out->build_ms = (double)fs.ns_build / 1e6;
         out->resolve_ms = (double)fs.ns_resolve / 1e6;
         out->shade_ms = (double)fs.ns_shade / 1e6;
-        m->stats(state, &out->stats);
+        om_method_get_stats(m, state, &out->stats);
         if (st == OM_OK && hook) hook(state, out);
     }
     if (st) fprintf(stderr, "bench: %s: %s\n", name, d.msg);

@@ -75,7 +75,7 @@ static int frame(const bscene *b, bsetup *bs, uint32_t threads, double *ms, tall
     om_diag d;
     const uint64_t t0 = om_clock_ns(NULL);
     if (om_render_frame(&fd, &fa, &fs, &d) != OM_OK) {
-        fprintf(stderr, "bench: %s %s: %s\n", b->name, bs->m->name, d.msg);
+        fprintf(stderr, "bench: %s %s: %s\n", b->name, om_method_name(bs->m), d.msg);
         return 1;
     }
     *ms = (double)(om_clock_ns(NULL) - t0) / 1e6;

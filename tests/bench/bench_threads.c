@@ -49,7 +49,7 @@ static int frame(const bscene *b, bsetup *t, om_jobs *jobs, int k, double *ms, d
     om_diag d;
     const uint64_t t0 = om_clock_ns(NULL);
     if (om_render_frame(&fd, &fa, &fs, &d) != OM_OK) {
-        fprintf(stderr, "bench: %s %s: %s\n", b->name, t->m->name, d.msg);
+        fprintf(stderr, "bench: %s %s: %s\n", b->name, om_method_name(t->m), d.msg);
         return 1;
     }
     *ms = (double)(om_clock_ns(NULL) - t0) / 1e6;

@@ -154,7 +154,7 @@ static void method_cfg(om_method_cfg *c, const om_method *m, const size_cfg *sz,
          * each method's whole footprint on the small scene at 160x120 within 256 KiB
          * (the counting firmware checks it), which takes spsm's 24-byte texels a map of
          * 64 and asm a cap of 96 KiB */
-        om_method_cfg_set(c, "map", strcmp(m->name, "spsm") ? 96 : 64, NULL);
+        om_method_cfg_set(c, "map", strcmp(om_method_name(m), "spsm") ? 96 : 64, NULL);
         om_method_cfg_set(c, "hybrid.map", 64, NULL);
         om_method_cfg_set(c, "asm.cap", 96u << 10, NULL);
         om_method_cfg_set(c, "rtw.importance", 64, NULL);
@@ -276,21 +276,21 @@ static void count_scene(const char *tag, const char *text, int whole, int *bad)
     for (size_t k = 0; k < om_method_count(); k++) {
         const om_method *m = om_method_at(k);
 #ifdef OM_CROSS_COUNT_ONLY
-        if (strcmp(m->name, OM_CROSS_COUNT_ONLY)) continue;
+        if (strcmp(om_method_name(m), OM_CROSS_COUNT_ONLY)) continue;
 #endif
         om_method_cfg cfg;
         method_cfg(&cfg, m, &sz, 0);
         size_t mn, full;
         om_arena ma, fa;
         void *state;
-        if (m->bytes(&cfg, &s, sz.w, sz.h, &mn, &full) != OM_OK || mn > room) {
-            say("too big", tag, m->name);
+        if (om_method_bytes(m, &cfg, &s, sz.w, sz.h, &mn, &full) != OM_OK || mn > room) {
+            say("too big", tag, om_method_name(m));
             *bad = 1;
             continue;
         }
         stack_paint();
         om_arena_init(&ma, method_mem, full < room ? full : room, "method");
-        if (m->init(&state, &ma, &cfg, &s, sz.w, sz.h, &d) != OM_OK) { *bad |= fail(tag, m->name, "init", &d); continue; }
+        if (om_method_init(m, &state, &ma, &cfg, &s, sz.w, sz.h, &d) != OM_OK) { *bad |= fail(tag, om_method_name(m), "init", &d); continue; }
         om_shade_cfg shade;
         om_shade_cfg_default(&shade);
         om_framebuffer fb = {OM_RGB565, sz.w, sz.rows, sz.w * 2, pixels};
@@ -305,12 +305,12 @@ static void count_scene(const char *tag, const char *text, int whole, int *bad)
          * frame also gets room to keep the first pass's triangle ids where that leaves
          * the method its full arena (the default scene's frame arena has room) */
         size_t fbytes = frame_need;
-        if (whole && (m->flags & OM_METHOD_OBSERVES) && full + om_frame_bytes_ids(&s, sz.w, sz.h) <= room)
+        if (whole && (om_method_flags(m) & OM_METHOD_OBSERVES) && full + om_frame_bytes_ids(&s, sz.w, sz.h) <= room)
             fbytes += om_frame_bytes_ids(&s, sz.w, sz.h);
-        for (int f = 0; f < (strcmp(m->name, "asm") ? 1 : 2); f++) {
+        for (int f = 0; f < (strcmp(om_method_name(m), "asm") ? 1 : 2); f++) {
             om_arena_init(&fa, frame_mem, whole ? fbytes : sizeof frame_mem, "frame");
             const uint64_t t0 = count_now(NULL);
-            if (om_render_frame(&fd, &fa, &fs, &d) != OM_OK) { *bad |= fail(tag, m->name, "render", &d); n = 0; break; }
+            if (om_render_frame(&fd, &fa, &fs, &d) != OM_OK) { *bad |= fail(tag, om_method_name(m), "render", &d); n = 0; break; }
             n = count_now(NULL) - t0;
             frame_peak = fa.peak;
         }
@@ -323,14 +323,14 @@ static void count_scene(const char *tag, const char *text, int whole, int *bad)
         put_s(&l, "count ");
         put_s(&l, tag);
         put_s(&l, " ");
-        put_s(&l, m->name);
+        put_s(&l, om_method_name(m));
         for (size_t i = 0; i < sizeof fig / sizeof fig[0]; i++) {
             put_s(&l, " ");
             put_dec(&l, fig[i]);
         }
         om_host_puts(l.buf);
         if (whole && (all > WHOLE || stack > STACK_ROOM)) {
-            say(all > WHOLE ? "over its whole budget" : "stack deeper than its room", tag, m->name);
+            say(all > WHOLE ? "over its whole budget" : "stack deeper than its room", tag, om_method_name(m));
             *bad = 1;
         }
     }
@@ -424,30 +424,30 @@ static int run_case(const xcase *c, const size_cfg *sz)
         size_t mn, full;
         om_arena ma, fa;
         void *state;
-        if (m->bytes(&cfg, &s, sz->w, sz->h, &mn, &full) != OM_OK || mn > sizeof method_mem) {
+        if (om_method_bytes(m, &cfg, &s, sz->w, sz->h, &mn, &full) != OM_OK || mn > sizeof method_mem) {
             line l = {{0}, 0};
             put_s(&l, "too big: ");
             put_s(&l, name[0]);
             put_s(&l, " ");
-            put_s(&l, m->name);
+            put_s(&l, om_method_name(m));
             om_host_puts(l.buf);
             bad = 1;
             continue;
         }
         /* one pass when it fits, else what there is: the result must not change */
         om_arena_init(&ma, method_mem, full < sizeof method_mem ? full : sizeof method_mem, "method");
-        if (m->init(&state, &ma, &cfg, &s, sz->w, sz->h, &d) != OM_OK) { bad |= fail(name[0], m->name, "init", &d); continue; }
+        if (om_method_init(m, &state, &ma, &cfg, &s, sz->w, sz->h, &d) != OM_OK) { bad |= fail(name[0], om_method_name(m), "init", &d); continue; }
         hashes h;
-        if (render(&s, m, state, sz, c->t0, &fa, &h, &d) != OM_OK) { bad |= fail(name[0], m->name, "render", &d); continue; }
-        print_hashes(name[0], m->name, &h);
+        if (render(&s, m, state, sz, c->t0, &fa, &h, &d) != OM_OK) { bad |= fail(name[0], om_method_name(m), "render", &d); continue; }
+        print_hashes(name[0], om_method_name(m), &h);
         if (c->t1 >= 0.0f) {
-            if (render(&s, m, state, sz, c->t1, &fa, &h, &d) != OM_OK) { bad |= fail(name[1], m->name, "render", &d); continue; }
-            print_hashes(name[1], m->name, &h);
+            if (render(&s, m, state, sz, c->t1, &fa, &h, &d) != OM_OK) { bad |= fail(name[1], om_method_name(m), "render", &d); continue; }
+            print_hashes(name[1], om_method_name(m), &h);
         }
         if (!c->text && !c->aa && sz->w == 160) {   /* the embedded proof's figures */
             line l = {{0}, 0};
             put_s(&l, "bytes ");
-            put_s(&l, m->name);
+            put_s(&l, om_method_name(m));
             put_s(&l, " ");
             put_dec(&l, ma.peak);
             put_s(&l, " min ");

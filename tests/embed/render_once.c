@@ -43,7 +43,7 @@ int render_once(void)
     om_method_cfg_default(&cfg, m);
     om_method_cfg_set(&cfg, "map", 96, NULL);       /* 96 x 96 x 4 bytes: 37 KB */
     om_arena_init(&ma, method_mem, sizeof method_mem, "method");
-    if (!m || m->init(&state, &ma, &cfg, &scene, 160, 120, &d) != OM_OK) return -1;
+    if (!m || om_method_init(m, &state, &ma, &cfg, &scene, 160, 120, &d) != OM_OK) return -1;
 
     om_shade_cfg shade;
     om_shade_cfg_default(&shade);

@@ -44,13 +44,13 @@ int render_sized(void)
     cam.height = H;
     om_method_cfg_default(&cfg, m);                 /* map 1024: 4 MiB */
     if (om_view_init(&view, &cam, &light, &scene, &d) != OM_OK ||
-        m->bytes(&cfg, &scene, W, H, &min, &full) != OM_OK) { free(scene_mem); return -1; }
+        om_method_bytes(m, &cfg, &scene, W, H, &min, &full) != OM_OK) { free(scene_mem); return -1; }
     size_t frame_bytes = om_frame_bytes_scene(&scene, W, H);
     void *method_mem = malloc(full), *frame_mem = malloc(frame_bytes);
     uint8_t *pixels = malloc((size_t)W * H * 3);
     om_arena_init(&ma, method_mem, method_mem ? full : 0, "method");
     om_arena_init(&fa, frame_mem, frame_mem ? frame_bytes : 0, "frame");
-    if (pixels && m->init(&state, &ma, &cfg, &scene, W, H, &d) == OM_OK) {
+    if (pixels && om_method_init(m, &state, &ma, &cfg, &scene, W, H, &d) == OM_OK) {
         om_shade_cfg shade;
         om_shade_cfg_default(&shade);
         om_framebuffer fb = {OM_RGB888, W, H, W * 3, pixels};

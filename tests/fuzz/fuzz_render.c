@@ -58,7 +58,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         om_method_cfg_set(&cfg, "asm.cap", 1u << 20, NULL);
         om_method_cfg_set(&cfg, "rtw.importance", 32, NULL);
         size_t mn, full;
-        if (m->bytes(&cfg, &s, cam.width, cam.height, &mn, &full) != OM_OK || full > (32u << 20)) continue;
+        if (om_method_bytes(m, &cfg, &s, cam.width, cam.height, &mn, &full) != OM_OK || full > (32u << 20)) continue;
         /* an arena between below-minimum and one pass, by the control byte */
         size_t give = (ctl & 0x40) ? full : (ctl & 0x80) ? mn : mn / 2;
         unsigned char *mb = guarded_alloc(give), *fb_mem = guarded_alloc(fbytes);
@@ -67,7 +67,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         om_arena_init(&ma, mb + GUARD, give, "method");
         om_arena_init(&fa, fb_mem + GUARD, fbytes, "frame");
         void *state;
-        if (m->init(&state, &ma, &cfg, &s, cam.width, cam.height, &d) == OM_OK) {
+        if (om_method_init(m, &state, &ma, &cfg, &s, cam.width, cam.height, &d) == OM_OK) {
             om_shade_cfg shade;
             om_shade_cfg_default(&shade);
             om_framebuffer fb = {OM_RGB888, cam.width, rows, (size_t)cam.width * 3, px};

@@ -78,7 +78,7 @@ static int path(const om_scene *s, const om_method *m, const om_method_cfg *cfg,
 {
     size_t mn, full;
     om_diag d;
-    if (m->bytes(cfg, s, W, H, &mn, &full) != OM_OK) return 1;
+    if (om_method_bytes(m, cfg, s, W, H, &mn, &full) != OM_OK) return 1;
     void *mem = malloc(full + 64), *fmem = malloc(om_frame_bytes(W, H));
     static uint8_t px[W * H * 2];
     memset(mem, 0x3C, full + 64);
@@ -86,7 +86,7 @@ static int path(const om_scene *s, const om_method *m, const om_method_cfg *cfg,
     om_arena_init(&ma, mem, full, "method");
     om_arena_init(&fa, fmem, om_frame_bytes(W, H), "frame");
     void *state;
-    int bad = m->init(&state, &ma, cfg, s, W, H, &d) != OM_OK;
+    int bad = om_method_init(m, &state, &ma, cfg, s, W, H, &d) != OM_OK;
     float tend = end_time(s);
     for (int f = 0; f < frames && !bad; f++) {
         om_camera cam;
@@ -106,7 +106,7 @@ static int path(const om_scene *s, const om_method *m, const om_method_cfg *cfg,
         fd.strip_rows = 0; fd.fb = &fb; fd.on_strip = grab; fd.user = &g; fd.clock = om_clock_ns;
         om_frame_stats fs;
         if (om_render_frame(&fd, &fa, &fs, &d) != OM_OK) {
-            fprintf(stderr, "stability: %s frame %d: %s\n", m->name, f, d.msg);
+            fprintf(stderr, "stability: %s frame %d: %s\n", om_method_name(m), f, d.msg);
             bad = 1;
         }
         ms[f] = (double)(fs.ns_eye + fs.ns_observe + fs.ns_build + fs.ns_resolve + fs.ns_shade) / 1e6;
@@ -157,7 +157,7 @@ int main(int argc, char **argv)
             const om_method *m = om_method_at(k);
             settings(text, m, &cfg);
             if (path(&b.s, m, &cfg, frames, mk, ms, &peak)) {
-                printf("stability: FAIL %s / %s: a frame did not render, or the arena was overrun\n", name, m->name);
+                printf("stability: FAIL %s / %s: a frame did not render, or the arena was overrun\n", name, om_method_name(m));
                 failures++;
                 continue;
             }
@@ -179,21 +179,21 @@ int main(int argc, char **argv)
                 if (f > 0) om_flicker_add(&fl, ref + (size_t)(f - 1) * n, mk + (size_t)(f - 1) * n, ref + (size_t)f * n, mk + (size_t)f * n, n);
                 if (fl.flicker - before > most) { most = fl.flicker - before; flicker_frame = f; }
             }
-            if ((m->flags & OM_METHOD_EXACT) && wrong_frames) {
-                printf("stability: FAIL %s / %s: an exact method is wrong on %d frames\n", name, m->name, wrong_frames);
+            if ((om_method_flags(m) & OM_METHOD_EXACT) && wrong_frames) {
+                printf("stability: FAIL %s / %s: an exact method is wrong on %d frames\n", name, om_method_name(m), wrong_frames);
                 failures++;
             }
             size_t peak2;
             double ms2[240];
             if (path(&b.s, m, &cfg, frames, again, ms2, &peak2) || memcmp(again, mk, n * (size_t)frames)) {
-                printf("stability: FAIL %s / %s: a second run is not bit-identical\n", name, m->name);
+                printf("stability: FAIL %s / %s: a second run is not bit-identical\n", name, om_method_name(m));
                 failures++;
             }
             double med = bench_median(ms, frames);
-            printf("%-12s %-5s %7.3f%% %7.3f%% %7.3f%% %7.3f%% %8.2f %10zu\n", name, m->name,
+            printf("%-12s %-5s %7.3f%% %7.3f%% %7.3f%% %7.3f%% %8.2f %10zu\n", name, om_method_name(m),
                    100 * sum / frames, 100 * worst, 100 * edge / frames, 100 * om_flicker_share(&fl), med, peak);
             if (out) {
-                fprintf(out, "%s,%s,%d,%.6f,%.6f,%.6f,%.6f,%.3f,%zu,%d,", name, m->name, frames, sum / frames,
+                fprintf(out, "%s,%s,%d,%.6f,%.6f,%.6f,%.6f,%.3f,%zu,%d,", name, om_method_name(m), frames, sum / frames,
                         worst, edge / frames, om_flicker_share(&fl), med, peak, flicker_frame);
                 for (int f = 0; f < frames; f++) fprintf(out, "%s%.6f", f ? ";" : "", share[f]);
                 fputc('\n', out);

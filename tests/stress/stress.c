@@ -53,7 +53,7 @@ static om_status run(ctx *c, const om_method *m, const om_method_cfg *cfg, size_
     om_arena_init(&ma, buf + GUARD, budget, "method");
     om_arena_init(&fa, fmem, sizeof fmem, "frame");
     void *state;
-    om_status st = m->init(&state, &ma, cfg, &c->b->s, W, H, d);
+    om_status st = om_method_init(m, &state, &ma, cfg, &c->b->s, W, H, d);
     for (int f = 0; f < 2 && st == OM_OK; f++) {
         om_shade_cfg shade;
         om_shade_cfg_default(&shade);
@@ -86,15 +86,15 @@ static void stress_method(ctx *c, const om_method *m)
     om_method_cfg_set(&cfg, "asm.cap", 2u << 20, NULL);
     om_method_cfg_set(&cfg, "rtw.importance", 64, NULL);
     size_t mn, full;
-    if (m->bytes(&cfg, &c->b->s, W, H, &mn, &full) != OM_OK) { fail(c->b->name, m->name, 0, "bytes query failed"); return; }
+    if (om_method_bytes(m, &cfg, &c->b->s, W, H, &mn, &full) != OM_OK) { fail(c->b->name, om_method_name(m), 0, "bytes query failed"); return; }
     om_diag d;
     bool guards;
     if (run(c, m, &cfg, full, c->full, &guards, &d) != OM_OK || !guards) {
-        fail(c->b->name, m->name, full, "the full budget does not render");
+        fail(c->b->name, om_method_name(m), full, "the full budget does not render");
         return;
     }
-    bool exact = !strcmp(m->name, "ref") || !strcmp(m->name, "izb");
-    if (exact && memcmp(c->full, c->ref, sizeof c->ref)) fail(c->b->name, m->name, full, "differs from the reference");
+    bool exact = !strcmp(om_method_name(m), "ref") || !strcmp(om_method_name(m), "izb");
+    if (exact && memcmp(c->full, c->ref, sizeof c->ref)) fail(c->b->name, om_method_name(m), full, "differs from the reference");
     c->full_share = share(c->ref, c->full);
     char minimum[32];
     snprintf(minimum, sizeof minimum, "%zu", mn);
@@ -114,29 +114,29 @@ static void stress_method(ctx *c, const om_method *m)
         memset(&d, 0, sizeof d);
         om_status st = run(c, m, &cfg, b, mask, &guards, &d);
         runs++;
-        if (!guards) fail(c->b->name, m->name, b, "wrote outside its arena");
+        if (!guards) fail(c->b->name, om_method_name(m), b, "wrote outside its arena");
         if (st == OM_E_BUDGET) {
             refused++;
-            if (b >= mn) fail(c->b->name, m->name, b, "refused a budget at or above its minimum");
-            if (!strstr(d.msg, minimum)) fail(c->b->name, m->name, b, "the refusal does not name the minimum");
+            if (b >= mn) fail(c->b->name, om_method_name(m), b, "refused a budget at or above its minimum");
+            if (!strstr(d.msg, minimum)) fail(c->b->name, om_method_name(m), b, "the refusal does not name the minimum");
             /* the engine stays usable */
             uint8_t *again = malloc(W * H);
             if (run(c, m, &cfg, full, again, &guards, &d) != OM_OK || memcmp(again, c->full, W * H))
-                fail(c->b->name, m->name, b, "not usable after a refusal");
+                fail(c->b->name, om_method_name(m), b, "not usable after a refusal");
             free(again);
         } else if (st != OM_OK) {
-            fail(c->b->name, m->name, b, om_status_str(st));
+            fail(c->b->name, om_method_name(m), b, om_status_str(st));
         } else if (b < mn) {
-            fail(c->b->name, m->name, b, "ran below its documented minimum (the minimum is too high)");
+            fail(c->b->name, om_method_name(m), b, "ran below its documented minimum (the minimum is too high)");
         } else if (exact ? memcmp(mask, c->ref, W * H) != 0
                          : mn == full ? memcmp(mask, c->full, W * H) != 0
                                       : share(c->ref, mask) > 2 * c->full_share + 0.01) {
-            fail(c->b->name, m->name, b, "outside its accuracy contract");
+            fail(c->b->name, om_method_name(m), b, "outside its accuracy contract");
         }
     }
     free(mask);
     printf("stress: %-12s %-5s minimum %9zu, full %9zu: %d budgets, %d refused\n", c->b->name,
-           m->name, mn, full, runs, refused);
+           om_method_name(m), mn, full, runs, refused);
 }
 
 int main(void)
@@ -174,7 +174,7 @@ int main(void)
         size_t mn, full;
         const om_method *ref = om_method_find("ref");
         om_method_cfg_default(&cfg, ref);
-        ref->bytes(&cfg, &b.s, W, H, &mn, &full);
+        om_method_bytes(ref, &cfg, &b.s, W, H, &mn, &full);
         if (run(c, ref, &cfg, full, c->ref, &guards, &d) != OM_OK) return 1;
         for (size_t i = 0; i < om_method_count(); i++) stress_method(c, om_method_at(i));
         free(c);

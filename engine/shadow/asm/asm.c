@@ -39,7 +39,7 @@
  * Bias: the constant and slope-scaled bias of the conventional map (cfg bias_const,
  * bias_slope in texels of the node the sample is tested in); the paper notes the ID
  * test does not remove the bias problem. pcf and normal_offset do not apply. */
-#include "../shadow.h"
+#include "../method.h"
 #include "asm.h"
 
 #include <float.h>
@@ -765,9 +765,11 @@ static const om_setting settings[] = {
 
 #undef SET
 
+extern const om__pass om__pass_asm;
 const om_method om__method_asm = {
     "asm", "adaptive shadow map: a tree of tiles refined where the eye needs it, within asm.cap",
     OM_METHOD_OBSERVES,
     asm_bytes, asm_init, asm_begin, asm_observe, asm_build, asm_resolve, asm_stats, NULL,
     settings, sizeof settings / sizeof settings[0], sizeof(om__asm_cfg),
+    OM__JOBS_ONLY(&om__bands_asm), OM__JOBS_ONLY(&om__pass_asm),
 };

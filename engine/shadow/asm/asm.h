@@ -24,7 +24,7 @@
 #ifndef OM_ASM_H
 #define OM_ASM_H
 
-#include "../../frame/frame.h"
+#include "../method.h"
 
 #define OM__ASM_NONE 0xFFFFFFFFu   /* no node (an empty cell) */
 #define OM__ASM_ROOT 0xFFFFFFFEu   /* the root's index: it is not in the pool */

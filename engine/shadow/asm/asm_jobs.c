@@ -26,7 +26,7 @@
  * the cells of the free nodes' first samples get them, as a strip at a time, every
  * other cell gets none, and the samples that fell in those are counted in their
  * cells, as root_tile counts them. */
-#include "../shadow.h"
+#include "../method.h"
 #include "asm.h"
 
 #if OM_WITH_JOBS

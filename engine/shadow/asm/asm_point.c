@@ -16,7 +16,7 @@
  * 2^-17 (128u) of each bounds them. The comparisons in asm.h add the stored depth's
  * rounding to float and a few units of room. */
 #include "asm.h"
-#include "../shadow.h"
+#include "../method.h"
 
 static bool pow2(double x)
 {

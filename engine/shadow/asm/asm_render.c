@@ -4,7 +4,7 @@
  * projects the scene and bounds each triangle in base texels, and lays a grid of cells
  * over them so that a tile gathers its triangles from its cells; lean mode keeps none
  * of it and tests every triangle. asm.c decides which tiles exist. */
-#include "../shadow.h"
+#include "../method.h"
 #include "asm.h"
 
 #include <float.h>

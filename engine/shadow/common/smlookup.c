@@ -248,13 +248,6 @@ OM_INLINE bool plain_locate(const plain *P, const bool spot, const om_sample *sm
  * is located. The same terms either way. Both this loop and plain_locate must sit in
  * line (OM_INLINE): gcc for the M4 otherwise calls them, with `spot` a variable, and
  * every constant of P is loaded again per sample (+0.07 M instructions a frame). */
-#ifndef OM_SMLOOK_DIRECT
-#if defined(__ARM_ARCH_PROFILE) && __ARM_ARCH_PROFILE == 'M'
-#define OM_SMLOOK_DIRECT 1
-#else
-#define OM_SMLOOK_DIRECT 0
-#endif
-#endif
 #if OM_SMLOOK_DIRECT
 OM_INLINE void plain_tests(const plain *P, const bool spot, const uint32_t *depth, om_strip *st,
                           size_t n, uint32_t *samples, uint32_t *shadowed)

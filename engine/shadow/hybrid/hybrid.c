@@ -738,4 +738,5 @@ const om_method om__method_hybrid = {
     OM_METHOD_EXACT, hybrid_bytes, hybrid_init, hybrid_begin, hybrid_observe, om__hybrid_build,
     hybrid_resolve, hybrid_stats, NULL, settings, sizeof settings / sizeof settings[0],
     sizeof(hybrid_cfg),
+    OM__JOBS_ONLY(&om__bands_hybrid), OM__JOBS_ONLY(&om__pass_hybrid),
 };

@@ -4,6 +4,7 @@
 #ifndef OM_HYBRID_H
 #define OM_HYBRID_H
 
+#include "../method.h"
 #include "../common/occlude.h"
 
 /* Classifies a sample of the current frame (after the method's build) by the map

@@ -5,7 +5,7 @@
 #ifndef OM_HYBRID_METHOD_H
 #define OM_HYBRID_METHOD_H
 
-#include "../shadow.h"
+#include "../method.h"
 #include "hybrid.h"
 
 #include <float.h>

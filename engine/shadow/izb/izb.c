@@ -16,7 +16,7 @@
  * consecutive samples, each with its own BSP — memory stays fixed whatever the image
  * size. The tie rule, depth test and transmittance are the reference's own, so the
  * result equals the reference exactly, whatever the tiling. */
-#include "../shadow.h"
+#include "../method.h"
 #include "izb.h"
 
 extern const om_method om__method_izb;
@@ -736,4 +736,5 @@ const om_method om__method_izb = {
     "izb", "irregular z-buffer (alias-free shadow maps): exact, BSP over the visible samples",
     OM_METHOD_EXACT, izb_bytes, izb_init, izb_begin, izb_observe, izb_build, izb_resolve,
     izb_stats, NULL, settings, sizeof settings / sizeof settings[0], sizeof(om__izb_cfg),
+    NULL, OM__JOBS_ONLY(&om__pass_izb),
 };

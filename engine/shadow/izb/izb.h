@@ -73,7 +73,7 @@ typedef struct om__izb_cfg {
 } om__izb_cfg;
 
 /* Its entry in the settings of a method whose struct T holds it at `f` (a field
- * designator: izb_leaf, or part.izb_leaf); izb.pool's is shadow.h's. */
+ * designator: izb_leaf, or part.izb_leaf); izb.pool's is method.h's. */
 #define OM__SET_IZB_LEAF(T, f) \
     OM__SETTING(T, f, "izb.leaf", OM_SETTING_U32, 1, 65536, 64, "most samples in a BSP leaf (the paper: 64)")
 

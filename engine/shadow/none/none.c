@@ -1,7 +1,7 @@
 /* none.c — the method with no occluders: every exposed sample is lit. It is the
  * smallest complete example of the method interface, and the lit rule's (a) and (b)
  * alone (facing the light, inside its frustum) decide its image. */
-#include "../shadow.h"
+#include "../method.h"
 
 typedef struct none_state { uint32_t frames; } none_state;
 
@@ -76,4 +76,5 @@ const om_method om__method_none = {
     "none", "no occluders: every sample facing the light inside its frustum is lit", 0,
     none_bytes, none_init, none_begin, none_observe, none_build, none_resolve, none_stats, NULL,
     NULL, 0, 0,
+    OM__JOBS_ONLY(&om__bands_none), NULL,
 };

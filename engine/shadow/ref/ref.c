@@ -8,7 +8,7 @@
  * predicate decides. With the memory for it, the walk runs on the light's grid instead
  * (ref_light.h), over packets of neighbouring samples: the same filter's answer for
  * the triangles that matter, in fewer steps. */
-#include "../shadow.h"
+#include "../method.h"
 #include "../common/occlude.h"
 #include "bvh.h"
 #include "ref_light.h"
@@ -480,4 +480,5 @@ const om_method om__method_ref = {
     "ref", "exact reference: shadow segments through a BVH, the shared occlusion predicate",
     OM_METHOD_EXACT, ref_bytes, ref_init, ref_begin, ref_observe, ref_build, ref_resolve,
     ref_stats, NULL, NULL, 0, 0,
+    OM__JOBS_ONLY(&om__bands_ref), OM__JOBS_ONLY(&om__pass_ref),
 };

@@ -16,7 +16,7 @@
  *            in float here where that gives the same bits)
  * All state lives in the method's arena; nothing persists between frames but the
  * buffers. */
-#include "../shadow.h"
+#include "../method.h"
 #include "rtw.h"
 #include "../common/occlude.h"   /* OM_LIGHT_GRID */
 
@@ -777,9 +777,11 @@ static const om_setting settings[] = {
 
 #undef SET
 
+extern const om__pass om__pass_rtw;
 const om_method om__method_rtw = {
     "rtw", "rectilinear texture warping: importance-warped shadow map with 1-D warp tables",
     OM_METHOD_OBSERVES,
     rtw_bytes, rtw_init, rtw_begin, rtw_observe, rtw_build, rtw_resolve, rtw_stats, NULL,
     settings, sizeof settings / sizeof settings[0], sizeof(om__rtw_cfg),
+    OM__JOBS_ONLY(&om__bands_rtw), OM__JOBS_ONLY(&om__pass_rtw),
 };

@@ -20,6 +20,7 @@
 #ifndef OM_RTW_H
 #define OM_RTW_H
 
+#include "../method.h"
 #include "../common/smlookup.h"
 
 #define OM_RTW_ALPHA 0.001f        /* shadow-edge function away from edges (section 5.3) */

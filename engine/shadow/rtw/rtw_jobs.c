@@ -10,7 +10,7 @@
  * folded into the state's by cells, as jobs too. On one thread, without the host's
  * threads or where the frame's arena has no room for the slots, rtw_warp.c analyses
  * into the state's map directly. */
-#include "../shadow.h"
+#include "../method.h"
 #include "rtw.h"
 
 #if OM_WITH_JOBS

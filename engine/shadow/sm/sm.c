@@ -5,7 +5,7 @@
  * along its normal by `normal_offset` texels, is shadowed in a texel when its light
  * depth minus the bias is beyond the stored depth; the bias rules and PCF live in
  * smlookup.c, shared with the RTW map. */
-#include "../shadow.h"
+#include "../method.h"
 #include "../common/smlookup.h"
 
 /* sm's configuration: what its settings (at the end of this file) set. */
@@ -192,4 +192,5 @@ const om_method om__method_sm = {
     "sm", "conventional shadow map: depth from the light, bias, optional PCF", 0,
     sm_bytes, sm_init, sm_begin, sm_observe, sm_build, sm_resolve, sm_stats, NULL,
     settings, sizeof settings / sizeof settings[0], sizeof(sm_cfg),
+    OM__JOBS_ONLY(&om__bands_sm), NULL,
 };

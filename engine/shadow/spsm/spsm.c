@@ -864,8 +864,10 @@ static const om_setting settings[] = {
 
 #undef SET
 
+extern const om__pass om__pass_spsm;
 const om_method om__method_spsm = {
     "spsm", "sub-pixel shadow map: 128-bit texels with the nearest triangle, silhouette recovery",
     OM_METHOD_OBSERVES, spsm_bytes, spsm_init, spsm_begin, spsm_observe, om__spsm_build, spsm_resolve, spsm_stats,
     spsm_observes, settings, sizeof settings / sizeof settings[0], sizeof(om__spsm_cfg),
+    OM__JOBS_ONLY(&om__bands_spsm), OM__JOBS_ONLY(&om__pass_spsm),
 };

@@ -4,7 +4,7 @@
 #ifndef OM_SPSM_METHOD_H
 #define OM_SPSM_METHOD_H
 
-#include "../shadow.h"
+#include "../method.h"
 #include "spsm_lookup.h"
 
 #define OM__SPSM_TIE_DZ (OM__SPSM_LINK_DZ / 2)   /* the build's near tie: one surface to recovery */
