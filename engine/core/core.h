@@ -80,9 +80,10 @@ static inline float om__sqrtf(float x)
 #if (defined(__GNUC__) || defined(__clang__)) && defined(__arm__) && defined(__ARM_FP) && (__ARM_FP & 4)
     /* 32-bit ARM with a single-precision unit: its instruction alone. The compiler's
      * own (errno kept, as C asks) tests for a negative argument first, to call the
-     * library: three instructions per root, twice a covered pixel on a Cortex-M4F
-     * (the exposure marks and the lookup's bias). A negative argument gives a NaN
-     * either way; no test or rounding of the engine tells one NaN from another. */
+     * library: a test and a branch per root, and a Cortex-M4F takes a root twice a
+     * covered pixel (the exposure marks and the lookup's bias). A negative argument
+     * gives a NaN either way; no test or rounding of the engine tells one NaN from
+     * another. */
     float r;
     __asm__("vsqrt.f32 %0, %1" : "=t"(r) : "t"(x));
     return r;
@@ -172,8 +173,8 @@ double om__exp2(double x);
 /* A hint that the line holding *p is about to be written: fetched, and every other
  * core's copy of it dropped, ahead of the store. For an array that one thread writes
  * by parts and every thread then reads (the bins' vertices on a host's threads), each
- * store would otherwise wait for the other cores' copies to be dropped: random 100K's
- * light bins took twice the CPU time on two threads that they took on one. x86 needs
+ * store would otherwise wait for the other cores' copies to be dropped, and a second
+ * thread would add more waiting than work. x86 needs
  * its own instruction: the compilers' write hint is a read prefetch there unless the
  * build targets PREFETCHW, which AMD's x86-64 CPUs and Intel's since Broadwell list
  * (CPUID's PRFCHW); older Intel ones are said to take it as a no-op, which this

@@ -219,8 +219,9 @@ static inline int32_t holds_centre(int32_t xa, int32_t xb, int32_t xc, int32_t y
  * out once it covers a pixel centre, the bins one per vertex for all its triangles. */
 #define BATCH 8
 #define LANES (3 * BATCH)
-/* How many batches ahead om__bins_make_verts asks for its vertices' lines (about 2 KB:
- * random 100K's light bins on two threads took as long as on one without it). */
+/* How many batches ahead om__bins_make_verts asks for its vertices' lines (about 2 KB):
+ * far enough that a line is fetched, and the other cores' copies dropped, before its
+ * store (see OM_PREFETCH_WRITE). */
 #define PREFETCH_AHEAD 8
 
 typedef struct lanes {
@@ -473,7 +474,7 @@ static inline void bin_tri(const om_scene *s, const om_mat4 *vp, om_raster *r, u
 /* Where the CPU has lanes, the bins' rows are scanned SCAN triangles at a time: which
  * of them reach the target's rows [y0, y1], in a loop over lanes with no branch (a
  * compiler tests four an instruction), so that a band passes over the many triangles
- * outside it at a fraction of a test each (issue 26: every band of a frame scans every
+ * outside it at a fraction of a test each (every band of a frame scans every
  * triangle's rows). Without lanes (a Cortex-M) the hits would only be stored and read
  * again, and each triangle is tested as it comes. The same triangles either way. */
 #define SCAN 32

@@ -1,5 +1,5 @@
-/* parse.c — the scene text format (see om_scene_parse in ombra.h and the grammar in the
- * README): the commands and the two passes over the text (parameters, their ranges
+/* parse.c — the scene text format (see om_scene_parse in ombra.h and the grammar in
+ * FORMAT.md): the commands and the two passes over the text (parameters, their ranges
  * and the messages are params.c's).
  * The first pass validates every line and counts what it will produce (om_scene_bytes
  * stops there), so every error comes with a line and column before any memory is

@@ -1,8 +1,8 @@
 /* asm_point.c — where a sample lands on the Adaptive Shadow Map's light image (asm.h):
  * its place, light depth, bias and footprint ratio, exactly in double (what every
  * decision of the method is defined by), and in float with error bounds (the fast
- * path: a Cortex-M4F runs double in software routines of 30-100 instructions each, and
- * every looked-up sample needs some forty such operations).
+ * path: a Cortex-M4F runs double in software routines, and every looked-up sample
+ * needs dozens of such operations).
  *
  * The float path decides only where its bounds leave no doubt, so the frames, the
  * tree and its statistics are the exact path's. Bounds (u = 2^-24, float's unit

@@ -196,9 +196,9 @@ static uint8_t test(const om__smlook *L, const tap *tp)
  * and its loads independent, so that many of them are in flight at once; and each
  * tap's centre texel is asked for as soon as it is located, so that the load is on its
  * way while the rest of the block is located. A warped map spreads the view over the
- * whole map, and its loads miss the cache: rtw's lookup at map 2048 on the default
- * scene took about 1.5x sm's without the hint and 1.2x with it. The hint changes no
- * term: they are the same as testing sample by sample. */
+ * whole map, and its loads miss the cache: the hint overlaps those misses with the
+ * locating. The hint changes no term: they are the same as testing sample by
+ * sample. */
 #define SMLOOK_BLOCK 32
 
 /* The plain map with one tap and no normal offset (sm's usual settings): the
@@ -247,7 +247,7 @@ OM_INLINE bool plain_locate(const plain *P, const bool spot, const om_sample *sm
  * Cortex-M cores; define it 1 elsewhere to try it) each sample is tested as soon as it
  * is located. The same terms either way. Both this loop and plain_locate must sit in
  * line (OM_INLINE): gcc for the M4 otherwise calls them, with `spot` a variable, and
- * every constant of P is loaded again per sample (+0.07 M instructions a frame). */
+ * every constant of P is loaded again per sample. */
 #if OM_SMLOOK_DIRECT
 OM_INLINE void plain_tests(const plain *P, const bool spot, const uint32_t *depth, om_strip *st,
                           size_t n, uint32_t *samples, uint32_t *shadowed)

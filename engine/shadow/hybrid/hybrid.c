@@ -50,9 +50,9 @@
  * the scene alone; and a strip's uncertain samples make several tiles to share out.
  * But every tile walks every triangle (or with candidates, hybrid_tile.c, finds them
  * among every triangle): twice the scene's triangles, at least TILE_LEAST and at
- * most TILE_CAP, keeps that walk small beside a tile's own work (callgrind, one
- * thread, 1024x768: tiles of 32768 cost random-100K 15% more frame than one tile,
- * the default scene 3% less); a tile of many samples is cut into regions instead. */
+ * most TILE_CAP, keeps that walk small beside a tile's own work, where smaller tiles
+ * would set up a large scene's triangles again in each; a tile of many samples is cut
+ * into regions instead. */
 #define TILE_LEAST 32768u
 #define TILE_CAP 262144u
 
@@ -66,10 +66,8 @@ static uint32_t tile_most(const om_scene *s)
  * of the image's larger side (at least 16): texels of about 4 x 4 pixels where the
  * light's image and the camera's agree, and memory that scales with the image (256 at
  * 1024x768, 32 at 160x120). A finer map leaves fewer samples uncertain but costs
- * more to build and clear than the irregular pass it saves (callgrind, one thread,
- * 1024x768, maps 128 / 256 / 512, M instructions a frame: default scene 346.5 /
- * 342.1 / 352.2, random-10K 304.4 / 304.6 / 317.8, random-100K 505.2 / 510.8 / 531.1; at
- * 640x480 128 against 256: 157.2 / 158.5 and 139.5 / 141.8). */
+ * more to build and clear than the irregular pass it saves; a coarser one leaves the
+ * irregular pass more than its build saves. */
 static uint32_t map_side(const hybrid_cfg *c, uint32_t w, uint32_t h)
 {
     if (c->hybrid_map) return c->hybrid_map;
@@ -298,9 +296,8 @@ const om__lspace *om__hybrid_lspace(const void *state) { return &((const hybrid_
  * lit (surely_lit), and only for the rest each one's exact depth (om__zdepth: an
  * integer division) and lookup. One lane where a double is a software routine
  * (OM_FAST_FLOAT): no vector unit there, and om__project_xy itself. Else 64 lanes:
- * each batch sets up the light's matrix and constants in vector registers again
- * (callgrind, default scene at 1024x768, one thread: 16 lanes 310.8 M instructions a
- * frame, 32 308.0 M, 64 306.7 M). */
+ * each batch sets up the light's matrix and constants in vector registers again, so
+ * wider batches set them up fewer times. */
 #if OM_FAST_FLOAT
 #define LANES 1
 #else
@@ -561,9 +558,9 @@ static uint32_t starts_here(hybrid_state *m, const om_strip *st)
 
 /* ---- the same on the lent threads, in `parts` parts of the strip's samples (about
  * sixteen a thread, up to 64, taken as threads come free: a strip's uncertain samples
- * bunch up, and with four a thread on two threads one part held half the keys' work
- * on the default scene): each part counts its marked samples, and the counts say
- * where each tile begins and where each part's keys go in a tile. A part writes the
+ * bunch up, and with a few parts a thread one part can hold much of the keys' work):
+ * each part counts its marked samples, and the counts say where each tile begins and
+ * where each part's keys go in a tile. A part writes the
  * keys of its samples that fall in the tile, in their order, where its first one goes;
  * a sample whose projection fails (none: the bands marked it after the same
  * projection) would leave a gap, closed after. So the same keys as tile_keys, in the
@@ -686,9 +683,9 @@ static void hybrid_pass_merge(void *state, const uint32_t counts[8])
     m->tile.regions += counts[3];
 }
 
-/* begin with the vertex projection left to the jobs, in ranges of vertices (300K
- * vertices at random 100K, about 59 M instructions, which would otherwise hold every
- * other thread up); the build that reads them runs after. */
+/* begin with the vertex projection left to the jobs, in ranges of vertices (a large
+ * scene's projection would otherwise hold every other thread up); the build that
+ * reads them runs after. */
 static om_status hybrid_pass_begin(void *state, const om_view *v, uint32_t *items, om_diag *d)
 {
     (void)d;

@@ -199,8 +199,8 @@ static void build_rows(hybrid_state *m, uint32_t row0, uint32_t row1, const uint
 #if OM_WITH_JOBS && (defined(__GNUC__) || defined(__clang__))
         /* A band's list skips through the scene, and its triangles' projected vertices
          * were written by every thread's parts of the set-up: ask for the next ones'
-         * early (a hint: no effect on what is computed). Random 100K on two threads:
-         * the bands took 4.6 ms without, as long as one thread took for them all. */
+         * early (a hint: no effect on what is computed); without it a band waits on
+         * the other cores' lines and two threads gain nothing over one. */
         if (tris && m->ls.verts && i + 8 < n) {
             const uint32_t *nx = s->idx + (size_t)tris[i + 8] * 3;
             for (int k = 0; k < 3; k++) __builtin_prefetch(&m->ls.verts[nx[k]]);
@@ -301,8 +301,8 @@ static void band_rows(void *user, uint32_t b, void *scratch)
 }
 
 /* The map by bands, about sixteen a thread (up to MOST_BANDS) taken as threads come
- * free: the rows' cost follows the scene (with four a thread on two threads, one band
- * held two thirds of the default scene's build). False where the tile has no room for
+ * free: the rows' cost follows the scene (with a few bands a thread, one band can
+ * hold most of the build). False where the tile has no room for
  * the lists (small scenes, whose build is short). */
 static bool build_bands(hybrid_state *m)
 {

@@ -23,8 +23,8 @@
 /* Cells per side of a block (the coarse level a triangle looks at first). */
 #define BLOCK 4
 /* Most cells of a tile's grid per sample: finer cells let a small triangle reach
- * fewer samples, more of them cost a large one more cell tests (on the Cortex-M4's
- * small scene 1 cost 23.4 M instructions a frame, 2 23.9 M, 4 25.1 M). */
+ * fewer samples, more of them cost a large one more cell tests; one a sample is the
+ * balance on the scenes the project measures. */
 #define CELL_SAMPLES 1u
 /* Most cells a triangle's bounds may reach for the samples in them to be checked
  * against it before its setup. */
@@ -32,18 +32,17 @@
 /* Least samples of a region: with room for candidates, a tile of at least two regions'
  * samples is cut into regions of whole rows of its blocks, each of at least this many
  * (and at least a tile's OM__HTILE_REGIONS-th), that walk the tile's candidates apart:
- * jobs of the host's threads, where a tile's walk over the scene's triangles was one
- * (on random 100K at 1024x768 its one tile of 182K samples was half the frame). The
+ * jobs of the host's threads, where a tile's walk over the scene's triangles would be
+ * one job (a large scene's one tile can be much of the frame). The
  * candidates are the triangles whose projected box meets the tile's bounds nearer
  * than its farthest sample, found once in OM__HTILE_PARTS parts of the triangles and
  * listed by the regions their rows reach; a region then walks its lists and tests
  * their boxes against its own bounds, so a triangle that reaches two regions is set
  * up in each. The cut depends on the tile's samples alone, and each sample meets the
  * triangles that reach it in the scene's order in either walk: the same terms, and
- * the same counts whatever runs the jobs. What it costs one thread (1024x768):
- * instructions a frame (callgrind) random 100K 441.7 M -> 459.7 M, the default scene
- * 249.5 M -> 256.3 M, but about the same time (the candidates are read in order, a
- * line each); 16384 samples a region cost the same within 0.4%. */
+ * the same counts whatever runs the jobs. On one thread it adds a little work but
+ * about no time (the candidates are read in order, a line each), and the region's
+ * size matters little. */
 #define REGION_SAMPLES 8192u
 /* Entries of a region's list ahead of the one it walks whose candidate is fetched. */
 #define PREFETCH 8

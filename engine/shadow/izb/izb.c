@@ -87,10 +87,10 @@ static size_t pool_bytes_of(uint32_t samples, uint32_t leaf)
  * grid, where one that reaches none of its samples costs it little); small tiles keep their keys, nodes and cells in the cache, leave little to clear, and give
  * the host's threads several jobs of the like cost (a strip's tiles are cut in the
  * screen's order, and where a cloud shadows the top half of the image, two tiles
- * differ threefold). With many triangles, though, most reach every tile and are set up
- * in each (clipping and projecting in double), so the pool grows faster than the
- * triangle count: on random clouds at 1024x768 (izb.md) 32768 samples (10 tiles) at
- * 100K triangles, 4 tiles at 300K, one pass from about 900K. */
+ * differ several times over). With many triangles, though, most reach every tile and
+ * are set up in each (clipping and projecting in double), so the pool grows faster
+ * than the triangle count: at 1024x768 a frame is one pass from about 900K triangles
+ * (izb.md). */
 #define TILE_LEAST 32768u
 #define TILE_SQ 20
 
@@ -165,8 +165,8 @@ static om_status setup(om__izb *z, om__lgrid *g, om_arena *a, const om__izb_cfg 
     /* The vertex projection when the pool keeps at least half the samples it would
      * have without it: without it, every tile sets up every triangle of the scene
      * (clipping and projecting in double), which costs far more than the tiles that
-     * half the pool adds (on the Cortex-M4, strips of 8 rows: 88 M instructions a frame
-     * of the small scene's 95 M went to that setup). */
+     * half the pool adds (in a microcontroller's thin strips that setup would be most
+     * of the frame). */
     size_t left0 = om_arena_left(a), with_cache = parts_bytes(s, true), lean = parts_bytes(s, false);
     uint32_t p_with = left0 >= with_cache ? pool_fit(left0 - with_cache, least, want, z->leaf) : 0;
     uint32_t p_lean = left0 >= lean ? pool_fit(left0 - lean, least, want, z->leaf) : 0;
@@ -569,8 +569,8 @@ static void count_rows(uint32_t *out, const om_strip *st, uint32_t r0, uint32_t 
 }
 
 /* The rows counted as jobs of the pass's slots, each its share of the rows: on one
- * thread the count is a whole pass over the strip's terms (4.7 M instructions a
- * 1024x768 frame on x86-64), which held every other thread up. */
+ * thread the count is a whole pass over the strip's terms, which would hold every
+ * other thread up. */
 typedef struct rows_job { uint32_t *out; const om_strip *st; uint32_t parts; } rows_job;
 
 static void rows_part(void *user, uint32_t k, void *scratch)
@@ -626,10 +626,9 @@ static size_t tile_start(const izb_state *m, const om_strip *st, uint32_t k)
 
 /* The tile job k runs. The frame hands slot p the jobs p, p + P, ... (om__pass), and a
  * strip's tiles mostly cost less the lower they lie on the screen (the top's samples
- * lie far, under more of the scene: on random 100K at 1024x768 the first of ten took
- * 11.1 ms of thread time, the last 1.2), so each round of P jobs takes its P tiles in the other
- * direction from the round before: slot 0 gets tiles 0, 2P - 1, 2P, ..., the last slot
- * P - 1, P, 3P - 1, ... Which slot runs a tile changes no term or count. */
+ * lie far, under more of the scene), so each round of P jobs takes its P tiles in the
+ * other direction from the round before: slot 0 gets tiles 0, 2P - 1, 2P, ..., the
+ * last slot P - 1, P, 3P - 1, ... Which slot runs a tile changes no term or count. */
 static uint32_t tile_of(const izb_state *m, uint32_t k)
 {
     const uint32_t slots = m->lend ? m->lend->slots : 1, p = m->ntiles < slots ? m->ntiles : slots;
@@ -678,9 +677,8 @@ static void izb_pass_merge(void *state, const uint32_t counts[8])
     s->tiles += counts[6];
 }
 
-/* begin with the vertex projection left to the jobs, in ranges of vertices: about 200
- * instructions a vertex on x86-64, 59 M a frame of random 100K triangles, which would
- * otherwise hold every other thread up. */
+/* begin with the vertex projection left to the jobs, in ranges of vertices: on the
+ * calling thread a large scene's projection would hold every other thread up. */
 static om_status izb_pass_begin(void *state, const om_view *v, uint32_t *items, om_diag *d)
 {
     (void)d;

@@ -33,8 +33,7 @@ typedef struct ref_state {
  *         a frame has many samples a packet can share;
  * CACHE   the vertex projection and leaves of 4, the BVH's own nodes re-bounded on the
  *         light's grid every frame in place of their 3-D boxes, walked per sample:
- *         about half the bytes (on the small scene at 160x120, 107 KB of 207 KB), for
- *         a 256 KiB machine;
+ *         about half the bytes, for a 256 KiB machine;
  * LEAST   no projection cache, leaves of 32: a fraction of the nodes, for the smallest
  *         machines, walked along the segment in 3-D. */
 enum { LEAST, CACHE, PACKETS };
@@ -153,8 +152,8 @@ static void fit_job(void *user, uint32_t k, void *scratch)
 /* The BVH's boxes on this frame's light grid (a stage of its own, so the frame's clock
  * counts it): one pass into their own arrays, the middle mode into the nodes. With the
  * frame's threads the one pass's parts are their jobs, and the few nodes above them
- * are fitted here after (at random 100K the fit read the projected vertices of 100K
- * triangles on the calling thread, 15.9 M instructions). */
+ * are fitted here after (the fit reads every triangle's projected vertices, which on
+ * the calling thread alone would hold the others up in a large scene). */
 static om_status ref_build(void *state, om_diag *d)
 {
     (void)d;
@@ -414,10 +413,10 @@ static void ref_band(const void *state, om_strip *st, void *scratch, uint32_t co
 const om__bands om__bands_ref = {ref_band, ref_merge, sizeof(packet), NULL, NULL, NULL};
 
 /* A pass of no jobs of its own (the bands resolve), for its begin and its threads: the
- * projection of the scene's vertices, on the calling thread of one frame of random
- * 100K triangles 300K vertices (about 10% of a frame at 1024x768 on one thread), runs
- * as the frame's jobs in ranges, before the build, and the build's fit by the parts
- * lend's slots take (ref_build). The same vertices and boxes however cut. */
+ * projection of the scene's vertices (on the calling thread, a sizeable share of a
+ * large scene's frame) runs as the frame's jobs in ranges, before the build, and the
+ * build's fit by the parts lend's slots take (ref_build). The same vertices and
+ * boxes however cut. */
 static size_t ref_pass_scratch(const void *state, const om_scene *s)
 {
     (void)state; (void)s;

@@ -291,8 +291,7 @@ static void emit(tess_ctx *x, const tvert *a, const tvert *b, const tvert *c)
  * edge's warped length below the limit (>= one texel) within log2(2 n size) levels.
  * Work stays bounded for hostile scenes (thousands of map-sized triangles): past a cap
  * (64 triangles per scene triangle plus 64 map-covering layers at the limit; real
- * scenes use a small part of it: 65K of 1.6M on the default scene at 2.5%) the rest of
- * the frame is drawn without splitting. */
+ * scenes use a small part of it) the rest of the frame is drawn without splitting. */
 static void tess(tess_ctx *x, const tvert *a, const tvert *b, const tvert *c, int depth)
 {
     bool sab = false, sbc = false, sca = false;
@@ -550,7 +549,7 @@ void om__rtw_render_map(om__rtw *m)
 
 /* smlookup.c's warped test takes the sample's light coordinates, their warp and the
  * bias texel's division by the warp's density in double, which a Cortex-M4F runs in
- * software (about 2,600 instructions a sample). Here the same test runs in float: what
+ * software routines. Here the same test runs in float: what
  * the double arithmetic decides (the warped texel on each axis, the bias texel) comes
  * from float where a proven bound leaves no doubt, and the rest is smlookup.c's float
  * arithmetic, the same operations in the same order. A sample float is unsure of (next

@@ -101,8 +101,8 @@ static om_status spsm_init(void **state, om_arena *a, const om_method_cfg *mc, c
     m->fwords = row_words(2 * m->size);
     m->fdepth = m->fneed = NULL;
     /* Marking costs a projection per sample and saves the build a texel's work where
-     * no sample reads: it pays when the map is finer than the image (measured at
-     * 1024x768: a loss at maps 512 and 1024, a gain from 2048). */
+     * no sample reads: it pays only when the map is finer than the image, where most
+     * texels go unread. */
     m->marks = c->spsm_records == 2 ||
                (c->spsm_records == 0 && (uint64_t)m->size * m->size > 2u * (uint64_t)w * h);
     const size_t bits = (size_t)m->size * m->words;
@@ -399,12 +399,11 @@ typedef struct receiver { float zf, gxf, gyf; bool ok; } receiver;
 
 /* The light's matrix applied to the two directions, a function of the normal alone:
  * kept in the window (w->rd) for the normal w->rn, since neighbouring uncertain samples
- * mostly lie on one flat surface (counted on the small scene at 160x120, map 64: 2,434
- * of 2,514 have the normal of the one before). Equal values suffice, though the two
- * halves of a floor quad give its normal 0 and -0: +, - and * give equal values from
- * equal values (a zero's sign moves only a zero's), the one division's quotients (by
- * det) are replaced by 0 where det is zero, and the plane meets the tests only through
- * +, -, * and comparisons. */
+ * mostly lie on one flat surface (nearly all have the normal of the one before). Equal
+ * values suffice, though the two halves of a floor quad give its normal 0 and -0:
+ * +, - and * give equal values from equal values (a zero's sign moves only a zero's),
+ * the one division's quotients (by det) are replaced by 0 where det is zero, and the
+ * plane meets the tests only through +, -, * and comparisons. */
 static void surface_dirs(const om__spsm_state *m, om__spsm_win *w, const float nv[3])
 {
     if (w->rd_have && nv[0] == w->rn[0] && nv[1] == w->rn[1] && nv[2] == w->rn[2]) return;
@@ -623,8 +622,8 @@ static uint8_t lookup(const om__spsm_state *m, om__spsm_win *w, uint32_t n[8], c
      * nearer than it over the texel (conservative rasterization and depth; but for a
      * near tie, which is one surface with it). We also accept a stored triangle that
      * does not cover the sample but lies in its plane (the other half of a floor quad):
-     * it too was the nearest thing in the texel. That halves the uncertain samples at
-     * no measured cost in accuracy. */
+     * it too was the nearest thing in the texel. That takes many samples out of
+     * recovery at no cost in accuracy. */
     om__spsm_dtri *t = w->t;
     size_t at = (size_t)ty * m->size + (size_t)tx;
     if (at != w->t4_at) {

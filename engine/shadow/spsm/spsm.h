@@ -76,7 +76,7 @@ void om__spsm_qtable_build(om__spsm_qtable *t);
  * orientation (empty, full or isotropic pattern). nn = 2: a thin occluder along the
  * tangent: both sides are tried and must agree (Figure 8, bottom right). spsm.c's
  * recovery uses `keep`; the normals are the paper's tangent estimate, which feeds its
- * one-sided boundary phi (measured worse here, see README), kept for that comparison. */
+ * one-sided boundary phi (measured worse here, see spsm.md), kept for that comparison. */
 typedef struct om__spsm_tangent {
     uint16_t keep;
     uint8_t nn;

@@ -65,7 +65,7 @@ static void hulls_build(om__spsm_boundary *b)
  * convex hull of its points. Where the paper links the lit-side vertices along the
  * tangent into phi and shadows everything beyond it, the hull also closes the piece
  * on its far side, so two thin occluders a texel or more apart (a fence) do not shadow
- * the gap between them (see README: the one-sided phi measured worse). */
+ * the gap between them (see spsm.md: the one-sided phi measured worse). */
 /* The pieces as a union-find over the occluders (at most nine): a vertex's piece is
  * its triangles', and every link joins two occluders' sets. */
 static int root(uint8_t up[9], int k)
