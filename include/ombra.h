@@ -433,40 +433,37 @@ typedef struct om_frame_desc {
     om_parallel_for_fn parallel_for;  /* may be NULL: one thread, inline */
     void *parallel_user;   /* the parallel-for's `host` */
     uint32_t threads;      /* jobs at once (0 or 1: inline); each needs its share of the
-                              frame arena (om_frame_bytes_jobs), and a frame arena with
-                              room for fewer runs that many */
+                              frame arena (om_frame_bytes), and a frame arena with room
+                              for fewer runs that many */
     om_worker_fn worker;   /* may be NULL (above) */
 } om_frame_desc;
 
-/* Bytes the frame arena needs for width x strip_rows (samples, terms and the eye
- * pass's depth and triangle-ID buffers). */
-size_t om_frame_bytes(uint32_t width, uint32_t strip_rows);
-/* The same plus the bins of scene s (4 bytes a triangle and 12 a vertex): with strips,
- * each strip then sets up only the triangles that reach its rows, from vertices
- * projected once per frame, instead of clipping and setting up all of them. A frame
- * arena of om_frame_bytes gives the same pixels, more slowly. */
-size_t om_frame_bytes_scene(const om_scene *s, uint32_t width, uint32_t strip_rows);
-/* What the frame arena needs beyond om_frame_bytes(_scene) to run `threads` jobs at
- * once with method m on scene s (0 for threads <= 1): each job's scratch for the
- * method's resolve, and the bins of the light's map for a method whose depth pass runs
- * by bands of the map (sm; s may be NULL: without them, each band walks every
- * triangle).
- * With threads > 1 the frame splits each strip into bands of rows: the eye pass and
- * shading run on bands at once, and so does the resolve of the built-in methods whose
- * resolve allows it (DESIGN.md lists them); the others resolve a strip at a
- * time. A whole-frame render (one strip) also uses the bins when they fit after the
- * jobs' scratch, but for one on two jobs whose scene has more than one vertex for
- * every 8 pixels: its eye pass splits the triangles in halves instead, with no more
- * memory (DESIGN.md). */
-size_t om_frame_bytes_jobs(const om_method *m, const om_scene *s, uint32_t threads);
-/* What the frame arena may hold beyond those so that a frame through strips keeps the
- * triangle under every pixel of a width x height image from its first eye pass (2
- * bytes a pixel where s has fewer than 65535 triangles, else 4). A frame that passes
- * over the image more than once (a method that observes, such as asm and rtw, or a
- * directional light) then rasterizes the scene once, and its later passes only
- * resolve the samples from these ids. Without the room, each pass rasterizes again,
- * for the same pixels. */
-size_t om_frame_bytes_ids(const om_scene *s, uint32_t width, uint32_t height);
+/* What the frame arena needs for the frame fd describes, by what each step buys; each
+ * field is a total, at least the one before it. The frame runs in any arena of at
+ * least `least` bytes and uses what more it is given, step by step, for the same
+ * pixels, faster. From fd it reads: the view (its image's size and light), strip_rows,
+ * threads, the method (may be NULL: no method's jobs), its state (may be NULL: a bound
+ * for the method's default settings) and the scene (may be NULL: no bins, and jobs
+ * without the light map's bins). */
+typedef struct om_frame_need {
+    size_t least;      /* a strip's samples, terms and the eye pass's depth and triangle ids */
+    size_t with_bins;  /* + the scene's bins (4 bytes a triangle, 12 a vertex): each strip
+                          (or band) sets up only the triangles that reach its rows, from
+                          vertices projected once */
+    size_t with_jobs;  /* + what `threads` jobs need at once: each job's scratch for the
+                          method's resolve and pass, and the light map's bins for a method
+                          whose depth pass runs by bands of the map (none for threads <= 1,
+                          nor where the engine carries no jobs code: OM_WITH_JOBS) */
+    size_t with_ids;   /* + the image's triangle ids (2 bytes a pixel under 65535 triangles,
+                          else 4): a frame through strips that passes over the image more
+                          than once rasterizes the scene once, and its later passes resolve
+                          from them */
+    size_t whole;      /* all the frame can use: with_ids where it passes over the image
+                          through strips more than once (a method that observes, a
+                          directional light), else with_jobs */
+} om_frame_need;
+/* OM_E_INVALID without fd, its view or out. */
+om_status om_frame_bytes(const om_frame_desc *fd, om_frame_need *out);
 /* Renders one frame. The frame arena is rewound on return; the method's arena keeps
  * what the method keeps. */
 om_status om_render_frame(const om_frame_desc *fd, om_arena *frame_arena,

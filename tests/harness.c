@@ -3,6 +3,7 @@
 #include "test.h"
 
 #include <stdlib.h>
+#include <string.h>
 
 bool h_scene_parse(h_scene *hs, const char *text) { return h_scene_parse_ld(hs, text, NULL); }
 
@@ -118,7 +119,7 @@ om_status h_render_in(const om_scene *s, const char *name, const om_method_cfg *
     if ((st = om_method_bytes(m, &c, s, W, H, &mn, &full))) return st;
     if (method_bytes) full = method_bytes;
     uint32_t rows = strip_rows ? strip_rows : H;
-    size_t fbytes = om_frame_bytes_scene(s, W, rows);
+    size_t fbytes = h_frame_bins(s, W, rows);
     void *mm = malloc(full), *fm = malloc(fbytes), *px = malloc((size_t)W * rows * 3);
     om_arena ma, fa;
     om_arena_init(&ma, mm, full, "method");
@@ -139,4 +140,51 @@ om_status h_render_in(const om_scene *s, const char *name, const om_method_cfg *
     free(fm);
     free(px);
     return st;
+}
+
+static void no_jobs(void *host, om_job_fn fn, void *job_user, uint32_t n)
+{
+    (void)host;
+    for (uint32_t i = 0; i < n; i++) fn(job_user, i);
+}
+
+om_frame_need h_frame_need(const om_method *m, const om_scene *s, uint32_t width, uint32_t height, uint32_t rows,
+                           uint32_t threads)
+{
+    om_view v;
+    om_frame_desc fd;
+    om_frame_need need;
+    memset(&v, 0, sizeof v);
+    memset(&fd, 0, sizeof fd);
+    memset(&need, 0, sizeof need);
+    v.cam.width = width;
+    v.cam.height = height;
+    v.light.kind = OM_LIGHT_SPOT;
+    fd.view = &v;
+    fd.scene = s;
+    fd.method = m;
+    fd.strip_rows = rows;
+    fd.threads = threads;
+    fd.parallel_for = threads > 1 ? no_jobs : NULL;
+    om_frame_bytes(&fd, &need);
+    return need;
+}
+
+size_t h_frame_least(uint32_t width, uint32_t rows) { return h_frame_need(NULL, NULL, width, rows, rows, 1).least; }
+
+size_t h_frame_bins(const om_scene *s, uint32_t width, uint32_t rows)
+{
+    return h_frame_need(NULL, s, width, rows, rows, 1).with_bins;
+}
+
+size_t h_frame_jobs(const om_method *m, const om_scene *s, uint32_t threads)
+{
+    const om_frame_need n = h_frame_need(m, s, 1, 1, 0, threads);
+    return n.with_jobs - n.with_bins;
+}
+
+size_t h_frame_ids(const om_scene *s, uint32_t width, uint32_t height)
+{
+    const om_frame_need n = h_frame_need(NULL, s, width, height, 1, 1);
+    return n.with_ids - n.with_jobs;
 }

@@ -37,6 +37,17 @@ om_status h_view(om_view *v, const om_scene *s, float t, uint32_t w, uint32_t h,
 void h_frame_desc(om_frame_desc *fd, om_shade_cfg *shade, const om_scene *s, const om_view *v,
                   const om_method *m, void *state, om_framebuffer *fb, uint32_t strip_rows);
 
+/* The frame size query (om_frame_bytes) for a width x height image through strips of
+ * `rows` rows (0: whole), scene s and method m (each may be NULL), with a parallel-for
+ * of `threads` jobs; a spot light. h_frame_least, _bins: its least and with_bins for
+ * strips of `rows` rows; h_frame_jobs and h_frame_ids: what its jobs and ids add. */
+om_frame_need h_frame_need(const om_method *m, const om_scene *s, uint32_t width, uint32_t height, uint32_t rows,
+                           uint32_t threads);
+size_t h_frame_least(uint32_t width, uint32_t rows);
+size_t h_frame_bins(const om_scene *s, uint32_t width, uint32_t rows);
+size_t h_frame_jobs(const om_method *m, const om_scene *s, uint32_t threads);
+size_t h_frame_ids(const om_scene *s, uint32_t width, uint32_t height);
+
 /* Renders with method `name` and configuration `cfg` (NULL: defaults; one made for
  * another method: the settings they share, om_method_cfg_from) at the scene's
  * camera (w x h when non-zero) and time t; fills mask[w*h] and, if given, terms and

@@ -53,7 +53,7 @@ static bool arun_init(arun *r, const om_scene *s, const om_method_cfg *c, uint32
     if (lean) full = mn;
     r->bytes = full;
     r->mem = malloc(full);
-    r->fmem = malloc(om_frame_bytes(W, H));
+    r->fmem = malloc(h_frame_least(W, H));
     r->px = malloc((size_t)W * H * 3);
     om_arena a;
     om_arena_init(&a, r->mem, full, "method");
@@ -100,7 +100,7 @@ static om_status arun_frame(arun *r, float t, float tl, uint32_t strip, uint8_t 
     if (st) return st;
     uint32_t rows = strip ? strip : r->H;
     om_arena fa;
-    om_arena_init(&fa, r->fmem, om_frame_bytes(r->W, rows), "frame");
+    om_arena_init(&fa, r->fmem, h_frame_least(r->W, rows), "frame");
     om_framebuffer fb = {OM_RGB888, r->W, rows, (size_t)r->W * 3, (uint8_t *)r->px};
     om_shade_cfg shade;
     agrab g = {mask, terms};

@@ -112,8 +112,8 @@ static void strips_equal_whole(void)
                 /* all the bins, the rows alone (no room for the vertices), none */
                 const int bins = 2 - k / 4;
                 const uint32_t n = strips[k % 4];
-                frame_size = bins == 2 ? om_frame_bytes_scene(&s, 80, n)
-                           : bins == 1 ? om_frame_bytes(80, n) + om__bins_rows_bytes(&s) : om_frame_bytes(80, n);
+                frame_size = bins == 2 ? h_frame_bins(&s, 80, n)
+                           : bins == 1 ? h_frame_least(80, n) + om__bins_rows_bytes(&s) : h_frame_least(80, n);
                 memset(pix_b, 0, sizeof pix_b);
                 CHECK_OK(render(&s, &l, n, OM_RGB888, &b));
                 CHECK_EQ_U(frame_carves, (uint32_t)(4 + bins));
@@ -229,7 +229,7 @@ static void frame_budget(void)
     om_shade_cfg shade;
     om_frame_desc fd;
     h_frame_desc(&fd, &shade, &s, &v, m, state, &fb, 4);
-    size_t need = om_frame_bytes(80, 4);
+    size_t need = h_frame_least(80, 4);
     /* The query covers any alignment of the host's buffer; the four arrays' padding is
      * at most 4 * 7 bytes, so 29 bytes fewer can never be enough. Guard bytes around
      * the arena must survive a failing and a succeeding frame. */

@@ -124,11 +124,11 @@ static void budgets(void)
     CHECK_OK(h_view(&v, &hs.s, 0, W, H, NULL));
     size_t sizes[3] = {mn, (mn + full) / 2, full};
     for (int k = 0; k < 3; k++) {
-        unsigned char *mem = malloc(sizes[k]), *fmem = malloc(om_frame_bytes(W, H));
+        unsigned char *mem = malloc(sizes[k]), *fmem = malloc(h_frame_least(W, H));
         unsigned char *px = malloc(W * H * 3);
         om_arena ma, fa;
         om_arena_init(&ma, mem, sizes[k], "method");
-        om_arena_init(&fa, fmem, om_frame_bytes(W, H), "frame");
+        om_arena_init(&fa, fmem, h_frame_least(W, H), "frame");
         CHECK_OK(om_method_init(m, &state, &ma, &c, &hs.s, W, H, &d));
         CHECK(ma.peak <= sizes[k]);
         om_framebuffer fb = {OM_RGB888, W, H, W * 3, px};
@@ -182,10 +182,10 @@ static void default_pool(void)
         CHECK_MSG(diff == 0, "pool %s: %d samples differ", k ? "one pass" : "default", diff);
         /* the tiles it took, through a frame of its own */
         size_t bytes = k ? full_one : full;
-        unsigned char *mem = malloc(bytes), *fmem = malloc(om_frame_bytes(W2, H2)), *px = malloc(W2 * H2 * 3);
+        unsigned char *mem = malloc(bytes), *fmem = malloc(h_frame_least(W2, H2)), *px = malloc(W2 * H2 * 3);
         om_arena ma, fa;
         om_arena_init(&ma, mem, bytes, "method");
-        om_arena_init(&fa, fmem, om_frame_bytes(W2, H2), "frame");
+        om_arena_init(&fa, fmem, h_frame_least(W2, H2), "frame");
         om_view v;
         om_diag d;
         void *state;
@@ -380,7 +380,7 @@ static izb_run izb_frame(const om_scene *s, const char *pool, size_t bytes, uint
     cam.width = W;
     cam.height = H;
     CHECK_OK(om_view_init(&v, &cam, &light, s, NULL));
-    const size_t fbytes = om_frame_bytes(W, rows ? rows : H);
+    const size_t fbytes = h_frame_least(W, rows ? rows : H);
     unsigned char *mem = malloc(bytes), *fmem = malloc(fbytes), *px = malloc(W * H * 3);
     om_arena ma, fa;
     om_arena_init(&ma, mem, bytes, "method");

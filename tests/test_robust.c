@@ -243,7 +243,7 @@ static void largest_image(void)
         cam.width = cam.height = 8192;
         om_view v;
         CHECK_OK(om_view_init(&v, &cam, &s.light, &s, NULL));
-        size_t mn, full, fbytes = om_frame_bytes(8192, 64);
+        size_t mn, full, fbytes = h_frame_least(8192, 64);
         CHECK_OK(om_method_bytes(m, &c, &s, 8192, 8192, &mn, &full));
         void *mem = malloc(full), *fmem = malloc(fbytes), *px = malloc(8192 * 64 * 2);
         om_arena ma, fa;

@@ -173,10 +173,10 @@ static om_status run_rtw(const om_scene *s, const om_method_cfg *c, uint32_t w, 
     if (!m) return OM_E_NOTFOUND;
     if ((st = om_method_bytes(m, c, s, w, h, &mn, &full))) return st;
     uint32_t rows = strip ? strip : h;
-    void *mm = malloc(full), *fm = malloc(om_frame_bytes(w, rows)), *px = malloc((size_t)w * rows * 3);
+    void *mm = malloc(full), *fm = malloc(h_frame_least(w, rows)), *px = malloc((size_t)w * rows * 3);
     om_arena ma, fa;
     om_arena_init(&ma, mm, full, "method");
-    om_arena_init(&fa, fm, om_frame_bytes(w, rows), "frame");
+    om_arena_init(&fa, fm, h_frame_least(w, rows), "frame");
     void *state;
     om_diag d;
     st = om_method_init(m, &state, &ma, c, s, w, h, &d);

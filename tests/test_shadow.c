@@ -533,10 +533,10 @@ static void ref_small_equals_fast(void)
     CHECK_OK(h_view(&v, &hs.s, 0, W, H, NULL));
     for (int k = 0; k < 2; k++) {
         const size_t size = k ? full - 1 : mn;
-        unsigned char *mem = malloc(size), *fmem = malloc(om_frame_bytes(W, H)), *px = malloc(W * H * 3);
+        unsigned char *mem = malloc(size), *fmem = malloc(h_frame_least(W, H)), *px = malloc(W * H * 3);
         om_arena ma, fa;
         om_arena_init(&ma, mem, size, "method");
-        om_arena_init(&fa, fmem, om_frame_bytes(W, H), "frame");
+        om_arena_init(&fa, fmem, h_frame_least(W, H), "frame");
         void *state;
         CHECK_OK(om_method_init(m, &state, &ma, &c, &hs.s, W, H, NULL));
         om_framebuffer fb = {OM_RGB888, W, H, W * 3, px};

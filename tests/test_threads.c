@@ -95,7 +95,7 @@ static om_status on_strip(void *user, const om_strip *st, const om_framebuffer *
     return OM_OK;
 }
 
-/* One frame of method m with a fresh state; frame arena of om_frame_bytes_scene (or
+/* One frame of method m with a fresh state; frame arena of om_frame_bytes' with_bins (or
  * without bins, om_frame_bytes) plus job_bytes for the jobs. */
 static frame_out render_on(const om_scene *s, const om_method *m, const char *set, uint32_t W,
                            uint32_t H, uint32_t rows, om_parallel_for_fn pf, void *host, om_worker_fn worker,
@@ -110,7 +110,7 @@ static frame_out render_on(const om_scene *s, const om_method *m, const char *se
     size_t mn, full;
     if ((o.st = om_method_bytes(m, &c, s, W, H, &mn, &full))) return o;
     uint32_t r = rows ? rows : H;
-    size_t fbytes = (bins ? om_frame_bytes_scene(s, W, r) : om_frame_bytes(W, r)) + job_bytes;
+    size_t fbytes = (bins ? h_frame_bins(s, W, r) : h_frame_least(W, r)) + job_bytes;
     void *mm = malloc(full), *fm = malloc(fbytes), *px = malloc((size_t)W * r * 3);
     /* The frame arena filled with bytes that differ with the thread count and strips
      * (0x00, 0xFF, NaNs...): the frame carves its per-pixel buffers and bins without
@@ -182,8 +182,8 @@ static void same_bits(void)
                 CHECK_MSG(one.st == OM_OK && one.jobs == 1, "%s: inline frame", om_method_name(m));
                 for (int k = 0; k < 7; k++) {
                     uint32_t n = k < 6 ? threads[k] : 5;
-                    frame_out o = k < 6 ? render(&hs.s, m, 120, 90, rows, om_jobs_for, pools[k], n, om_frame_bytes_jobs(m, &hs.s, n), true)
-                                        : render(&hs.s, m, 120, 90, rows, backwards, NULL, n, om_frame_bytes_jobs(m, &hs.s, n), true);
+                    frame_out o = k < 6 ? render(&hs.s, m, 120, 90, rows, om_jobs_for, pools[k], n, h_frame_jobs(m, &hs.s, n), true)
+                                        : render(&hs.s, m, 120, 90, rows, backwards, NULL, n, h_frame_jobs(m, &hs.s, n), true);
                     CHECK_MSG(o.st == OM_OK && o.jobs == n, "%s: %u jobs ran %u", om_method_name(m), n, o.jobs);
                     CHECK_MSG(o.hash == one.hash, "%s light %d strips %u: %u threads%s change the frame",
                               om_method_name(m), li, rows, n, k < 6 ? "" : " backwards");
@@ -205,20 +205,20 @@ static void fewer_jobs(void)
     if (!h_scene_parse(&hs, om_scene_default_text())) return;
     const om_method *m = om_method_find("ref");
     frame_out one = render(&hs.s, m, 64, 48, 0, NULL, NULL, 1, 0, true);
-    frame_out three = render(&hs.s, m, 64, 48, 0, backwards, NULL, 8, om_frame_bytes_jobs(m, &hs.s, 3), true);
-    frame_out three_nobins = render(&hs.s, m, 64, 48, 0, backwards, NULL, 8, om_frame_bytes_jobs(m, &hs.s, 3), false);
-    frame_out none = render(&hs.s, m, 64, 48, 0, backwards, NULL, 8, om_frame_bytes_jobs(m, &hs.s, 1), false);
+    frame_out three = render(&hs.s, m, 64, 48, 0, backwards, NULL, 8, h_frame_jobs(m, &hs.s, 3), true);
+    frame_out three_nobins = render(&hs.s, m, 64, 48, 0, backwards, NULL, 8, h_frame_jobs(m, &hs.s, 3), false);
+    frame_out none = render(&hs.s, m, 64, 48, 0, backwards, NULL, 8, h_frame_jobs(m, &hs.s, 1), false);
     CHECK_EQ_U(three.jobs, 3);
     CHECK_EQ_U(three_nobins.jobs, 3);
     CHECK_EQ_U(none.jobs, 1);
     CHECK(three.hash == one.hash && three_nobins.hash == one.hash && none.hash == one.hash);
-    CHECK_EQ_U(om_frame_bytes_jobs(m, &hs.s, 1), 0);
-    CHECK(om_frame_bytes_jobs(m, &hs.s, 4) == 2 * om_frame_bytes_jobs(m, &hs.s, 2));
+    CHECK_EQ_U(h_frame_jobs(m, &hs.s, 1), 0);
+    CHECK(h_frame_jobs(m, &hs.s, 4) == 2 * h_frame_jobs(m, &hs.s, 2));
     /* sm's map by bands, with the light's bins and without (one band a job) */
     const om_method *sm = om_method_find("sm");
     frame_out sm1 = render(&hs.s, sm, 64, 48, 0, NULL, NULL, 1, 0, true);
-    frame_out sm3 = render(&hs.s, sm, 64, 48, 0, backwards, NULL, 3, om_frame_bytes_jobs(sm, &hs.s, 3), false);
-    frame_out sm3_lean = render(&hs.s, sm, 64, 48, 0, backwards, NULL, 3, om_frame_bytes_jobs(sm, NULL, 3), false);
+    frame_out sm3 = render(&hs.s, sm, 64, 48, 0, backwards, NULL, 3, h_frame_jobs(sm, &hs.s, 3), false);
+    frame_out sm3_lean = render(&hs.s, sm, 64, 48, 0, backwards, NULL, 3, h_frame_jobs(sm, NULL, 3), false);
     CHECK(sm3.jobs == 3 && sm3_lean.jobs == 3);
     CHECK(sm3.hash == sm1.hash && sm3_lean.hash == sm1.hash);
     h_scene_free(&hs);
@@ -248,7 +248,7 @@ static void eye_halves(void)
     h_scene hs;
     if (!h_scene_parse(&hs, two_planes)) return;
     const om_method *m = om_method_find("none");
-    const size_t two_b = om_frame_bytes_jobs(m, &hs.s, 2), three_b = om_frame_bytes_jobs(m, &hs.s, 3);
+    const size_t two_b = h_frame_jobs(m, &hs.s, 2), three_b = h_frame_jobs(m, &hs.s, 3);
     frame_out one = render(&hs.s, m, 8, 6, 0, NULL, NULL, 1, 0, true);
     frame_out two = render(&hs.s, m, 8, 6, 0, backwards, NULL, 2, two_b, true);
     frame_out lean = render(&hs.s, m, 8, 6, 0, backwards, NULL, 2, two_b, false);
@@ -289,10 +289,10 @@ static void asm_frames(const om_scene *s, uint32_t rows, om_parallel_for_fn pf, 
     om_arena ma, fa;
     om_arena_init(&ma, mm, full, "method");
     CHECK_OK(om_method_init(m, &state, &ma, &c, s, W, H, &d));
-    /* om_frame_bytes_jobs is for the default settings; a larger tree's jobs need more */
+    /* om_frame_bytes' with_jobs is for the default settings; a larger tree's jobs need more */
     const bool big_tree = strstr(set, "asm.tile=4") != NULL;
     const size_t big = state && threads > 1 && big_tree ? threads * (m->pass->scratch(state, s) + 64) : 0;
-    const size_t fbytes = om_frame_bytes_scene(s, W, r) + om_frame_bytes_jobs(m, s, threads) + big;
+    const size_t fbytes = h_frame_bins(s, W, r) + h_frame_jobs(m, s, threads) + big;
     void *fm = malloc(fbytes);
     for (int f = 0; f < nframes && state; f++) {
         om_camera cam, cam0;
@@ -377,7 +377,7 @@ static frame_out pass_frame(const om_scene *s, const om_method *m, const char *s
     return render_on(s, m, set, 160, 120, rows, h->pool >= 0 ? om_jobs_for : backwards,
                      h->pool >= 0 ? (void *)pools[h->pool] : (void *)calls,
                      !h->worker ? NULL : h->pool >= 0 ? om_jobs_worker : rotating, n,
-                     om_frame_bytes_jobs(m, h->lean ? NULL : s, n), true);
+                     h_frame_jobs(m, h->lean ? NULL : s, n), true);
 }
 
 /* ---- hybrid: its bands look the map up and mark the samples they leave uncertain;
@@ -452,7 +452,7 @@ static void hybrid_regions(void)
                 render_on(&hs.s, m, "", 480, 360, 0, h->pool >= 0 ? om_jobs_for : backwards,
                           h->pool >= 0 ? (void *)pools[h->pool] : (void *)&calls,
                           !h->worker ? NULL : h->pool >= 0 ? om_jobs_worker : rotating, n,
-                          om_frame_bytes_jobs(m, h->lean ? NULL : &hs.s, n), true);
+                          h_frame_jobs(m, h->lean ? NULL : &hs.s, n), true);
             CHECK_MSG(o.st == OM_OK && o.hash == one.hash &&
                           !memcmp(o.ms.counters, one.ms.counters, sizeof o.ms.counters),
                       "hybrid regions: %u threads%s change the frame", n, h->what);
@@ -538,7 +538,7 @@ static void settings_by_bands(void)
             for (uint32_t n = 2; n <= 5; n += 3)
                 for (int lean = 0; lean < (rows ? 1 : 2); lean++) {   /* strips' bins come first */
                     frame_out o = render_set(&hs.s, m, sets[i][1], 96, 72, rows, backwards, NULL, n,
-                                             om_frame_bytes_jobs(m, lean ? NULL : &hs.s, n), !lean);
+                                             h_frame_jobs(m, lean ? NULL : &hs.s, n), !lean);
                     CHECK_MSG(o.st == OM_OK && o.jobs == n, "%s %s strips %u%s: %u jobs ran %u", om_method_name(m), sets[i][1], rows, lean ? " lean" : "", n, o.jobs);
                     CHECK_MSG(o.hash == one.hash, "%s %s strips %u: %u bands%s change the frame", om_method_name(m),
                               sets[i][1], rows, n, lean ? " without bins" : "");
@@ -552,7 +552,7 @@ static void settings_by_bands(void)
 
 /* A frame through strips that passes over the image more than once (asm and rtw
  * observe; a directional light is fitted) keeps its first pass's triangle ids where the
- * arena has om_frame_bytes_ids beyond the rest, and its later passes resolve from them:
+ * arena has om_frame_bytes' with_ids beyond the rest, and its later passes resolve from them:
  * the same frames and counters as without the room, inline and with jobs; a frame that
  * passes once (sm under the spot light) carves none. */
 static void kept_ids(void)
@@ -561,14 +561,14 @@ static void kept_ids(void)
     for (int li = 0; li < 2; li++) {
         h_scene hs;
         if (!h_scene_parse(&hs, li ? directional : om_scene_default_text())) continue;
-        const size_t ids = om_frame_bytes_ids(&hs.s, 120, 90);
+        const size_t ids = h_frame_ids(&hs.s, 120, 90);
         CHECK(ids >= 120 * 90 * 2);
         for (int mi = 0; mi < 3; mi++) {
             const om_method *m = om_method_find(names[mi]);
             const bool twice = li || mi < 2;
             for (uint32_t rows = 8; rows <= 40; rows += 32)
                 for (uint32_t n = 1; n <= 3; n += 2) {
-                    const size_t jb = om_frame_bytes_jobs(m, &hs.s, n);
+                    const size_t jb = h_frame_jobs(m, &hs.s, n);
                     om_parallel_for_fn pf = n > 1 ? backwards : NULL;
                     frame_out a = render(&hs.s, m, 120, 90, rows, pf, NULL, n, jb, true);
                     frame_out b = render(&hs.s, m, 120, 90, rows, pf, NULL, n, jb + ids, true);

@@ -106,7 +106,7 @@ static double median(double *v, int n)
 om_status cli_measure(const om_method *m, const om_method_cfg *cfg, const cli_scene *cs,
                       const om_view *v, int runs, uint8_t *mask, uint8_t *rgb, cli_point *p, om_diag *d)
 {
-    return cli_measure_strips(m, cfg, cs, v, runs, 0, om_frame_bytes(v->cam.width, v->cam.height), mask,
+    return cli_measure_strips(m, cfg, cs, v, runs, 0, cli_frame_rows(NULL, v->cam.width, v->cam.height, false), mask,
                               rgb, p, d);
 }
 
@@ -134,8 +134,9 @@ om_status cli_measure_strips(const om_method *m, const om_method_cfg *cfg, const
     if (st) return st;
     /* threads: each job's scratch, and the bins the bands of a whole frame use */
     if (cli_threads() > 1) {
-        fbytes += om_frame_bytes_jobs(m, &cs->scene, cli_threads());
-        if (!rows || rows >= H) fbytes += om_frame_bytes_scene(&cs->scene, W, H) - om_frame_bytes(W, H);
+        const om_frame_need need = cli_frame_need(m, NULL, &cs->scene, v, rows, true);
+        fbytes += need.with_jobs - need.with_bins;
+        if (!rows || rows >= H) fbytes += need.with_bins - need.least;
     }
     void *mem = malloc(full ? full : 1), *fmem = malloc(fbytes), *px = malloc((size_t)W * H * 3);
     if (!mem || !fmem || !px) {

@@ -351,3 +351,31 @@ void cli_frame_jobs(om_frame_desc *fd)
     fd->threads = om_jobs_threads(pool);
     fd->worker = pool ? om_jobs_worker : NULL;
 }
+
+om_frame_need cli_frame_need(const om_method *m, const void *state, const om_scene *s, const om_view *v,
+                             uint32_t rows, bool jobs)
+{
+    om_frame_desc fd;
+    om_frame_need need;
+    memset(&fd, 0, sizeof fd);
+    memset(&need, 0, sizeof need);
+    fd.scene = s;
+    fd.view = v;
+    fd.method = m;
+    fd.method_state = (void *)(uintptr_t)state;   /* the query only reads it */
+    fd.strip_rows = rows;
+    if (jobs) cli_frame_jobs(&fd);
+    om_frame_bytes(&fd, &need);
+    return need;
+}
+
+size_t cli_frame_rows(const om_scene *s, uint32_t width, uint32_t rows, bool bins)
+{
+    om_view v;
+    memset(&v, 0, sizeof v);
+    v.cam.width = width;
+    v.cam.height = rows;
+    v.light.kind = OM_LIGHT_SPOT;
+    const om_frame_need need = cli_frame_need(NULL, NULL, s, &v, rows, false);
+    return bins ? need.with_bins : need.least;
+}

@@ -68,6 +68,14 @@ void cli_threads_stop(void);
 uint32_t cli_threads(void);
 /* Hands the pool to a frame: its parallel-for and thread count. */
 void cli_frame_jobs(om_frame_desc *fd);
+/* The frame size query (om_frame_bytes) for method m (m and its state may be NULL) on
+ * scene s (may be NULL) seen by v, through strips of `rows` rows (0: whole), with the
+ * pool's jobs when `jobs`. */
+om_frame_need cli_frame_need(const om_method *m, const void *state, const om_scene *s, const om_view *v,
+                             uint32_t rows, bool jobs);
+/* Its least (with_bins, when bins) for a width-pixel image through strips of `rows`
+ * rows, without jobs. */
+size_t cli_frame_rows(const om_scene *s, uint32_t width, uint32_t rows, bool bins);
 
 int cmd_render(int argc, char **argv);
 int cmd_info(int argc, char **argv);
@@ -101,7 +109,7 @@ om_status cli_measure(const om_method *m, const om_method_cfg *cfg, const cli_sc
                       const om_view *v, int runs, uint8_t *mask, uint8_t *rgb, cli_point *p,
                       om_diag *d);
 /* The same through strips of `rows` rows (0: the whole frame at once) in a frame arena
- * of fbytes (om_frame_bytes_scene's, or more, lets the strips use row bins). */
+ * of fbytes (om_frame_bytes' with_bins, or more, lets the strips use row bins). */
 om_status cli_measure_strips(const om_method *m, const om_method_cfg *cfg, const cli_scene *cs,
                              const om_view *v, int runs, uint32_t rows, size_t fbytes, uint8_t *mask,
                              uint8_t *rgb, cli_point *p, om_diag *d);

@@ -84,19 +84,13 @@ static om_status run_frame(run *r, const cli_scene *cs, const om_view *v, uint32
                            om_diag *d)
 {
     uint32_t W = v->cam.width;
-    *frame_bytes = bins ? om_frame_bytes_scene(&cs->scene, W, rows) : om_frame_bytes(W, rows);
-    /* Threads: each job's scratch, and bins for the bands of a whole frame (under a
-     * --budget there is no room kept for them: the frame runs with what fits). */
-    if (jobs) {
-        *frame_bytes += om_frame_bytes_jobs(r->m, &cs->scene, cli_threads());
-        if (rows == v->cam.height) *frame_bytes = om_frame_bytes_scene(&cs->scene, W, rows) +
-                                                 om_frame_bytes_jobs(r->m, &cs->scene, cli_threads());
-    }
-    /* Strips of a frame that passes over the image more than once: room to keep the
-     * first pass's triangle ids, so the scene is rasterized once (om_frame_bytes_ids) */
-    if (jobs && rows < v->cam.height &&
-        ((om_method_flags(r->m) & OM_METHOD_OBSERVES) || v->light.kind == OM_LIGHT_DIRECTIONAL))
-        *frame_bytes += om_frame_bytes_ids(&cs->scene, W, v->cam.height);
+    const om_frame_need need = cli_frame_need(r->m, r->state, &cs->scene, v, rows, jobs);
+    *frame_bytes = bins ? need.with_bins : need.least;
+    /* Threads: each job's scratch, the bins for the bands of a whole frame, and for
+     * strips of a frame that passes over the image more than once the first pass's
+     * triangle ids, so the scene is rasterized once (under a --budget there is no
+     * room kept for them: the frame runs with what fits). */
+    if (jobs && (bins || rows == v->cam.height)) *frame_bytes = need.whole;
     void *frame_mem = malloc(*frame_bytes);
     om_framebuffer fb;
     fb.format = fmt;
@@ -274,9 +268,10 @@ int cmd_render(int argc, char **argv)
     if (budget) {
         /* a row of the frame: its arena's share and the framebuffer's pixels */
         size_t px = (size_t)W * om_format_bpp(fmt);
-        size_t one = om_frame_bytes(W, 1) + px, row_bytes = om_frame_bytes(W, 2) - om_frame_bytes(W, 1) + px;
+        size_t one = cli_frame_rows(NULL, W, 1, false) + px;
+        size_t row_bytes = cli_frame_rows(NULL, W, 2, false) - cli_frame_rows(NULL, W, 1, false) + px;
         size_t rest = budget > cs.bytes ? budget - cs.bytes : 0;
-        if (rest < main_run.full + om_frame_bytes(W, rows)) {
+        if (rest < main_run.full + cli_frame_rows(NULL, W, rows, false)) {
             size_t spare = rest > main_run.min + one ? rest - main_run.min - one : 0;
             main_run.given = main_run.min + spare / 2;
             if (main_run.given > main_run.full) main_run.given = main_run.full;
@@ -295,7 +290,7 @@ int cmd_render(int argc, char **argv)
             goto out;
         }
         if (fit < rows) rows = (uint32_t)fit;
-        bins = rows < H && left >= om_frame_bytes_scene(&cs.scene, W, rows) + (size_t)rows * px;
+        bins = rows < H && left >= cli_frame_rows(&cs.scene, W, rows, true) + (size_t)rows * px;
     }
     /* The outputs open (as temporaries) before any work, so an unwritable one fails
      * at once; they replace the old files only once all are complete. */
@@ -428,7 +423,7 @@ int cmd_info(int argc, char **argv)
            s->hi.z);
     printf("light: %s\n", s->light.kind == OM_LIGHT_SPOT ? "spot" : "directional");
     printf("bytes at %ux%u: scene %zu, frame %zu (whole) / %zu (one row)\n", W, H, cs.bytes,
-           om_frame_bytes(W, H), om_frame_bytes(W, 1));
+           cli_frame_rows(NULL, W, H, false), cli_frame_rows(NULL, W, 1, false));
     for (size_t i = 0; i < om_method_count(); i++) {
         const om_method *m = om_method_at(i);
         size_t mn, full;

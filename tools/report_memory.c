@@ -75,18 +75,18 @@ static bool fit(const om_method *m, const char *setting, const cli_scene *cs, ui
     if (!configure(m, setting, &cfg) || om_method_bytes(m, &cfg, &cs->scene, W, H, &mn, &full) != OM_OK) return false;
     uint32_t lo = W <= 160 ? 1 : H < MIN_ROWS ? H : MIN_ROWS;
     size_t base = cs->bytes + full;
-    *need = base + om_frame_bytes(W, lo);
+    *need = base + cli_frame_rows(NULL, W, lo, false);
     if (*need > budget) return false;
     snprintf(c->setting, sizeof c->setting, "%s", setting);
     c->method = full;
     c->rows = lo;
     for (uint32_t r = H; r >= lo; r = r > lo && r / 2 < lo ? lo : r / 2) {
-        size_t with_bins = om_frame_bytes_scene(&cs->scene, W, r), plain = om_frame_bytes(W, r);
+        size_t with_bins = cli_frame_rows(&cs->scene, W, r, true), plain = cli_frame_rows(NULL, W, r, false);
         if (base + with_bins <= budget) { c->rows = r; c->fbytes = with_bins; break; }
         if (base + plain <= budget) { c->rows = r; c->fbytes = plain; break; }
         if (r == lo) break;
     }
-    if (!c->fbytes) c->fbytes = om_frame_bytes(W, lo);
+    if (!c->fbytes) c->fbytes = cli_frame_rows(NULL, W, lo, false);
     c->total = base + c->fbytes;
     return true;
 }

@@ -80,7 +80,7 @@ static void cell(FILE *f, const char *method, const double *v, int n, int flick)
 static om_status path(const om_scene *s, const om_method *m, const om_method_cfg *cfg, int frames,
                       int last, uint8_t *prev, uint8_t *cur, uint8_t *rgb, om_diag *d)
 {
-    size_t mn, full, fbytes = om_frame_bytes(SW, SH);
+    size_t mn, full, fbytes = cli_frame_rows(NULL, SW, SH, false);
     om_status st = om_method_bytes(m, cfg, s, SW, SH, &mn, &full);
     if (st) return st;
     void *mem = malloc(full ? full : 1), *fmem = malloc(fbytes), *px = malloc((size_t)SW * SH * 3);

@@ -43,7 +43,7 @@ typedef struct om__bands {
  * the frame arena: for work that does not split by rows (izb's tiles of exposed
  * samples, each with its own pool and BSP). The contract:
  * - scratch(state, s): bytes one job needs (aligned to 16 by the frame). With state
- *   NULL (om_frame_bytes_jobs, before there is a state) a bound for the method's
+ *   NULL (om_frame_bytes' with_jobs, before there is a state) a bound for the method's
  *   default settings from the scene alone, 0 when s is NULL; with the state, the
  *   exact bytes, at most that bound under the default settings.
  * - Per strip, after the bands' resolve and merge (when the method has bands) and

@@ -61,6 +61,9 @@ typedef struct bsetup {
 /* Non-zero where it cannot (after bench_teardown of what it made). */
 int bench_setup(bsetup *t, const bscene *b, const char *name, uint32_t W, uint32_t H, uint32_t threads);
 void bench_teardown(bsetup *t);
+/* The frame arena for a whole W x H frame of method m (may be NULL) on scene s (may
+ * be NULL: no bins) with `threads` jobs: om_frame_bytes' with_jobs. */
+size_t bench_frame_bytes(const om_method *m, const om_scene *s, uint32_t W, uint32_t H, uint32_t threads);
 /* A frame of t on one thread: *fd filled but for the parallel-for, and *fa over t's
  * frame arena. */
 void bench_frame_desc(bsetup *t, const bscene *b, om_frame_desc *fd, om_arena *fa);

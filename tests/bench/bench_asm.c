@@ -55,14 +55,14 @@ static int bframe(brun *r, const bscene *b, const om_camera *cam, const om_light
     static void *fmem, *px;
     const uint32_t W = cam->width, H = cam->height;
     if (!fmem) {
-        fmem = malloc(om_frame_bytes(1024, 768));
+        fmem = malloc(bench_frame_bytes(NULL, NULL, 1024, 768, 1));
         px = malloc((size_t)1024 * 768 * 3);
     }
     om_view v;
     om_diag d;
     if (om_view_init(&v, cam, light, &b->s, &d)) return 1;
     om_arena fa;
-    om_arena_init(&fa, fmem, om_frame_bytes(W, H), "frame");
+    om_arena_init(&fa, fmem, bench_frame_bytes(NULL, NULL, W, H, 1), "frame");
     om_framebuffer fb = {OM_RGB888, W, H, (size_t)W * 3, (uint8_t *)px};
     om_shade_cfg shade;
     om_shade_cfg_default(&shade);

@@ -99,6 +99,30 @@ int bench_view(const bscene *b, uint32_t W, uint32_t H, float t, om_view *v)
     return om_view_init(v, &cam, &light, &b->s, &d) != OM_OK;
 }
 
+static void inline_for(void *host, om_job_fn fn, void *job_user, uint32_t n)
+{
+    (void)host;
+    for (uint32_t i = 0; i < n; i++) fn(job_user, i);
+}
+
+size_t bench_frame_bytes(const om_method *m, const om_scene *s, uint32_t W, uint32_t H, uint32_t threads)
+{
+    om_view v;
+    om_frame_desc fd;
+    om_frame_need need;
+    memset(&v, 0, sizeof v);
+    memset(&fd, 0, sizeof fd);
+    v.cam.width = W;
+    v.cam.height = H;
+    v.light.kind = OM_LIGHT_SPOT;
+    fd.view = &v;
+    fd.scene = s;
+    fd.method = m;
+    fd.threads = threads;
+    fd.parallel_for = threads > 1 ? inline_for : NULL;
+    return om_frame_bytes(&fd, &need) == OM_OK ? need.with_jobs : 0;
+}
+
 int bench_setup(bsetup *t, const bscene *b, const char *name, uint32_t W, uint32_t H, uint32_t threads)
 {
     memset(t, 0, sizeof *t);
@@ -109,7 +133,7 @@ int bench_setup(bsetup *t, const bscene *b, const char *name, uint32_t W, uint32
     if (!t->m) return 1;
     om_method_cfg_default(&c, t->m);
     if (bench_view(b, W, H, 0, &t->v) || om_method_bytes(t->m, &c, &b->s, W, H, &mn, &full)) return 1;
-    t->fbytes = om_frame_bytes_scene(&b->s, W, H) + om_frame_bytes_jobs(t->m, &b->s, threads);
+    t->fbytes = bench_frame_bytes(t->m, &b->s, W, H, threads);
     t->mem = malloc(full);
     t->fmem = malloc(t->fbytes);
     uint8_t *px = malloc((size_t)W * H * 3);
@@ -164,15 +188,15 @@ int bench_run_hooked(const bscene *b, const char *name, const om_method_cfg *cfg
         fprintf(stderr, "bench: cannot set up %s\n", name);
         return 1;
     }
-    void *mem = malloc(full), *fmem = malloc(om_frame_bytes(W, H)), *px = malloc((size_t)W * H * 3);
+    void *mem = malloc(full), *fmem = malloc(bench_frame_bytes(NULL, NULL, W, H, 1)), *px = malloc((size_t)W * H * 3);
     /* A host that renders frame after frame has its arenas resident: touch every page
      * now, so that the first-touch faults of a fresh malloc (hundreds of ms for a large
      * map) are not charged to the method that happens to write them first. */
     if (mem) memset(mem, 0, full);
-    if (fmem) memset(fmem, 0, om_frame_bytes(W, H));
+    if (fmem) memset(fmem, 0, bench_frame_bytes(NULL, NULL, W, H, 1));
     om_arena ma, fa;
     om_arena_init(&ma, mem, full, "method");
-    om_arena_init(&fa, fmem, om_frame_bytes(W, H), "frame");
+    om_arena_init(&fa, fmem, bench_frame_bytes(NULL, NULL, W, H, 1), "frame");
     void *state;
     uint64_t t0 = om_clock_ns(NULL);
     om_status st = om_method_init(m, &state, &ma, &c, &b->s, W, H, &d);

@@ -179,8 +179,7 @@ static void method_cfg(om_method_cfg *c, const om_method *m, const size_cfg *sz,
  * point and the sum of all these: the whole footprint). asm is counted on its second
  * frame, when its tiles are cached, as a frame of a running application would be.
  *
- * On the small scene the whole footprint must stay within WHOLE (256 KiB, issue
- * #29's target): the frame arena gets what om_frame_bytes_scene asks, and the method
+ * On the small scene the whole footprint must stay within WHOLE (256 KiB): the frame arena gets what om_frame_bytes calls with_bins, and the method
  * what its bytes query calls full where that fits the rest, else the rest (it
  * then works in smaller pieces); a method whose minimum does not fit prints "too big",
  * one whose footprint ends over prints "over its whole budget", and both fail the run. The default
@@ -265,7 +264,12 @@ static void count_scene(const char *tag, const char *text, int whole, int *bad)
     cam.width = sz.w;
     cam.height = sz.h;
     if (om_view_init(&v, &cam, &light, &s, &d) != OM_OK) { *bad |= fail(tag, "-", "view", &d); return; }
-    const size_t frame_need = om_frame_bytes_scene(&s, sz.w, sz.rows), stat = static_bytes();
+    om_frame_desc q;   /* the frame size query: the strips with their bins, and the ids */
+    om_frame_need need;
+    memset(&q, 0, sizeof q);
+    q.scene = &s; q.view = &v; q.strip_rows = sz.rows;
+    if (om_frame_bytes(&q, &need) != OM_OK) { *bad |= fail(tag, "-", "frame bytes", &d); return; }
+    const size_t frame_need = need.with_bins, ids = need.with_ids - need.with_jobs, stat = static_bytes();
     /* what a method may take: all that is left of WHOLE, or (default scene) 256 KiB */
     size_t room = sizeof method_mem;
     if (whole) {
@@ -305,8 +309,7 @@ static void count_scene(const char *tag, const char *text, int whole, int *bad)
          * frame also gets room to keep the first pass's triangle ids where that leaves
          * the method its full arena (the default scene's frame arena has room) */
         size_t fbytes = frame_need;
-        if (whole && (om_method_flags(m) & OM_METHOD_OBSERVES) && full + om_frame_bytes_ids(&s, sz.w, sz.h) <= room)
-            fbytes += om_frame_bytes_ids(&s, sz.w, sz.h);
+        if (whole && (om_method_flags(m) & OM_METHOD_OBSERVES) && full + ids <= room) fbytes += ids;
         for (int f = 0; f < (strcmp(om_method_name(m), "asm") ? 1 : 2); f++) {
             om_arena_init(&fa, frame_mem, whole ? fbytes : sizeof frame_mem, "frame");
             const uint64_t t0 = count_now(NULL);

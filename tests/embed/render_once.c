@@ -52,8 +52,8 @@ int render_once(void)
     memset(&fd, 0, sizeof fd);
     fd.scene = &scene; fd.view = &view; fd.method = m; fd.method_state = state;
     fd.shade = &shade; fd.strip_rows = 8; fd.fb = &fb; fd.on_strip = show;
-    /* at least om_frame_bytes(160, 8); om_frame_bytes_scene(&scene, 160, 8) lets each
-     * strip set up only the triangles that reach it */
+    /* om_frame_bytes(&fd, &need): at least need.least; need.with_bins lets each strip
+     * set up only the triangles that reach it */
     om_arena_init(&fa, frame_mem, sizeof frame_mem, "frame");
     return om_render_frame(&fd, &fa, NULL, &d) == OM_OK ? 0 : -1;
 }

@@ -1,6 +1,6 @@
 /* render_sized.c — the README's second embedding example, for a host with memory to
  * spare (a console, a desktop): every arena exactly as big as the engine's bytes
- * queries say, taken from malloc; the default scene at 640x480 in one RGB888 frame
+ * queries (om_method_bytes, om_frame_bytes) say, taken from malloc; the default scene at 640x480 in one RGB888 frame
  * with `sm`. `make check` builds it with the project's warning flags, runs it, and
  * checks that its frame is the one `ombra render` draws with the same settings;
  * tests/embed/readme.sh fails when the README's copy (between the markers) differs.
@@ -13,54 +13,46 @@
 
 static uint64_t hash = OM_HASH_INIT;
 
-static om_status keep(void *user, const om_strip *st, const om_framebuffer *fb)
-{
-    (void)user;   /* one strip: the whole frame, fb->pixels holds it */
-    hash = om_hash(hash, fb->pixels, (size_t)st->rows * fb->stride);
-    return OM_OK;
-}
-
 int render_sized(void)
 {
     enum { W = 640, H = 480 };
     const char *text = om_scene_default_text();
     const om_method *m = om_method_find("sm");
-    om_diag d;
     size_t scene_bytes, min, full;
+    om_arena sa, ma, fa;
     om_scene scene;
     om_camera cam;
     om_light light;
     om_view view;
     om_method_cfg cfg;
-    om_arena sa, ma, fa;
-    void *state;
+    om_shade_cfg shade;
+    om_frame_desc fd;
+    om_frame_need need;
+    om_diag d;
     int ok = -1;
     if (!m || om_scene_bytes(text, strlen(text), NULL, &scene_bytes, &d) != OM_OK) return -1;
-    void *scene_mem = malloc(scene_bytes);
+    void *scene_mem = malloc(scene_bytes), *method_mem = NULL, *frame_mem = NULL;
+    om_framebuffer fb = {OM_RGB888, W, H, W * 3, malloc((size_t)W * H * 3)};
     om_arena_init(&sa, scene_mem, scene_mem ? scene_bytes : 0, "scene");
-    if (om_scene_parse(text, strlen(text), NULL, &sa, &scene, &d) != OM_OK) { free(scene_mem); return -1; }
-    om_scene_at(&scene, 0.0f, &cam, &light);
-    cam.width = W;
-    cam.height = H;
-    om_method_cfg_default(&cfg, m);                 /* map 1024: 4 MiB */
-    if (om_view_init(&view, &cam, &light, &scene, &d) != OM_OK ||
-        om_method_bytes(m, &cfg, &scene, W, H, &min, &full) != OM_OK) { free(scene_mem); return -1; }
-    size_t frame_bytes = om_frame_bytes_scene(&scene, W, H);
-    void *method_mem = malloc(full), *frame_mem = malloc(frame_bytes);
-    uint8_t *pixels = malloc((size_t)W * H * 3);
-    om_arena_init(&ma, method_mem, method_mem ? full : 0, "method");
-    om_arena_init(&fa, frame_mem, frame_mem ? frame_bytes : 0, "frame");
-    if (pixels && om_method_init(m, &state, &ma, &cfg, &scene, W, H, &d) == OM_OK) {
-        om_shade_cfg shade;
-        om_shade_cfg_default(&shade);
-        om_framebuffer fb = {OM_RGB888, W, H, W * 3, pixels};
-        om_frame_desc fd;
-        memset(&fd, 0, sizeof fd);
-        fd.scene = &scene; fd.view = &view; fd.method = m; fd.method_state = state;
-        fd.shade = &shade; fd.strip_rows = H; fd.fb = &fb; fd.on_strip = keep;
-        ok = om_render_frame(&fd, &fa, NULL, &d) == OM_OK ? 0 : -1;
+    om_method_cfg_default(&cfg, m);                 /* map 2048: 16 MiB */
+    om_shade_cfg_default(&shade);
+    memset(&fd, 0, sizeof fd);
+    fd.scene = &scene; fd.view = &view; fd.method = m; fd.shade = &shade; fd.fb = &fb;
+    if (fb.pixels && om_scene_parse(text, strlen(text), NULL, &sa, &scene, &d) == OM_OK) {
+        om_scene_at(&scene, 0.0f, &cam, &light);
+        cam.width = W;
+        cam.height = H;
+        if (om_view_init(&view, &cam, &light, &scene, &d) == OM_OK && om_frame_bytes(&fd, &need) == OM_OK &&
+            om_method_bytes(m, &cfg, &scene, W, H, &min, &full) == OM_OK &&
+            (method_mem = malloc(full)) != NULL && (frame_mem = malloc(need.whole)) != NULL) {
+            om_arena_init(&ma, method_mem, full, "method");
+            om_arena_init(&fa, frame_mem, need.whole, "frame");
+            ok = om_method_init(m, &fd.method_state, &ma, &cfg, &scene, W, H, &d) == OM_OK &&
+                 om_render_frame(&fd, &fa, NULL, &d) == OM_OK ? 0 : -1;
+        }
     }
-    free(pixels);
+    if (ok == 0) hash = om_hash(hash, fb.pixels, (size_t)W * H * 3);   /* one strip: the whole frame */
+    free(fb.pixels);
     free(frame_mem);
     free(method_mem);
     free(scene_mem);

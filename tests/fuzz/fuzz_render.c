@@ -46,7 +46,13 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     om_view v;
     if (om_view_init(&v, &cam, &light, &s, &d) != OM_OK) goto out;
     uint32_t rows = 1 + (ctl & 3) * 3;
-    size_t fbytes = om_frame_bytes(cam.width, rows);
+    om_frame_desc q;   /* the frame arena: its least for strips of `rows` rows */
+    om_frame_need need;
+    memset(&q, 0, sizeof q);
+    q.view = &v;
+    q.strip_rows = rows;
+    if (om_frame_bytes(&q, &need) != OM_OK) abort();
+    size_t fbytes = need.least;
     for (size_t k = 0; k < om_method_count(); k++) {
         const om_method *m = om_method_at(k);
         om_method_cfg cfg;   /* small maps and structures, where m takes them */

@@ -79,12 +79,12 @@ static int path(const om_scene *s, const om_method *m, const om_method_cfg *cfg,
     size_t mn, full;
     om_diag d;
     if (om_method_bytes(m, cfg, s, W, H, &mn, &full) != OM_OK) return 1;
-    void *mem = malloc(full + 64), *fmem = malloc(om_frame_bytes(W, H));
+    void *mem = malloc(full + 64), *fmem = malloc(bench_frame_bytes(NULL, NULL, W, H, 1));
     static uint8_t px[W * H * 2];
     memset(mem, 0x3C, full + 64);
     om_arena ma, fa;
     om_arena_init(&ma, mem, full, "method");
-    om_arena_init(&fa, fmem, om_frame_bytes(W, H), "frame");
+    om_arena_init(&fa, fmem, bench_frame_bytes(NULL, NULL, W, H, 1), "frame");
     void *state;
     int bad = om_method_init(m, &state, &ma, cfg, s, W, H, &d) != OM_OK;
     float tend = end_time(s);

@@ -610,7 +610,7 @@ static om_status asm_resolve(void *state, om_strip *st, om_diag *d)
 }
 
 
-/* By bands on the host's threads (frame.h, om__bands): each band looks up its own
+/* By bands on the host's threads (method.h, om__bands): each band looks up its own
  * samples with a cache of its own and writes nothing of the state. The use stamps are
  * the one thing a lookup leaves in the tree: a band marks each sample whose lookup
  * descended with the leaf it found (1 + its index, 0xFFFF the base, in its term's green

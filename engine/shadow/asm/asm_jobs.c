@@ -1,5 +1,5 @@
 /* asm_jobs.c — Adaptive Shadow Maps on the host's threads: the tile renders, the view
- * analysis of observe and the scan behind resolve's use stamps as jobs (frame.h's
+ * analysis of observe and the scan behind resolve's use stamps as jobs (method.h's
  * om__lend, through asm's om__pass), with the tree the same bits as on one thread.
  * asm.c decides what is made and analysed; this file cuts the work into jobs, gives
  * each job its scratch and puts what the jobs found on the tree afterwards, on the

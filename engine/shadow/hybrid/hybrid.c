@@ -46,7 +46,7 @@
 
 /* Most uncertain samples a tile takes, whatever izb.pool says (tile_most): the tiles
  * are the jobs of the pass on the host's threads (om__pass, below), each with a
- * tile's memory of its own from the frame arena, which om_frame_bytes_jobs sizes from
+ * tile's memory of its own from the frame arena, which om_frame_bytes' with_jobs sizes from
  * the scene alone; and a strip's uncertain samples make several tiles to share out.
  * But every tile walks every triangle (or with candidates, hybrid_tile.c, finds them
  * among every triangle): twice the scene's triangles, at least TILE_LEAST and at

@@ -492,7 +492,7 @@ void om__izb_resolve(om__izb *z, om_strip *st)
     }
 }
 
-/* ---- the pass on the host's threads (frame.h, om__pass): one job a tile, each with a
+/* ---- the pass on the host's threads (method.h, om__pass): one job a tile, each with a
  * pool of the state's size in its scratch; the same tiles as om__izb_resolve, so the
  * same terms and counts whatever the number of jobs. */
 

@@ -428,7 +428,7 @@ static uint32_t render_exact(const om__rtw *m, om_raster *r, const om__bins *bin
         for (int k = 0; k < 3; k++)
             ok = ok && om__finite(c[k].x) && om__finite(c[k].y) && om__finite(c[k].z) && om__finite(c[k].w);
         if (!ok) continue;
-        if (!OM_WITH_JOBS) {   /* one band, the whole map: every fill counts (frame.h) */
+        if (!OM_WITH_JOBS) {   /* one band, the whole map: every fill counts (config.h) */
             drawn += (uint32_t)om__raster_tri_on_hiz(r, m->hiz, c, t, OM_LIGHT_GRID, OM_LIGHT_GRID);
             continue;
         }

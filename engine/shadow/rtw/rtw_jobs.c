@@ -1,5 +1,5 @@
 /* rtw_jobs.c — Rectilinear Texture Warping's backward analysis on the host's threads
- * (frame.h's om__lend, through rtw's om__pass), with the importance map the same bits
+ * (method.h's om__lend, through rtw's om__pass), with the importance map the same bits
  * as on one thread.
  *
  * The analysis keeps, per cell of the importance map, the largest importance of the

@@ -278,7 +278,7 @@ static void raster_scene(const om__spsm_state *m, om_raster *r, const om__bins *
 {
     const om_scene *s = m->scene;
     const uint32_t y0 = r->target->y0, y1 = r->target->y0 + r->target->rows - 1;
-    const uint32_t *rows = OM_WITH_JOBS && bins ? bins->rows : NULL;   /* (frame.h) */
+    const uint32_t *rows = OM_WITH_JOBS && bins ? bins->rows : NULL;   /* (config.h) */
     const om__vsnap *vs = OM_WITH_JOBS && bins && fine == 1 ? bins->verts : NULL;
     om__cull cl;
     om__cull_begin(&cl, s, &m->view.light_vp);

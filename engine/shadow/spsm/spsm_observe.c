@@ -1,6 +1,6 @@
 /* spsm_observe.c — the Sub-Pixel Shadow Map's observe (not in the paper; spsm.c says
  * why): each exposed sample marks the texel its lookup will centre on, and the build
- * makes records only around the marks. On the host's threads (frame.h's om__lend,
+ * makes records only around the marks. On the host's threads (method.h's om__lend,
  * through spsm's om__pass) a strip's samples go by bands of rows, each into its slot's
  * own marks (a slot's scratch, zeroed by the frame once a frame); set bits are the
  * same in any order and however split, and before the build reads them the slots'
