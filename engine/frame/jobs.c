@@ -64,25 +64,6 @@ size_t om__jobs_bytes(const om_method *m, const void *state, const om_scene *s, 
            map_bins_bytes(b, s);
 }
 
-/* Whether om__stage sg is an eye pass that rasterizes by bands (each sets up every
- * triangle that reaches its rows): it takes bands of band_rows; every other stage fine
- * bands. */
-static bool rasters(const om__frame *c, om__stage sg)
-{
-    return sg == OM__STAGE_EYE && c->j.eye && !c->j.half_depth && !(c->ids && c->ids_have);
-}
-
-static uint32_t stage_rows(const om__frame *c, om__stage sg)
-{
-    return rasters(c, sg) ? c->j.band_rows : c->j.fine_rows;
-}
-
-/* The number of om__stage sg's bands over the current strip. */
-static uint32_t stage_bands(const om__frame *c, om__stage sg)
-{
-    return (c->strip.rows + stage_rows(c, sg) - 1) / stage_rows(c, sg);
-}
-
 /* A pass slot's scratch, zeroed by the slot's first job (on its thread, not all on the
  * caller's: for izb it is megabytes a thread). */
 static void *slot_scratch(om__job_slot *sl)
@@ -94,108 +75,179 @@ static void *slot_scratch(om__job_slot *sl)
     return sl->scratch;
 }
 
-static void band_job(void *user, uint32_t b)
+/* The stages: each runs job b of one call of the host's parallel-for (run_stage). A
+ * job writes only its own band's rows, its own slot, or the parts its index names. */
+
+/* Slot b of the pass: jobs b, b + P, ... of the method's pass (om__pass) or of a
+ * stage it runs on the lent slots (om__lend.run). */
+static void stage_pass(om__frame *c, uint32_t b)
 {
-    const om__frame *c = (const om__frame *)user;
+    om__job_slot *sl = &c->j.pass_slots[b];
+    void *scratch = slot_scratch(sl);
+    for (uint32_t k = b; k < c->j.pass_jobs; k += c->j.pass_slots_now)
+        if (c->j.lend_fn) c->j.lend_fn(c->j.lend_user, k, scratch);
+        else c->j.pass->job(c->fd->method_state, &c->strip, k, scratch, sl->counts);
+}
+
+/* Job b of the pass on the slot of the thread that runs it (om_frame_desc.worker). */
+static void stage_pass_any(om__frame *c, uint32_t b)
+{
     const om_frame_desc *fd = c->fd;
-    if (c->j.stage == OM__STAGE_PASS || c->j.stage == OM__STAGE_LEND) {   /* slot b: jobs b, b + P, ... (om__pass) */
-        om__job_slot *sl = &c->j.pass_slots[b];
-        void *scratch = slot_scratch(sl);
-        for (uint32_t k = b; k < c->j.pass_jobs; k += c->j.pass_slots_now)
-            if (c->j.stage == OM__STAGE_PASS) c->j.pass->job(fd->method_state, &c->strip, k, scratch, sl->counts);
-            else c->j.lend_fn(c->j.lend_user, k, scratch);   /* a method's own stage (om__lend) */
-        return;
+    om__job_slot *sl = &c->j.pass_slots[fd->worker(fd->parallel_user) % c->j.pass_max];   /* in bounds whatever the host says */
+    c->j.pass->job(fd->method_state, &c->strip, b, slot_scratch(sl), sl->counts);
+}
+
+/* A method's own job b, without scratch (om__lend.run_any). */
+static void stage_lend_any(om__frame *c, uint32_t b)
+{
+    c->j.lend_fn(c->j.lend_user, b, NULL);
+}
+
+/* Items [first, end) of BANDS_PER_JOB * jobs parts of n. */
+static uint32_t part_at(const om__frame *c, uint32_t n, uint32_t b)
+{
+    return (uint32_t)((uint64_t)n * b / (BANDS_PER_JOB * c->jobs));
+}
+
+/* Part b of the pass's per-frame items (om__pass.setup). */
+static void stage_pass_setup(om__frame *c, uint32_t b)
+{
+    const uint32_t n = c->j.setup_items;
+    c->j.pass->setup(c->fd->method_state, part_at(c, n, b), part_at(c, n, b + 1));
+}
+
+/* Part b of the bins' vertices, then (once they are all made) of the triangles' rows. */
+static void stage_bin_verts(om__frame *c, uint32_t b)
+{
+    const uint32_t n = c->fd->scene->nverts;
+    om__bins_make_verts(c->fd->scene, c->j.mk_vp, c->j.mk_w, c->j.mk_h, c->j.mk, part_at(c, n, b),
+                        part_at(c, n, b + 1));
+}
+
+static void stage_bin_rows(om__frame *c, uint32_t b)
+{
+    const uint32_t n = c->fd->scene->ntris;
+    om__bins_make_rows(c->fd->scene, c->j.mk_vp, c->j.mk_w, c->j.mk_h, c->j.mk, part_at(c, n, b),
+                       part_at(c, n, b + 1));
+}
+
+/* Part b of the triangles over the whole strip: the halves, half b into target b;
+ * else into its thread's target, cleared by the first part the thread runs (only that
+ * thread touches it). */
+static void stage_eye_half(om__frame *c, uint32_t b)
+{
+    const om_frame_desc *fd = c->fd;
+    const uint32_t n = fd->scene->ntris, k = c->j.eye_parts;
+    const uint32_t w = k == 2 ? b : fd->worker(fd->parallel_user) % 2;
+    om_target tg = c->tg;
+    if (w == 1) {
+        tg.depth = c->j.half_depth;
+        tg.id = c->j.half_id;
     }
-    if (c->j.stage == OM__STAGE_PASS_ANY) {   /* pass job b, on the slot of the thread that runs it */
-        om__job_slot *sl = &c->j.pass_slots[fd->worker(fd->parallel_user) % c->j.pass_max];   /* in bounds whatever the host says */
-        c->j.pass->job(fd->method_state, &c->strip, b, slot_scratch(sl), sl->counts);
-        return;
+    if (!c->j.part_drawn[w]) {
+        om__target_clear(&tg);
+        c->j.part_drawn[w] = true;
     }
-    if (c->j.stage == OM__STAGE_LEND_ANY) {   /* a method's own job b, without scratch (om__lend.run_any) */
-        c->j.lend_fn(c->j.lend_user, b, NULL);
-        return;
-    }
-    if (c->j.stage == OM__STAGE_PASS_SETUP) {   /* part b of BANDS_PER_JOB * jobs */
-        const uint32_t parts = BANDS_PER_JOB * c->jobs, n = c->j.setup_items;
-        c->j.pass->setup(fd->method_state, (uint32_t)((uint64_t)n * b / parts),
-                       (uint32_t)((uint64_t)n * (b + 1) / parts));
-        return;
-    }
-    if (c->j.stage == OM__STAGE_BIN_VERTS || c->j.stage == OM__STAGE_BIN_ROWS) {
-        const uint32_t parts = BANDS_PER_JOB * c->jobs;
-        const uint32_t n = c->j.stage == OM__STAGE_BIN_VERTS ? fd->scene->nverts : fd->scene->ntris;
-        const uint32_t a = (uint32_t)((uint64_t)n * b / parts), e = (uint32_t)((uint64_t)n * (b + 1) / parts);
-        if (c->j.stage == OM__STAGE_BIN_VERTS) om__bins_make_verts(fd->scene, c->j.mk_vp, c->j.mk_w, c->j.mk_h, c->j.mk, a, e);
-        else om__bins_make_rows(fd->scene, c->j.mk_vp, c->j.mk_w, c->j.mk_h, c->j.mk, a, e);
-        return;
-    }
-    if (c->j.stage == OM__STAGE_EYE_HALF) {   /* part b of the triangles, over the whole strip */
-        const uint32_t n = fd->scene->ntris, k = c->j.eye_parts;
-        /* the halves: half b into target b; else its thread's target, cleared by
-         * the first part the thread runs (only that thread touches it) */
-        const uint32_t w = k == 2 ? b : fd->worker(fd->parallel_user) % 2;
-        om_target tg = c->tg;
-        if (w == 1) {
-            tg.depth = c->j.half_depth;
-            tg.id = c->j.half_id;
-        }
-        if (!c->j.part_drawn[w]) {
-            om__target_clear(&tg);
-            ((om__frame *)user)->j.part_drawn[w] = true;
-        }
-        om__eye_raster_part(fd->scene, c->view, &tg, (uint32_t)((uint64_t)n * b / k),
-                            (uint32_t)((uint64_t)n * (b + 1) / k));
-        return;
-    }
-    if (c->j.stage == OM__STAGE_BUILD) {
-        b = c->j.slots[b].run;   /* see order_bands */
-        uint32_t y0 = b * c->j.map_band, rows = c->j.map_size - y0;
-        c->j.bands->build_rows(fd->method_state, c->j.map_bins.rows ? &c->j.map_bins : NULL, y0,
-                             rows < c->j.map_band ? rows : c->j.map_band, c->j.slots[b].counts);
-        return;
-    }
-    const uint32_t band = stage_rows(c, c->j.stage), r0 = b * band;
-    size_t off = (size_t)r0 * c->strip.width;
+    om__eye_raster_part(fd->scene, c->view, &tg, (uint32_t)((uint64_t)n * b / k),
+                        (uint32_t)((uint64_t)n * (b + 1) / k));
+}
+
+/* Band b of the light's map, in the order order_bands chose. */
+static void stage_build(om__frame *c, uint32_t b)
+{
+    b = c->j.slots[b].run;
+    const uint32_t y0 = b * c->j.map_band, rows = c->j.map_size - y0;
+    c->j.bands->build_rows(c->fd->method_state, c->j.map_bins.rows ? &c->j.map_bins : NULL, y0,
+                           rows < c->j.map_band ? rows : c->j.map_band, c->j.slots[b].counts);
+}
+
+/* Band b of the current strip (rows of c->j.rows_now): its strip, and its offset. */
+static om_strip band_of(const om__frame *c, uint32_t b, size_t *off)
+{
+    const uint32_t band = c->j.rows_now, r0 = b * band;
     om_strip st = c->strip;
+    *off = (size_t)r0 * c->strip.width;
     st.y0 += r0;
     st.rows = c->strip.rows - r0 < band ? c->strip.rows - r0 : band;
-    st.samples += off;
-    st.terms += off;
-    if (c->j.stage == OM__STAGE_EYE_MERGE) {   /* the second target's nearer pixels; a tie to the lower triangle */
-        const size_t n = (size_t)st.rows * st.width;
-        uint32_t *depth = c->tg.depth + off, *id = c->tg.id + off;
-        const uint32_t *hd = c->j.half_depth + off, *hi = c->j.half_id + off;
-        if (!c->j.part_drawn[1]) return;   /* every part in the first */
-        if (!c->j.part_drawn[0]) {         /* every part in the second */
-            memcpy(depth, hd, n * sizeof *depth);
-            memcpy(id, hi, n * sizeof *id);
-            return;
-        }
-        for (size_t i = 0; i < n; i++)
-            if (hd[i] < depth[i] || (hd[i] == depth[i] && hi[i] < id[i])) {
-                depth[i] = hd[i];
-                id[i] = hi[i];
-            }
-    } else if (c->j.stage == OM__STAGE_EYE) {
-        if (c->j.eye) {
-            om_target tg = c->tg;
-            tg.y0 = st.y0;
-            tg.rows = st.rows;
-            tg.depth += off;
-            tg.id += off;
-            if (c->j.half_depth) om__eye_resolve(fd->scene, c->view, &tg, &st, c->j.mark);   /* merged */
-            else om__frame_eye_rows(c, &tg, &st, c->j.mark);
-        } else if (c->j.mark) {
-            om__frame_mark(c->view, &st);
-        }
-    } else if (c->j.stage == OM__STAGE_RESOLVE) {
-        c->j.bands->resolve(fd->method_state, &st, c->j.slots[b].scratch, c->j.slots[b].counts);
-    } else {
-        om_framebuffer fb = *fd->fb;
-        fb.pixels += (size_t)r0 * fb.stride;
-        fb.rows = st.rows;
-        om__shade_strip(fd->scene, c->view, fd->shade, &st, &fb);
+    st.samples += *off;
+    st.terms += *off;
+    return st;
+}
+
+/* The second target's nearer pixels into the first; a tie to the lower triangle. */
+static void stage_eye_merge(om__frame *c, uint32_t b)
+{
+    size_t off;
+    const om_strip st = band_of(c, b, &off);
+    const size_t n = (size_t)st.rows * st.width;
+    uint32_t *depth = c->tg.depth + off, *id = c->tg.id + off;
+    const uint32_t *hd = c->j.half_depth + off, *hi = c->j.half_id + off;
+    if (!c->j.part_drawn[1]) return;   /* every part in the first */
+    if (!c->j.part_drawn[0]) {         /* every part in the second */
+        memcpy(depth, hd, n * sizeof *depth);
+        memcpy(id, hi, n * sizeof *id);
+        return;
     }
+    for (size_t i = 0; i < n; i++)
+        if (hd[i] < depth[i] || (hd[i] == depth[i] && hi[i] < id[i])) {
+            depth[i] = hd[i];
+            id[i] = hi[i];
+        }
+}
+
+/* The band's eye pass (from the merged halves: their samples alone) and marks. */
+static void stage_eye(om__frame *c, uint32_t b)
+{
+    size_t off;
+    om_strip st = band_of(c, b, &off);
+    if (c->j.eye) {
+        om_target tg = c->tg;
+        tg.y0 = st.y0;
+        tg.rows = st.rows;
+        tg.depth += off;
+        tg.id += off;
+        if (c->j.half_depth) om__eye_resolve(c->fd->scene, c->view, &tg, &st, c->j.mark);
+        else om__frame_eye_rows(c, &tg, &st, c->j.mark);
+    } else if (c->j.mark) {
+        om__frame_mark(c->view, &st);
+    }
+}
+
+static void stage_resolve(om__frame *c, uint32_t b)
+{
+    size_t off;
+    om_strip st = band_of(c, b, &off);
+    c->j.bands->resolve(c->fd->method_state, &st, c->j.slots[b].scratch, c->j.slots[b].counts);
+}
+
+static void stage_shade(om__frame *c, uint32_t b)
+{
+    size_t off;
+    const om_strip st = band_of(c, b, &off);
+    om_framebuffer fb = *c->fd->fb;
+    fb.pixels += (size_t)(st.y0 - c->strip.y0) * fb.stride;
+    fb.rows = st.rows;
+    om__shade_strip(c->fd->scene, c->view, c->fd->shade, &st, &fb);
+}
+
+static void band_job(void *user, uint32_t b)
+{
+    om__frame *c = (om__frame *)user;
+    c->j.stage(c, b);
+}
+
+/* Runs `stage` as `n` jobs of the host's parallel-for. */
+static void run_stage(om__frame *c, void (*stage)(om__frame *c, uint32_t b), uint32_t n)
+{
+    c->j.stage = stage;
+    c->fd->parallel_for(c->fd->parallel_user, band_job, c, n);
+}
+
+/* The same over the current strip's bands of `rows` rows. */
+static void run_bands(om__frame *c, void (*stage)(om__frame *c, uint32_t b), uint32_t rows)
+{
+    c->j.rows_now = rows;
+    run_stage(c, stage, (c->strip.rows + rows - 1) / rows);
 }
 
 /* A frame of one strip on two jobs splits its eye pass by triangles (see the top)
@@ -275,19 +327,6 @@ static void clear_counts(om__job_slot *sl, uint32_t n)
     for (uint32_t j = 0; j < n; j++) memset(sl[j].counts, 0, sizeof sl[j].counts);
 }
 
-/* Runs one stage over `nbands` bands on the host's threads. */
-static void run_stage(om__frame *c, om__stage sg, uint32_t nbands)
-{
-    c->j.stage = sg;
-    c->fd->parallel_for(c->fd->parallel_user, band_job, c, nbands);
-}
-
-/* The same over the current strip's bands. */
-static void run_bands(om__frame *c, om__stage sg)
-{
-    run_stage(c, sg, stage_bands(c, sg));
-}
-
 /* om__bins_make on the host's threads: the vertices, then the triangles' rows, each
  * cut into parts (the same bins however cut: om__bins_make_verts). */
 void om__jobs_make_bins(om__frame *c, const om_mat4 *vp, uint32_t w, uint32_t h, const om__bins *b)
@@ -300,8 +339,8 @@ void om__jobs_make_bins(om__frame *c, const om_mat4 *vp, uint32_t w, uint32_t h,
     c->j.mk_vp = vp;
     c->j.mk_w = w;
     c->j.mk_h = h;
-    run_stage(c, OM__STAGE_BIN_VERTS, BANDS_PER_JOB * c->jobs);
-    run_stage(c, OM__STAGE_BIN_ROWS, BANDS_PER_JOB * c->jobs);
+    run_stage(c, stage_bin_verts, BANDS_PER_JOB * c->jobs);
+    run_stage(c, stage_bin_rows, BANDS_PER_JOB * c->jobs);
 }
 
 /* The light depth pass by bands of the map (om__bands.build_rows): with bins,
@@ -318,7 +357,7 @@ static void build_map(om__frame *c)
     const uint32_t nb = (c->j.map_size + c->j.map_band - 1) / c->j.map_band;
     clear_counts(c->j.slots, nb);
     order_bands(c, c->j.map_bins.rows, c->j.map_band, nb);
-    run_stage(c, OM__STAGE_BUILD, nb);
+    run_stage(c, stage_build, nb);
     merge_counts(c->j.slots, nb, c->j.bands->merge, c->fd->method_state);
 }
 
@@ -339,8 +378,9 @@ static void run_pass(om__frame *c)
     c->j.pass_jobs = k;
     c->j.pass_slots_now = p;
     clear_counts(c->j.pass_slots, used);
-    if (any) run_stage(c, OM__STAGE_PASS_ANY, k);
-    else run_stage(c, OM__STAGE_PASS, p);
+    c->j.lend_fn = NULL;
+    if (any) run_stage(c, stage_pass_any, k);
+    else run_stage(c, stage_pass, p);
     merge_counts(c->j.pass_slots, used, c->j.pass->merge, state);
 }
 
@@ -351,7 +391,7 @@ om_status om__jobs_begin(om__frame *c, const om_view *v, om_diag *d)
     void *state = c->fd->method_state;
     if (!OM_WITH_JOBS || !c->j.pass || !c->j.pass->begin) return c->fd->method->begin(state, v, d);
     om_status st = c->j.pass->begin(state, v, &c->j.setup_items, d);
-    if (st == OM_OK && c->j.setup_items) run_stage(c, OM__STAGE_PASS_SETUP, BANDS_PER_JOB * c->jobs);
+    if (st == OM_OK && c->j.setup_items) run_stage(c, stage_pass_setup, BANDS_PER_JOB * c->jobs);
     return st;
 }
 
@@ -365,7 +405,7 @@ static void lend_run(const om__lend *l, void (*fn)(void *user, uint32_t k, void 
     c->j.lend_user = user;
     c->j.pass_jobs = n;
     c->j.pass_slots_now = n < c->j.pass_max ? n : c->j.pass_max;
-    run_stage(c, OM__STAGE_LEND, c->j.pass_slots_now);
+    run_stage(c, stage_pass, c->j.pass_slots_now);
 }
 
 static void table_fn(void *user, uint32_t k, void *scratch) { ((void **)user)[k] = scratch; }
@@ -424,7 +464,7 @@ static void lend_run_any(const om__lend *l, void (*fn)(void *user, uint32_t k, v
     if (n == 0) return;
     c->j.lend_fn = fn;
     c->j.lend_user = user;
-    run_stage(c, OM__STAGE_LEND_ANY, n);
+    run_stage(c, stage_lend_any, n);
 }
 
 /* Carves the jobs' slots: as many as the host asks for and the arena holds beyond
@@ -524,10 +564,13 @@ void om__jobs_eye(om__frame *c, bool eye, bool mark)
     c->j.mark = mark;
     if (eye && c->j.half_depth) {
         c->j.part_drawn[0] = c->j.part_drawn[1] = false;
-        run_stage(c, OM__STAGE_EYE_HALF, c->j.eye_parts);
-        run_bands(c, OM__STAGE_EYE_MERGE);
+        run_stage(c, stage_eye_half, c->j.eye_parts);
+        run_bands(c, stage_eye_merge, c->j.fine_rows);
     }
-    run_bands(c, OM__STAGE_EYE);
+    /* an eye pass that rasterizes takes bands of band_rows (each sets up every
+     * triangle that reaches its rows); one that resolves merged halves or kept ids,
+     * and the marks alone, fine bands */
+    run_bands(c, stage_eye, eye && !c->j.half_depth && !(c->ids && c->ids_have) ? c->j.band_rows : c->j.fine_rows);
 }
 
 bool om__jobs_build(om__frame *c)
@@ -544,7 +587,7 @@ bool om__jobs_resolve(om__frame *c)
     if (c->j.bands) {
         const uint32_t n = FINE_BANDS_PER_JOB * c->jobs;
         clear_counts(c->j.slots, n);
-        run_bands(c, OM__STAGE_RESOLVE);
+        run_bands(c, stage_resolve, c->j.fine_rows);
         merge_counts(c->j.slots, n, c->j.bands->merge, state);
     }
     if (c->j.pass) run_pass(c);
@@ -554,7 +597,7 @@ bool om__jobs_resolve(om__frame *c)
 
 void om__jobs_shade(om__frame *c)
 {
-    if (OM_WITH_JOBS) run_bands(c, OM__STAGE_SHADE);
+    if (OM_WITH_JOBS) run_bands(c, stage_shade, c->j.fine_rows);
 }
 
 size_t om__jobs_map_bins_bytes(const om_method *m, const om_scene *s)

@@ -16,12 +16,7 @@ typedef struct om__job_slot {
     uint32_t weight; /* order_bands' estimate of band k's work */
 } om__job_slot;
 
-/* What one call of the host's parallel-for runs (jobs.c). */
-typedef enum {
-    OM__STAGE_EYE, OM__STAGE_RESOLVE, OM__STAGE_SHADE, OM__STAGE_BUILD, OM__STAGE_PASS, OM__STAGE_PASS_ANY,
-    OM__STAGE_PASS_SETUP, OM__STAGE_LEND, OM__STAGE_LEND_ANY, OM__STAGE_BIN_VERTS, OM__STAGE_BIN_ROWS,
-    OM__STAGE_EYE_HALF, OM__STAGE_EYE_MERGE
-} om__stage;
+struct om__frame;
 
 /* The jobs' part of a frame: jobs.c alone reads and writes it. */
 typedef struct om__frame_jobs {
@@ -35,11 +30,13 @@ typedef struct om__frame_jobs {
     void (*lend_fn)(void *user, uint32_t k, void *scratch);   /* a lent stage's (om__lend) */
     void *lend_user;
     om__lend lend;
-    om__stage stage;           /* what the current parallel-for call runs */
-    bool eye, mark;            /* OM__STAGE_EYE: run the eye pass, mark exposure */
+    /* What the current call of the parallel-for runs: job b of it is stage(c, b). */
+    void (*stage)(struct om__frame *c, uint32_t b);
+    uint32_t rows_now;         /* a band stage's rows a band */
+    bool eye, mark;            /* the eye stage: run the eye pass, mark exposure */
     om__bins map_bins;         /* the light map's (rows NULL: none) */
-    uint32_t map_size, map_band;   /* OM__STAGE_BUILD: the map's side, rows per band */
-    const om__bins *mk;        /* OM__STAGE_BIN_*: the bins being made, through mk_vp */
+    uint32_t map_size, map_band;   /* the map build: the map's side, rows per band */
+    const om__bins *mk;        /* the bins being made, through mk_vp */
     const om_mat4 *mk_vp;
     uint32_t mk_w, mk_h;
     uint32_t *half_depth, *half_id;   /* one strip, two jobs: the second target, or NULL */
