@@ -42,7 +42,7 @@ all: $(O)/ombra
 # V=1 shows the full compiler lines.
 Q = $(if $(V),,@)
 
-$(O)/%.o: %.c $(wildcard include/*.h engine/*/*.h engine/*/*/*.h platform/*.h tools/*.h tests/*.h)
+$(O)/%.o: %.c $(wildcard include/*.h engine/*.h engine/*/*.h engine/*/*/*.h platform/*.h tools/*.h tests/*.h)
 	@mkdir -p $(dir $@)
 	@$(if $(V),,echo "  CC $(O)/$<")
 	$(Q)$(CC) $(CFLAGS_ALL) -c $< -o $@
@@ -202,13 +202,13 @@ VERSION := $(shell sed -n 's/^\#define OMBRA_VERSION_STRING "\(.*\)"/\1/p' inclu
 install: $(O)/libombra.a $(O)/ombra
 	install -d $(DESTDIR)$(PREFIX)/lib/pkgconfig $(DESTDIR)$(PREFIX)/include $(DESTDIR)$(PREFIX)/bin
 	install -m 644 $(O)/libombra.a $(DESTDIR)$(PREFIX)/lib/libombra.a
-	install -m 644 include/ombra.h $(DESTDIR)$(PREFIX)/include/ombra.h
+	install -m 644 include/ombra.h include/ombra_measure.h $(DESTDIR)$(PREFIX)/include/
 	install -m 755 $(O)/ombra $(DESTDIR)$(PREFIX)/bin/ombra
 	sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@VERSION@|$(VERSION)|' tools/ombra.pc.in \
 	  >$(DESTDIR)$(PREFIX)/lib/pkgconfig/ombra.pc
 
 uninstall:
-	rm -f $(DESTDIR)$(PREFIX)/lib/libombra.a $(DESTDIR)$(PREFIX)/include/ombra.h \
+	rm -f $(DESTDIR)$(PREFIX)/lib/libombra.a $(DESTDIR)$(PREFIX)/include/ombra.h $(DESTDIR)$(PREFIX)/include/ombra_measure.h \
 	  $(DESTDIR)$(PREFIX)/bin/ombra $(DESTDIR)$(PREFIX)/lib/pkgconfig/ombra.pc
 
 # Installs into a scratch directory, builds the embedding example against that copy

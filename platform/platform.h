@@ -6,6 +6,7 @@
 #define OM_PLATFORM_H
 
 #include "ombra.h"
+#include "ombra_measure.h"
 #include <stdio.h>
 
 /* The most bytes om_file_read takes from one file: past it the read stops with

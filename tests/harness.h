@@ -5,6 +5,7 @@
 #define OM_HARNESS_H
 
 #include "ombra.h"
+#include "ombra_measure.h"
 
 typedef struct h_scene {
     void *mem;

@@ -1,6 +1,7 @@
 /* test_core.c — arena (exhaustion, alignment, rewind, fault injection), pools,
  * deterministic trigonometry and the diagnostic formatter. */
 #include "test.h"
+#include "../engine/testing.h"
 #include "../engine/core/core.h"
 
 #include <math.h>
@@ -75,11 +76,17 @@ static void arena_fault_injection(void)
     om_arena a;
     void *p;
     om_arena_init(&a, buf, sizeof buf, "t");
-    a.fail_at = 2;
+    om__test_fail_carve(&a, 2);
     CHECK_OK(om_arena_alloc(&a, 8, 8, &p, NULL));
     CHECK(om_arena_alloc(&a, 8, 8, &p, NULL) == OM_E_BUDGET);
     CHECK_OK(om_arena_alloc(&a, 8, 8, &p, NULL));
     CHECK(om_arena_need(10, 8) >= 10 + 7);
+}
+
+/* The library says which release it is, as the header does. */
+static void version_matches_header(void)
+{
+    CHECK(strcmp(om_version(), OMBRA_VERSION_STRING) == 0);
 }
 
 static void pool_recycles(void)
@@ -137,6 +144,7 @@ void suite_core(void)
     RUN(arena_exhaustion);
     RUN(arena_rewind_peak);
     RUN(arena_fault_injection);
+    RUN(version_matches_header);
     RUN(pool_recycles);
     RUN(trig_matches_libm);
     RUN(formatter);

@@ -2,6 +2,7 @@
  * difference image and flicker. */
 #include "test.h"
 #include "ombra.h"
+#include "ombra_measure.h"
 
 static void counts_and_edge_band(void)
 {

@@ -4,6 +4,7 @@
  * views (empty scene, camera inside a mesh, everything behind the near plane, images
  * of 0x0, 1x1 and 8192x8192) give a status and a message or a correct frame. */
 #include "test.h"
+#include "../engine/testing.h"
 #include "harness.h"
 
 #include <math.h>
@@ -88,8 +89,8 @@ static void failure_injection(void)
         for (uint32_t n = 1; n <= method_carves + frame_carves; n++) {
             om_arena_init(&ma, mem, full, "method");
             om_arena_init(&fa, fmem, sizeof fmem, "frame");
-            if (n <= method_carves) ma.fail_at = n;
-            else fa.fail_at = n - method_carves;
+            if (n <= method_carves) om__test_fail_carve(&ma, n);
+            else om__test_fail_carve(&fa, n - method_carves);
             om_status st = om_method_init(f.m, &state, &ma, &f.cfg, &hs.s, W, H, NULL);
             if (st != OM_OK) {
                 if (st != OM_E_BUDGET) bad++;
@@ -113,7 +114,7 @@ static void failure_injection(void)
         om_arena a;
         om_scene s;
         om_arena_init(&a, smem, bytes, "scene");
-        a.fail_at = n;
+        om__test_fail_carve(&a, n);
         om_status st = om_scene_parse(small_scene, strlen(small_scene), NULL, &a, &s, NULL);
         CHECK(st == OM_OK || st == OM_E_BUDGET);
     }

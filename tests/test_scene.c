@@ -3,6 +3,7 @@
  * right status, line and column, om_scene_at and the default scene. OBJ meshes are in
  * test_obj.c, random mutations in test_scene_fuzz.c, shared helpers in scene_util.c. */
 #include "test.h"
+#include "../engine/testing.h"
 #include "scene_util.h"
 
 #include <math.h>
@@ -427,7 +428,7 @@ static void bytes_exact(void)
         om_arena a;
         om_scene s;
         om_arena_init(&a, buf, sizeof buf, "scene");
-        a.fail_at = k;
+        om__test_fail_carve(&a, k);
         om_status st = om_scene_parse(six, strlen(six), NULL, &a, &s, NULL);
         CHECK(st == (k <= 6 ? OM_E_BUDGET : OM_OK));
         if (k <= 6) CHECK_EQ_U(a.used, 0);

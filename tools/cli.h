@@ -5,6 +5,7 @@
 #define OM_CLI_H
 
 #include "ombra.h"
+#include "ombra_measure.h"
 #include "../platform/platform.h"
 
 #include <stdio.h>

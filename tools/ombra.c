@@ -113,7 +113,7 @@ int main(int argc, char **argv)
         return argc < 2 ? 2 : 0;
     }
     if (!strcmp(argv[1], "--version") || !strcmp(argv[1], "-V")) {
-        printf("ombra %s\n", OMBRA_VERSION_STRING);
+        printf("ombra %s\n", om_version());
         return 0;
     }
     if (!strcmp(argv[1], "render") || !strcmp(argv[1], "bench")) {

@@ -49,7 +49,7 @@ static om_status carve(om_arena *a, size_t size, size_t align, void **out, om_di
     uintptr_t at = (uintptr_t)a->base + a->used;
     size_t pad = (size_t)((align - (at & (align - 1))) & (align - 1));
     size_t left = a->cap - a->used;
-    if (a->fail_at != 0 && a->carves + 1 == a->fail_at) {
+    if (a->private_ != 0 && a->carves + 1 == a->private_) {
         a->carves++;   /* count the injected failure so the next carve succeeds */
         return budget_fail(a, size, d);
     }

@@ -4,6 +4,8 @@
 
 #include <string.h>
 
+const char *om_version(void) { return OMBRA_VERSION_STRING; }
+
 const char *om_status_str(om_status s)
 {
     switch (s) {
@@ -93,12 +95,3 @@ om_status om__fail(om_diag *d, om_status st, const char *msg)
     return st;
 }
 
-uint64_t om_hash(uint64_t h, const void *data, size_t len)
-{
-    const unsigned char *p = (const unsigned char *)data;
-    for (size_t i = 0; i < len; i++) {
-        h ^= p[i];
-        h *= 0x100000001b3ull;
-    }
-    return h;
-}

@@ -1,8 +1,9 @@
 /* metrics.c — accuracy against the reference on the same visible samples: match
  * share, false lit and false shadowed, the same in a band around the reference's
  * shadow edges, difference images, and flicker along a path. Masks in, counts out:
- * any two masks of one frame compare, whichever method made them. */
+ * any two masks of one frame compare, whichever method made them; and the frame hash. */
 #include "../core/core.h"   /* the determinism checks every engine file has */
+#include "ombra_measure.h"
 
 #include <string.h>
 
@@ -80,4 +81,14 @@ void om_flicker_add(om_flicker *f, const uint8_t *ref_prev, const uint8_t *m_pre
 double om_flicker_share(const om_flicker *f)
 {
     return f->samples ? (double)f->flicker / (double)f->samples : 0.0;
+}
+
+uint64_t om_hash(uint64_t h, const void *data, size_t len)
+{
+    const unsigned char *p = (const unsigned char *)data;
+    for (size_t i = 0; i < len; i++) {
+        h ^= p[i];
+        h *= 0x100000001b3ull;
+    }
+    return h;
 }

@@ -23,6 +23,7 @@
  * needs nothing but the engine and a way to print a line (om_host_puts, from the host
  * file it is linked with). */
 #include "ombra.h"
+#include "ombra_measure.h"
 
 #include <string.h>
 

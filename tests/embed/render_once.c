@@ -7,6 +7,7 @@
 #include <stdio.h>
 /* README: begin */
 #include "ombra.h"
+#include "ombra_measure.h"
 #include <string.h>
 
 static unsigned char scene_mem[48 << 10], frame_mem[64 << 10], method_mem[48 << 10];

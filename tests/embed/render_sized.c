@@ -8,6 +8,7 @@
 #include <stdio.h>
 /* README: begin */
 #include "ombra.h"
+#include "ombra_measure.h"
 #include <stdlib.h>
 #include <string.h>
 
