@@ -213,7 +213,7 @@ static void resolve_run(const om_view *v, const eye_tri *et, uint32_t x0, uint32
  * run_end, and the vertices of the triangles that the cache will lack when the runs
  * come (tag: the cache's triangle per way, kept a batch ahead) in `fetched`, in the
  * order they will be set up. Their loads are made together, so that they overlap: on
- * a scene of many small triangles (issue 26's random 100K) nearly every run is a
+ * a scene of many small triangles (a dense random cloud) nearly every run is a
  * triangle not yet set up, whose indices and vertices lie anywhere in the scene, and a
  * setup that waited on its own loads spent most of its time there. Returns the number
  * of runs; *xe moves past them. */
@@ -288,10 +288,9 @@ static void resolve_ids(const om_scene *s, const om_view *v, const om_target *tg
                     et->sure = et->tried = false;
                     et->seen = 0;
                 }
-                /* expo_setup costs about what it saves on eight pixels: tried once the
+                /* expo_setup costs about what it saves on a few pixels: tried once the
                  * triangle has EYE_LAZY pixels in the strip (its answer changes no bit,
-                 * only the work; 16 gave the fewest instructions on the M4, 4 to 32 within
-                 * 0.5% of it) */
+                 * only the work; EYE_LAZY is where the M4's count is least) */
                 if (mark && !et->tried && (et->seen += x1 - x) >= EYE_LAZY) {
                     expo_setup(v, &fr, et);
                     et->tried = true;

@@ -31,8 +31,8 @@
  * build take BANDS_PER_JOB: each band sets up every triangle that reaches its rows.
  * The stages whose work is per pixel (a method's resolve, shading, the eye pass that
  * resolves ids, the halves' merge) take FINE_BANDS_PER_JOB, which costs no more: their
- * work can crowd a few rows (ref's rays where random 100K's cloud stands: one of 8
- * bands held a third of the frame's rays, and the other thread waited 6 to 13 ms). */
+ * work can crowd a few rows (ref's rays where a dense cloud stands), and a few coarse
+ * bands would leave one thread with most of it. */
 #define BANDS_PER_JOB 4
 #define FINE_BANDS_PER_JOB 16
 
@@ -252,14 +252,14 @@ static void run_bands(om__frame *c, void (*stage)(om__frame *c, uint32_t b), uin
 
 /* A frame of one strip on two jobs splits its eye pass by triangles (see the top)
  * when the scene has more than one vertex for every HALVES_PIXELS pixels: the bins
- * cost about 10 ns a vertex, the second target's clearing and merging about 1.3 ns a
- * pixel (random 100K at 1024x768, 300K vertices: the eye pass's jobs take 8% less
- * CPU time by halves; the default scene, 12K vertices, and random 10K, 30K, take
- * less with the bins). */
+ * cost a little per vertex, the second target's clearing and merging a little per
+ * pixel, and a vertex costs the bins several times what a pixel costs the halves, so
+ * a scene dense in vertices for its image takes less CPU time by halves, and a sparse
+ * one less with the bins. */
 #define HALVES_PIXELS 8
 /* Parts of the triangles where the host names the thread: as many as the fine bands
- * of two jobs, so that the slower thread waits for at most a small part at the end
- * (random 100K at 1024x768: the halves' jobs took 5.9 and 4.2 ms in one frame). */
+ * of two jobs, so that the slower thread waits for at most a small part at the end,
+ * where two fixed halves can leave one thread waiting for the other's whole. */
 #define EYE_PARTS (2 * FINE_BANDS_PER_JOB)
 
 /* At most this many triangles' rows are read to weigh the bands (order_bands). */
@@ -271,15 +271,13 @@ static void run_bands(om__frame *c, void (*stage)(om__frame *c, uint32_t b), uin
  * the indices, [nb k / T, nb (k + 1) / T) for share k, back and forth (share 0, 1, ..,
  * T - 1, T - 1, .., 0, 0, ..), each share heaviest first; in row order without rows.
  * A heavy band that starts last keeps one thread busy while the others wait (a scene
- * whose triangles crowd a few rows: issue 26's random cloud), and a host that gives each
- * thread its own share of the indices (the platform's pool) would give one thread all
- * the heaviest of bands merely sorted: on random 100K (sm, 1024x768, two threads) the
- * build took 0.80-0.87 of the two CPUs' ideal sorted, 0.94-1.00 dealt. Where T does not
- * divide nb they stay sorted. The strip's stages run in row order: such a host then
- * finds each band's rows in the cache of the thread that wrote them in the last stage
- * (the default scene's eye pass: its bands took 17-20% more CPU time on two threads
- * than on one heaviest first, none more in row order). Which band a job runs changes
- * when it finishes, never a pixel. */
+ * whose triangles crowd a few rows, such as a dense random cloud), and a host that
+ * gives each thread its own share of the indices (the platform's pool) would give one
+ * thread all the heaviest of bands merely sorted; dealt, each share gets its part of
+ * them. Where T does not divide nb they stay sorted. The strip's stages run in row
+ * order: such a host then finds each band's rows in the cache of the thread that wrote
+ * them in the last stage, which a heaviest-first order of the eye pass's bands would
+ * lose. Which band a job runs changes when it finishes, never a pixel. */
 static void order_bands(om__frame *c, const uint32_t *rows, uint32_t band, uint32_t nb)
 {
     om__job_slot *sl = c->j.slots;
@@ -365,9 +363,9 @@ static void build_map(om__frame *c)
  * then their counts added up in slot order. Where the host says which thread runs a
  * job (om_frame_desc.worker) and every thread has a slot, each job is one of the
  * host's, on its thread's slot: the host hands them out as threads come free, so a
- * thread that the system slows or a heavy tile holds up no fixed share (on this
- * project's 2-CPU machine the same thread runs up to a third slower than the other
- * for a while). Otherwise slot p runs jobs p, p + P, ... */
+ * thread that the system slows or a heavy tile holds up no fixed share (a virtual
+ * machine's CPUs can run at different speeds for a while). Otherwise slot p runs jobs
+ * p, p + P, ... */
 static void run_pass(om__frame *c)
 {
     void *state = c->fd->method_state;
