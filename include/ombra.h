@@ -365,12 +365,14 @@ const om_setting *om_method_setting(const om_method *m, const char *name);
  * image: the least it can work with (*min), and the size it is meant to run at
  * (*full): one pass for every method but izb, whose full is its default pool (it tiles
  * where the scene has few triangles for its samples, which is faster there).
- * OM_E_INVALID for a NULL argument or a configuration made for another method. */
+ * OM_E_INVALID for a NULL argument, a side outside 1..OM_MAX_DIM, or a configuration
+ * made for another method. */
 om_status om_method_bytes(const om_method *m, const om_method_cfg *c, const om_scene *s, uint32_t width,
                           uint32_t height, size_t *min, size_t *full);
 /* Creates m's state in arena a (at least *min bytes of om_method_bytes); the method
  * keeps `a` for its per-frame scratch, so the arena is the method's until the host is
- * done with the state. *state is NULL on failure. */
+ * done with the state. *state is NULL on failure; OM_E_INVALID as om_method_bytes,
+ * OM_E_BUDGET where the arena is too small. */
 om_status om_method_init(const om_method *m, void **state, om_arena *a, const om_method_cfg *c,
                          const om_scene *s, uint32_t width, uint32_t height, om_diag *d);
 /* The state's counters and bytes after a frame (zeros for NULL). */

@@ -15,7 +15,7 @@ void om_arena_init(om_arena *a, void *buf, size_t size, const char *name)
 
 size_t om_arena_need(size_t size, size_t align)
 {
-    return size + (align > 1 ? align - 1 : 0);
+    return om__size_add(size, align > 1 ? align - 1 : 0);
 }
 
 static om_status budget_fail(om_arena *a, size_t asked, om_diag *d)
@@ -93,12 +93,12 @@ size_t om_arena_left(const om_arena *a) { return a->cap - a->used; }
 
 /* ---- pools */
 
-static size_t pool_item(size_t item_size) { return (item_size + 7u) & ~(size_t)7u; }
+static size_t pool_item(size_t item_size) { return om__size_add(item_size, 7u) & ~(size_t)7u; }
 
 size_t om_pool_bytes(size_t item_size, uint32_t count)
 {
-    return om_arena_need(pool_item(item_size) * count, 8) +
-           om_arena_need(sizeof(uint32_t) * count, 4);
+    return om__size_add(om_arena_need(om__size_mul(pool_item(item_size), count), 8),
+                        om_arena_need(om__size_mul(sizeof(uint32_t), count), 4));
 }
 
 om_status om_pool_init(om_pool *p, om_arena *a, size_t item_size, uint32_t count,
@@ -109,8 +109,8 @@ om_status om_pool_init(om_pool *p, om_arena *a, size_t item_size, uint32_t count
     memset(p, 0, sizeof *p);
     if (item_size == 0 || count == 0)
         return om__fail(d, OM_E_INVALID, "pool needs a non-zero item size and count");
-    if ((st = om_arena_alloc(a, pool_item(item_size) * count, 8, &items, d)) != OM_OK) return st;
-    if ((st = om_arena_alloc(a, sizeof(uint32_t) * count, 4, &next, d)) != OM_OK) return st;
+    if ((st = om_arena_alloc(a, om__size_mul(pool_item(item_size), count), 8, &items, d)) != OM_OK) return st;
+    if ((st = om_arena_alloc(a, om__size_mul(sizeof(uint32_t), count), 4, &next, d)) != OM_OK) return st;
     p->items = (unsigned char *)items;
     p->item_size = pool_item(item_size);
     p->count = count;

@@ -25,6 +25,12 @@
 #pragma STDC FP_CONTRACT OFF
 #endif
 
+/* ---- size arithmetic that saturates at SIZE_MAX instead of wrapping: a byte count
+ * that does not fit a size_t asks for more than any arena holds, so a carve of it
+ * fails with OM_E_BUDGET (on 32-bit targets as on 64-bit ones). */
+static inline size_t om__size_add(size_t a, size_t b) { return a > SIZE_MAX - b ? SIZE_MAX : a + b; }
+static inline size_t om__size_mul(size_t a, size_t b) { return b && a > SIZE_MAX / b ? SIZE_MAX : a * b; }
+
 /* ---- diagnostics: a bounded string builder (no stdio in the engine) */
 typedef struct om__str { char *buf; size_t cap, len; } om__str;
 
