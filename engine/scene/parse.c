@@ -80,8 +80,8 @@ static om_status do_camera(parser *p)
     c.height = (uint32_t)val(pl, P_SIZE, 1, 480.0);
     c.znear = (float)val(pl, P_NEAR, 0, 0.1);
     c.zfar = (float)val(pl, P_FAR, 0, 1000.0);
-    if (v3_eq(c.eye, c.target))
-        return om__parse_fail(p, OM_E_RANGE, pl[P_TARGET].vcol[0], "camera eye and target must differ",
+    if (v3_no_dir(om__sub(c.target, c.eye)))
+        return om__parse_fail(p, OM_E_RANGE, pl[P_TARGET].vcol[0], "camera eye and target must differ: their difference gives no direction",
                     NULL, 0, NULL);
     if (v3_zero(c.up))
         return om__parse_fail(p, OM_E_RANGE, pl[P_UP].vcol[0], "'up' must not be zero", NULL, 0, NULL);
@@ -119,8 +119,8 @@ static om_status do_light(parser *p)
         l.fov_deg = (float)val(pl, P_FOV, 0, 60.0);
         l.znear = (float)val(pl, P_NEAR, 0, 0.5);
         l.zfar = (float)val(pl, P_FAR, 0, 1000.0);
-        if (v3_eq(l.pos, l.target))
-            return om__parse_fail(p, OM_E_RANGE, pl[P_TARGET].vcol[0], "light pos and target must differ",
+        if (v3_no_dir(om__sub(l.target, l.pos)))
+            return om__parse_fail(p, OM_E_RANGE, pl[P_TARGET].vcol[0], "light pos and target must differ: their difference gives no direction",
                         NULL, 0, NULL);
         if ((st = om__parse_near_far(p, pl, l.znear, l.zfar)) != OM_OK) return st;
         l.dir = om__normalize(om__sub(l.target, l.pos));
@@ -131,8 +131,8 @@ static om_status do_light(parser *p)
         l.kind = OM_LIGHT_DIRECTIONAL;
         l.pos = l.target = om__v3(0, 0, 0);
         l.dir = pv3(&pl[P_DIR], 0);
-        if (v3_zero(l.dir))
-            return om__parse_fail(p, OM_E_RANGE, pl[P_DIR].vcol[0], "'dir' must not be zero", NULL, 0, NULL);
+        if (v3_no_dir(l.dir))
+            return om__parse_fail(p, OM_E_RANGE, pl[P_DIR].vcol[0], "'dir' must not be zero, nor too short to give a direction", NULL, 0, NULL);
     }
     p->light = l;
     p->have_light = true;
@@ -572,8 +572,8 @@ static om_status do_key(parser *p)
         k.t = tf;
         k.eye = pv3(&pl[P_EYE], 0);
         k.target = pv3(&pl[P_TARGET], 0);
-        if (v3_eq(k.eye, k.target))
-            return om__parse_fail(p, OM_E_RANGE, pl[P_TARGET].vcol[0], "camera eye and target must differ",
+        if (v3_no_dir(om__sub(k.target, k.eye)))
+            return om__parse_fail(p, OM_E_RANGE, pl[P_TARGET].vcol[0], "camera eye and target must differ: their difference gives no direction",
                         NULL, 0, NULL);
         if (p->ncam && !(tf > p->cam_t)) return key_order(p, what, tcol, p->cam_t, p->cam_t_line);
         if (p->ncam && om__path_meets(p->cam_k.eye, p->cam_k.target, k.eye, k.target))
@@ -598,16 +598,16 @@ static om_status do_key(parser *p)
                         0, NULL);
         form = 2;
         k.dir = pv3(&pl[P_DIR], 0);
-        if (v3_zero(k.dir))
-            return om__parse_fail(p, OM_E_RANGE, pl[P_DIR].vcol[0], "'dir' must not be zero", NULL, 0, NULL);
+        if (v3_no_dir(k.dir))
+            return om__parse_fail(p, OM_E_RANGE, pl[P_DIR].vcol[0], "'dir' must not be zero, nor too short to give a direction", NULL, 0, NULL);
     } else {
         if (!pl[P_POS].has || !pl[P_TARGET].has)
             return om__parse_missing(p, what, "pos X Y Z and target X Y Z, or dir X Y Z");
         form = 1;
         k.pos = pv3(&pl[P_POS], 0);
         k.target = pv3(&pl[P_TARGET], 0);
-        if (v3_eq(k.pos, k.target))
-            return om__parse_fail(p, OM_E_RANGE, pl[P_TARGET].vcol[0], "light pos and target must differ",
+        if (v3_no_dir(om__sub(k.target, k.pos)))
+            return om__parse_fail(p, OM_E_RANGE, pl[P_TARGET].vcol[0], "light pos and target must differ: their difference gives no direction",
                         NULL, 0, NULL);
         k.dir = om__normalize(om__sub(k.target, k.pos));
     }

@@ -84,8 +84,15 @@ static inline double val(const pv *pl, int id, int i, double def) { return pl[id
 /* paths.c: whether a - b, lerped from (a0, b0) to (a1, b1), (nearly) vanishes. */
 bool om__path_meets(om_vec3 a0, om_vec3 b0, om_vec3 a1, om_vec3 b1);
 
-static inline bool v3_eq(om_vec3 a, om_vec3 b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
 static inline bool v3_zero(om_vec3 a) { return a.x == 0.0f && a.y == 0.0f && a.z == 0.0f; }
+/* Whether v gives no direction: its unit vector (om__normalize, as the view makes
+ * it) is zero, as for a vector too short for float to square. The view refuses such a
+ * camera or light (om_view_init), so the parser does, with the line and column. */
+static inline bool v3_no_dir(om_vec3 v)
+{
+    const om_vec3 n = om__normalize(v);
+    return om__dot(n, n) == 0.0f;
+}
 
 
 #endif
