@@ -19,6 +19,9 @@
  * the file and the system's reason, or OM_E_BUDGET for a file of more than max bytes
  * (a regular file is refused by its size before anything is read). */
 om_status om_file_read_max(const char *path, size_t max, char **data, size_t *len, om_diag *d);
+/* The same for a text (a scene, an OBJ file): a NUL byte, which no text holds, ends
+ * the read at its chunk with OM_E_PARSE, so a large binary file is not read whole. */
+om_status om_file_read_text(const char *path, size_t max, char **data, size_t *len, om_diag *d);
 /* om_file_read_max with OM_FILE_MAX. */
 om_status om_file_read(const char *path, char **data, size_t *len, om_diag *d);
 
@@ -43,6 +46,9 @@ typedef struct om_file_loader {
 /* OM_E_IO only when out of memory (scene_path may be NULL: the current directory). */
 om_status om_file_loader_init(om_file_loader *fl, const char *scene_path);
 om_loader om_file_loader_get(om_file_loader *fl);
+/* Frees the files' bytes but keeps their paths (which files a scene read); a later
+ * load of one reads it again. */
+void om_file_loader_drop_data(om_file_loader *fl);
 void om_file_loader_free(om_file_loader *fl);
 
 /* A parallel-for on a pool of threads (jobs.c): om_jobs_for is an om_parallel_for_fn

@@ -104,7 +104,7 @@ om_status cli_scene_load(cli_scene *cs, const char *path, size_t budget, om_diag
     om_status st;
     /* With a budget, the scene's text and meshes count against it while they are
      * held, and the arena is refused by its bytes query before anything is made. */
-    if (path && (st = om_file_read_max(path, budget ? budget : OM_FILE_MAX, &cs->text, &len, d)) != OM_OK)
+    if (path && (st = om_file_read_text(path, budget ? budget : OM_FILE_MAX, &cs->text, &len, d)) != OM_OK)
         return st;
     if (path) text = cs->text;
     if (om_file_loader_init(&cs->files, path) != OM_OK) return cli_oom(d);
@@ -134,8 +134,9 @@ om_status cli_scene_load(cli_scene *cs, const char *path, size_t budget, om_diag
         om_arena_init(&cs->arena, cs->mem, cs->bytes, "scene");
         st = om_scene_parse(text, len, &ld, &cs->arena, &cs->scene, d);
     }
-    /* The scene keeps nothing of its text or files. */
-    om_file_loader_free(&cs->files);
+    /* The scene keeps nothing of its text or files; their paths stay, so that a
+     * command can refuse to write over a file the scene read (cli_scene_free). */
+    om_file_loader_drop_data(&cs->files);
     free(cs->text);
     cs->text = NULL;
     return st;

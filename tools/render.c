@@ -240,6 +240,18 @@ int cmd_render(int argc, char **argv)
     om_status st = cli_scene_load(&cs, scene_path, budget, &d);
     const char *where = scene_path ? scene_path : "default scene";
     if (st != OM_OK) { cli_scene_free(&cs); return cli_error(where, &d, st); }
+    /* nor may an output be a mesh the scene read (it would be gone after the run) */
+    for (size_t i = 0; i < cs.files.nfiles; i++) {
+        const char *paths[4] = {cs.files.files[i].path, out, mask, diff};
+        const char *names[4] = {"a mesh of the scene", "--out", "--mask", "--diff"};
+        for (size_t k = 1; k < 4; k++)
+            if (paths[k] && om_out_same(paths[k], paths[0])) {
+                fprintf(stderr, "ombra render: %s and %s name the same file '%s': each needs "
+                        "its own\n(see 'ombra render --help')\n", names[0], names[k], paths[0]);
+                cli_scene_free(&cs);
+                return 2;
+            }
+    }
 
     om_camera cam;
     om_light light;
