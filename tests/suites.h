@@ -13,6 +13,7 @@
     X(suite_frame) \
     X(suite_platform) \
     X(suite_shadow) \
+    X(suite_shadow_common) \
     X(suite_measure) \
     X(suite_izb) \
     X(suite_rtw) \

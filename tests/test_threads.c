@@ -18,41 +18,6 @@ static void backwards(void *host, om_job_fn fn, void *user, uint32_t n)
     for (uint32_t i = n; i-- > 0;) fn(user, i);
 }
 
-/* The platform's pool runs every index of every call once, whatever the threads and n
- * (each thread's chunk first, then the others' next jobs): counted per index. */
-typedef struct once_ctx {
-    om_jobs *pool;
-    uint32_t threads, count[100], bad_worker;
-} once_ctx;
-
-static void count_once(void *user, uint32_t i)
-{
-    once_ctx *o = (once_ctx *)user;
-    __atomic_fetch_add(&o->count[i], 1u, __ATOMIC_RELAXED);
-    if (om_jobs_worker(o->pool) >= o->threads) __atomic_store_n(&o->bad_worker, 1u, __ATOMIC_RELAXED);
-}
-
-static void pool_each_once(void)
-{
-    static const uint32_t threads[] = {1, 2, 3, 7, 16}, ns[] = {0, 1, 2, 3, 5, 7, 16, 17, 31, 64, 100};
-    for (int k = 0; k < 5; k++) {
-        once_ctx o;
-        memset(&o, 0, sizeof o);
-        o.threads = threads[k];
-        CHECK_OK(om_jobs_start(&o.pool, threads[k], NULL));
-        for (int round = 0; round < 3; round++)
-            for (int c = 0; c < 11; c++) {
-                memset(o.count, 0, sizeof o.count);
-                om_jobs_for(o.pool, count_once, &o, ns[c]);
-                for (uint32_t i = 0; i < 100; i++)
-                    CHECK_MSG(o.count[i] == (i < ns[c]), "%u threads, n %u: job %u ran %u times", threads[k],
-                              ns[c], i, o.count[i]);
-            }
-        CHECK(!o.bad_worker);
-        om_jobs_stop(o.pool);
-    }
-}
-
 /* A worker index for `backwards`: each job another slot of 5 (its jobs run one at a
  * time, so any index is one that no running job holds); host counts the calls. */
 static uint32_t rotating(void *host)
@@ -586,7 +551,6 @@ static void kept_ids(void)
 
 void suite_threads(void)
 {
-    RUN(pool_each_once);
     RUN(same_bits);
     RUN(fewer_jobs);
     RUN(eye_halves);
