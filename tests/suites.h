@@ -12,6 +12,8 @@
     X(suite_scene_raster) \
     X(suite_frame) \
     X(suite_platform) \
+    X(suite_ref) \
+    X(suite_sm) \
     X(suite_shadow) \
     X(suite_shadow_common) \
     X(suite_measure) \
@@ -24,7 +26,6 @@
     X(suite_hybrid) \
     X(suite_settings) \
     X(suite_threads) \
-    X(suite_lent) \
     /* end of list */
 #endif
 #define X(suite) void suite(void);
