@@ -29,7 +29,7 @@ PTHREAD = -pthread
 ENGINE_SRC   = $(sort $(wildcard engine/*/*.c engine/*/*/*.c))
 PLATFORM_SRC = $(sort $(wildcard platform/*.c))
 TOOL_SRC     = $(sort $(wildcard tools/*.c))
-TEST_SRC     = $(sort $(wildcard tests/*.c tests/unit/*.c tests/method/*.c))
+TEST_SRC     = $(sort $(wildcard tests/*.c tests/unit/*.c tests/method/*.c tests/property/*.c))
 BENCH_SRC    = $(sort $(wildcard tests/bench/*.c))
 
 ENGINE_OBJ   = $(ENGINE_SRC:%.c=$(O)/%.o)

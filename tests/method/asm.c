@@ -1,6 +1,6 @@
 /* method/asm.c — Adaptive Shadow Maps (issue 5): the tree's rules driven directly (pool,
- * LRU among nodes not used last frame, replacement only by greater benefit, subtrees
- * go with their node, the descent), the memory cap along camera paths for caps from the
+ * LRU among nodes not used last frame, replacement only by greater benefit, subtrees go
+ * with their node, the descent), the memory cap along camera paths for caps from the
  * smallest usable to generous, progressive refinement of a still view against the
  * reference and the conventional map of the same memory, budgets that name their
  * minimum, and bit-identical frames (strips included). On threads: a kept state's

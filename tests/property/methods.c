@@ -1,7 +1,7 @@
-/* test_shadow.c — what every method holds: the reference's samples and exposure,
+/* property/methods.c — what every method holds: the reference's samples and exposure,
  * frames under odd lights, and a kept state's frames those of a fresh one. */
-#include "test.h"
-#include "harness.h"
+#include "../test.h"
+#include "../harness.h"
 
 #include <stdlib.h>
 
@@ -117,7 +117,7 @@ static void kept_state_as_fresh(void)
                     "key light 4 pos -5 10 3 target 0 0 0\n", 1.0f);
 }
 
-void suite_shadow(void)
+void suite_methods(void)
 {
     RUN(methods_agree_on_samples);
     RUN(odd_lights);

@@ -1,14 +1,14 @@
-/* test_threads.c — many cores, same bits: every method's frame (pixels, terms, mask)
- * and counters with 1, 2, 3, 4, 7 and 16 threads through the platform's pool, and with
- * a parallel-for that runs its jobs backwards, against the inline frame; whole frames
- * and strips, a spot and a directional light, each over a frame arena holding other
- * bytes. And the frame arena: room for N jobs but not N + 1 runs N; the eye pass by
- * parts on threads; triangle ids kept between passes. A method's own threading tests
- * are in its own suite, tests/method/<method>.c. */
-#include "test.h"
-#include "harness.h"
-#include "jobs_util.h"
-#include "../platform/platform.h"
+/* property/threads.c — many cores, same bits: every method's frame (pixels, terms, mask)
+ * and counters with 1, 2, 3, 4, 7 and 16 threads through the platform's pool, and with a
+ * parallel-for that runs its jobs backwards, against the inline frame; whole frames and
+ * strips, a spot and a directional light, each over a frame arena holding other bytes.
+ * And the frame arena: room for N jobs but not N + 1 runs N; the eye pass by parts on
+ * threads; triangle ids kept between passes. A method's own threading tests are in its
+ * own suite, tests/method/<method>.c. */
+#include "../test.h"
+#include "../harness.h"
+#include "../jobs_util.h"
+#include "../../platform/platform.h"
 
 #include <stdio.h>
 #include <stdlib.h>
