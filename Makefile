@@ -29,7 +29,7 @@ PTHREAD = -pthread
 ENGINE_SRC   = $(sort $(wildcard engine/*/*.c engine/*/*/*.c))
 PLATFORM_SRC = $(sort $(wildcard platform/*.c))
 TOOL_SRC     = $(sort $(wildcard tools/*.c))
-TEST_SRC     = $(sort $(wildcard tests/*.c))
+TEST_SRC     = $(sort $(wildcard tests/*.c tests/unit/*.c tests/method/*.c tests/property/*.c))
 BENCH_SRC    = $(sort $(wildcard tests/bench/*.c))
 
 ENGINE_OBJ   = $(ENGINE_SRC:%.c=$(O)/%.o)
@@ -79,7 +79,7 @@ test:
 	  { echo "determinism: FAIL — frames from $$b differ from gcc-O2:"; \
 	    diff build/gcc-O2/frame-hashes.txt build/$$b/frame-hashes.txt; exit 1; }; done; \
 	  echo "determinism: ok — every method's frame is bit-identical across gcc/clang -O0/-O2"
-	sh tests/freestanding.sh
+	sh tests/sh/freestanding.sh
 
 # The fuzz targets' entry points without libFuzzer, replayed over the inputs that once
 # crashed or hung a target and the hostile inputs of issue 24 (tests/fuzz/regress/),
@@ -107,7 +107,7 @@ $(O)/embed-render-sized: tests/embed/render_sized.c $(O)/libombra.a include/ombr
 
 # The same example in a firmware with only `sm`: registry.c (the only file that reads
 # OM_WITH_*) compiled with every other method off and linked ahead of the library;
-# tests/methods.sh checks that no other method's code came along and that the frame
+# tests/sh/methods.sh checks that no other method's code came along and that the frame
 # is the full library's.
 ONLY_SM = -DOM_WITH_NONE=0 -DOM_WITH_REF=0 -DOM_WITH_ASM=0 -DOM_WITH_RTW=0 -DOM_WITH_SPSM=0 \
           -DOM_WITH_IZB=0 -DOM_WITH_HYBRID=0
@@ -121,12 +121,12 @@ check: $(O)/run-tests $(O)/ombra $(FUZZ_TARGETS:%=$(O)/fuzz-replay-%) $(O)/embed
        $(O)/embed-render-sized $(O)/embed-only-sm $(O)/bench $(O)/stress $(O)/stability
 	@echo "== $(O)"
 	$(O)/run-tests
-	sh tests/cli.sh $(O)/ombra
+	sh tests/sh/cli.sh $(O)/ombra
 	$(Q)$(REPLAY)
 	$(O)/embed-render-once
 	sh tests/embed/sized.sh $(O)
 	sh tests/embed/readme.sh
-	sh tests/methods.sh $(O)
+	sh tests/sh/methods.sh $(O)
 
 # Every method rendered on 2 threads, whole and through strips, by the command $(1)
 # (under $(2), a checker or nothing), into directory $(3): the sanitizers and valgrind

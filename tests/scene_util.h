@@ -1,5 +1,5 @@
-/* scene_util.h — helpers the scene suites share (test_scene.c, test_obj.c,
- * test_scene_fuzz.c): scene text copied into a heap block of exactly its length, a
+/* scene_util.h — helpers the scene suites share (unit/scene.c, unit/obj.c,
+ * unit/scene_fuzz.c): scene text copied into a heap block of exactly its length, a
  * bytes query and then a parse into an arena of exactly that many bytes, and small
  * vector checks on the result. */
 #ifndef OM_SCENE_UTIL_H

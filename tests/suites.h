@@ -1,4 +1,5 @@
-/* suites.h — the list of test suites; each tests/test_*.c defines one. */
+/* suites.h — the list of test suites, in the order they run: each file of tests/unit/
+ * (one an engine module), tests/method/ (one a method) and tests/property/ defines one. */
 #ifndef OM_SUITES_H
 #define OM_SUITES_H
 #ifndef OM_SUITES
@@ -11,19 +12,21 @@
     X(suite_hiz) \
     X(suite_scene_raster) \
     X(suite_frame) \
-    X(suite_platform) \
-    X(suite_shadow) \
     X(suite_measure) \
-    X(suite_izb) \
-    X(suite_rtw) \
-    X(suite_asm) \
-    X(suite_robust) \
-    X(suite_spsm) \
-    X(suite_oracle) \
-    X(suite_hybrid) \
+    X(suite_platform) \
     X(suite_settings) \
+    X(suite_shadow_common) \
+    X(suite_ref) \
+    X(suite_sm) \
+    X(suite_asm) \
+    X(suite_rtw) \
+    X(suite_spsm) \
+    X(suite_izb) \
+    X(suite_hybrid) \
+    X(suite_methods) \
+    X(suite_oracle) \
+    X(suite_robust) \
     X(suite_threads) \
-    X(suite_lent) \
     /* end of list */
 #endif
 #define X(suite) void suite(void);

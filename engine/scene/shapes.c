@@ -4,7 +4,7 @@
  *
  * Every closed shape is wound counter-clockwise seen from outside, so the geometric
  * normal cross(v1 - v0, v2 - v0) points out, and shares its vertices so each edge
- * belongs to exactly two triangles (tests/test_scene.c checks both). Shapes are built
+ * belongs to exactly two triangles (tests/unit/scene.c checks both). Shapes are built
  * in double and rounded to float once, after the transform, so a scene gives the same
  * bits on every machine (trigonometry is core's om__sin/om__cos, not libm's). */
 #include "scene.h"

@@ -213,7 +213,7 @@ static uint64_t count_now(void *user)
 }
 
 /* .data and .bss but for the three arenas' buffers: the strip's pixels, the C
- * library's and the driver's own (the engine has none: tests/freestanding.sh). */
+ * library's and the driver's own (the engine has none: tests/sh/freestanding.sh). */
 static size_t static_bytes(void)
 {
     const size_t all = (size_t)((uintptr_t)&__data_end - (uintptr_t)&__data_start) +

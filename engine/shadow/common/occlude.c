@@ -214,7 +214,7 @@ bool om__lspace_tri(const om__lspace *ls, uint32_t t, om__ltri *lt)
  * it) means the double's Q is below z, blocked; Q - e above z, not blocked. Between
  * them the double decides. The depth clamp of om__rtri_depth changes nothing: the
  * exact depth at a point inside lies between the vertices', and clamping only moves
- * the double's value towards it. tests/test_shadow.c calls this next to the
+ * the double's value towards it. tests/unit/shadow_common.c calls this next to the
  * threshold. */
 
 /* |v| < 2^48 as a float with one rounding: both halves are exact floats. */

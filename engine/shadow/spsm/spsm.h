@@ -62,7 +62,7 @@ uint8_t om__spsm_q_encode(double d);
 /* The same code from the table's boundaries, for the build (no arctangent): the code
  * whose boundaries enclose d, 254 - that of -d for d < 0, 127 for NaN. It agrees with
  * om__spsm_q_encode but within 2^-22 of a boundary, and the table's error bound holds
- * for it to that much (tests/test_spsm.c). */
+ * for it to that much (tests/method/spsm.c). */
 uint8_t om__spsm_q_encode_f(const om__spsm_qtable *t, float d);
 /* Builds the table from om__tan/om__log2/om__exp2 (bit-identical everywhere). Code 254
  * (x = 1, a slope of 90 degrees) decodes to twice code 253 and 0 to its negative. */

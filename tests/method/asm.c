@@ -1,13 +1,16 @@
-/* test_asm.c — Adaptive Shadow Maps (issue 5): the tree's rules driven directly (pool,
- * LRU among nodes not used last frame, replacement only by greater benefit, subtrees
- * go with their node, the descent), the memory cap along camera paths for caps from the
+/* method/asm.c — Adaptive Shadow Maps (issue 5): the tree's rules driven directly (pool,
+ * LRU among nodes not used last frame, replacement only by greater benefit, subtrees go
+ * with their node, the descent), the memory cap along camera paths for caps from the
  * smallest usable to generous, progressive refinement of a still view against the
  * reference and the conventional map of the same memory, budgets that name their
- * minimum, and bit-identical frames (strips included). */
-#include "test.h"
-#include "harness.h"
-#include "../engine/shadow/method.h"
-#include "../engine/shadow/asm/asm.h"
+ * minimum, and bit-identical frames (strips included). On threads: a kept state's
+ * frames, counters and tree the same on 1 to 16 threads (asm_bands), and observe and the
+ * tile renders on lent slots leaving the tree one thread leaves (asm_jobs_tree). */
+#include "../test.h"
+#include "../harness.h"
+#include "../jobs_util.h"
+#include "../../engine/shadow/method.h"
+#include "../../engine/shadow/asm/asm.h"
 
 #include <stdlib.h>
 #include <math.h>
@@ -663,6 +666,218 @@ static void float_path_is_exact(void)
     }
 }
 
+/* ---- asm: its bands look up with caches of their own and write nothing of the tree;
+ * the use stamps of their lookups are put on the tree after the bands (om__bands.
+ * finish). A state kept over frames, a still light, a moving camera and one sample
+ * in 200 analysed (so that most leaves are stamped by lookups alone, and a missing
+ * stamp changes the tree): the same frames, counters, nodes and stamps for any number
+ * of jobs and their order, frame after frame. */
+static void asm_frames(const om_scene *s, uint32_t rows, om_parallel_for_fn pf, void *host, uint32_t threads,
+                       uint64_t *hash, uint32_t counters[][8], int nframes, const char *set)
+{
+    const om_method *m = om_method_find("asm");
+    enum { W = 160, H = 120 };
+    om_method_cfg c = h_cfg("asm", set);
+    size_t mn, full;
+    om_diag d;
+    CHECK_OK(om_method_bytes(m, &c, s, W, H, &mn, &full));
+    const uint32_t r = rows ? rows : H;
+    void *mm = malloc(full), *px = malloc((size_t)W * r * 3), *state = NULL;
+    om_arena ma, fa;
+    om_arena_init(&ma, mm, full, "method");
+    CHECK_OK(om_method_init(m, &state, &ma, &c, s, W, H, &d));
+    /* om_frame_bytes' with_jobs is for the default settings; a larger tree's jobs need more */
+    const bool big_tree = strstr(set, "asm.tile=4") != NULL;
+    const size_t big = state && threads > 1 && big_tree ? threads * (m->pass->scratch(state, s) + 64) : 0;
+    const size_t fbytes = h_frame_bins(s, W, r) + h_frame_jobs(m, s, threads) + big;
+    void *fm = malloc(fbytes);
+    for (int f = 0; f < nframes && state; f++) {
+        om_camera cam, cam0;
+        om_light light, moving;
+        om_view v;
+        om_scene_at(s, 0.0f, &cam0, &light);   /* the light held still: the tree lives on */
+        om_scene_at(s, 0.15f * (float)f, &cam, &moving);
+        cam.width = W;
+        cam.height = H;
+        CHECK_OK(om_view_init(&v, &cam, &light, s, &d));
+        om_arena_init(&fa, fm, fbytes, "frame");
+        om_framebuffer fb = {OM_RGB888, W, r, (size_t)W * 3, (uint8_t *)px};
+        om_shade_cfg shade;
+        om_frame_desc fd;
+        h_frame_desc(&fd, &shade, s, &v, m, state, &fb, rows);
+        fd.on_strip = frame_hash_strip; fd.user = &hash[f];
+        fd.parallel_for = pf; fd.parallel_user = host; fd.threads = threads;
+        hash[f] = OM_HASH_INIT;
+        om_frame_stats fs;
+        CHECK_OK(om_render_frame(&fd, &fa, &fs, &d));
+        CHECK_MSG(fs.jobs == (pf ? threads : 1), "asm: %u jobs ran %u", threads, fs.jobs);
+        om_method_stats ms;
+        om_method_get_stats(m, state, &ms);
+        memcpy(counters[f], ms.counters, sizeof counters[f]);
+        /* and the tree: every node's place and use stamp */
+        const om__asm_tree *t = om__asm_tree_of(state);
+        if (big_tree) CHECK(t->lay.count >= 0xFFFFu);   /* finish finds the leaves again */
+        uint64_t th = OM_HASH_INIT;
+        th = om_hash(th, &t->root.stamp, sizeof t->root.stamp);
+        for (uint32_t i = 0; i < t->lay.count; i++) {
+            const om__asm_node *nd = (const om__asm_node *)om_pool_item(&t->pool, i);
+            if (nd->alive) th = om_hash(om_hash(th, &i, sizeof i), nd, sizeof *nd);
+        }
+        hash[f] = om_hash(hash[f], &th, sizeof th);
+    }
+    free(mm);
+    free(fm);
+    free(px);
+}
+
+static void asm_bands(void)
+{
+    static const uint32_t threads[] = {2, 3, 4, 7, 16};
+    enum { NF = 6 };
+    om_jobs *pools[5];
+    for (int k = 0; k < 5; k++) CHECK_OK(om_jobs_start(&pools[k], threads[k], NULL));
+    /* the third: a tree of more than 0xFFFF nodes, whose leaves the bands cannot name */
+    for (int li = 0; li < 3; li++) {
+        h_scene hs;
+        if (!h_scene_parse(&hs, li == 1 ? directional_scene : om_scene_default_text())) continue;
+        const char *set = li < 2 ? "asm.cap=400000 asm.stride=200"
+                                 : "asm.cap=16000000 asm.tile=4 asm.cells=2 asm.root=16 asm.stride=300 asm.work=200";
+        for (uint32_t rows = 0; rows <= 24; rows += 24) {
+            uint64_t h1[NF], hn[NF];
+            uint32_t c1[NF][8], cn[NF][8];
+            asm_frames(&hs.s, rows, NULL, NULL, 1, h1, c1, NF, set);
+            for (int k = 0; k < 6; k++) {
+                uint32_t n = k < 5 ? threads[k] : 5;
+                asm_frames(&hs.s, rows, k < 5 ? om_jobs_for : backwards, k < 5 ? pools[k] : NULL, n, hn, cn, NF, set);
+                for (int f = 0; f < NF; f++)
+                    CHECK_MSG(hn[f] == h1[f] && !memcmp(cn[f], c1[f], sizeof c1[f]),
+                              "asm case %d strips %u frame %d: %u threads%s change the frame", li, rows, f, n,
+                              k < 5 ? "" : " backwards");
+            }
+        }
+        h_scene_free(&hs);
+    }
+    for (int k = 0; k < 5; k++) om_jobs_stop(pools[k]);
+}
+
+/* ---- asm: observe's analysis and the tile renders as jobs (asm_jobs.c). The method
+ * driven directly, its tree hashed after observe and after build (use marks, benefits,
+ * every cell's benefit and need, every tile, the triangle grid), on method memory
+ * filled with different garbage, with the jobs lent to it run backwards
+ * on 3 slots against none lent: views still, jumping between two places (so that
+ * nodes were last used two frames before) or moving on each frame (jump < 0: so that
+ * some were not used in the last frame), caps that leave the free list short or not
+ * (and the last set with nodes left that observe may replace: it then runs a strip at
+ * a time), strips of 8 rows or one. */
+
+static uint64_t asm_tree_hash(const void *state)
+{
+    om__asm_tree *t = (om__asm_tree *)om__asm_tree_of(state);
+    const om__asm_state *m = (const om__asm_state *)state;
+    uint64_t h = OM_HASH_INIT;
+    if (m->gready) {   /* the frame's triangle grid: its starts and lists */
+        const size_t g2 = (size_t)m->gside * m->gside;
+        h = om_hash(om_hash(h, m->gstart, (g2 + 1) * sizeof *m->gstart), m->glist, m->gstart[g2] * sizeof *m->glist);
+    }
+    for (uint32_t i = 0; i <= t->lay.count; i++) {
+        const uint32_t idx = i == t->lay.count ? OM__ASM_ROOT : i;
+        om__asm_tile tl;
+        om__asm_tile_of(t, idx, &tl);
+        if (!tl.node->alive && idx != OM__ASM_ROOT) continue;
+        const size_t c2 = (size_t)tl.cells * tl.cells, t2 = (size_t)tl.size * tl.size;
+        h = om_hash(om_hash(h, &idx, sizeof idx), tl.node, sizeof *tl.node);
+        h = om_hash(om_hash(h, tl.ben, c2 * sizeof *tl.ben), tl.need, c2 * sizeof *tl.need);
+        h = om_hash(om_hash(h, tl.child, c2 * sizeof *tl.child), tl.depth, t2 * sizeof *tl.depth);
+        h = tl.id16 ? om_hash(h, tl.id16, t2 * sizeof *tl.id16) : om_hash(h, tl.id32, t2 * sizeof *tl.id32);
+    }
+    return h;
+}
+
+static void asm_jobs_case(const om_scene *s, const char *set, uint32_t rows, float jump, bool lend,
+                          uint64_t out[][2], uint32_t *used, int nframes)
+{
+    enum { W = 96, H = 72 };
+    const om_method *m = om_method_find("asm");
+    const om__pass *ps = m->pass;
+    om_method_cfg c = h_cfg("asm", set);
+    size_t mn, full;
+    om_diag d;
+    CHECK_OK(om_method_bytes(m, &c, s, W, H, &mn, &full));
+    void *mm = malloc(full), *state = NULL;
+    memset(mm, lend ? 0x5A : 0xA5, full);   /* what init leaves unwritten differs between the two */
+    uint32_t *depth = calloc((size_t)W * H, sizeof *depth), *id = calloc((size_t)W * H, sizeof *id);
+    om_sample *smp = calloc((size_t)W * H, sizeof *smp);
+    om_term *terms = calloc((size_t)W * H, sizeof *terms), *kept = calloc((size_t)W * H, sizeof *terms);
+    om_arena ma;
+    om_arena_init(&ma, mm, full, "method");
+    CHECK_OK(om_method_init(m, &state, &ma, &c, s, W, H, &d));
+    CHECK(ps && ps->lend);
+    lent3 h;
+    const size_t sb = ps->scratch(state, s);
+    for (int k = 0; k < 3; k++) h.slot[k] = calloc(1, sb ? sb : 1);
+    const om__lend l = {lent_run, lent_run, &h, 3};
+    for (int f = 0; f < nframes && state && ps && ps->lend; f++) {
+        om_camera cam, cam0;
+        om_light light, moving;
+        om_view v;
+        om_scene_at(s, 0.0f, &cam0, &light);
+        om_scene_at(s, jump < 0.0f ? -jump * (float)f : jump * (float)(f & 1) + 0.05f * (float)f, &cam, &moving);
+        cam.width = W;
+        cam.height = H;
+        CHECK_OK(om_view_init(&v, &cam, &light, s, &d));
+        om_target tg = {W, H, 0, H, depth, id};
+        om_strip st = {W, H, 0, H, smp, terms};
+        om__eye_pass_mark(s, &v, &tg, &st, NULL);
+        memcpy(kept, terms, (size_t)W * H * sizeof *terms);
+        ps->lend(state, lend ? &l : NULL);
+        CHECK_OK(m->begin(state, &v, &d));
+        for (uint32_t y = 0; y < H; y += rows) {
+            om_strip sub = {W, H, y, y + rows > H ? H - y : rows, smp + (size_t)y * W, terms + (size_t)y * W};
+            CHECK_OK(m->observe(state, &sub, &d));
+        }
+        CHECK(!memcmp(kept, terms, (size_t)W * H * sizeof *terms));   /* observe leaves them */
+        out[f][0] = asm_tree_hash(state);
+        CHECK_OK(m->build(state, &d));
+        out[f][1] = asm_tree_hash(state);
+        ps->lend(state, NULL);
+        CHECK_OK(m->resolve(state, &st, &d));
+        *used += ((const om__asm_state *)state)->tree.created;
+    }
+    for (int k = 0; k < 3; k++) free(h.slot[k]);
+    free(mm);
+    free(depth);
+    free(id);
+    free(smp);
+    free(terms);
+    free(kept);
+}
+
+static void asm_jobs_tree(void)
+{
+    static const char *const sets[] = {"asm.cap=300000 asm.stride=1 asm.root=256 asm.work=100000",
+                                       "asm.cap=2000000 asm.stride=1 asm.root=256 asm.work=100000",
+                                       "asm.cap=200000 asm.stride=3", "asm.stride=2 asm.work=1000",
+                                       "asm.cap=600000 asm.stride=1 asm.root=256 asm.work=10000"};
+    enum { NF = 6 };
+    h_scene hs;
+    if (!h_scene_parse(&hs, om_scene_default_text())) return;
+    for (int k = 0; k < 5; k++)
+        for (uint32_t rows = 8; rows <= 72; rows += 64)
+            for (int j = 0; j < 3; j++) {
+                const float jump = j == 0 ? 0.0f : j == 1 ? 2.5f : -1.0f;
+                uint64_t a[NF][2], b[NF][2];
+                uint32_t ua = 0, ub = 0;
+                asm_jobs_case(&hs.s, sets[k], rows, jump, false, a, &ua, NF);
+                asm_jobs_case(&hs.s, sets[k], rows, jump, true, b, &ub, NF);
+                CHECK(ua > 0 && ua == ub);
+                for (int f = 0; f < NF; f++)
+                    CHECK_MSG(a[f][0] == b[f][0] && a[f][1] == b[f][1],
+                              "asm %s, strips of %u, jump %d, frame %d: the tree after %s differs", sets[k], rows, j,
+                              f, a[f][0] != b[f][0] ? "observe" : "build");
+            }
+    h_scene_free(&hs);
+}
+
 void suite_asm(void)
 {
     RUN(tree_layout);
@@ -675,4 +890,6 @@ void suite_asm(void)
     RUN(float_bounds_hold);
     RUN(float_path_is_exact);
     RUN(odd_settings_render);
+    RUN(asm_bands);
+    RUN(asm_jobs_tree);
 }

@@ -1,8 +1,8 @@
-/* test_core.c — arena (exhaustion, alignment, rewind, fault injection), pools,
+/* unit/core.c — arena (exhaustion, alignment, rewind, fault injection), pools,
  * deterministic trigonometry and the diagnostic formatter. */
-#include "test.h"
-#include "../engine/testing.h"
-#include "../engine/core/core.h"
+#include "../test.h"
+#include "../../engine/testing.h"
+#include "../../engine/core/core.h"
 
 #include <math.h>
 

@@ -1,12 +1,13 @@
-/* test_raster.c — the fixed-point rasterizer: hand-checked masks, both windings, the
+/* unit/raster.c — the fixed-point rasterizer: hand-checked masks, both windings, the
  * top-left rule, watertightness of shared edges (fans, grids, random triangulations,
  * sub-pixel vertices), clipping at the near and far planes, coordinates that would
  * overflow 32-bit setup, conservative coverage, the point-in-triangle test, and the
  * entry for triangles already on the grid, the plain depth pass made alongside a
- * conservative one, depth passes on rectilinear grids, and non-finite vertices. */
-#include "test.h"
-#include "../engine/raster/raster.h"
-#include "../engine/core/core.h"
+ * conservative one, depth passes on rectilinear grids, non-finite vertices, and the
+ * depth's division by 32-bit words. */
+#include "../test.h"
+#include "../../engine/raster/raster.h"
+#include "../../engine/core/core.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -59,7 +60,7 @@ static bool depth_near_plane(const int64_t x[3], const int64_t y[3], const uint3
     return (err << 34) <= aD * (((i128)1 << 33) + 2 * ((gx < 0 ? -gx : gx) + (gy < 0 ? -gy : gy)));
 }
 #else
-#error "test_raster.c checks depths in 128-bit integers: build the tests with gcc or clang on a 64-bit host"
+#error "unit/raster.c checks depths in 128-bit integers: build the tests with gcc or clang on a 64-bit host"
 #endif
 
 /* Rasterizes one triangle alone and adds its coverage to count_buf. */
@@ -835,6 +836,50 @@ static void non_finite_vertices_draw_nothing(void)
     CHECK_EQ_U(touched, 0);
 }
 
+static uint32_t rnd32(uint32_t *s)
+{
+    *s ^= *s << 13;   /* xorshift: every bit as random as the others */
+    *s ^= *s >> 17;
+    *s ^= *s << 5;
+    return *s;
+}
+
+/* om__zdepth by 32-bit words (raster.h, the Cortex-M4's way) gives the 64-bit
+ * division's quotient: every shift, significands at both ends of their range, next to
+ * each other and random, wherever the quotient fits 32 bits (z < w). */
+static void zdepth_by_words(void)
+{
+    uint32_t seed = 0x2545F491u, bad = 0, n = 0;
+    for (int s = -24; s <= 32; s++)
+        for (int i = 0; i < 4000; i++) {
+            uint32_t mz, mw;
+            switch (i % 8) {
+            case 0: mz = rnd32(&seed) % 0xFFFFFFu + 1; mw = 0xFFFFFFu; break;
+            case 1: mw = (rnd32(&seed) & 0x7FFFFFu) | 0x800000u; mz = mw - 1 - rnd32(&seed) % 4; break;
+            case 2: mz = (rnd32(&seed) & 0x7FFFFFu) | 0x800000u; mw = 0x800000u; break;
+            case 3: mz = rnd32(&seed) % 64 + 1; mw = rnd32(&seed) % 64 + 1; break;   /* subnormal-like */
+            default: mz = rnd32(&seed) % 0xFFFFFFu + 1; mw = rnd32(&seed) % 0xFFFFFFu + 1; break;
+            }
+            const uint64_t z = mz, w = mw;
+            /* the quotient must fit 32 bits, as it does for z < w */
+            if (s > 0 && (z << s) / w > 0xFFFFFFFFu) continue;
+            const uint64_t want = s >= 0 ? (z << s) / w : z / (w << -s);
+            bad += om__zdepth_words(mz, mw, s) != want;
+            n++;
+        }
+    CHECK_MSG(bad == 0 && n > 150000, "%u of %u quotients differ", bad, n);
+    /* and through om__zdepth, whichever way it divides: depths of floats */
+    const float zs[] = {1e-40f, 1e-30f, 0.25f, 0.5f, 0.999f, 1.0f, 3.0f, 1e20f};
+    for (int a = 0; a < 8; a++)
+        for (int b = 0; b < 8; b++) {
+            const float z = zs[a], w = zs[b];
+            const double q = (double)z / (double)w * 4294967296.0;   /* exact enough to floor here */
+            const uint32_t want = !(z > 0.0f) ? 0 : !(z < w) ? 0xFFFFFFFFu : (uint32_t)floor(q);
+            CHECK_MSG(om__zdepth(z, w) == want || (q - floor(q)) * (q - floor(q)) < 1e-12,
+                      "zdepth(%g, %g) = %u, not %u", (double)z, (double)w, om__zdepth(z, w), want);
+        }
+}
+
 void suite_raster(void)
 {
     RUN(hand_checked_masks);
@@ -854,4 +899,5 @@ void suite_raster(void)
     RUN(conservative_centres_match_depth_pass);
     RUN(strips_match_whole);
     RUN(non_finite_vertices_draw_nothing);
+    RUN(zdepth_by_words);
 }

@@ -1,15 +1,15 @@
-/* test_hiz.c — the coarse depth of depth-only targets (om__hiz_words, hiz.c):
+/* unit/hiz.c — the coarse depth of depth-only targets (om__hiz_words, hiz.c):
  * maps drawn with it hold exactly the bits drawn without it, over random and
  * adversarial triangles (huge ones through one point, as the slow scene of issue 24
  * makes them; flat ties; depths at 0 and 2^32 - 1; steep slivers at the slopes' limit;
  * small ones between), at pixel centres and on rectilinear grids, whole and by bands;
  * its bounds stay above every stored depth; and a scene's light map of 300 huge
  * triangles is the same through om__scene_raster_hiz. */
-#include "test.h"
-#include "../engine/raster/scene_raster.h"
-#include "../engine/scene/scene.h"
-#include "scene_util.h"
-#include "harness.h"
+#include "../test.h"
+#include "../../engine/raster/scene_raster.h"
+#include "../../engine/scene/scene.h"
+#include "../scene_util.h"
+#include "../harness.h"
 
 #include <stdlib.h>
 #include <string.h>

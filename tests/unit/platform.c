@@ -1,10 +1,10 @@
-/* test_platform.c — the PPM/PGM sinks (headers, streamed rows, mask values, format
+/* unit/platform.c — the PPM/PGM sinks (headers, streamed rows, mask values, format
  * conversion), output files that keep the old bytes until the new ones are whole,
- * the mesh loader (each file once, long directories kept) and file reading errors
- * that name the file. */
+ * the mesh loader (each file once, long directories kept), file reading errors
+ * that name the file, and the pool of threads (platform/jobs.c). */
 #define _XOPEN_SOURCE 700   /* mkdir, dirent */
-#include "test.h"
-#include "../platform/platform.h"
+#include "../test.h"
+#include "../../platform/platform.h"
 
 #include <dirent.h>
 #include <stdlib.h>
@@ -199,6 +199,41 @@ static void loader_reads_each_file_once(void)
     om_file_loader_free(&fl);
 }
 
+/* The platform's pool runs every index of every call once, whatever the threads and n
+ * (each thread's chunk first, then the others' next jobs): counted per index. */
+typedef struct once_ctx {
+    om_jobs *pool;
+    uint32_t threads, count[100], bad_worker;
+} once_ctx;
+
+static void count_once(void *user, uint32_t i)
+{
+    once_ctx *o = (once_ctx *)user;
+    __atomic_fetch_add(&o->count[i], 1u, __ATOMIC_RELAXED);
+    if (om_jobs_worker(o->pool) >= o->threads) __atomic_store_n(&o->bad_worker, 1u, __ATOMIC_RELAXED);
+}
+
+static void pool_each_once(void)
+{
+    static const uint32_t threads[] = {1, 2, 3, 7, 16}, ns[] = {0, 1, 2, 3, 5, 7, 16, 17, 31, 64, 100};
+    for (int k = 0; k < 5; k++) {
+        once_ctx o;
+        memset(&o, 0, sizeof o);
+        o.threads = threads[k];
+        CHECK_OK(om_jobs_start(&o.pool, threads[k], NULL));
+        for (int round = 0; round < 3; round++)
+            for (int c = 0; c < 11; c++) {
+                memset(o.count, 0, sizeof o.count);
+                om_jobs_for(o.pool, count_once, &o, ns[c]);
+                for (uint32_t i = 0; i < 100; i++)
+                    CHECK_MSG(o.count[i] == (i < ns[c]), "%u threads, n %u: job %u ran %u times", threads[k],
+                              ns[c], i, o.count[i]);
+            }
+        CHECK(!o.bad_worker);
+        om_jobs_stop(o.pool);
+    }
+}
+
 void suite_platform(void)
 {
     RUN(ppm_round_trip);
@@ -206,4 +241,5 @@ void suite_platform(void)
     RUN(outputs_replace_whole_or_not_at_all);
     RUN(grey_sink_writes_pgm);
     RUN(loader_reads_each_file_once);
+    RUN(pool_each_once);
 }

@@ -3,7 +3,7 @@
 # that together they need nothing from outside but memcpy/memset/memmove/memcmp and
 # exactly-rounded libm functions (no malloc, no stdio, no sin/cos/tan/atan/pow/exp).
 set -eu
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 CC=${CC:-cc}
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT

@@ -1,6 +1,6 @@
-/* test_measure.c — the metrics on hand-made masks: counts, the edge band, the
+/* unit/measure.c — the metrics on hand-made masks: counts, the edge band, the
  * difference image and flicker. */
-#include "test.h"
+#include "../test.h"
 #include "ombra.h"
 #include "ombra_measure.h"
 

@@ -1,4 +1,4 @@
-/* test_oracle.c — the reference against an independent oracle, and surfaces that
+/* property/oracle.c — the reference against an independent oracle, and surfaces that
  * never shadow themselves.
  *
  * The oracle shares nothing with the occlusion predicate: for every exposed sample it
@@ -14,8 +14,8 @@
  *     what the grid resolves);
  *   - other: none of these; a test fails on any.
  * and the share that disagrees must stay within 0.005% of the covered samples. */
-#include "test.h"
-#include "harness.h"
+#include "../test.h"
+#include "../harness.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -1,11 +1,11 @@
-/* test_robust.c — nothing crashes, nothing is lost: every arena carve of every method
- * fails once in turn and the next frame still renders correctly; pathological geometry
- * (NaN, infinities, 1e30, zero-area and needle triangles, coincident vertices) and
- * views (empty scene, camera inside a mesh, everything behind the near plane, images
+/* property/robust.c — nothing crashes, nothing is lost: every arena carve of every
+ * method fails once in turn and the next frame still renders correctly; pathological
+ * geometry (NaN, infinities, 1e30, zero-area and needle triangles, coincident vertices)
+ * and views (empty scene, camera inside a mesh, everything behind the near plane, images
  * of 0x0, 1x1 and 8192x8192) give a status and a message or a correct frame. */
-#include "test.h"
-#include "../engine/testing.h"
-#include "harness.h"
+#include "../test.h"
+#include "../../engine/testing.h"
+#include "../harness.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -1,10 +1,10 @@
-/* test_obj.c — OBJ meshes and the scene's mesh line: om_obj_count's counts of
+/* unit/obj.c — OBJ meshes and the scene's mesh line: om_obj_count's counts of
  * vertices and triangles (polygons fanned, negative indices, skipped statements) and
  * its errors with line and column; meshes brought in through a loader, moved by their
  * transforms, with errors inside the OBJ or from the loader named with both files'
  * lines; a file that changes between the two passes is noticed. */
-#include "test.h"
-#include "scene_util.h"
+#include "../test.h"
+#include "../scene_util.h"
 
 #include <stdlib.h>
 

@@ -1,14 +1,16 @@
-/* test_izb.c — the irregular z-buffer equals the reference sample for sample: on the
+/* method/izb.c — the irregular z-buffer equals the reference sample for sample: on the
  * default scene, on seeded random scenes with semi-transparent casters, on a hot spot
  * (a floor at a grazing light angle), under a directional light, and at every tiling
  * from one pass down to tiles of a few rows, through strips too. Budgets below the
  * minimum fail naming it; budgets between minimum and one pass tile; the default pool
  * takes tiles where the scene has few triangles for the image. The triangles binned on
  * the light's image (lgrid.c) list each triangle where its box lies, made in parts or
- * at once, and a tile that walks only its own gives the same terms and counts. */
-#include "test.h"
-#include "harness.h"
-#include "../engine/shadow/izb/izb.h"
+ * at once, and a tile that walks only its own gives the same terms and counts. Its
+ * tiles as jobs give the same frame on any number of threads (izb_pass). */
+#include "../test.h"
+#include "../harness.h"
+#include "../jobs_util.h"
+#include "../../engine/shadow/izb/izb.h"
 
 #include <stdlib.h>
 
@@ -445,6 +447,54 @@ static void grid_same_walk(void)
     }
 }
 
+/* ---- izb: its tiles of exposed samples as jobs (om__pass), each with a pool of its
+ * own from the frame arena. The same terms, pixels and counters for any number of jobs
+ * and their order, whole frames and strips, one tile or many (izb.pool); a frame arena
+ * without room for two pools runs the tiles inline, the same again. */
+static void izb_pass(void)
+{
+    om_jobs *pools[4];
+    uint32_t calls = 0;
+    const om_method *m = om_method_find("izb");
+    for (int k = 0; k < 4; k++) CHECK_OK(om_jobs_start(&pools[k], pass_threads[k], NULL));
+    for (int li = 0; li < 2; li++) {
+        h_scene hs;
+        if (!h_scene_parse(&hs, li ? directional_scene : om_scene_default_text())) continue;
+        for (int pi = 0; pi < 3; pi++)
+            for (uint32_t rows = 0; rows <= 24; rows += 24) {
+                static const uint32_t pool_of[] = {0, 397, 2000};
+                char set[32];
+                snprintf(set, sizeof set, "izb.pool=%u", pool_of[pi]);
+                frame_out one = render_set(&hs.s, m, set, 160, 120, rows, NULL, NULL, 1, 0, true);
+                CHECK_MSG(one.st == OM_OK && one.jobs == 1, "izb: inline frame");
+                size_t last_peak = 0;
+                /* a pool of 397 leaves many tiles a strip */
+                CHECK_MSG(pi != 1 || one.ms.counters[5] > 3 * (rows ? 120 / rows : 1), "izb pool %u: %u tiles",
+                          pool_of[pi], one.ms.counters[5]);
+                for (size_t k = 0; k < PASS_HOSTS; k++) {
+                    const pass_host *h = &pass_hosts[k];
+                    const uint32_t n = host_threads(h);
+                    const bool lean = h->lean;   /* room for the bands' slots only: the tiles inline */
+                    frame_out o = pass_frame(&hs.s, m, set, rows, h, pools, &calls);
+                    CHECK_MSG(o.st == OM_OK && o.jobs == n, "izb: %u jobs ran %u", n, o.jobs);
+                    CHECK_MSG(o.hash == one.hash && !memcmp(o.ms.counters, one.ms.counters, sizeof o.ms.counters),
+                              "izb light %d pool %u strips %u: %u threads%s change the frame", li, pool_of[pi],
+                              rows, n, h->what);
+                    /* the pools of two jobs at least (keys of 24 bytes, two buffers); the
+                     * lean frame (5 jobs, as the one before it) without them */
+                    size_t pool = pool_of[pi] ? pool_of[pi] : 160 * 120;
+                    if (!lean) CHECK_MSG(o.peak > one.peak + 2 * 48 * pool, "izb %u jobs: no pools (%zu vs %zu)",
+                                         n, o.peak, one.peak);
+                    else CHECK_MSG(o.peak + 2 * 48 * pool < last_peak, "izb lean: %zu vs %zu", o.peak, last_peak);
+                    last_peak = o.peak;
+                }
+            }
+        h_scene_free(&hs);
+    }
+    CHECK_MSG(calls > 0, "izb: the pass never asked the host which thread runs a job");
+    for (int k = 0; k < 4; k++) om_jobs_stop(pools[k]);
+}
+
 void suite_izb(void)
 {
     RUN(izb_default_scene);
@@ -455,4 +505,5 @@ void suite_izb(void)
     RUN(default_pool);
     RUN(grid_lists);
     RUN(grid_same_walk);
+    RUN(izb_pass);
 }

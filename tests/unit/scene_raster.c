@@ -1,4 +1,4 @@
-/* test_scene_raster.c — the walk over a scene's triangles (om__scene_raster,
+/* unit/scene_raster.c — the walk over a scene's triangles (om__scene_raster,
  * scene_raster.c): without vertex bins it transforms, tests, projects and boxes a batch
  * of triangles at a time and passes over those whose box holds no pixel centre. Its
  * maps and ids must be exactly those of sending every triangle on its own through
@@ -8,11 +8,12 @@
  * batch; into whole targets and strips, depth and depth + id, with and without the
  * culling of closed shapes and the coarse depth. With the frame's bins (rows and
  * vertices snapped alone), whose triangles a 32-bit box test passes over first, too;
- * and the bins themselves, made in parts, against each vertex projected alone. */
-#include "test.h"
-#include "../engine/raster/scene_raster.h"
-#include "../engine/raster/hiz.h"
-#include "harness.h"
+ * and the bins themselves, made in parts, against each vertex projected alone. And the
+ * back-face culling of closed shapes (om__cull) leaving light and eye maps the same. */
+#include "../test.h"
+#include "../../engine/raster/scene_raster.h"
+#include "../../engine/raster/hiz.h"
+#include "../harness.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -264,9 +265,127 @@ static void centre_rows_at_the_edges(void)
     CHECK(drawn > W * W / 2);
 }
 
+/* Rasterizes the scene through vp without and with culling into (d0, i0) and (d1, i1)
+ * (ids NULL: depth only) and counts the texels that differ; *covered counts those the
+ * unculled pass reached. */
+static uint32_t cull_diff(const om_scene *s, const om_mat4 *vp, uint32_t n, uint32_t *d0, uint32_t *i0,
+                          uint32_t *d1, uint32_t *i1, uint32_t *covered)
+{
+    om_raster_mode mode = i0 ? OM_RASTER_DEPTH_ID : OM_RASTER_DEPTH;
+    om_target t0 = {n, n, 0, n, d0, i0}, t1 = {n, n, 0, n, d1, i1};
+    om__scene_raster(s, vp, &t0, mode, false, NULL);
+    om__scene_raster(s, vp, &t1, mode, true, NULL);
+    uint32_t diff = 0;
+    *covered = 0;
+    for (uint32_t i = 0; i < n * n; i++) {
+        diff += d0[i] != d1[i] || (i0 && i0[i] != i1[i]);
+        *covered += d0[i] != UINT32_MAX;
+    }
+    return diff;
+}
+
+/* Back-face culling of a light's depth map (om__cull): the scene records its closed
+ * shapes, and on them the map is the same bits with and without culling, wherever the
+ * light is; a solid that holds the light or that the near plane cuts is not culled
+ * (culling it would lose its nearest, back-facing, surface). */
+static void light_cull_keeps_the_map(void)
+{
+    enum { N = 512 };
+    static uint32_t full[N * N], culled[N * N];
+    h_scene hs;
+    if (!h_scene_parse(&hs, "camera eye 0 6 9 target 0 0 0 fov 60 size 160 120 near 0.1 far 100\n"
+                            "light spot pos 6 8 5 target 0 0 0 fov 70 near 0.5 far 40\n"
+                            "plane size 20 20 divisions 4\n"
+                            "box size 2 1 3 rotate 10 20 30 translate -3 0.8 0\n"
+                            "sphere radius 1 segments 24 rings 12 scale 1 0.5 2 rotate 0 40 0 translate 0 1 -3\n"
+                            "triangles count 60 seed 1 area 4 in -5 0 -5 5 3 5\n"
+                            "box size 1 1 1 scale -1 2 1 rotate 0 30 0 translate 3 0.5 2\n"
+                            "cylinder radius 0.5 height 2 segments 20 rotate 90 0 0 translate 2 1 -2\n"
+                            "box size 4 4 4 translate 8 2 8\n"))
+        return;
+    const om_scene *s = &hs.s;
+    /* the three boxes, the sphere and the cylinder, in scene order; not the plane or
+     * the triangle cloud */
+    static const uint32_t counts[5] = {12, 2 * 24 * 11, 12, 4 * 20, 12};
+    CHECK_EQ_U(s->nsolids, 5);
+    uint32_t first[5] = {32, 32 + 12, 32 + 12 + 2 * 24 * 11 + 60, 0, 0};
+    first[3] = first[2] + 12;
+    first[4] = first[3] + 80;
+    for (uint32_t k = 0; k < s->nsolids && k < 5; k++) {
+        const om_solid *o = &s->solids[k];
+        CHECK_EQ_U(o->first, first[k]);
+        CHECK_EQ_U(o->count, counts[k]);
+        for (uint32_t t = o->first; t < o->first + o->count; t++)
+            for (int c = 0; c < 3; c++) {
+                om_vec3 v = s->verts[s->idx[3 * t + c]];
+                CHECK(v.x >= o->lo.x && v.y >= o->lo.y && v.z >= o->lo.z);
+                CHECK(v.x <= o->hi.x && v.y <= o->hi.y && v.z <= o->hi.z);
+            }
+    }
+    CHECK_EQ_U(first[4] + 12, s->ntris);
+    /* lights: above, grazing, inside the last box, with a near plane through the
+     * first box, and a directional light */
+    static const float lights[5][8] = {
+        {6, 8, 5, 0, 0, 0, 0.5f, 40}, {-9, 2, -7, 0, 0.5f, 0, 0.5f, 40},
+        {8, 2, 8, 0, 0, 0, 0.2f, 40}, {-3, 3.5f, 0, -3, 0, 0, 2.6f, 20}, {0, 0, 0, 0, 0, 0, 0, 0}};
+    for (int k = 0; k < 5; k++) {
+        om_camera cam;
+        om_light light;
+        om_scene_at(s, 0, &cam, &light);
+        const float *l = lights[k];
+        if (k == 4) {
+            light.kind = OM_LIGHT_DIRECTIONAL;
+            light.dir = om__v3(0.3f, -1.0f, 0.2f);
+        } else {
+            light.pos = om__v3(l[0], l[1], l[2]);
+            light.target = om__v3(l[3], l[4], l[5]);
+            light.znear = l[6];
+            light.zfar = l[7];
+        }
+        om_view v;
+        CHECK_OK(om_view_init(&v, &cam, &light, s, NULL));
+        uint32_t covered, diff = cull_diff(s, &v.light_vp, N, full, NULL, culled, NULL, &covered);
+        CHECK_MSG(diff == 0, "light %d: %u of %u covered texels differ", k, diff, covered);
+        CHECK(covered > N * N / 8);
+        /* which solids were culled */
+        om__cull cl;
+        om__cull_begin(&cl, s, &v.light_vp);
+        unsigned on = 0;
+        for (uint32_t t = 0; t < s->ntris; t++)
+            if (om__cull_next(&cl, t))
+                for (unsigned j = 0; j < 5; j++)
+                    if (t == first[j]) on |= 1u << j;
+        /* light 0 has the last box behind it and light 2 inside it; light 3's near
+         * plane (y = 0.9) cuts every solid, though the light is inside none */
+        unsigned want = k == 0 || k == 2 ? 0x0Fu : k == 3 ? 0u : 0x1Fu;
+        CHECK_MSG(on == want, "light %d: solids culled %#x, expected %#x", k, on, want);
+    }
+    /* the eye pass culls too: the same depths and visible triangles from the scene's
+     * camera, from one inside the last box and from one whose near plane cuts it */
+    static const float eyes[3][7] = {{0, 6, 9, 0, 0, 0, 0.1f}, {8, 2, 8, 0, 0, 0, 0.1f},
+                                     {8, 2, 11, 8, 2, 0, 1.5f}};
+    static uint32_t ids_full[N * N], ids_culled[N * N];
+    for (int k = 0; k < 3; k++) {
+        om_camera cam;
+        om_light light;
+        om_scene_at(s, 0, &cam, &light);
+        const float *e = eyes[k];
+        cam.eye = om__v3(e[0], e[1], e[2]);
+        cam.target = om__v3(e[3], e[4], e[5]);
+        cam.znear = e[6];
+        om_view v;
+        CHECK_OK(om_view_init(&v, &cam, &light, s, NULL));
+        uint32_t covered, diff = cull_diff(s, &v.cam_vp, N, full, ids_full, culled, ids_culled, &covered);
+        CHECK_MSG(diff == 0, "eye %d: %u of %u covered texels differ", k, diff, covered);
+        CHECK(covered > N * N / 8);
+    }
+    h_scene_free(&hs);
+}
+
 void suite_scene_raster(void)
 {
     RUN(scene_walk_same_as_one_by_one);
     RUN(bins_depths_at_the_edges);
     RUN(centre_rows_at_the_edges);
+    RUN(light_cull_keeps_the_map);
 }

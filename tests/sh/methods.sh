@@ -3,10 +3,10 @@
 # settings (they live in each method's table), and a firmware built with only `sm`
 # (registry.c under OM_WITH_*=0 for the others) carries none of the other methods'
 # code and renders the frame the full library renders.
-# Usage: sh tests/methods.sh BUILD_DIR (after make has built embed-render-once and
+# Usage: sh tests/sh/methods.sh BUILD_DIR (after make has built embed-render-once and
 # embed-only-sm there).
 set -u
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 O=$1
 fail=0
 bad() { fail=1; echo "methods: FAIL — $1"; }

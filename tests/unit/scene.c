@@ -1,10 +1,10 @@
-/* test_scene.c — the scene text format, procedural shapes and paths: values and
+/* unit/scene.c — the scene text format, procedural shapes and paths: values and
  * defaults as parsed, exact byte queries, closed outward-wound shapes, errors with the
  * right status, line and column, om_scene_at and the default scene. OBJ meshes are in
- * test_obj.c, random mutations in test_scene_fuzz.c, shared helpers in scene_util.c. */
-#include "test.h"
-#include "../engine/testing.h"
-#include "scene_util.h"
+ * unit/obj.c, random mutations in unit/scene_fuzz.c, shared helpers in scene_util.c. */
+#include "../test.h"
+#include "../../engine/testing.h"
+#include "../scene_util.h"
 
 #include <math.h>
 #include <stdlib.h>

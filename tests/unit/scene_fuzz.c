@@ -1,9 +1,9 @@
-/* test_scene_fuzz.c — random mutations of the default scene's text (flipped, deleted,
+/* unit/scene_fuzz.c — random mutations of the default scene's text (flipped, deleted,
  * inserted and duplicated bytes, cut-short text) through both passes of the scene
  * reader: never a crash or an out-of-range status, both passes agree on errors, and
  * every scene that parses holds in-range indices, materials and finite vertices. */
-#include "test.h"
-#include "scene_util.h"
+#include "../test.h"
+#include "../scene_util.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -1,10 +1,10 @@
-/* test_settings.c — every method owns its settings: each table entry lies inside the
+/* unit/settings.c — every method owns its settings: each table entry lies inside the
  * method's own configuration (no two overlap), its default is inside its range and is
  * what om_method_cfg_default writes, values outside the range or of another method are
  * refused, and om_method_cfg_from carries only what two methods share. */
-#include "test.h"
-#include "harness.h"
-#include "../engine/shadow/method.h"   /* the tables themselves (cfg_bytes) */
+#include "../test.h"
+#include "../harness.h"
+#include "../../engine/shadow/method.h"   /* the tables themselves (cfg_bytes) */
 
 #include <math.h>
 

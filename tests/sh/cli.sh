@@ -1,7 +1,7 @@
 #!/bin/sh
 # cli.sh — the `ombra` command as a user runs it: help, a default render, strips and
 # budgets giving the same frame, and errors that name the file, line and fix.
-# Usage: sh tests/cli.sh path/to/ombra
+# Usage: sh tests/sh/cli.sh path/to/ombra
 set -u
 OMBRA=$1
 dir=$(dirname "$OMBRA")/cli-test
@@ -297,7 +297,7 @@ rm -f "$dir/long.pgm"
 # What the parser accepts renders, and what would not is refused with its line and
 # column: values as floats (fov 179.999999 is 180), near below 1e7, far below 1e8,
 # and key paths along which the eye meets its target or a light's dir meets zero.
-regress=$(dirname "$0")/fuzz/regress
+regress=$(dirname "$0")/../fuzz/regress
 for f in far-1e8 far-99999999 near-1e7 fov-179 keys-eye-on-target; do
     expect 1 "$f.scene is refused" -- "$OMBRA" render "$regress/$f.scene" --time 1 --out "$dir/z.ppm"
     has "$dir/err" "$f.scene: line [0-9]*, col [0-9]*: " "$f.scene's error has a line and column"

@@ -1,13 +1,15 @@
-/* test_spsm.c — Sub-Pixel Shadow Maps: conservative coverage against an exact overlap
+/* method/spsm.c — Sub-Pixel Shadow Maps: conservative coverage against an exact overlap
  * test, the 128-bit texel's packing, the derivative code's error profile (section 3.4),
  * the build's table code against it, the pattern table, accuracy against the reference and the conventional map (the
  * default scene, a dense mesh), bit-identical frames, budgets and statistics; the
  * lookup's float depth tests against the double ones and its 32-bit edge values against
- * the shared routine; the build's plane without double against the double one. */
-#include "test.h"
-#include "harness.h"
-#include "../engine/shadow/spsm/spsm.h"
-#include "../engine/shadow/spsm/spsm_lookup.h"
+ * the shared routine; the build's plane without double against the double one. Its
+ * threading tests are method/rtw.c's settings_by_bands and observe_lent, which test
+ * rtw and spsm together. */
+#include "../test.h"
+#include "../harness.h"
+#include "../../engine/shadow/spsm/spsm.h"
+#include "../../engine/shadow/spsm/spsm_lookup.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -1,10 +1,10 @@
-/* test_frame.c — the eye pass, the lit rule's geometric half, shading and the frame
+/* unit/frame.c — the eye pass, the lit rule's geometric half, shading and the frame
  * driver: exact visible points, strips identical to a whole frame, pixel formats,
  * budgets, and the method registry. Scenes are built by hand so this suite does not
  * depend on the parser. */
-#include "test.h"
-#include "harness.h"
-#include "../engine/shadow/method.h"
+#include "../test.h"
+#include "../harness.h"
+#include "../../engine/shadow/method.h"
 
 #include <math.h>
 #include <stdlib.h>

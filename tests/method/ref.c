@@ -1,0 +1,304 @@
+/* method/ref.c — the reference: analytic cases, the BVH walk against a brute-force
+ * loop over every triangle (semi-transparent casters included), the one-pass fit of
+ * the light's BVH in parts, and its smaller modes giving the one-pass terms. Its
+ * independent oracle is property/oracle.c's. */
+#include "../test.h"
+#include "../harness.h"
+#include "../../engine/shadow/common/occlude.h"
+#include "../../engine/shadow/ref/ref_light.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+#define W 160
+#define H 120
+static uint8_t mask[W * H];
+static om_term terms[W * H];
+static om_sample samples[W * H];
+
+static const char *default_scene(void) { return om_scene_default_text(); }
+
+static om_status capture_terms(void *user, const om_strip *st, const om_framebuffer *fb)
+{
+    (void)fb;
+    om_term *t = *(om_term **)user;
+    memcpy(t + (size_t)st->y0 * st->width, st->terms, (size_t)st->rows * st->width * sizeof *t);
+    return OM_OK;
+}
+
+static void square_under_sun(void)
+{
+    h_scene hs;
+    if (!h_scene_parse(&hs, "camera eye 0 6 6 target 0 0 0 fov 60 size 160 120 near 0.1 far 100\n"
+                            "light directional dir 0 -1 0\n"
+                            "plane size 20 20\n"
+                            "plane size 2 2 translate 0 1 0\n"))
+        return;
+    CHECK_OK(h_render(&hs.s, "ref", NULL, 0, 0, 0, 0, mask, NULL, samples));
+    int checked = 0, shadowed = 0, wrong = 0;
+    for (int i = 0; i < W * H; i++) {
+        if (samples[i].tri == OM_NO_TRI || samples[i].p[1] > 0.5f) continue;   /* floor only */
+        float x = fabsf(samples[i].p[0]), z = fabsf(samples[i].p[2]);
+        if (fabsf(x - 1) < 1e-4f || fabsf(z - 1) < 1e-4f) continue;
+        bool expect_shadow = x < 1 && z < 1;
+        checked++;
+        shadowed += expect_shadow;
+        if ((mask[i] == OM_MASK_SHADOW) != expect_shadow) wrong++;
+    }
+    CHECK_MSG(wrong == 0, "%d of %d floor samples wrong", wrong, checked);
+    CHECK(shadowed > 200 && checked > 5000);
+    h_scene_free(&hs);
+}
+
+/* Segment p -> l against triangle (a, b, c) in double: 1 clearly hit, -1 clearly
+ * missed, 0 within eps of an edge or an end (left out of the comparison). */
+static int seg_tri(const double p[3], const double l[3], const om_vec3 *a, const om_vec3 *b,
+                   const om_vec3 *c, double eps)
+{
+    double d[3] = {l[0] - p[0], l[1] - p[1], l[2] - p[2]};
+    double e1[3] = {b->x - a->x, b->y - a->y, b->z - a->z}, e2[3] = {c->x - a->x, c->y - a->y, c->z - a->z};
+    double q[3] = {d[1] * e2[2] - d[2] * e2[1], d[2] * e2[0] - d[0] * e2[2], d[0] * e2[1] - d[1] * e2[0]};
+    double det = e1[0] * q[0] + e1[1] * q[1] + e1[2] * q[2];
+    if (fabs(det) < 1e-12) return -1;
+    double s[3] = {p[0] - a->x, p[1] - a->y, p[2] - a->z};
+    double u = (s[0] * q[0] + s[1] * q[1] + s[2] * q[2]) / det;
+    double r[3] = {s[1] * e1[2] - s[2] * e1[1], s[2] * e1[0] - s[0] * e1[2], s[0] * e1[1] - s[1] * e1[0]};
+    double v = (d[0] * r[0] + d[1] * r[1] + d[2] * r[2]) / det;
+    double t = (e2[0] * r[0] + e2[1] * r[1] + e2[2] * r[2]) / det;
+    if (u > eps && v > eps && u + v < 1 - eps && t > eps && t < 1 - eps) return 1;
+    if (u < -eps || v < -eps || u + v > 1 + eps || t < -eps || t > 1 + eps) return -1;
+    return 0;
+}
+
+static void sphere_under_spot(void)
+{
+    h_scene hs;
+    if (!h_scene_parse(&hs, "camera eye 0 5 7 target 0 0.5 0 fov 50 size 160 120 near 0.1 far 100\n"
+                            "light spot pos 1 8 0.5 target 0 0 0 fov 70 near 1 far 30\n"
+                            "plane size 20 20\n"
+                            "sphere radius 1 segments 48 rings 24 translate 0 1.5 0\n"))
+        return;
+    CHECK_OK(h_render(&hs.s, "ref", NULL, 0, 0, 0, 0, mask, terms, samples));
+    const double L[3] = {1, 8, 0.5};
+    int checked = 0, shadowed = 0, wrong = 0;
+    for (int i = 0; i < W * H; i++) {
+        /* floor samples inside the light's frustum (outside it nothing is lit) */
+        if (samples[i].tri == OM_NO_TRI || samples[i].tri >= 2 || !(terms[i].flags & OM_TERM_EXPOSED))
+            continue;
+        double p[3] = {samples[i].p[0], samples[i].p[1], samples[i].p[2]};
+        int verdict = -1;
+        for (uint32_t t = 2; t < hs.s.ntris && verdict != 1; t++) {
+            const uint32_t *ix = hs.s.idx + 3 * t;
+            int r = seg_tri(p, L, &hs.s.verts[ix[0]], &hs.s.verts[ix[1]], &hs.s.verts[ix[2]], 1e-4);
+            if (r == 1) verdict = 1;
+            else if (r == 0) verdict = 0;
+        }
+        if (verdict == 0) continue;
+        checked++;
+        shadowed += verdict == 1;
+        if ((mask[i] == OM_MASK_SHADOW) != (verdict == 1)) wrong++;
+    }
+    CHECK_MSG(wrong == 0, "%d of %d floor samples wrong", wrong, checked);
+    CHECK(shadowed > 200 && checked > 5000);
+    h_scene_free(&hs);
+}
+
+/* The reference's BVH walk must give exactly what testing every triangle gives. */
+static void bvh_equals_brute_force(void)
+{
+    static const char *scenes[] = {
+        "camera eye 0 5 8 target 0 0.5 0 fov 55 size 160 120\n"
+        "light spot pos 3 9 2 target 0 0 0 fov 75 near 1 far 40\n"
+        "plane size 14 14\n"
+        "triangles count 400 seed 3 area 25 in -3 0.3 -3 3 3 3\n"
+        "triangles count 200 seed 4 area 20 in -3 0.3 -3 3 3 3 albedo 1 0.6 0.2 opacity 0.5\n",
+        "camera eye 2 4 6 target 0 0.5 0 fov 60 size 160 120\n"
+        "light spot pos -4 7 -1 target 0 0 0 fov 80 near 0.5 far 40\n"
+        "plane size 14 14 divisions 6\n"
+        "sphere radius 0.8 segments 20 rings 10 translate 0.5 1.2 0 opacity 0.6 albedo 0.2 0.9 0.9\n"
+        "box size 1 2 1 translate -1 1 0\n"
+        "triangles count 150 seed 9 area 6 in -2 2 -2 2 3 2 opacity 0.3\n",
+    };
+    for (int k = 0; k < 2; k++) {
+        h_scene hs;
+        if (!h_scene_parse(&hs, scenes[k])) return;
+        CHECK_OK(h_render(&hs.s, "ref", NULL, 0, 0, 0, 0, NULL, terms, samples));
+        om_view v;
+        CHECK_OK(h_view(&v, &hs.s, 0, 0, 0, NULL));
+        static unsigned char mem[1 << 20];
+        om_arena a;
+        om_arena_init(&a, mem, sizeof mem, "t");
+        om__lspace ls;
+        CHECK_OK(om__lspace_init(&ls, &a, &hs.s, NULL));
+        om__lspace_begin(&ls, &v);
+        int diff = 0, partial = 0, blocked = 0;
+        for (int i = 0; i < W * H; i++) {
+            if (!(terms[i].flags & OM_TERM_EXPOSED)) continue;
+            om__lpoint p;
+            om__odepth od = {{0, 0, 0}};
+            if (om__lspace_point(&ls, &samples[i], &p))
+                for (uint32_t t = 0; t < hs.s.ntris; t++) {
+                    om__ltri lt;
+                    if (om__lspace_tri(&ls, t, &lt) && om__blocks(&lt, &p)) {
+                        om__odepth m = om__material_odepth(&hs.s.mats[hs.s.tri_mat[t]]);
+                        om__odepth_add(&od, &m);
+                    }
+                }
+            om_term want;
+            om__odepth_term(&od, &want);
+            if (want.r != terms[i].r || want.g != terms[i].g || want.b != terms[i].b) diff++;
+            partial += want.r != 255 && (want.r != 0 || want.g != 0);
+            blocked += want.r != 255;
+        }
+        CHECK_MSG(diff == 0, "scene %d: %d samples differ from brute force", k, diff);
+        CHECK_MSG(partial > 50 && blocked > 500, "scene %d: %d partial, %d blocked", k, partial, blocked);
+        h_scene_free(&hs);
+    }
+}
+
+/* The reference's one-pass fit in parts (ref_light.h, om__lbvh_plan): the parts and the
+ * nodes above them hold every node once and the parts every triangle once, and fitted
+ * part by part (last first, as threads may take them) and then the top, every node
+ * and triangle box is the same bits as the fit of the whole tree in one pass from the
+ * last node back. A cloud of 20K triangles (many parts), one with a floor the light's
+ * near plane clips, the default scene, and three triangles (the root a leaf). */
+static void lbvh_fit_in_parts(void)
+{
+    static const char *scenes[] = {
+        "camera eye 0 6 14 target 0 1 0 fov 50\n"
+        "light spot pos 8 20 6 target 0 0 0 fov 60 near 5 far 60\n"
+        "triangles count 20000 seed 7 area 20 in -5 0.5 -5 5 3 5\n",
+        "camera eye 0 6 14 target 0 1 0 fov 50\n"
+        "light spot pos 0 3 0 target 0 0 0 fov 120 near 1 far 60\n"
+        "plane size 40 40 divisions 8\n"
+        "triangles count 3000 seed 2 area 20 in -5 -1 -5 5 5 5\n",
+        NULL,
+        "camera eye 0 2 5 target 0 0 0\n"
+        "light spot pos 1 5 1 target 0 0 0\n"
+        "triangles count 3 seed 1 area 2 in -1 0 -1 1 1 1\n",
+    };
+    static unsigned char mem[12 << 20];
+    for (int k = 0; k < 4; k++) {
+        h_scene hs;
+        if (!h_scene_parse(&hs, scenes[k] ? scenes[k] : om_scene_default_text())) return;
+        const om_scene *s = &hs.s;
+        om_view v;
+        CHECK_OK(h_view(&v, s, 0, 0, 0, NULL));
+        om_arena a;
+        om_arena_init(&a, mem, sizeof mem, "t");
+        om__lspace ls;
+        om__bvh b;
+        om__lbvh parts, whole;
+        CHECK_OK(om__lspace_init(&ls, &a, s, NULL));
+        CHECK_OK(om__lbvh_init(&parts, &a, s, 4, NULL));
+        CHECK_OK(om__lbvh_init(&whole, &a, s, 4, NULL));
+        CHECK_OK(om__bvh_build(&b, &a, s, 4, NULL));
+        unsigned char *seen = (unsigned char *)calloc(b.nnodes + s->ntris, 1);
+        if (!seen) return;
+        om__lbvh_plan(&parts, &b);
+        if (k == 0) CHECK_MSG(parts.nparts >= 8, "%u parts", parts.nparts);
+        if (k == 3) CHECK(parts.nparts == 1 && parts.ntop == 0);
+        CHECK(parts.nparts >= 1 && parts.nparts <= OM__LBVH_PARTS && parts.ntop == parts.nparts - 1);
+        for (uint32_t i = 0; i < parts.ntop; i++) {
+            CHECK(parts.top[i] < b.nnodes && b.nodes[parts.top[i]].count == 0);
+            seen[parts.top[i]]++;
+        }
+        for (uint32_t p = 0; p < parts.nparts; p++) {
+            const om__lbvh_part *q = &parts.parts[p];
+            CHECK(q->node < b.nnodes && q->lo <= q->hi && q->hi <= b.nnodes && q->thi <= s->ntris);
+            seen[q->node]++;
+            for (uint32_t i = q->lo; i < q->hi && i < b.nnodes; i++) seen[i]++;
+            for (uint32_t t = q->tlo; t < q->thi && t < s->ntris; t++) seen[b.nnodes + t]++;
+        }
+        uint32_t once = 0;
+        for (uint32_t i = 0; i < b.nnodes + s->ntris; i++) once += seen[i] == 1;
+        CHECK_EQ_U(once, b.nnodes + s->ntris);
+        free(seen);
+        /* the whole tree as one part: the fit in one pass from the last node back */
+        whole.nparts = 1;
+        whole.ntop = 0;
+        whole.parts[0].node = 0;
+        whole.parts[0].lo = b.nnodes > 1 ? 1 : 0;
+        whole.parts[0].hi = b.nnodes > 1 ? b.nnodes : 0;
+        whole.parts[0].tlo = 0;
+        whole.parts[0].thi = s->ntris;
+        om__lspace_begin(&ls, &v);
+        const size_t nb = b.nnodes * sizeof(om__lnode), tb = s->ntris * sizeof(om__lbox);
+        memset(parts.nodes, 0xA5, nb);   /* what a fit leaves unwritten shows */
+        memset(parts.tris, 0xA5, tb);
+        memset(whole.nodes, 0x5A, nb);
+        memset(whole.tris, 0x5A, tb);
+        for (uint32_t p = parts.nparts; p-- > 0;) om__lbvh_fit_part(&parts, &b, &ls, p);
+        om__lbvh_fit_top(&parts, &b, &ls);
+        om__lbvh_fit(&whole, &b, &ls);
+        CHECK_MSG(!memcmp(parts.nodes, whole.nodes, nb) && !memcmp(parts.tris, whole.tris, tb),
+                  "scene %d: the fit in %u parts differs from the whole tree's", k, parts.nparts);
+        /* and that one bounds what it should: the root's box holds every vertex */
+        uint32_t out = 0;
+        for (uint32_t i = 0; i < s->nverts; i++) {
+            const om__lvert *vx = &ls.verts[i];
+            const om__lbox *r = &whole.nodes[0].box;
+            if (vx->x != INT32_MIN)
+                out += vx->x < r->lox || vx->x > r->hix || vx->y < r->loy || vx->y > r->hiy || vx->z < r->zmin;
+        }
+        CHECK_EQ_U(out, 0);
+        h_scene_free(&hs);
+    }
+}
+
+/* The reference at its least memory (no vertex cache, leaves of 32, boxes found from
+ * the vertices during the build), and just below its one-pass size (the vertex cache
+ * and the 3-D walk, without the packets), gives exactly the one-pass terms. */
+static void ref_small_equals_fast(void)
+{
+    h_scene hs;
+    if (!h_scene_parse(&hs, default_scene())) return;
+    static om_term fast[W * H], small[W * H];
+    CHECK_OK(h_render(&hs.s, "ref", NULL, W, H, 0, 0, NULL, fast, NULL));
+    const om_method *m = om_method_find("ref");
+    om_method_cfg c;
+    om_method_cfg_default(&c, m);
+    size_t mn, full;
+    CHECK_OK(om_method_bytes(m, &c, &hs.s, W, H, &mn, &full));
+    CHECK(mn < full / 4);
+    om_view v;
+    CHECK_OK(h_view(&v, &hs.s, 0, W, H, NULL));
+    for (int k = 0; k < 2; k++) {
+        const size_t size = k ? full - 1 : mn;
+        unsigned char *mem = malloc(size), *fmem = malloc(h_frame_least(W, H)), *px = malloc(W * H * 3);
+        om_arena ma, fa;
+        om_arena_init(&ma, mem, size, "method");
+        om_arena_init(&fa, fmem, h_frame_least(W, H), "frame");
+        void *state;
+        CHECK_OK(om_method_init(m, &state, &ma, &c, &hs.s, W, H, NULL));
+        om_framebuffer fb = {OM_RGB888, W, H, W * 3, px};
+        om_shade_cfg shade;
+        om_frame_desc fd;
+        h_frame_desc(&fd, &shade, &hs.s, &v, m, state, &fb, 0);
+        /* terms out through a strip callback */
+        struct cap { om_term *t; } cp = {small};
+        fd.user = &cp;
+        fd.on_strip = capture_terms;
+        memset(small, 0, sizeof small);
+        CHECK_OK(om_render_frame(&fd, &fa, NULL, NULL));
+        CHECK(!memcmp(fast, small, sizeof fast));
+        om_method_stats ms;
+        om_method_get_stats(m, state, &ms);
+        CHECK(ma.peak <= size);
+        if (k) CHECK(ms.bytes_used > mn && ms.bytes_used < full / 2);   /* the middle mode */
+        else CHECK(ma.peak <= mn);
+        free(mem);
+        free(fmem);
+        free(px);
+    }
+    h_scene_free(&hs);
+}
+
+void suite_ref(void)
+{
+    RUN(square_under_sun);
+    RUN(sphere_under_spot);
+    RUN(bvh_equals_brute_force);
+    RUN(lbvh_fit_in_parts);
+    RUN(ref_small_equals_fast);
+}
