@@ -231,6 +231,55 @@ static void pathological_views(void)
 
 /* The largest image, through strips, with the cheapest methods (the others follow the
  * same frame code; their memory at this size is the stress runs' subject). */
+/* A host's misuse gets a status, never a crash: every method's bytes and init with a
+ * side of 0 or past OM_MAX_DIM, and a frame without its method state, without a frame
+ * arena, or with a format outside om_format. */
+static void hostile_calls(void)
+{
+    h_scene hs;
+    if (!h_scene_parse(&hs, "box size 1 1 1\nplane size 4 4\n")) return;
+    static unsigned char mem[1 << 16];
+    size_t mn, full;
+    for (size_t k = 0; k < om_method_count(); k++) {
+        const om_method *m = om_method_at(k);
+        om_method_cfg c;
+        om_arena a;
+        void *state = (void *)&a;
+        om_diag d;
+        om_method_cfg_default(&c, m);
+        om_arena_init(&a, mem, sizeof mem, "method");
+        const uint32_t sides[4][2] = {{0, 120}, {160, 0}, {OM_MAX_DIM + 1, 8}, {8, OM_MAX_DIM + 1}};
+        for (int i = 0; i < 4; i++) {
+            CHECK_MSG(om_method_bytes(m, &c, &hs.s, sides[i][0], sides[i][1], &mn, &full) == OM_E_INVALID,
+                      "%s bytes at %ux%u", om_method_name(m), sides[i][0], sides[i][1]);
+            CHECK_MSG(om_method_init(m, &state, &a, &c, &hs.s, sides[i][0], sides[i][1], &d) == OM_E_INVALID &&
+                          state == NULL && a.used == 0,
+                      "%s init at %ux%u", om_method_name(m), sides[i][0], sides[i][1]);
+        }
+        CHECK(om_method_bytes(m, NULL, &hs.s, 16, 16, &mn, &full) == OM_E_INVALID);
+        CHECK(om_method_init(NULL, &state, &a, &c, &hs.s, 16, 16, &d) == OM_E_INVALID);
+    }
+    CHECK(om_method_bytes(NULL, NULL, NULL, 16, 16, &mn, &full) == OM_E_INVALID);
+    om_view v;
+    om_frame_desc fd;
+    om_shade_cfg shade;
+    uint8_t px[16 * 8 * 3];
+    om_framebuffer fb = {OM_RGB888, 16, 8, 16 * 3, px};
+    static unsigned char fmem[1 << 18];
+    om_arena fa;
+    om_diag d;
+    CHECK_OK(h_view(&v, &hs.s, 0.0f, 16, 8, NULL));
+    h_frame_desc(&fd, &shade, &hs.s, &v, om_method_find("sm"), NULL, &fb, 0);
+    om_arena_init(&fa, fmem, sizeof fmem, "frame");
+    CHECK(om_render_frame(&fd, &fa, NULL, &d) == OM_E_INVALID && strstr(d.msg, "state"));
+    fd.method_state = &fa;   /* never read: the frame refuses first */
+    CHECK(om_render_frame(&fd, NULL, NULL, &d) == OM_E_INVALID);
+    fb.format = (om_format)9;
+    CHECK(om_render_frame(&fd, &fa, NULL, &d) == OM_E_INVALID && strstr(d.msg, "format"));
+    CHECK(fa.used == 0);
+    h_scene_free(&hs);
+}
+
 static void largest_image(void)
 {
     if (getenv("OM_TEST_QUICK")) return;   /* valgrind runs skip the 67M-pixel frame */
@@ -271,4 +320,5 @@ void suite_robust(void)
     RUN(pathological_geometry);
     RUN(pathological_views);
     RUN(largest_image);
+    RUN(hostile_calls);
 }

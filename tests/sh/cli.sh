@@ -159,6 +159,17 @@ expect 1 "an empty output name" -- "$OMBRA" render --size 16x12 --out ''
 has "$dir/err" "'': cannot create" "an empty output name is refused"
 expect 2 "--out and --mask the same file" -- "$OMBRA" render --size 16x12 --out "$dir/good.ppm" --mask "$dir/./good.ppm"
 has "$dir/err" "same file" "the same path twice explained"
+# nor may an output be a mesh the scene reads: refused before anything is written
+printf 'v 0 0 0\nv 1 0 0\nv 0 0 1\nf 1 2 3\n' >"$dir/tri.obj"
+printf 'mesh tri.obj\n' >"$dir/mesh.scene"
+expect 2 "--out over a mesh the scene reads" -- "$OMBRA" render "$dir/mesh.scene" --size 16x12 --out "$dir/tri.obj"
+has "$dir/err" "a mesh of the scene and --out name the same file" "the mesh named"
+if [ "$(head -c 6 "$dir/tri.obj")" = "v 0 0 " ]; then ok; else bad "the mesh was overwritten"; fi
+expect 2 "--mask over a mesh the scene reads" -- "$OMBRA" render "$dir/mesh.scene" --size 16x12 --out "$dir/m.ppm" --mask "$dir/./tri.obj"
+# a binary file as the scene is refused at its first bytes, not read whole
+head -c 3000000 /dev/zero >"$dir/zeros.scene"
+expect 1 "a file of zeros as the scene" -- "$OMBRA" render "$dir/zeros.scene" --size 16x12 --out "$dir/z.ppm"
+has "$dir/err" "not a text file: byte 0 is NUL" "the NUL byte named"
 cmp -s "$dir/good.ppm" "$dir/keep.ppm" && ok || bad "--out x --mask x damaged x"
 expect 2 "--diff over --out" -- "$OMBRA" render --size 16x12 --against ref --out "$dir/good.ppm" --diff "$dir/good.ppm"
 expect 2 "--out over the scene" -- "$OMBRA" render "$dir/ok.scene" --out "$dir/ok.scene"

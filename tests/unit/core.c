@@ -83,6 +83,25 @@ static void arena_fault_injection(void)
     CHECK(om_arena_need(10, 8) >= 10 + 7);
 }
 
+/* Byte counts saturate instead of wrapping: a pool of 2^61 items of 8 bytes asks for
+ * more than any arena holds, and its carve fails without a write (a 32-bit host wraps
+ * at 2^29 items the same way). */
+static void sizes_never_wrap(void)
+{
+    unsigned char buf[1024];
+    om_arena a;
+    om_pool p;
+    om_arena_init(&a, buf, sizeof buf, "t");
+    CHECK(om_arena_need(SIZE_MAX, 64) == SIZE_MAX);
+    CHECK(om_arena_need(SIZE_MAX - 3, 8) == SIZE_MAX);
+    CHECK(om_pool_bytes((size_t)1 << 61, 8) == SIZE_MAX);
+    CHECK(om_pool_bytes(SIZE_MAX, 1) == SIZE_MAX);
+    CHECK(om_pool_bytes(8, UINT32_MAX) >= (size_t)UINT32_MAX * 8 || om_pool_bytes(8, UINT32_MAX) == SIZE_MAX);
+    CHECK(om_pool_init(&p, &a, (size_t)1 << 61, 8, NULL) == OM_E_BUDGET);
+    CHECK(om_pool_init(&p, &a, SIZE_MAX, 2, NULL) == OM_E_BUDGET);
+    CHECK(a.used == 0);
+}
+
 /* The library says which release it is, as the header does. */
 static void version_matches_header(void)
 {
@@ -145,6 +164,7 @@ void suite_core(void)
     RUN(arena_rewind_peak);
     RUN(arena_fault_injection);
     RUN(version_matches_header);
+    RUN(sizes_never_wrap);
     RUN(pool_recycles);
     RUN(trig_matches_libm);
     RUN(formatter);

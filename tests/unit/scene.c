@@ -588,6 +588,11 @@ static void parse_errors(void)
     expect_err("light point pos 1 2 3\n", OM_E_PARSE, 1, 7, "expected 'spot' or 'directional'");
     expect_err("light\n", OM_E_PARSE, 1, 6, "expected 'spot' or 'directional'");
     expect_err("light spot pos 1 2 3 target 1 2 3\n", OM_E_RANGE, 1, 29, "pos and target must differ");
+    /* apart, but by a vector float cannot square: the view would refuse them */
+    expect_err("camera eye 0 0 0 target 0 0 1e-30\n", OM_E_RANGE, 1, 25, "gives no direction");
+    expect_err("light spot pos 0 5 0 target 0 5 1e-30\n", OM_E_RANGE, 1, 29, "gives no direction");
+    expect_err("light directional dir 0 -1e-30 0\n", OM_E_RANGE, 1, 23, "too short to give a direction");
+    expect_err("key camera 0 eye 0 0 0 target 1e-30 0 0\n", OM_E_RANGE, 1, 31, "gives no direction");
     expect_err("light spot pos 1 2 3\n", OM_E_PARSE, 1, 1, "needs pos X Y Z and target X Y Z");
     expect_err("key\n", OM_E_PARSE, 1, 4, "expected 'camera' or 'light' after 'key'");
     expect_err("key camera eye 0 0 1 target 0 0 0\n", OM_E_PARSE, 1, 12,
