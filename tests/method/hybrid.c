@@ -9,7 +9,7 @@
 #include "../test.h"
 #include "../harness.h"
 #include "../jobs_util.h"
-#include "../../engine/shadow/hybrid/hybrid_method.h"
+#include "../../engine/shadow/hybrid/hybrid.h"
 
 #include <stdlib.h>
 

@@ -13,7 +13,7 @@
 #include "../jobs_util.h"
 #include "../../engine/shadow/rtw/rtw.h"
 #include "../../engine/shadow/common/occlude.h"
-#include "../../engine/shadow/spsm/spsm_method.h"
+#include "../../engine/shadow/spsm/spsm.h"
 
 #include <math.h>
 #include <stdlib.h>

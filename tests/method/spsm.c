@@ -8,7 +8,7 @@
  * rtw and spsm together. */
 #include "../test.h"
 #include "../harness.h"
-#include "../../engine/shadow/spsm/spsm.h"
+#include "../../engine/shadow/spsm/spsm_texel.h"
 #include "../../engine/shadow/spsm/spsm_lookup.h"
 
 #include <math.h>

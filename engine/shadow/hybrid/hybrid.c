@@ -42,7 +42,7 @@
  * The uncertain samples go through an irregular z-buffer of their own, a tile of them
  * at a time (izb.pool, or as many as the arena holds; hybrid_tile.c): every test there
  * is the predicate, om__blocks, so those answers are the reference's too. */
-#include "hybrid_method.h"
+#include "hybrid.h"
 
 /* Most uncertain samples a tile takes, whatever izb.pool says (tile_most): the tiles
  * are the jobs of the pass on the host's threads (om__pass, below), each with a

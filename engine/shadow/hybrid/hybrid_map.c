@@ -4,7 +4,7 @@
  * cover. On the host's threads, by bands of the map's rows: a texel's updates come from
  * the same triangles in the same order whichever band holds it (the first to touch it
  * gives its slopes), so the same map. */
-#include "hybrid_method.h"
+#include "hybrid.h"
 
 /* A double depth to float, never above it: when rounding went up, from a point a
  * depth unit and a millionth below, far beyond half a float step. */

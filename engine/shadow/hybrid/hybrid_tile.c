@@ -18,7 +18,7 @@
  * sample that is still open in the cells it reaches once, whatever their order in a
  * cell, so the terms and the counts do not depend on where the tile runs or what its
  * memory held. */
-#include "hybrid.h"
+#include "hybrid_tile.h"
 
 /* Cells per side of a block (the coarse level a triangle looks at first). */
 #define BLOCK 4

@@ -1,8 +1,8 @@
 /* spsm.c — Sub-Pixel Shadow Maps (paper 004, Lecocq et al., i3D 2014): a shadow map
  * whose texels keep a 128-bit record of the nearest triangle, so shadow edges are
  * rebuilt below texel size. The texel format, the derivative code and the tangent
- * table are in spsm_texel.c (spsm.h), the recovered outline in spsm_outline.c
- * (spsm_lookup.h), the build in spsm_build.c (spsm_method.h: the state); this file
+ * table are in spsm_texel.c (spsm_texel.h), the recovered outline in spsm_outline.c
+ * (spsm_lookup.h), the build in spsm_build.c (spsm.h: the state); this file
  * owns the method's settings and lookup, spsm_observe.c its observe.
  *
  * Observe (not in the paper; spsm.records, by default when the map is finer than the
@@ -32,7 +32,7 @@
  * The depth tolerance is what the record cannot resolve: half a 16-bit depth step for
  * rounding, one step of margin, and the derivative code's error bound times the
  * distance from the texel centre. No bias setting is used. */
-#include "spsm_method.h"
+#include "spsm.h"
 
 OM__CFG_FITS(om__spsm_cfg);
 extern const om_method om__method_spsm;

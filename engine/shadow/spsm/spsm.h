@@ -1,134 +1,153 @@
-/* spsm.h — the parts of Sub-Pixel Shadow Maps (paper 004) that the tests reach into:
- * the 128-bit texel and its packing (section 3.3), the power-of-arctangent code for
- * depth derivatives (section 3.4) and the tangent look-up table indexed by the 3x3
- * depth-test pattern (section 4.2, Figure 8). The method itself is in spsm.c.
- *
- * Units. Positions are on the map's sub-texel grid: 1/256 texel (OM_SUBPIX), the grid
- * the rasterizer snaps to, so a texel centre is an integer point. Depth is the
- * rasterizer's z/w * 2^32 ("raw"); the texel keeps its top 16 bits ("steps" of 2^16).
- * A derivative is coded in steps per texel divided by OM_SPSM_DSCALE. */
+/* spsm.h — the state of the SPSM method (paper 004), shared by its two halves:
+ * spsm.c (settings, observe, lookup and recovery: sections 4 and 5) and spsm_build.c
+ * (the conservative build of the records: section 3.2). */
 #ifndef OM_SPSM_H
 #define OM_SPSM_H
 
-#include "../../frame/frame.h"
+#include "../method.h"
+#include "spsm_lookup.h"
 
-/* One texel, exactly 16 bytes (checked below). vx/vy: the nearest triangle's three
- * vertices as offsets from the texel centre in the 16-bit "o16" code; z: depth of the
- * triangle's plane at the texel centre, rounded to 16 bits; qx/qy: the plane's depth
- * derivatives in the power-of-arctangent code. Whether a texel holds a triangle at all
- * is kept outside it (spsm.c: its depth buffer still at the far plane). */
-typedef struct om__spsm_texel {
-    uint16_t vx[3], vy[3];
-    uint16_t z;
-    uint8_t qx, qy;
-} om__spsm_texel;
+#define OM__SPSM_TIE_DZ (OM__SPSM_LINK_DZ / 2)   /* the build's near tie: one surface to recovery */
+#define OM__SPSM_TIES 0xFFu                      /* the depth buffer's low bits: ties counted
+                                                    (texel) */
 
-/* C99 has no _Static_assert: a negative array size fails the build instead. */
-typedef char om__spsm_texel_is_16_bytes[sizeof(om__spsm_texel) == 16 ? 1 : -1];
+/* What spsm's settings (spsm.c) set. */
+typedef struct om__spsm_cfg {
+    uint32_t map_size;
+    uint32_t spsm_aa;      /* sub-samples at uncertain samples, 0 or 1 = off */
+    uint32_t spsm_records; /* which texel records the build makes: 1 every one (the
+                              paper's build), 2 only those the view reads (observe
+                              marks them), 0 = 2 when the map has more than twice as
+                              many texels as the image has pixels, else 1. The same
+                              frames either way; only the time differs. */
+    uint32_t spsm_fine;    /* 1: the plain-map fallback at 2 x 2 points per texel (16
+                              more bytes per texel and a second pass; fewer false-lit
+                              samples along fine rims), 0: at texel centres */
+} om__spsm_cfg;
 
-#define OM_SPSM_LINK 256       /* silhouette recovery bridges gaps up to a texel */
-#define OM_SPSM_DSCALE 8.0    /* a coded derivative of 1 = 8 depth steps per texel */
+/* The lookup's moving parts. Its 3x3 of decoded texels: consecutive samples mostly
+ * fall in the same texel, and the 3x3 around it depends on nothing but the map and
+ * that texel's index, so it is kept from one sample to the next while `t4_at` names
+ * the texel (and what it shares with the next texel's 3x3 is kept too: shift_window):
+ * bit k of `t_have` says t[k] is decoded. The recovery's occluders (pointers into t)
+ * and outline for the pattern `bd_keep` of the texel t4_at, while bd_have; and the
+ * texel centres that may join the outline (cand_k: their texels): those nearer than
+ * the sample, which varies, do. bd is the outline without them, bx with those in
+ * bx_pts (a superset of bd's hulls: points only join pieces).
+ * Nothing in it changes an answer, only the work: a strip resolves with the state's
+ * own, a band with one of its job's (om__spsm_win_reset first). */
+typedef struct om__spsm_win {
+    om__spsm_dtri t[9];
+    size_t t4_at;
+    uint32_t t_have;
+    const om__spsm_dtri *occ[9];
+    uint8_t occ_k[9];            /* occ[j] is t[occ_k[j]] */
+    int nocc;
+    om__spsm_outline_pt cand[9];
+    uint8_t cand_k[9];
+    int ncand;
+    uint16_t bx_pts;
+    om__spsm_boundary bd, bx;
+    uint16_t bd_keep;
+    bool bd_have;
+    /* the float plane of each texel at the sample being looked up (om__spsm_pf_at:
+     * the lit test's at t[4], Algorithm 1's at the others), which recovery's pattern
+     * test reads again: set for every t[k].ok before recover runs */
+    om__spsm_pf pf[9];
+    /* spsm.c's receiver_plane: the light's matrix applied to two directions in the
+     * surface of normal rn (while rd_have) */
+    float rn[3];
+    float rd[2][4];
+    bool rd_have;
+} om__spsm_win;
 
-/* o16: a vertex offset v (grid units, relative to the texel centre) as a small float:
- * sign bit, 4-bit exponent e, 11-bit mantissa m; |v| = m when e = 0, else
- * (2048 + m) << (e - 1). Offsets below 16 texels are exact (the grid itself); beyond,
- * the relative error is at most 2^-12 (a quarter texel at 1000 texels), and the
- * largest magnitude, 4095 << 14 (about 2^26, the rasterizer's whole projected range),
- * is where larger offsets saturate. A far vertex so keeps the direction of its edges
- * near the texel, which a fixed-point window clamped at its border would not. */
-uint16_t om__spsm_o16_encode(int64_t v);
-/* In line: the lookup decodes six per texel record it reads. */
-static inline int64_t om__spsm_o16_decode(uint16_t c)
+/* Forgets what the window holds (all of it, so that nothing is read unset). */
+static inline void om__spsm_win_reset(om__spsm_win *w)
 {
-    unsigned e = (c >> 11) & 15u, m = c & 2047u;
-    int64_t a = e == 0 ? (int64_t)m : (int64_t)(2048u + m) << (e - 1);
-    return (c & 0x8000u) ? -a : a;
+    memset(w, 0, sizeof *w);
+    w->t4_at = (size_t)-1;
 }
 
-/* The derivative code of section 3.4 (Equations 2-4) with n = 5:
- * Q(d) = round(127 * (1 + x^5)), x = (2/pi) atan(d), and its decoding table. */
-typedef struct om__spsm_qtable {
-    double dec[256];       /* decoded derivative, steps per texel / DSCALE */
-    double err[256];       /* half the gap to the neighbouring codes: the error bound */
-    float up[128];         /* up[k]: where code 127 + k gives way to the next (the
-                              boundary decode_at(127.5 + k), rounded to float); up[127]
-                              is infinite */
-    float decf[256], errf[256];   /* dec and err in raw depth per grid unit (times
-                              65536 * OM_SPSM_DSCALE / OM_SUBPIX, exact in double),
-                              rounded to float: what the lookup's float tests read */
-} om__spsm_qtable;
+typedef struct om__spsm_state {
+    const om_scene *scene;
+    om__spsm_cfg cfg;
+    uint32_t size;
+    om__spsm_texel *tex;
+    uint32_t *depth;             /* minimum conservative depth: the build's depth test
+                                  * (low 8 bits: ties so far; all ones: empty) */
+    uint32_t *cdepth;            /* nearest depth at each texel centre (fallback) */
+    /* spsm.fine: the plain map at 2 x 2 points per texel (plain_shadow), and need at
+     * those points, fwords words per row */
+    bool fine;
+    uint32_t *fdepth, *fneed;
+    uint32_t fwords;
+    /* Texels the lookup will read, one bit each, `words` 32-bit words per row: `seen`
+     * (the samples' texels, from observe) grown by one texel into `need` (build). */
+    uint32_t *seen, *need;
+    /* need_rows: bit y set when row y of need has any bit (the build passes over the
+     * others: with marks, nothing in them is read) */
+    uint32_t *need_rows;
+    uint32_t words;
+    bool marks;                  /* observe marks texels (spsm.records); else need is full */
+    om_view view;
+    om__spsm_qtable q;
+    om__spsm_tangent lut[512];
+    /* per frame */
+    uint32_t samples, lit, shadowed, uncertain, recovered, needed;
+    om__spsm_win win;            /* the lookup's, a strip at a time */
+#if OM_WITH_JOBS
+    om__lent lent;               /* the host's threads for this frame's observe (spsm_observe.c) */
+#endif
+} om__spsm_state;
 
-uint8_t om__spsm_q_encode(double d);
-/* The same code from the table's boundaries, for the build (no arctangent): the code
- * whose boundaries enclose d, 254 - that of -d for d < 0, 127 for NaN. It agrees with
- * om__spsm_q_encode but within 2^-22 of a boundary, and the table's error bound holds
- * for it to that much (tests/method/spsm.c). */
-uint8_t om__spsm_q_encode_f(const om__spsm_qtable *t, float d);
-/* Builds the table from om__tan/om__log2/om__exp2 (bit-identical everywhere). Code 254
- * (x = 1, a slope of 90 degrees) decodes to twice code 253 and 0 to its negative. */
-void om__spsm_qtable_build(om__spsm_qtable *t);
-
-/* Tangent estimate (section 4.2, Figures 7 and 8). Index: the 3x3 depth-test pattern,
- * bit (dy + 1) * 3 + (dx + 1) set when texel (dx, dy) around the sample's texel holds
- * an occluder. `keep` is the pattern after dropping texels that are not 4-connected to
- * another (Figure 7b, c); `n` gives up to two integer normals of the silhouette,
- * pointing from the lit side into the shadow (x right, y down on the map). nn = 0: no
- * orientation (empty, full or isotropic pattern). nn = 2: a thin occluder along the
- * tangent: both sides are tried and must agree (Figure 8, bottom right). spsm.c's
- * recovery uses `keep`; the normals are the paper's tangent estimate, which feeds its
- * one-sided boundary phi (measured worse here, see spsm.md), kept for that comparison. */
-typedef struct om__spsm_tangent {
-    uint16_t keep;
-    uint8_t nn;
-    int8_t n[2][2];
-} om__spsm_tangent;
-
-void om__spsm_tangent_build(om__spsm_tangent lut[512]);
-
-/* Packs the snapped triangle `t` (as the rasterizer hands it to a fragment, with its
- * double plane, om__rtri_plane) into the texel at (x, y); qx, qy are its derivative
- * codes (the same for every texel of it). The centre depth is om__spsm_centre_z's. */
-void om__spsm_pack(om__spsm_texel *out, const om__rtri *t, int32_t x, int32_t y, uint8_t qx,
-                   uint8_t qy);
-/* The record's depth: the double plane at the centre of texel (x, y), not clamped to
- * the triangle's depth range (the lookup extrapolates from there), rounded to 16 bits
- * and clamped to them. */
-uint16_t om__spsm_centre_z(const om__rtri *t, int32_t x, int32_t y);
-
-/* The same in two parts, for the build: the vertices' y codes depend only on the
- * triangle and the texel row, so a run of texels along a row encodes them once
- * (om__spsm_row_codes) and packs each texel x of the row with them and its centre
- * depth z (om__spsm_pack_row). */
-void om__spsm_row_codes(uint16_t vy[3], const om__rtri *t, int32_t y);
-void om__spsm_pack_row(om__spsm_texel *out, const om__rtri *t, int32_t x, uint8_t qx, uint8_t qy,
-                       const uint16_t vy[3], uint16_t z);
-
-/* What the build takes from a triangle's double plane (om__rtri_plane: the slopes'
- * codes, the direction depth falls in, the centre depths om__spsm_centre_z), found
- * without double where that is sure: the slopes' exact numerators in float with an
- * error bound, and the centre depth from the fixed-point plane (om__rtri_zat), which
- * is within a unit of the exact plane where the double one is within far less.
- * Where the bounds leave a doubt the build asks the double plane itself. */
-typedef struct om__spsm_fplane {
-    float zx, zy;            /* the slopes, raw depth per grid unit */
-    bool sure;               /* qx, qy, down_x, down_y are the double plane's */
-    uint8_t qx, qy;          /* om__spsm_q_encode_f of the slopes (float) / 2^11 */
-    bool down_x, down_y;     /* whether the slopes (float) are > 0 */
-    uint32_t reach;          /* centre depths: the doubt around a code boundary (raw
-                                units); 0: none decided here */
-} om__spsm_fplane;
-
-/* Sets f for triangle t (the fixed-point plane set, om__rtri_zplane) whose vertex
- * depths, in the order of t->e, are z. */
-void om__spsm_fplane_setup(om__spsm_fplane *f, const om__spsm_qtable *q, const om__rtri *t, const uint32_t z[3]);
-/* om__spsm_centre_z(t, x, y) for a texel (x, y) whose square the triangle touches, or
- * -1 where f cannot be sure of it. */
-static inline int32_t om__spsm_centre_zf(const om__spsm_fplane *f, const om__rtri *t, int32_t x, int32_t y)
+/* The texel holding grid position g (x or y), clamped to the map (so negative
+ * positions need no floor division: they clamp to 0). */
+static inline int64_t om__spsm_texel_of(const om__spsm_state *m, int64_t g)
 {
-    if (!f->reach) return -1;
-    const uint32_t k = om__rtri_zat(t, (int64_t)x * OM_SUBPIX + OM_SUBPIX / 2, (int64_t)y * OM_SUBPIX + OM_SUBPIX / 2) +
-                       32768u, r = k & 0xFFFFu;
-    return r >= f->reach && r + f->reach < 65536u ? (int32_t)(k >> 16) : -1;
+    /* in 32 bits: om__project_xy's positions lie below 2^26 */
+    const int32_t t = g < 0 ? 0 : (int32_t)((uint32_t)g >> OM_SUBPIX_BITS), last = (int32_t)m->size - 1;
+    return t > last ? last : t;
 }
+
+/* Observe (spsm_observe.c): each exposed sample of the strip marks its texel in seen;
+ * on the host's threads by bands of rows, each into its slot's marks, which
+ * om__spsm_observe_fold puts into seen before the build reads it (map_of calls it;
+ * nothing to do where no band ran). */
+void om__spsm_observe(om__spsm_state *m, const om_strip *st);
+void om__spsm_observe_fold(om__spsm_state *m);
+
+/* The part of the segment (ax, ay) + t (dx, dy), t in [0, 1], that lies in the closed
+ * square [0, side] x [0, side] (coordinates relative to its corner): its ends t0 <= t1
+ * (Liang-Barsky), false when it misses. In float: the callers take the least depth of a
+ * triangle inside a texel's square at such an end (spsm_build.c's clipped_min and
+ * spsm.c's consistent_min), where an end off by 2^-22 of the edge moves that depth by
+ * as little of the edge's depth range, far below a 16-bit depth step. */
+static inline bool om__spsm_clip_f(float ax, float ay, float dx, float dy, float side, float *t0, float *t1)
+{
+    const float a[2] = {ax, ay}, d[2] = {dx, dy};
+    float lo = 0.0f, hi = 1.0f;
+    for (int k = 0; k < 2; k++) {
+        if (d[k] == 0.0f) {
+            if (!(a[k] >= 0.0f && a[k] <= side)) return false;
+            continue;
+        }
+        const float inv = 1.0f / d[k];
+        float ta = -a[k] * inv, tb = (side - a[k]) * inv;
+        if (ta > tb) { const float s = ta; ta = tb; tb = s; }
+        if (ta > lo) lo = ta;
+        if (tb < hi) hi = tb;
+        if (!(lo <= hi)) return false;
+    }
+    *t0 = lo;
+    *t1 = hi;
+    return true;
+}
+
+/* The build (spsm_build.c): the records the lookup will read, from the marks; by bands
+ * of the map's rows (om__bands: map_of on the calling thread, then build_rows for
+ * each band), or all at once. */
+om_status om__spsm_build(void *state, om_diag *d);
+uint32_t om__spsm_map_of(void *state, const om_mat4 **vp);
+void om__spsm_build_rows(const void *state, const om__bins *bins, uint32_t y0, uint32_t rows, uint32_t counts[8]);
 
 #endif

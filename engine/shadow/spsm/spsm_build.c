@@ -7,7 +7,7 @@
  * map's depth at texel centres is made in the same pass, and with spsm.fine the plain
  * map at twice the resolution in a second one. With marks (spsm.c's observe) all of it
  * is done only at the texels the lookup will read. */
-#include "spsm_method.h"
+#include "spsm.h"
 
 /* need = seen grown by one texel each way (the 3x3 the lookup decodes); returns the
  * number of texels in it. Bits past the map's width in a row's last word may be set:
@@ -51,7 +51,7 @@ typedef struct build_ctx {
     float zf[3];                 /* the vertex depths in float (clipped_min) */
     bool down_x, down_y;         /* whether depth falls along x, along y */
     uint8_t qx, qy;              /* the derivative codes */
-    om__spsm_fplane fp;          /* the double plane's answers without it (spsm.h) */
+    om__spsm_fplane fp;          /* the double plane's answers without it (spsm_texel.h) */
     om__rtri dt;                 /* the triangle with its double plane, where fp is */
     bool have_dt;                /* not sure (made on demand) */
     /* the y codes of the row being filled, for the triangle with these y coordinates:
@@ -103,7 +103,7 @@ static void tri_setup(build_ctx *b, const om__rtri *t)
         b->down_x = b->fp.down_x;
         b->down_y = b->fp.down_y;
     } else {
-        /* derivatives in depth steps per texel, scaled (spsm.h): raw per grid unit
+        /* derivatives in depth steps per texel, scaled (spsm_texel.h): raw per grid unit
          * times OM_SUBPIX / OM__SPSM_STEP / OM_SPSM_DSCALE = 2^-11, exact in float */
         const om__rtri *d = double_plane(b, t);
         const float gx = (float)d->zx, gy = (float)d->zy, k = (float)(OM_SUBPIX / OM__SPSM_STEP / OM_SPSM_DSCALE);

@@ -1,11 +1,11 @@
 /* spsm_lookup.h — what the SPSM lookup (spsm.c) and its silhouette outline
  * (spsm_outline.c, section 4.2 and Figure 10) share: a texel record decoded around the
  * sample's texel, its plane (Equation 1), and the outline built from the occluders the
- * depth-test pattern keeps. Units as in spsm.h: grid units of 1/256 texel, raw depth. */
+ * depth-test pattern keeps. Units as in spsm_texel.h: grid units of 1/256 texel, raw depth. */
 #ifndef OM_SPSM_LOOKUP_H
 #define OM_SPSM_LOOKUP_H
 
-#include "spsm.h"
+#include "spsm_texel.h"
 
 #define OM__SPSM_STEP 65536.0                     /* one 16-bit depth step in raw units */
 #define OM__SPSM_TOL0 (1.5 * OM__SPSM_STEP)       /* what a record's depth cannot resolve at

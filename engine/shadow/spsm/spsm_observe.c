@@ -5,7 +5,7 @@
  * own marks (a slot's scratch, zeroed by the frame once a frame); set bits are the
  * same in any order and however split, and before the build reads them the slots'
  * marks are ORed into the state's by ranges of words, as jobs too. */
-#include "spsm_method.h"
+#include "spsm.h"
 
 /* The texel a sample's lookup will centre on, false when the sample does not project.
  * The lookup projects with om__project, whose position is this om__project_xy's: the

@@ -2,9 +2,9 @@
  * tangent look-up table (section 4.2, Figure 8): vertex offsets in 16 bits, depth
  * derivatives in 8 bits, and the 512 depth-test patterns. Everything here is integer
  * or built from the engine's deterministic functions, so every build agrees. */
-#include "spsm.h"
+#include "spsm_texel.h"
 
-/* ---- o16 vertex offsets (section 3.3; our choice of code, see spsm.h) */
+/* ---- o16 vertex offsets (section 3.3; our choice of code, see spsm_texel.h) */
 
 /* Bits in x > 0: one instruction where the compiler offers it (the pack runs per
  * texel written, and far vertices are the wide case), else five steps. */
@@ -220,7 +220,7 @@ void om__spsm_pack(om__spsm_texel *out, const om__rtri *t, int32_t x, int32_t y,
     om__spsm_pack_row(out, t, x, qx, qy, vy, om__spsm_centre_z(t, x, y));
 }
 
-/* ---- the build's plane without double (om__spsm_fplane, spsm.h)
+/* ---- the build's plane without double (om__spsm_fplane, spsm_texel.h)
  *
  * om__rtri_plane's slope along x is zx = fl(fl(fl(dz1 y2) - fl(dz2 y1)) fl(1 / area2))
  * (offsets from vertex 0, each product below 2^62): it is within 2^-50 S / area2 of
