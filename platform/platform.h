@@ -55,6 +55,11 @@ void om_file_loader_free(om_file_loader *fl);
  * whose `host` is the pool. om_jobs_start starts threads - 1 workers (the caller is
  * the last thread); threads <= 1 starts none and runs every job inline. */
 typedef struct om_jobs om_jobs;
+/* What each thread of a pool past the caller costs the process beyond the arenas (its
+ * stack's touched pages and the system's records of it): counted at twice the 8 KB or
+ * so a worker adds to the peak resident size on Linux, so that a memory budget that
+ * counts them holds. */
+#define OM_JOBS_WORKER_BYTES ((size_t)16 << 10)
 om_status om_jobs_start(om_jobs **out, uint32_t threads, om_diag *d);
 void om_jobs_for(void *host, om_job_fn fn, void *user, uint32_t n);
 /* The threads a pool runs jobs on (1 for NULL), the caller's included. */

@@ -319,11 +319,20 @@ static om_jobs *pool;
 
 bool cli_threads_start(const char *cmd, const char *arg)
 {
+    return cli_threads_start_in(cmd, arg, 0, NULL);
+}
+
+bool cli_threads_start_in(const char *cmd, const char *arg, size_t budget, size_t *workers)
+{
     uint32_t n = om_cpus_online();
     if (arg && !cli_parse_u32(arg, 1, 1024, &n)) {
         cli_usage_error(cmd, "--threads takes a thread count 1..1024, not '%s'", arg);
         return false;
     }
+    /* Under a budget the workers are counted in it, and take at most a sixteenth. */
+    const size_t most = budget ? 1 + budget / 16 / OM_JOBS_WORKER_BYTES : 1024;
+    if (n > most) n = (uint32_t)most;
+    if (workers) *workers = budget ? (size_t)(n - 1) * OM_JOBS_WORKER_BYTES : 0;
     cli_threads_stop();
     om_diag d;
     om_status st = om_jobs_start(&pool, n, &d);

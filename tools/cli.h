@@ -65,6 +65,10 @@ const char *cli_sweep(const om_method *m);
  * cli_threads_start takes N as given ("0" or anything but 1..1024 is a usage error,
  * printed) or, for NULL, the CPUs online; cli_threads_stop ends the pool. */
 bool cli_threads_start(const char *cmd, const char *arg);
+/* The same within a memory budget (0: none): each worker past the caller counts
+ * OM_JOBS_WORKER_BYTES of it (*workers: their bytes), and the workers take at most a
+ * sixteenth of it, so the count is capped to what fits. */
+bool cli_threads_start_in(const char *cmd, const char *arg, size_t budget, size_t *workers);
 void cli_threads_stop(void);
 uint32_t cli_threads(void);
 /* Hands the pool to a frame: its parallel-for and thread count. */

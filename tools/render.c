@@ -24,7 +24,9 @@ static const char render_help[] =
     "  --format F        framebuffer format: rgb888 (default), rgb565, l8\n"
     "  --strip ROWS      render through strips of ROWS rows (default: whole frame)\n"
     "  --threads N       threads a frame runs on (default: the CPUs online); the\n"
-    "                    frame is the same bits with any N\n"
+    "                    frame is the same bits with any N; under --budget each\n"
+    "                    thread past the first counts 16 KiB of it, and threads take\n"
+    "                    at most a sixteenth of it (fewer start where more asked)\n"
     "  --budget BYTES    total memory for scene, frame and method (K, M, G suffixes),\n"
     "                    or 'none' (the default); the strip height shrinks to fit, down\n"
     "                    to one row\n"
@@ -216,7 +218,8 @@ int cmd_render(int argc, char **argv)
     }
     /* A grey frame is written as a PGM; the default name says so. */
     if (!out) out = fmt == OM_L8 ? "ombra.pgm" : "ombra.ppm";
-    if (!cli_threads_start("render", threads)) return 2;
+    size_t workers = 0;   /* what the pool's threads count of --budget */
+    if (!cli_threads_start_in("render", threads, budget, &workers)) return 2;
     if (diff && !against) return cli_usage_error("render", "%s needs --against", "--diff");
     main_run.m = om_method_find(mname);
     if (!main_run.m) return cli_unknown_method("render", "--method", mname);
@@ -282,7 +285,7 @@ int cmd_render(int argc, char **argv)
         size_t px = (size_t)W * om_format_bpp(fmt);
         size_t one = cli_frame_rows(NULL, W, 1, false) + px;
         size_t row_bytes = cli_frame_rows(NULL, W, 2, false) - cli_frame_rows(NULL, W, 1, false) + px;
-        size_t rest = budget > cs.bytes ? budget - cs.bytes : 0;
+        size_t rest = budget > cs.bytes + workers ? budget - cs.bytes - workers : 0;
         if (rest < main_run.full + cli_frame_rows(NULL, W, rows, false)) {
             size_t spare = rest > main_run.min + one ? rest - main_run.min - one : 0;
             main_run.given = main_run.min + spare / 2;
@@ -291,13 +294,16 @@ int cmd_render(int argc, char **argv)
         size_t left = rest > main_run.given ? rest - main_run.given : 0;
         size_t fit = left >= one ? 1 + (left - one) / row_bytes : 0;
         if (fit == 0) {
-            size_t need = cs.bytes + main_run.min + one;
+            size_t need = cs.bytes + workers + main_run.min + one;
             char hint[160];
             cli_method_hint(main_run.m, hint, sizeof hint);
-            fprintf(stderr, "ombra: --budget %zu is too small: this scene (%zu bytes), method '%s' "
+            char threads_part[64] = "";
+            if (workers)
+                snprintf(threads_part, sizeof threads_part, ", %u threads (%zu)", cli_threads(), workers);
+            fprintf(stderr, "ombra: --budget %zu is too small: this scene (%zu bytes)%s, method '%s' "
                     "(at least %zu) and one %u-pixel row (%zu) need %zu bytes; raise --budget, "
-                    "make --size smaller%s\n", budget, cs.bytes, mname, main_run.min, W, one,
-                    need, hint);
+                    "make --size smaller%s%s\n", budget, cs.bytes, threads_part, mname, main_run.min, W,
+                    one, need, workers ? ", use fewer --threads" : "", hint);
             rc = 1;
             goto out;
         }
@@ -436,6 +442,8 @@ int cmd_info(int argc, char **argv)
     printf("light: %s\n", s->light.kind == OM_LIGHT_SPOT ? "spot" : "directional");
     printf("bytes at %ux%u: scene %zu, frame %zu (whole) / %zu (one row)\n", W, H, cs.bytes,
            cli_frame_rows(NULL, W, H, false), cli_frame_rows(NULL, W, 1, false));
+    printf("threads: %u CPUs online; under --budget each thread past the first counts %zu bytes "
+           "of it, and threads take at most a sixteenth\n", om_cpus_online(), OM_JOBS_WORKER_BYTES);
     for (size_t i = 0; i < om_method_count(); i++) {
         const om_method *m = om_method_at(i);
         size_t mn, full;

@@ -159,6 +159,13 @@ expect 1 "an empty output name" -- "$OMBRA" render --size 16x12 --out ''
 has "$dir/err" "'': cannot create" "an empty output name is refused"
 expect 2 "--out and --mask the same file" -- "$OMBRA" render --size 16x12 --out "$dir/good.ppm" --mask "$dir/./good.ppm"
 has "$dir/err" "same file" "the same path twice explained"
+# threads under a budget: counted in it, capped to a sixteenth of it, the same frame
+expect 0 "many threads under a budget" -- "$OMBRA" render --size 160x120 --budget 1M --threads 1024 --method izb --out "$dir/t1024.ppm"
+h1024=$(grep '^hash' "$dir/out")
+expect 0 "one thread under a budget" -- "$OMBRA" render --size 160x120 --budget 1M --threads 1 --method izb --out "$dir/t1.ppm"
+if [ -n "$h1024" ] && [ "$h1024" = "$(grep '^hash' "$dir/out")" ]; then ok; else bad "--threads 1024 under --budget drew another frame"; fi
+expect 0 "info names the threads' share" -- "$OMBRA" info
+has "$dir/out" "counts 16384 bytes" "info reports what a thread counts of a budget"
 # nor may an output be a mesh the scene reads: refused before anything is written
 printf 'v 0 0 0\nv 1 0 0\nv 0 0 1\nf 1 2 3\n' >"$dir/tri.obj"
 printf 'mesh tri.obj\n' >"$dir/mesh.scene"
