@@ -127,6 +127,7 @@ check: $(O)/run-tests $(O)/ombra $(FUZZ_TARGETS:%=$(O)/fuzz-replay-%) $(O)/embed
 	sh tests/embed/sized.sh $(O)
 	sh tests/embed/readme.sh
 	sh tests/sh/methods.sh $(O)
+	SIZE=160x120 sh tests/sh/pairs.sh $(O)/ombra 100 $(O)/pairs
 
 # Every method rendered on 2 threads, whole and through strips, by the command $(1)
 # (under $(2), a checker or nothing), into directory $(3): the sanitizers and valgrind

@@ -5,8 +5,17 @@
  * the old file's bytes as they were. Streams and devices ("-", /dev/..., FIFOs) have
  * no "old file" to keep and are written directly; their errors name the path and
  * the system's reason like any other. Temporaries still open when SIGINT, SIGTERM,
- * SIGHUP or SIGXFSZ arrives are removed before the signal takes its usual course. */
+ * SIGHUP or SIGXFSZ arrives are removed before the signal takes its usual course.
+ *
+ * The files of one commit (an image and its mask) replace theirs as a pair: the
+ * renames run under an exclusive lock (flock) on each target's directory, taken in
+ * one order, so two runs committing to the same names never interleave their renames,
+ * and with those signals held back, so a signal cannot remove the second temporary
+ * once the first is in place. What no program can stop is SIGKILL (or a power cut)
+ * between two renames, microseconds apart: that can leave a new image beside an old
+ * mask. */
 #define _XOPEN_SOURCE 700   /* realpath, mkstemp, fchmod */
+#define _DEFAULT_SOURCE     /* flock */
 #include "platform.h"
 
 #include <errno.h>
@@ -14,6 +23,7 @@
 #include <signal.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -201,24 +211,6 @@ static bool finish(om_out *o)
     return !o->err;
 }
 
-/* The rename is durable once the directory is synced too; a system that cannot sync
- * a directory still has the file whole, old or new. */
-static void sync_dir(const char *target)
-{
-    const char *slash = strrchr(target, '/');
-    char *dir = slash ? malloc((size_t)(slash - target) + 2) : NULL;
-    if (slash && !dir) return;
-    if (dir) {
-        memcpy(dir, target, (size_t)(slash - target) + 1);
-        dir[slash - target + 1] = '\0';
-    }
-    int fd = open(dir ? dir : ".", O_RDONLY);
-    if (fd >= 0) {
-        fsync(fd);
-        close(fd);
-    }
-    free(dir);
-}
 
 void om_out_discard(om_out *o)
 {
@@ -233,6 +225,68 @@ void om_out_discard(om_out *o)
     o->tmp = o->target = NULL;
 }
 
+/* The directory of a target, opened for its lock (-1 where it cannot be). */
+static int dir_fd(const char *target, struct stat *sb)
+{
+    const char *slash = strrchr(target, '/');
+    char *dir = slash ? malloc((size_t)(slash - target) + 2) : NULL;
+    if (slash && !dir) return -1;
+    if (dir) {
+        memcpy(dir, target, (size_t)(slash - target) + 1);
+        dir[slash - target + 1] = '\0';
+    }
+    int fd = open(dir ? dir : ".", O_RDONLY);
+    free(dir);
+    if (fd >= 0 && fstat(fd, sb) != 0) {
+        close(fd);
+        fd = -1;
+    }
+    return fd;
+}
+
+/* The rename is durable once the directory is synced too; a system that cannot sync
+ * a directory still has the file whole, old or new. */
+static void sync_dir(const char *target)
+{
+    struct stat sb;
+    const int fd = dir_fd(target, &sb);
+    if (fd >= 0) {
+        fsync(fd);
+        close(fd);
+    }
+}
+
+/* Locks the directories of the commit's renames, each once, in the order of their
+ * device and inode numbers (so two commits never wait on each other crosswise);
+ * returns how many of fds[] it holds. A directory that cannot be locked is left
+ * unlocked: the renames are each atomic still. */
+#define LOCK_MAX 8
+static size_t lock_dirs(om_out *const *outs, size_t n, int *fds)
+{
+    struct stat sb[LOCK_MAX];
+    size_t k = 0;
+    for (size_t i = 0; i < n && k < LOCK_MAX; i++) {
+        if (!outs[i] || !outs[i]->tmp) continue;
+        struct stat st;
+        const int fd = dir_fd(outs[i]->target, &st);
+        if (fd < 0) continue;
+        size_t j = 0;
+        while (j < k && !(sb[j].st_dev == st.st_dev && sb[j].st_ino == st.st_ino)) j++;
+        if (j < k) { close(fd); continue; }
+        for (j = k; j > 0 && (sb[j - 1].st_dev > st.st_dev ||
+                              (sb[j - 1].st_dev == st.st_dev && sb[j - 1].st_ino > st.st_ino)); j--) {
+            sb[j] = sb[j - 1];
+            fds[j] = fds[j - 1];
+        }
+        sb[j] = st;
+        fds[j] = fd;
+        k++;
+    }
+    for (size_t j = 0; j < k; j++)
+        while (flock(fds[j], LOCK_EX) != 0 && errno == EINTR) {}
+    return k;
+}
+
 om_status om_out_commit(om_out *const *outs, size_t n, om_diag *d)
 {
     om_status st = OM_OK;
@@ -241,6 +295,15 @@ om_status om_out_commit(om_out *const *outs, size_t n, om_diag *d)
         if (!o || !o->f) continue;
         if (!finish(o) && st == OM_OK) st = fail(d, o->path, "cannot write", o->err);
     }
+    sigset_t hold, old;
+    sigemptyset(&hold);
+    sigaddset(&hold, SIGINT);
+    sigaddset(&hold, SIGTERM);
+    sigaddset(&hold, SIGHUP);
+    sigaddset(&hold, SIGXFSZ);
+    sigprocmask(SIG_BLOCK, &hold, &old);
+    int fds[LOCK_MAX];
+    const size_t locked = st == OM_OK ? lock_dirs(outs, n, fds) : 0;
     for (size_t i = 0; i < n && st == OM_OK; i++) {
         om_out *o = outs[i];
         if (!o || !o->tmp) continue;
@@ -250,8 +313,10 @@ om_status om_out_commit(om_out *const *outs, size_t n, om_diag *d)
         free(o->tmp);
         o->tmp = NULL;
     }
+    for (size_t j = 0; j < locked; j++) close(fds[j]);   /* (closing unlocks) */
     for (size_t i = 0; i < n; i++)
         if (outs[i]) om_out_discard(outs[i]);
+    sigprocmask(SIG_SETMASK, &old, NULL);
     return st;
 }
 
