@@ -375,7 +375,8 @@ om_status om_method_bytes(const om_method *m, const om_method_cfg *c, const om_s
  * OM_E_BUDGET where the arena is too small. */
 om_status om_method_init(const om_method *m, void **state, om_arena *a, const om_method_cfg *c,
                          const om_scene *s, uint32_t width, uint32_t height, om_diag *d);
-/* The state's counters and bytes after a frame (zeros for NULL). */
+/* The state's counters and bytes after a frame (zeros for NULL, or a state m did not
+ * make). */
 void om_method_get_stats(const om_method *m, const void *state, om_method_stats *out);
 
 /* ---------------------------------------------------------------- rendering */
@@ -474,7 +475,11 @@ typedef struct om_frame_need {
 /* OM_E_INVALID without fd, its view or out. */
 om_status om_frame_bytes(const om_frame_desc *fd, om_frame_need *out);
 /* Renders one frame. The frame arena is rewound on return; the method's arena keeps
- * what the method keeps. */
+ * what the method keeps. OM_E_INVALID, before anything is drawn, for a missing piece
+ * of fd or a frame arena, a framebuffer that is not as wide as the image or holds no
+ * strip, a format outside om_format, or a method state that om_method_init did not
+ * make for this method, this scene (its vertex and index arrays and counts) and this
+ * view's image size. */
 om_status om_render_frame(const om_frame_desc *fd, om_arena *frame_arena,
                           om_frame_stats *stats, om_diag *d);
 

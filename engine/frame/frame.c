@@ -110,6 +110,9 @@ static om_status check(const om_frame_desc *fd, const om_arena *fa, om_diag *d)
                                          "shading and framebuffer");
     const uint32_t W = fd->view->cam.width, H = fd->view->cam.height;
     const uint32_t rows = fd->strip_rows == 0 || fd->strip_rows > H ? H : fd->strip_rows;
+    if (!om__state_for(fd->method_state, fd->method, fd->scene, W, H))
+        return om__fail(d, OM_E_INVALID, "the method state was made for another method, scene or image size "
+                                         "(om_method_init it for this frame's)");
     if ((unsigned)fd->fb->format > (unsigned)OM_L8)
         return om__fail(d, OM_E_INVALID, "framebuffer format must be OM_RGB888, OM_RGB565 or OM_L8");
     if (fd->fb->width != W || fd->fb->rows < rows || !fd->fb->pixels ||

@@ -132,6 +132,20 @@ typedef struct om__pass {
 #define OM__JOBS_ONLY(p) NULL
 #endif
 
+/* What a state was made for: the first member of every method's state struct, filled
+ * by om_method_init once the method's init succeeds, so that a frame refuses a state
+ * made for another method, scene or image size (om_render_frame) rather than read it
+ * as its own. */
+typedef struct om__state_head {
+    const om_method *method;
+    const om_vec3 *verts;
+    const uint32_t *idx;
+    uint32_t nverts, ntris, width, height;
+} om__state_head;
+
+/* Whether `state` was made by method m for scene s at width x height. */
+bool om__state_for(const void *state, const om_method *m, const om_scene *s, uint32_t width, uint32_t height);
+
 /* A shadow method: a small table of functions behind one interface (registry.c lists
  * them; a method's own files define its table, `om__method_<name>`). */
 struct om_method {

@@ -65,13 +65,33 @@ om_status om_method_init(const om_method *m, void **state, om_arena *a, const om
     if (!m || !state || !a || !c || !s)
         return om__fail(d, OM_E_INVALID, "om_method_init needs a method, a state pointer, an arena, a configuration and a scene");
     if (!side_ok(width, height)) return om__fail(d, OM_E_INVALID, "image width and height must be 1..8192");
-    return m->init(state, a, c, s, width, height, d);
+    const om_status st = m->init(state, a, c, s, width, height, d);
+    if (st != OM_OK) {
+        *state = NULL;
+        return st;
+    }
+    om__state_head *h = (om__state_head *)*state;   /* every state's first member */
+    h->method = m;
+    h->verts = s->verts;
+    h->idx = s->idx;
+    h->nverts = s->nverts;
+    h->ntris = s->ntris;
+    h->width = width;
+    h->height = height;
+    return OM_OK;
+}
+
+bool om__state_for(const void *state, const om_method *m, const om_scene *s, uint32_t width, uint32_t height)
+{
+    const om__state_head *h = (const om__state_head *)state;
+    return h->method == m && h->verts == s->verts && h->idx == s->idx && h->nverts == s->nverts &&
+           h->ntris == s->ntris && h->width == width && h->height == height;
 }
 
 void om_method_get_stats(const om_method *m, const void *state, om_method_stats *out)
 {
     if (!out) return;
-    if (!m || !state) {
+    if (!m || !state || ((const om__state_head *)state)->method != m) {
         memset(out, 0, sizeof *out);
         return;
     }

@@ -38,7 +38,7 @@ static void table_row(const bscene *b, uint32_t W, uint32_t H)
         if (om_method_init(m, &state, &a, &cfg, &b->s, W, H, &d)) return;
         ti[r] = (double)(om_clock_ns(NULL) - ti0) / 1e6;
         if (m->begin(state, &v, &d)) return;
-        om__izb *z = (om__izb *)state;
+        om__izb *z = om__izb_of(state);
         size_t next = 0;
         uint64_t ns[3] = {0, 0, 0}, slot[2] = {0, 0};
         uint64_t tgrid = om_clock_ns(NULL);

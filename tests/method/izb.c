@@ -399,7 +399,7 @@ static izb_run izb_frame(const om_scene *s, const char *pool, size_t bytes, uint
     om_method_stats ms;
     om_method_get_stats(m, state, &ms);
     for (uint32_t k = 0; k < ms.ncounters && k < 8; k++) r.counters[k] = (uint32_t)ms.counters[k];
-    const om__izb *z = (const om__izb *)state;
+    const om__izb *z = om__izb_of(state);
     r.grid = z->grid ? z->grid->ready : 2;
     free(mem);
     free(fmem);

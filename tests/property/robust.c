@@ -233,7 +233,8 @@ static void pathological_views(void)
  * same frame code; their memory at this size is the stress runs' subject). */
 /* A host's misuse gets a status, never a crash: every method's bytes and init with a
  * side of 0 or past OM_MAX_DIM, and a frame without its method state, without a frame
- * arena, or with a format outside om_format. */
+ * arena, with a format outside om_format, or with a state made for another method,
+ * scene or image size. */
 static void hostile_calls(void)
 {
     h_scene hs;
@@ -272,10 +273,40 @@ static void hostile_calls(void)
     h_frame_desc(&fd, &shade, &hs.s, &v, om_method_find("sm"), NULL, &fb, 0);
     om_arena_init(&fa, fmem, sizeof fmem, "frame");
     CHECK(om_render_frame(&fd, &fa, NULL, &d) == OM_E_INVALID && strstr(d.msg, "state"));
-    fd.method_state = &fa;   /* never read: the frame refuses first */
+    const om_method *sm = om_method_find("sm");
+    om_method_cfg c;
+    om_arena sa;
+    void *st;
+    om_method_cfg_default(&c, sm);
+    CHECK_OK(om_method_cfg_set(&c, "map", 64, NULL));
+    om_arena_init(&sa, mem, sizeof mem, "method");
+    CHECK_OK(om_method_init(sm, &st, &sa, &c, &hs.s, 16, 8, &d));
+    fd.method_state = st;
     CHECK(om_render_frame(&fd, NULL, NULL, &d) == OM_E_INVALID);
     fb.format = (om_format)9;
     CHECK(om_render_frame(&fd, &fa, NULL, &d) == OM_E_INVALID && strstr(d.msg, "format"));
+    fb.format = OM_RGB888;
+    CHECK_OK(om_render_frame(&fd, &fa, NULL, &d));
+    /* a state read only by the method, scene and image size it was made for */
+    fd.method = om_method_find("izb");
+    CHECK(om_render_frame(&fd, &fa, NULL, &d) == OM_E_INVALID && strstr(d.msg, "another method"));
+    fd.method = sm;
+    h_scene other;
+    if (h_scene_parse(&other, "box size 1 1 1\nplane size 4 4\n")) {
+        fd.scene = &other.s;
+        CHECK(om_render_frame(&fd, &fa, NULL, &d) == OM_E_INVALID && strstr(d.msg, "another method, scene"));
+        fd.scene = &hs.s;
+        h_scene_free(&other);
+    }
+    om_view v2;
+    CHECK_OK(h_view(&v2, &hs.s, 0.0f, 8, 8, NULL));
+    om_framebuffer fb2 = {OM_RGB888, 8, 8, 8 * 3, px};
+    fd.view = &v2;
+    fd.fb = &fb2;
+    CHECK(om_render_frame(&fd, &fa, NULL, &d) == OM_E_INVALID && strstr(d.msg, "image size"));
+    om_method_stats ms;
+    om_method_get_stats(om_method_find("izb"), st, &ms);   /* another method's state: zeros */
+    CHECK(ms.ncounters == 0 && ms.bytes_used == 0);
     CHECK(fa.used == 0);
     h_scene_free(&hs);
 }

@@ -249,6 +249,7 @@ static inline int om__asm_fpt_finer(const om__asm_pctx *c, const om__asm_fpt *f,
 typedef struct om__asm_dvec { double x, y, z, w; } om__asm_dvec;
 
 typedef struct om__asm_state {
+    om__state_head head;   /* first (method.h) */
     const om_scene *scene;
     om__asm_cfg cfg;
     om__asm_tree tree;

@@ -36,6 +36,7 @@ extern const om_method om__method_hybrid;
 #define OM__HYBRID_PARTS 64u
 
 typedef struct hybrid_state {
+    om__state_head head;   /* first (method.h) */
     const om_scene *scene;
     om__lspace ls;
     om__odepth *mat_od;    /* each material's optical depth */

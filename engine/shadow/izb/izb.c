@@ -22,6 +22,7 @@
 extern const om_method om__method_izb;
 
 typedef struct izb_state {
+    om__state_head head;   /* first (method.h) */
     om__izb z;
     om__izb_cfg cfg;
     uint32_t width, height;
@@ -236,6 +237,8 @@ static om_status izb_init(void **state, om_arena *a, const om_method_cfg *mc, co
 
 /* begin but for the projection of the scene's vertices (when they are kept): returns
  * how many there are to project, which the pass's jobs do in ranges (izb_pass_setup). */
+om__izb *om__izb_of(void *state) { return &((izb_state *)state)->z; }
+
 static uint32_t begin_view(izb_state *m, const om_view *v)
 {
     om__lspace_view(&m->z.ls, v);

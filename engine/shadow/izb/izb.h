@@ -101,6 +101,8 @@ static inline uint32_t om__izb_zcode(const om__izb_key *k, int32_t x0, int32_t y
  * om__izb_tile_first(z, E, k + 1)) in the strip's order: full pools, the rest last.
  * The tiling depends on the strip and the pool only, so a tile gives the same counts
  * whether the tiles run one after another (om__izb_resolve) or as jobs (izb.c's pass). */
+/* The irregular z-buffer inside izb's state (for tests and benchmarks). */
+om__izb *om__izb_of(void *state);
 uint32_t om__izb_tiles(const om__izb *z, uint32_t exposed);
 uint32_t om__izb_tile_first(const om__izb *z, uint32_t exposed, uint32_t k);
 

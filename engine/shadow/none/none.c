@@ -3,7 +3,10 @@
  * alone (facing the light, inside its frustum) decide its image. */
 #include "../method.h"
 
-typedef struct none_state { uint32_t frames; } none_state;
+typedef struct none_state {
+    om__state_head head;   /* first (method.h) */
+    uint32_t frames;
+} none_state;
 
 static om_status none_bytes(const om_method_cfg *c, const om_scene *s, uint32_t w,
                             uint32_t h, size_t *min, size_t *full)

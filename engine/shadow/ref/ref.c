@@ -14,6 +14,7 @@
 #include "ref_light.h"
 
 typedef struct ref_state {
+    om__state_head head;   /* first (method.h) */
     const om_scene *scene;
     om__lspace ls;
     om__bvh bvh;

@@ -140,6 +140,7 @@ typedef struct om__rtw_cfg {
 } om__rtw_cfg;
 
 typedef struct om__rtw {
+    om__state_head head;   /* first (method.h) */
     const om_scene *scene;
     om__rtw_cfg cfg;
     uint32_t n;                /* importance map side = super-cells per axis */

@@ -19,6 +19,7 @@ OM__CFG_FITS(sm_cfg);
 extern const om_method om__method_sm;
 
 typedef struct sm_state {
+    om__state_head head;   /* first (method.h) */
     const om_scene *scene;
     sm_cfg cfg;
     uint32_t size;

@@ -69,6 +69,7 @@ static inline void om__spsm_win_reset(om__spsm_win *w)
 }
 
 typedef struct om__spsm_state {
+    om__state_head head;   /* first (method.h) */
     const om_scene *scene;
     om__spsm_cfg cfg;
     uint32_t size;
