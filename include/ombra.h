@@ -372,7 +372,9 @@ om_status om_method_bytes(const om_method *m, const om_method_cfg *c, const om_s
 /* Creates m's state in arena a (at least *min bytes of om_method_bytes); the method
  * keeps `a` for its per-frame scratch, so the arena is the method's until the host is
  * done with the state. *state is NULL on failure; OM_E_INVALID as om_method_bytes,
- * OM_E_BUDGET where the arena is too small. */
+ * OM_E_BUDGET where the arena is too small. A scene built by hand is checked first:
+ * OM_E_INVALID for an array missing for its counts or an index past its vertices or
+ * materials (a parsed scene always passes; keep a scene so when editing it). */
 om_status om_method_init(const om_method *m, void **state, om_arena *a, const om_method_cfg *c,
                          const om_scene *s, uint32_t width, uint32_t height, om_diag *d);
 /* The state's counters and bytes after a frame (zeros for NULL, or a state m did not

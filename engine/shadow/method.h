@@ -143,6 +143,10 @@ typedef struct om__state_head {
     uint32_t nverts, ntris, width, height;
 } om__state_head;
 
+/* Whether a scene's arrays hold what its counts and indices say (scene/check.c):
+ * om_method_init asks before a method reads a scene a host may have built by hand. */
+om_status om__scene_check(const om_scene *s, om_diag *d);
+
 /* Whether `state` was made by method m for scene s at width x height. */
 bool om__state_for(const void *state, const om_method *m, const om_scene *s, uint32_t width, uint32_t height);
 

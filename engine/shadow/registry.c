@@ -65,7 +65,9 @@ om_status om_method_init(const om_method *m, void **state, om_arena *a, const om
     if (!m || !state || !a || !c || !s)
         return om__fail(d, OM_E_INVALID, "om_method_init needs a method, a state pointer, an arena, a configuration and a scene");
     if (!side_ok(width, height)) return om__fail(d, OM_E_INVALID, "image width and height must be 1..8192");
-    const om_status st = m->init(state, a, c, s, width, height, d);
+    om_status st = om__scene_check(s, d);
+    if (st != OM_OK) return st;
+    st = m->init(state, a, c, s, width, height, d);
     if (st != OM_OK) {
         *state = NULL;
         return st;

@@ -261,6 +261,30 @@ static void hostile_calls(void)
         CHECK(om_method_init(NULL, &state, &a, &c, &hs.s, 16, 16, &d) == OM_E_INVALID);
     }
     CHECK(om_method_bytes(NULL, NULL, NULL, 16, 16, &mn, &full) == OM_E_INVALID);
+    /* a scene built by hand whose arrays do not hold what it says: refused by init */
+    {
+        om_scene bad;
+        const om_method *m = om_method_find("ref");
+        om_method_cfg c;
+        om_arena a;
+        void *state;
+        om_diag d;
+        om_method_cfg_default(&c, m);
+        hand_scene(&bad, 3);
+        idx[7] = 32;   /* past its 32 vertices */
+        om_arena_init(&a, mem, sizeof mem, "method");
+        CHECK(om_method_init(m, &state, &a, &c, &bad, 16, 12, &d) == OM_E_INVALID && state == NULL &&
+              strstr(d.msg, "triangle 2 names a vertex"));
+        hand_scene(&bad, 3);
+        tmat[1] = 1;   /* past its one material */
+        CHECK(om_method_init(m, &state, &a, &c, &bad, 16, 12, &d) == OM_E_INVALID && strstr(d.msg, "material"));
+        tmat[1] = 0;
+        hand_scene(&bad, 3);
+        bad.idx = NULL;
+        CHECK(om_method_init(m, &state, &a, &c, &bad, 16, 12, &d) == OM_E_INVALID && strstr(d.msg, "missing"));
+        hand_scene(&bad, 3);
+        CHECK_OK(om_method_init(m, &state, &a, &c, &bad, 16, 12, &d));
+    }
     om_view v;
     om_frame_desc fd;
     om_shade_cfg shade;
