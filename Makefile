@@ -84,7 +84,7 @@ test:
 # The fuzz targets' entry points without libFuzzer, replayed over the inputs that once
 # crashed or hung a target and the hostile inputs of issue 24 (tests/fuzz/regress/),
 # and the seeds: part of `make check`, so of `make test` and `make test-sanitize`.
-FUZZ_TARGETS = scene obj render
+FUZZ_TARGETS = scene obj render api
 FUZZ_INPUTS  = $(sort $(wildcard tests/fuzz/regress/* tests/fuzz/seeds/*))
 
 $(O)/fuzz-replay-%: tests/fuzz/fuzz_%.c tests/fuzz/replay.c $(O)/libombra.a

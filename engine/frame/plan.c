@@ -49,12 +49,12 @@ om_status om_frame_bytes(const om_frame_desc *fd, om_frame_need *out)
     const om_view *v = fd->view;
     const uint32_t W = v->cam.width, H = v->cam.height, rows = strip_rows(fd, H);
     const om_scene *s = fd->scene;
+    const void *state = om__state_of(fd->method_state, fd->method);
     out->least = least_bytes(W, rows);
     out->with_bins = out->least + om__frame_bins_bytes(s);
-    out->with_jobs = out->with_bins + om__jobs_bytes(fd->method, fd->method_state, s,
-                                                     fd->parallel_for ? fd->threads : 1);
+    out->with_jobs = out->with_bins + om__jobs_bytes(fd->method, state, s, fd->parallel_for ? fd->threads : 1);
     out->with_ids = out->with_jobs + om_arena_need(ids_bytes(s, W, H), 8);
-    const bool again = rows < H && (v->light.kind == OM_LIGHT_DIRECTIONAL || observes(fd->method, fd->method_state));
+    const bool again = rows < H && (v->light.kind == OM_LIGHT_DIRECTIONAL || observes(fd->method, state));
     out->whole = again ? out->with_ids : out->with_jobs;
     return OM_OK;
 }

@@ -147,6 +147,13 @@ typedef struct om__state_head {
  * om_method_init asks before a method reads a scene a host may have built by hand. */
 om_status om__scene_check(const om_scene *s, om_diag *d);
 
+/* `state` where method m made it, else NULL (a query given another method's state
+ * reads none of it). */
+static inline void *om__state_of(void *state, const om_method *m)
+{
+    return state && m && ((const om__state_head *)state)->method == m ? state : NULL;
+}
+
 /* Whether `state` was made by method m for scene s at width x height. */
 bool om__state_for(const void *state, const om_method *m, const om_scene *s, uint32_t width, uint32_t height);
 

@@ -11,7 +11,7 @@ mkdir -p "$out"
 SRC="$(find engine -name '*.c' | sort | tr '\n' ' ')"
 FLAGS="-std=c99 -g -O1 -ffp-contract=off -Iinclude -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all"
 status=0
-for t in scene obj render; do
+for t in scene obj render api; do
     mkdir -p "$out/$t/corpus" "$out/$t/crashes"
     # seeds: the default scene, the project's small scenes and OBJ files, and every
     # input that once crashed (tests/fuzz/regress)
@@ -37,7 +37,7 @@ for t in scene obj render; do
     fi
 done
 # Every input that once crashed a target is replayed against all of them.
-for t in scene obj render; do
+for t in scene obj render api; do
     [ -x "$out/fuzz_$t" ] || continue
     set -- tests/fuzz/regress/*
     [ -f "$1" ] || break

@@ -161,8 +161,10 @@ typedef struct binning { int axis; float lo, scale; } binning;
 
 static inline int bin_of(const binning *g, const box *t)
 {
-    int k = (int)((centre(t, g->axis) - g->lo) * g->scale);
-    return k < 0 ? 0 : k >= BINS ? BINS - 1 : k;
+    /* compared before the conversion: a NaN or huge centre (a hand-made scene's) has
+     * no int, and goes to an end bin */
+    const float f = (centre(t, g->axis) - g->lo) * g->scale;
+    return !(f > 0.0f) ? 0 : f >= (float)BINS ? BINS - 1 : (int)f;
 }
 
 /* Counts and bounds the triangles of [first, end) per bin. The loops below read the
