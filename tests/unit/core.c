@@ -83,9 +83,9 @@ static void arena_fault_injection(void)
     CHECK(om_arena_need(10, 8) >= 10 + 7);
 }
 
-/* Byte counts saturate instead of wrapping: a pool of 2^61 items of 8 bytes asks for
- * more than any arena holds, and its carve fails without a write (a 32-bit host wraps
- * at 2^29 items the same way). */
+/* Byte counts saturate instead of wrapping: 8 items of SIZE_MAX / 8 + 1 bytes (2^61 on
+ * a 64-bit host, 2^29 on a 32-bit one) ask for more than any arena holds, and the
+ * pool's carve fails without a write. */
 static void sizes_never_wrap(void)
 {
     unsigned char buf[1024];
@@ -94,10 +94,11 @@ static void sizes_never_wrap(void)
     om_arena_init(&a, buf, sizeof buf, "t");
     CHECK(om_arena_need(SIZE_MAX, 64) == SIZE_MAX);
     CHECK(om_arena_need(SIZE_MAX - 3, 8) == SIZE_MAX);
-    CHECK(om_pool_bytes((size_t)1 << 61, 8) == SIZE_MAX);
+    const size_t huge = SIZE_MAX / 8 + 1;
+    CHECK(om_pool_bytes(huge, 8) == SIZE_MAX);
     CHECK(om_pool_bytes(SIZE_MAX, 1) == SIZE_MAX);
     CHECK(om_pool_bytes(8, UINT32_MAX) >= (size_t)UINT32_MAX * 8 || om_pool_bytes(8, UINT32_MAX) == SIZE_MAX);
-    CHECK(om_pool_init(&p, &a, (size_t)1 << 61, 8, NULL) == OM_E_BUDGET);
+    CHECK(om_pool_init(&p, &a, huge, 8, NULL) == OM_E_BUDGET);
     CHECK(om_pool_init(&p, &a, SIZE_MAX, 2, NULL) == OM_E_BUDGET);
     CHECK(a.used == 0);
 }

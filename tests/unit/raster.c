@@ -12,6 +12,8 @@
 #include <math.h>
 #include <stdlib.h>
 
+#ifdef __SIZEOF_INT128__
+
 #define TW 32
 #define TH 32
 
@@ -38,7 +40,6 @@ static om_vec4 at(double X, double Y, uint32_t w, uint32_t h, float z)
     return v;
 }
 
-#ifdef __SIZEOF_INT128__
 __extension__ typedef __int128 i128;
 /* Whether depth d at grid point (px, py) is what raster.h promises for the plane
  * through the vertices (x, y, z), given in any order: the exact plane's value z(p)
@@ -59,9 +60,7 @@ static bool depth_near_plane(const int64_t x[3], const int64_t y[3], const uint3
     if (err > aD) return false;   /* beyond one unit: never allowed (and keeps what follows in range) */
     return (err << 34) <= aD * (((i128)1 << 33) + 2 * ((gx < 0 ? -gx : gx) + (gy < 0 ? -gy : gy)));
 }
-#else
-#error "unit/raster.c checks depths in 128-bit integers: build the tests with gcc or clang on a 64-bit host"
-#endif
+
 
 /* Rasterizes one triangle alone and adds its coverage to count_buf. */
 static void add_coverage(const om_vec4 c[3], uint32_t w, uint32_t h)
@@ -901,3 +900,11 @@ void suite_raster(void)
     RUN(non_finite_vertices_draw_nothing);
     RUN(zdepth_by_words);
 }
+#else
+/* A 32-bit build (make test-32) has no 128-bit integers, which this suite's depth
+ * checks need; the 64-bit builds run it. */
+void suite_raster(void)
+{
+    printf("  raster: skipped here (no 128-bit integers; the 64-bit builds run it)\n");
+}
+#endif
