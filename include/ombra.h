@@ -9,7 +9,11 @@
  *
  * Conventions: every fallible function returns an om_status; results go through
  * out-parameters; an optional om_diag* receives the details (bytes asked and left
- * for a budget error, line and column for a parse error) and may be NULL.
+ * for a budget error, line and column for a parse error) and may be NULL. A NULL
+ * where a declaration does not allow one is refused, never followed: a function that
+ * returns an om_status returns OM_E_INVALID, and the others do nothing and return 0,
+ * NULL, "" or a neutral value (om_metrics_match 1, om_flicker_share 0, om_hash its
+ * h). The inline accessors (om_term_lit, om_mask_of) read what they are handed.
  *
  * Measuring (masks, their comparison, flicker, frame hashes) is in ombra_measure.h;
  * the compile-time switches are listed in engine/core/config.h.
@@ -325,7 +329,8 @@ void om_method_cfg_default(om_method_cfg *c, const om_method *m);
 /* Sets a setting of c's method by name: OM_E_NOTFOUND when the method has no such
  * setting, OM_E_RANGE outside [min, max] or not whole for a whole-number setting. */
 om_status om_method_cfg_set(om_method_cfg *c, const char *name, double value, om_diag *d);
-/* Reads a setting's value: OM_E_NOTFOUND when c's method has no such setting. */
+/* Reads a setting's value: OM_E_NOTFOUND when c's method has no such setting (value
+ * may be NULL: whether it has it). */
 om_status om_method_cfg_get(const om_method_cfg *c, const char *name, double *value);
 /* m's defaults with the value of every setting of `from` (may be NULL) that m takes
  * too: to compare methods at the same "map", say. `from` may be c's own storage. */

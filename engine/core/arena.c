@@ -7,6 +7,7 @@
 
 void om_arena_init(om_arena *a, void *buf, size_t size, const char *name)
 {
+    if (!a) return;
     memset(a, 0, sizeof *a);
     a->base = (unsigned char *)buf;
     a->cap = buf ? size : 0;
@@ -42,7 +43,9 @@ static om_status budget_fail(om_arena *a, size_t asked, om_diag *d)
 /* Carves size bytes; zeroes them when `zero`. */
 static om_status carve(om_arena *a, size_t size, size_t align, void **out, om_diag *d, bool zero)
 {
+    if (!out) return om__fail(d, OM_E_INVALID, "an arena carve needs somewhere to put its pointer");
     *out = NULL;
+    if (!a) return om__fail(d, OM_E_INVALID, "an arena carve needs an arena");
     if (align == 0 || (align & (align - 1)) != 0 || align > 64)
         return om__fail(d, OM_E_INVALID, "arena alignment must be a power of two up to 64");
     /* Align the address, not the offset: the host's buffer may start anywhere. */
@@ -77,19 +80,20 @@ om_status om_arena_sub(om_arena *a, size_t size, const char *name, om_arena *chi
                        om_diag *d)
 {
     void *p;
+    if (!child) return om__fail(d, OM_E_INVALID, "om_arena_sub needs a child arena to fill");
     om_status st = om_arena_alloc(a, size, 16, &p, d);
     om_arena_init(child, st == OM_OK ? p : NULL, st == OM_OK ? size : 0, name);
     return st;
 }
 
-size_t om_arena_mark(const om_arena *a) { return a->used; }
+size_t om_arena_mark(const om_arena *a) { return a ? a->used : 0; }
 
 void om_arena_rewind(om_arena *a, size_t mark)
 {
-    if (mark <= a->used) a->used = mark;
+    if (a && mark <= a->used) a->used = mark;
 }
 
-size_t om_arena_left(const om_arena *a) { return a->cap - a->used; }
+size_t om_arena_left(const om_arena *a) { return a ? a->cap - a->used : 0; }
 
 /* ---- pools */
 
@@ -106,6 +110,7 @@ om_status om_pool_init(om_pool *p, om_arena *a, size_t item_size, uint32_t count
 {
     void *items, *next;
     om_status st;
+    if (!p || !a) return om__fail(d, OM_E_INVALID, "om_pool_init needs a pool and an arena");
     memset(p, 0, sizeof *p);
     if (item_size == 0 || count == 0)
         return om__fail(d, OM_E_INVALID, "pool needs a non-zero item size and count");
@@ -122,7 +127,7 @@ om_status om_pool_init(om_pool *p, om_arena *a, size_t item_size, uint32_t count
 
 void *om_pool_get(om_pool *p)
 {
-    if (p->free_head >= p->count) return NULL;
+    if (!p || p->free_head >= p->count) return NULL;
     uint32_t i = p->free_head;
     p->free_head = p->next[i];
     p->next[i] = p->count;
@@ -140,11 +145,12 @@ uint32_t om_pool_index(const om_pool *p, const void *item)
 
 void *om_pool_item(const om_pool *p, uint32_t index)
 {
-    return index < p->count ? p->items + (size_t)index * p->item_size : NULL;
+    return p && index < p->count ? p->items + (size_t)index * p->item_size : NULL;
 }
 
 void om_pool_put(om_pool *p, void *item)
 {
+    if (!p || !item || !p->count) return;
     uint32_t i = om_pool_index(p, item);
     if (i >= p->count) return;
     p->next[i] = p->free_head;

@@ -16,6 +16,7 @@ bool om__exposed(const om_view *v, om_sample *smp)
 
 void om_shade_cfg_default(om_shade_cfg *c)
 {
+    if (!c) return;
     c->ambient = 0.25f;
     c->bg_r = 36;
     c->bg_g = 44;

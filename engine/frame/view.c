@@ -61,6 +61,7 @@ om_status om_view_init(om_view *v, const om_camera *cam, const om_light *light,
                        const om_scene *s, om_diag *d)
 {
     om_status st;
+    if (!v || !cam || !light || !s) return om__fail(d, OM_E_INVALID, "om_view_init needs a view, a camera, a light and a scene");
     memset(v, 0, sizeof *v);
     if (cam->width < 1 || cam->width > OM_MAX_DIM || cam->height < 1 || cam->height > OM_MAX_DIM)
         return om__fail(d, OM_E_INVALID, "image size must be 1..8192 in each direction");
@@ -113,7 +114,7 @@ om_status om_view_init(om_view *v, const om_camera *cam, const om_light *light,
 
 void om_view_fit_light(om_view *v, const om_scene *s, om_vec3 lo, om_vec3 hi)
 {
-    if (v->light.kind != OM_LIGHT_DIRECTIONAL || !(lo.x <= hi.x && lo.y <= hi.y)) return;
+    if (!v || !s || v->light.kind != OM_LIGHT_DIRECTIONAL || !(lo.x <= hi.x && lo.y <= hi.y)) return;
     om_vec3 slo, shi;
     light_box(&v->light_view, s, &slo, &shi);
     ortho_from(v, lo.x, hi.x, lo.y, hi.y, -shi.z * 0.999f, -slo.z * 1.001f + 1e-3f);

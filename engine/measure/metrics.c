@@ -24,7 +24,9 @@ static bool near_edge(const uint8_t *ref, uint32_t w, uint32_t h, uint32_t x, ui
 void om_compare_masks(const uint8_t *ref, const uint8_t *m, uint32_t width, uint32_t height,
                       om_metrics *out)
 {
+    if (!out) return;
     memset(out, 0, sizeof *out);
+    if (!ref || !m) return;
     for (uint32_t y = 0; y < height; y++)
         for (uint32_t x = 0; x < width; x++) {
             size_t i = (size_t)y * width + x;
@@ -48,14 +50,14 @@ void om_compare_masks(const uint8_t *ref, const uint8_t *m, uint32_t width, uint
 
 double om_metrics_match(const om_metrics *m)
 {
-    if (m->samples == 0) return 1.0;
+    if (!m || m->samples == 0) return 1.0;
     return 1.0 - (double)(m->false_lit + m->false_shadowed) / (double)m->samples;
 }
 
 void om_diff_image(const uint8_t *ref, const uint8_t *m, uint32_t width, uint32_t height,
                    uint8_t *rgb)
 {
-    size_t n = (size_t)width * height;
+    const size_t n = ref && m && rgb ? (size_t)width * height : 0;
     for (size_t i = 0; i < n; i++) {
         uint8_t r = ref[i], a = m[i], *o = rgb + 3 * i;
         if (r == OM_MASK_BG || a == OM_MASK_BG) { o[0] = o[1] = o[2] = 0; }
@@ -68,6 +70,7 @@ void om_diff_image(const uint8_t *ref, const uint8_t *m, uint32_t width, uint32_
 void om_flicker_add(om_flicker *f, const uint8_t *ref_prev, const uint8_t *m_prev,
                     const uint8_t *ref, const uint8_t *m, size_t n)
 {
+    if (!f || !ref_prev || !m_prev || !ref || !m) return;
     for (size_t i = 0; i < n; i++) {
         if (ref_prev[i] == OM_MASK_BG || ref[i] == OM_MASK_BG || m_prev[i] == OM_MASK_BG ||
             m[i] == OM_MASK_BG)
@@ -80,13 +83,13 @@ void om_flicker_add(om_flicker *f, const uint8_t *ref_prev, const uint8_t *m_pre
 
 double om_flicker_share(const om_flicker *f)
 {
-    return f->samples ? (double)f->flicker / (double)f->samples : 0.0;
+    return f && f->samples ? (double)f->flicker / (double)f->samples : 0.0;
 }
 
 uint64_t om_hash(uint64_t h, const void *data, size_t len)
 {
     const unsigned char *p = (const unsigned char *)data;
-    for (size_t i = 0; i < len; i++) {
+    for (size_t i = 0; p && i < len; i++) {
         h ^= p[i];
         h *= 0x100000001b3ull;
     }

@@ -130,6 +130,7 @@ static void put(om_method_cfg *c, const om_setting *f, double value)
 
 void om_method_cfg_default(om_method_cfg *c, const om_method *m)
 {
+    if (!c) return;
     memset(c, 0, sizeof *c);
     c->method = m;
     for (uint32_t i = 0; m && i < m->nsettings; i++) put(c, &m->settings[i], m->settings[i].def);
@@ -137,6 +138,7 @@ void om_method_cfg_default(om_method_cfg *c, const om_method *m)
 
 om_status om_method_cfg_set(om_method_cfg *c, const char *name, double value, om_diag *d)
 {
+    if (!c) return om__fail(d, OM_E_INVALID, "om_method_cfg_set needs a configuration");
     const om_setting *f = om_method_setting(c->method, name);
     char tmp[8];
     if (!f) {
@@ -163,8 +165,10 @@ om_status om_method_cfg_set(om_method_cfg *c, const char *name, double value, om
 
 om_status om_method_cfg_get(const om_method_cfg *c, const char *name, double *value)
 {
+    if (!c) return OM_E_INVALID;
     const om_setting *f = om_method_setting(c->method, name);
     if (!f) return OM_E_NOTFOUND;
+    if (!value) return OM_OK;   /* only whether it has the setting */
     const unsigned char *p = c->store.bytes + f->offset;
     if (f->kind == OM_SETTING_U32) { uint32_t v; memcpy(&v, p, sizeof v); *value = v; }
     else if (f->kind == OM_SETTING_U64) { uint64_t v; memcpy(&v, p, sizeof v); *value = (double)v; }
@@ -175,6 +179,7 @@ om_status om_method_cfg_get(const om_method_cfg *c, const char *name, double *va
 void om_method_cfg_from(om_method_cfg *c, const om_method *m, const om_method_cfg *from)
 {
     om_method_cfg src;
+    if (!c) return;
     if (from) src = *from;
     else om_method_cfg_default(&src, NULL);
     om_method_cfg_default(c, m);

@@ -335,6 +335,49 @@ static void hostile_calls(void)
     h_scene_free(&hs);
 }
 
+/* Every public function handed NULL where its declaration does not allow one: a
+ * status or a neutral value, never a dereference (ombra.h's conventions). */
+static void null_arguments(void)
+{
+    om_diag d;
+    size_t z = 7;
+    void *p = &z;
+    uint8_t m8[4] = {0};
+    double v;
+    om_arena_init(NULL, NULL, 0, NULL);
+    CHECK(om_arena_alloc(NULL, 8, 8, &p, &d) == OM_E_INVALID && p == NULL);
+    CHECK(om_arena_sub(NULL, 8, "x", NULL, &d) == OM_E_INVALID);
+    CHECK(om_arena_mark(NULL) == 0 && om_arena_left(NULL) == 0);
+    om_arena_rewind(NULL, 0);
+    CHECK(om_pool_init(NULL, NULL, 8, 8, &d) == OM_E_INVALID);
+    CHECK(om_pool_get(NULL) == NULL && om_pool_item(NULL, 0) == NULL);
+    om_pool_put(NULL, m8);
+    CHECK(om_scene_bytes(NULL, 5, NULL, &z, &d) == OM_E_INVALID);
+    CHECK(om_scene_parse(NULL, 5, NULL, NULL, NULL, &d) == OM_E_INVALID);
+    CHECK(om_view_init(NULL, NULL, NULL, NULL, &d) == OM_E_INVALID);
+    om_view_fit_light(NULL, NULL, (om_vec3){0, 0, 0}, (om_vec3){1, 1, 1});
+    om_method_cfg_default(NULL, NULL);
+    CHECK(om_method_cfg_set(NULL, "map", 1, &d) == OM_E_INVALID);
+    CHECK(om_method_cfg_get(NULL, "map", &v) == OM_E_INVALID);
+    om_method_cfg_from(NULL, NULL, NULL);
+    om_shade_cfg_default(NULL);
+    CHECK(om_frame_bytes(NULL, NULL) == OM_E_INVALID);
+    CHECK(om_render_frame(NULL, NULL, NULL, &d) == OM_E_INVALID);
+    CHECK(om_method_name(NULL)[0] == 0 && om_method_summary(NULL)[0] == 0 && om_method_flags(NULL) == 0);
+    CHECK(om_method_nsettings(NULL) == 0 && om_method_setting_at(NULL, 0) == NULL);
+    CHECK(om_method_setting(NULL, NULL) == NULL && om_method_find(NULL) == NULL);
+    om_compare_masks(NULL, NULL, 4, 4, NULL);
+    om_compare_masks(m8, m8, 0, 0, NULL);
+    om_metrics mt;
+    om_compare_masks(NULL, m8, 2, 2, &mt);
+    CHECK(mt.samples == 0 && om_metrics_match(NULL) == 1.0);
+    om_diff_image(NULL, NULL, 4, 4, NULL);
+    om_flicker_add(NULL, NULL, NULL, NULL, NULL, 4);
+    CHECK(om_flicker_share(NULL) == 0.0);
+    CHECK(om_hash(42, NULL, 4) == 42);
+    CHECK(om_status_str((om_status)-1)[0] != 0 && om_status_str(OM_E_COUNT_)[0] != 0);
+}
+
 static void largest_image(void)
 {
     if (getenv("OM_TEST_QUICK")) return;   /* valgrind runs skip the 67M-pixel frame */
@@ -376,4 +419,5 @@ void suite_robust(void)
     RUN(pathological_views);
     RUN(largest_image);
     RUN(hostile_calls);
+    RUN(null_arguments);
 }
