@@ -335,6 +335,38 @@ static void hostile_calls(void)
     h_scene_free(&hs);
 }
 
+/* Every method's bytes query at the largest image and each setting at its largest
+ * never wraps (make test-32 runs it where size_t has 32 bits): izb's pool of 1e9
+ * samples asks for at least 16 bytes a sample, or SIZE_MAX; min <= full; and an arena
+ * short of min is refused. */
+static void largest_settings(void)
+{
+    h_scene hs;
+    if (!h_scene_parse(&hs, "box size 1 1 1\nplane size 4 4\n")) return;
+    static unsigned char mem[1 << 16];
+    for (size_t k = 0; k < om_method_count(); k++) {
+        const om_method *m = om_method_at(k);
+        for (uint32_t i = 0; i < om_method_nsettings(m); i++) {
+            const om_setting *f = om_method_setting_at(m, i);
+            om_method_cfg c;
+            size_t mn, full;
+            om_arena a;
+            void *state;
+            om_method_cfg_default(&c, m);
+            CHECK_OK(om_method_cfg_set(&c, f->name, f->max, NULL));
+            if (om_method_bytes(m, &c, &hs.s, OM_MAX_DIM, OM_MAX_DIM, &mn, &full) != OM_OK) continue;
+            CHECK_MSG(mn <= full, "%s %s=%g: min %zu > full %zu", om_method_name(m), f->name, f->max, mn, full);
+            if (!strcmp(f->name, "izb.pool") && !strcmp(om_method_name(m), "izb"))
+                CHECK_MSG(mn == SIZE_MAX || (double)mn >= 16e9, "izb pool 1e9 asks %zu bytes", mn);
+            om_arena_init(&a, mem, sizeof mem, "method");
+            if (mn > sizeof mem)
+                CHECK_MSG(om_method_init(m, &state, &a, &c, &hs.s, OM_MAX_DIM, OM_MAX_DIM, NULL) == OM_E_BUDGET,
+                          "%s %s=%g: init in 64 KiB of %zu", om_method_name(m), f->name, f->max, mn);
+        }
+    }
+    h_scene_free(&hs);
+}
+
 /* Every public function handed NULL where its declaration does not allow one: a
  * status or a neutral value, never a dereference (ombra.h's conventions). */
 static void null_arguments(void)
@@ -420,4 +452,5 @@ void suite_robust(void)
     RUN(largest_image);
     RUN(hostile_calls);
     RUN(null_arguments);
+    RUN(largest_settings);
 }

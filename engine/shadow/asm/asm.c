@@ -73,11 +73,14 @@ static size_t scene_bytes(const om_scene *s)
            om_arena_need((n + 31) / 32 * sizeof(uint32_t), 8);
 }
 
+/* (Saturating, as the layout's arena_bytes: a candidate list past what a 32-bit
+ * size_t holds asks for SIZE_MAX, which no arena has.) */
 static size_t scratch_bytes(const om__asm_layout *l, uint64_t ncand)
 {
     const size_t t2 = (size_t)l->tile * l->tile;
-    return 2 * om_arena_need(t2 * sizeof(uint32_t), 8) +
-           om_arena_need((size_t)ncand * sizeof(om__asm_cand), 8);
+    const size_t n = ncand > SIZE_MAX ? SIZE_MAX : (size_t)ncand;
+    return om__size_add(2 * om_arena_need(t2 * sizeof(uint32_t), 8),
+                        om_arena_need(om__size_mul(n, sizeof(om__asm_cand)), 8));
 }
 
 static uint64_t cand_count(const om__asm_layout *l)
@@ -88,8 +91,8 @@ static uint64_t cand_count(const om__asm_layout *l)
 
 static size_t asm_need(const om_scene *s, const om__asm_layout *l, bool lean)
 {
-    return om_arena_need(sizeof(om__asm_state), 16) + l->arena_bytes + scratch_bytes(l, cand_count(l)) +
-           (lean ? 0 : scene_bytes(s));
+    return om__size_add(om__size_add(om_arena_need(sizeof(om__asm_state), 16), l->arena_bytes),
+                        om__size_add(scratch_bytes(l, cand_count(l)), lean ? 0 : scene_bytes(s)));
 }
 
 static om_status asm_bytes(const om_method_cfg *mc, const om_scene *s, uint32_t w, uint32_t h,
@@ -171,7 +174,9 @@ static om_status asm_init(void **state, om_arena *a, const om_method_cfg *mc, co
     m->sdepth = (uint32_t *)p;
     if ((st = om_arena_alloc(a, t2 * sizeof(uint32_t), 8, &p, d))) return st;
     m->sid = (uint32_t *)p;
-    if ((st = om_arena_alloc(a, (size_t)nc * sizeof(om__asm_cand), 8, &p, d))) return st;
+    if ((st = om_arena_alloc(a, om__size_mul(nc > SIZE_MAX ? SIZE_MAX : (size_t)nc, sizeof(om__asm_cand)), 8, &p,
+                             d)))
+        return st;
     m->cand = (om__asm_cand *)p;
     m->ncand_max = nc > UINT32_MAX ? UINT32_MAX : (uint32_t)nc;
     for (uint32_t i = 0; i <= OM__ASM_MAX_LEVEL; i++) m->inv_scale[i] = (double)l.tile / om__asm_grid(&l, i);

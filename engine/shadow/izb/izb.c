@@ -74,12 +74,15 @@ static size_t parts_bytes(const om_scene *s, bool cache)
            om_arena_need((size_t)(s->nmats ? s->nmats : 1) * sizeof(om__odepth), 4);
 }
 
+/* (Saturating, as every byte count here: a pool past what a 32-bit size_t holds asks
+ * for SIZE_MAX, which no arena has.) */
 static size_t pool_bytes_of(uint32_t samples, uint32_t leaf)
 {
-    return om_arena_need((size_t)samples * sizeof(om__odepth), 16) +
-           2 * om_arena_need((size_t)samples * sizeof(om__izb_key), 16) +
-           om_arena_need((size_t)node_bound(samples, leaf) * sizeof(om__izb_node), 16) +
-           om_arena_need((size_t)cells_bound(samples) * sizeof(uint32_t), 16);
+    const size_t keys = om_arena_need(om__size_mul(samples, sizeof(om__izb_key)), 16);
+    return om__size_add(om__size_add(om_arena_need(om__size_mul(samples, sizeof(om__odepth)), 16),
+                                     om__size_add(keys, keys)),
+                        om__size_add(om_arena_need(om__size_mul(node_bound(samples, leaf), sizeof(om__izb_node)), 16),
+                                     om_arena_need(om__size_mul(cells_bound(samples), sizeof(uint32_t)), 16)));
 }
 
 /* The pool by default: tiles of at least TILE_LEAST samples, and at least n^2 /
@@ -125,8 +128,8 @@ static om_status pool_bytes(const om__izb_cfg *c, const om_scene *s, uint32_t w,
     if (c->izb_leaf < 1) return OM_E_INVALID;
     uint32_t one_pass = auto_pool(s, w, h), smallest = w;   /* the smallest tile: one row */
     if (c->izb_pool) one_pass = smallest = c->izb_pool;
-    *min = fixed_bytes(s, h, false) + pool_bytes_of(smallest, c->izb_leaf);
-    *full = fixed_bytes(s, h, true) + pool_bytes_of(one_pass, c->izb_leaf) + grid_bytes(s);
+    *min = om__size_add(fixed_bytes(s, h, false), pool_bytes_of(smallest, c->izb_leaf));
+    *full = om__size_add(om__size_add(fixed_bytes(s, h, true), pool_bytes_of(one_pass, c->izb_leaf)), grid_bytes(s));
     return OM_OK;
 }
 
@@ -195,16 +198,16 @@ static om_status setup(om__izb *z, om__lgrid *g, om_arena *a, const om__izb_cfg 
     if (!cap) cap = least;   /* (the caller checked the minimum: the carve below fails) */
     z->cap = cap;
     z->node_cap = node_bound(cap, z->leaf);
-    if ((st = om_arena_alloc(a, (size_t)cap * sizeof(om__odepth), 16, &p, d))) return st;
+    if ((st = om_arena_alloc(a, om__size_mul(cap, sizeof(om__odepth)), 16, &p, d))) return st;
     z->od = (om__odepth *)p;
-    if ((st = om_arena_alloc(a, (size_t)cap * sizeof(om__izb_key), 16, &p, d))) return st;
+    if ((st = om_arena_alloc(a, om__size_mul(cap, sizeof(om__izb_key)), 16, &p, d))) return st;
     z->keys = (om__izb_key *)p;
-    if ((st = om_arena_alloc(a, (size_t)cap * sizeof(om__izb_key), 16, &p, d))) return st;
+    if ((st = om_arena_alloc(a, om__size_mul(cap, sizeof(om__izb_key)), 16, &p, d))) return st;
     z->sorted = (om__izb_key *)p;
-    if ((st = om_arena_alloc(a, (size_t)z->node_cap * sizeof(om__izb_node), 16, &p, d))) return st;
+    if ((st = om_arena_alloc(a, om__size_mul(z->node_cap, sizeof(om__izb_node)), 16, &p, d))) return st;
     z->nodes = (om__izb_node *)p;
     z->cells_cap = cells_bound(cap);
-    if ((st = om_arena_alloc(a, (size_t)z->cells_cap * sizeof(uint32_t), 16, &p, d))) return st;
+    if ((st = om_arena_alloc(a, om__size_mul(z->cells_cap, sizeof(uint32_t)), 16, &p, d))) return st;
     z->cells = (uint32_t *)p;
     return OM_OK;
 }
