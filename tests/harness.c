@@ -1,5 +1,6 @@
 /* harness.c — see harness.h. */
 #include "harness.h"
+#include "frame_need.h"
 #include "test.h"
 
 #include <stdlib.h>
@@ -142,32 +143,10 @@ om_status h_render_in(const om_scene *s, const char *name, const om_method_cfg *
     return st;
 }
 
-static void no_jobs(void *host, om_job_fn fn, void *job_user, uint32_t n)
-{
-    (void)host;
-    for (uint32_t i = 0; i < n; i++) fn(job_user, i);
-}
-
 om_frame_need h_frame_need(const om_method *m, const om_scene *s, uint32_t width, uint32_t height, uint32_t rows,
                            uint32_t threads)
 {
-    om_view v;
-    om_frame_desc fd;
-    om_frame_need need;
-    memset(&v, 0, sizeof v);
-    memset(&fd, 0, sizeof fd);
-    memset(&need, 0, sizeof need);
-    v.cam.width = width;
-    v.cam.height = height;
-    v.light.kind = OM_LIGHT_SPOT;
-    fd.view = &v;
-    fd.scene = s;
-    fd.method = m;
-    fd.strip_rows = rows;
-    fd.threads = threads;
-    fd.parallel_for = threads > 1 ? no_jobs : NULL;
-    om_frame_bytes(&fd, &need);
-    return need;
+    return frame_need_of(m, s, width, height, rows, threads);
 }
 
 size_t h_frame_least(uint32_t width, uint32_t rows) { return h_frame_need(NULL, NULL, width, rows, rows, 1).least; }

@@ -1,5 +1,6 @@
 /* bench_main.c — the benchmark driver and the helpers of bench.h. */
 #include "bench.h"
+#include "../frame_need.h"
 
 #include <string.h>
 
@@ -99,28 +100,9 @@ int bench_view(const bscene *b, uint32_t W, uint32_t H, float t, om_view *v)
     return om_view_init(v, &cam, &light, &b->s, &d) != OM_OK;
 }
 
-static void inline_for(void *host, om_job_fn fn, void *job_user, uint32_t n)
-{
-    (void)host;
-    for (uint32_t i = 0; i < n; i++) fn(job_user, i);
-}
-
 size_t bench_frame_bytes(const om_method *m, const om_scene *s, uint32_t W, uint32_t H, uint32_t threads)
 {
-    om_view v;
-    om_frame_desc fd;
-    om_frame_need need;
-    memset(&v, 0, sizeof v);
-    memset(&fd, 0, sizeof fd);
-    v.cam.width = W;
-    v.cam.height = H;
-    v.light.kind = OM_LIGHT_SPOT;
-    fd.view = &v;
-    fd.scene = s;
-    fd.method = m;
-    fd.threads = threads;
-    fd.parallel_for = threads > 1 ? inline_for : NULL;
-    return om_frame_bytes(&fd, &need) == OM_OK ? need.with_jobs : 0;
+    return frame_need_of(m, s, W, H, 0, threads).with_jobs;
 }
 
 int bench_setup(bsetup *t, const bscene *b, const char *name, uint32_t W, uint32_t H, uint32_t threads)

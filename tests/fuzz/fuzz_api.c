@@ -7,12 +7,13 @@
  * another method, scene or size, and NULLs. Every call must return a status, never
  * crash or write outside its arena: guard bytes around every arena are checked. */
 #include "ombra.h"
+#include "../frame_need.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-#define GUARD 64
+#include "guard.h"
 
 typedef struct reader { const uint8_t *p; size_t n; } reader;
 
@@ -38,25 +39,6 @@ static float take_float(reader *r)
     return ((float)take(r, 2) - 32768.0f) / 4096.0f;
 }
 
-static bool guarded(const unsigned char *buf, size_t n)
-{
-    for (size_t i = 0; i < GUARD; i++)
-        if (buf[i] != 0xA5 || buf[GUARD + n + i] != 0xA5) return false;
-    return true;
-}
-
-static unsigned char *guarded_alloc(size_t n)
-{
-    unsigned char *b = malloc(n + 2 * GUARD);
-    if (b) memset(b, 0xA5, n + 2 * GUARD);
-    return b;
-}
-
-static void inline_for(void *host, om_job_fn fn, void *job_user, uint32_t n)
-{
-    (void)host;
-    for (uint32_t i = 0; i < n; i++) fn(job_user, i);
-}
 
 /* A scene built by hand: up to 12 vertices and 8 triangles from the input, indices and
  * material indices that may point past their arrays. */

@@ -8,21 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define GUARD 64
-
-static bool guarded(const unsigned char *buf, size_t n)
-{
-    for (size_t i = 0; i < GUARD; i++)
-        if (buf[i] != 0xA5 || buf[GUARD + n + i] != 0xA5) return false;
-    return true;
-}
-
-static unsigned char *guarded_alloc(size_t n)
-{
-    unsigned char *b = malloc(n + 2 * GUARD);
-    memset(b, 0xA5, n + 2 * GUARD);
-    return b;
-}
+#include "guard.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
