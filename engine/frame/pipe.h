@@ -77,7 +77,7 @@ void om__frame_eye_rows(const om__frame *c, const om_target *tg, om_strip *st, b
 void om__frame_mark(const om_view *v, om_strip *st);
 
 /* jobs.c. Each runs inline, or does nothing where it says so, when c->jobs is 1 (always
- * so where the engine carries no jobs code, OM_WITH_JOBS). */
+ * so where the engine carries no jobs code: config.h). */
 size_t om__jobs_bytes(const om_method *m, const void *state, const om_scene *s, uint32_t threads);
 /* The light map's bins where m's depth pass runs by bands of the map (0: none). */
 size_t om__jobs_map_bins_bytes(const om_method *m, const om_scene *s);
