@@ -4,7 +4,7 @@
  * default scene, a dense mesh), bit-identical frames, budgets and statistics; the
  * lookup's float depth tests against the double ones and its 32-bit edge values against
  * the shared routine; the build's plane without double against the double one. Its
- * threading tests are method/rtw.c's settings_by_bands and observe_lent, which test
+ * threading tests are property/threads.c's settings_by_bands and observe_lent, which test
  * rtw and spsm together. */
 #include "../test.h"
 #include "../harness.h"

@@ -3,12 +3,17 @@
  * parallel-for that runs its jobs backwards, against the inline frame; whole frames and
  * strips, a spot and a directional light, each over a frame arena holding other bytes.
  * And the frame arena: room for N jobs but not N + 1 runs N; the eye pass by parts on
- * threads; triangle ids kept between passes. A method's own threading tests are in its
- * own suite, tests/method/<method>.c. */
+ * threads; triangle ids kept between passes. And rtw and spsm together, which share
+ * the lent observe: settings that change how they work by bands give the frame of one
+ * thread (settings_by_bands), and observe on lent slots leaves the state observe on one
+ * thread leaves (observe_lent). A method's other threading tests are in its own suite,
+ * tests/method/<method>.c. */
 #include "../test.h"
 #include "../harness.h"
 #include "../jobs_util.h"
 #include "../../platform/platform.h"
+#include "../../engine/shadow/rtw/rtw.h"
+#include "../../engine/shadow/spsm/spsm.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -150,10 +155,121 @@ static void kept_ids(void)
     }
 }
 
+/* Settings that change how a method works by bands, on 2 and 5 backwards jobs, whole
+ * and through strips of 40, against the inline frame (frame and counters):
+ *  - rtw's warped map by bands: the exact map (with the light's bins, which pass over
+ *    the triangles that miss a band's grid rows, and without: the counters hold the
+ *    triangles drawn, counted in the band of a triangle's first grid row), the warped
+ *    vertices' map (the first band makes it whole), forward analysis;
+ *  - spsm's map by bands (a triangle touching one texel row of the whole map, not of
+ *    its band, takes its nearest vertex's depth; the fine map's rows are two of the
+ *    map's; with the light's bins and without) and its resolve by bands with AA (its
+ *    sub-samples' steps must not come from the next row, which another band holds),
+ *    with the fine plain map, its points all made or only those the lookup reads. */
+static void settings_by_bands(void)
+{
+    h_scene hs;
+    if (!h_scene_parse(&hs, om_scene_default_text())) return;
+    static const char *const sets[][2] = {
+        {"rtw", "map=512"}, {"rtw", "map=300 rtw.exact=0"}, {"rtw", "map=256 rtw.analysis=2 rtw.sigma=0"},
+        {"spsm", "map=256 spsm.aa=4"}, {"spsm", "map=512 spsm.aa=3 spsm.fine=1 spsm.records=1"},
+        {"spsm", "map=1024 spsm.fine=1 spsm.records=2"}, {"spsm", "map=64"},
+    };
+    for (size_t i = 0; i < sizeof sets / sizeof sets[0]; i++) {
+        const om_method *m = om_method_find(sets[i][0]);
+        for (uint32_t rows = 0; rows <= 40; rows += 40) {
+            frame_out one = render_set(&hs.s, m, sets[i][1], 96, 72, rows, NULL, NULL, 1, 0, true);
+            CHECK_MSG(one.st == OM_OK, "%s %s: inline frame", om_method_name(m), sets[i][1]);
+            for (uint32_t n = 2; n <= 5; n += 3)
+                for (int lean = 0; lean < (rows ? 1 : 2); lean++) {   /* strips' bins come first */
+                    frame_out o = render_set(&hs.s, m, sets[i][1], 96, 72, rows, backwards, NULL, n,
+                                             h_frame_jobs(m, lean ? NULL : &hs.s, n), !lean);
+                    CHECK_MSG(o.st == OM_OK && o.jobs == n, "%s %s strips %u%s: %u jobs ran %u", om_method_name(m), sets[i][1], rows, lean ? " lean" : "", n, o.jobs);
+                    CHECK_MSG(o.hash == one.hash, "%s %s strips %u: %u bands%s change the frame", om_method_name(m),
+                              sets[i][1], rows, n, lean ? " without bins" : "");
+                    CHECK_MSG(!memcmp(o.ms.counters, one.ms.counters, sizeof o.ms.counters),
+                              "%s %s strips %u: %u bands change the counters", om_method_name(m), sets[i][1], rows, n);
+                }
+        }
+    }
+    h_scene_free(&hs);
+}
+
+/* rtw's and spsm's observe on three lent slots (in reverse slot order), whole and in
+ * strips of 8 rows: the bands did run (their slots hold work to fold after observe),
+ * and after build the state's importance map and seen bits (rtw) and the texels the
+ * build reads (spsm's need) are those of observe on the calling thread. */
+static void observe_lent(void)
+{
+    enum { W = 96, H = 72 };
+    h_scene hs;
+    if (!h_scene_parse(&hs, om_scene_default_text())) return;
+    uint32_t *depth = calloc((size_t)W * H, sizeof *depth), *id = calloc((size_t)W * H, sizeof *id);
+    om_sample *smp = calloc((size_t)W * H, sizeof *smp);
+    om_term *terms = calloc((size_t)W * H, sizeof *terms);
+    static const char *const sets[][2] = {{"rtw", "map=256"}, {"spsm", "map=256 spsm.records=2"}};
+    for (int i = 0; i < 2; i++) {
+        const om_method *m = om_method_find(sets[i][0]);
+        const om__pass *ps = m->pass;
+        CHECK(ps && ps->lend && !ps->job);
+        if (!ps) continue;
+        om_method_cfg c = h_cfg(sets[i][0], sets[i][1]);
+        size_t mn, full;
+        om_diag d;
+        CHECK_OK(om_method_bytes(m, &c, &hs.s, W, H, &mn, &full));
+        uint64_t hash[2][2] = {{0}};
+        for (int lend = 0; lend < 2; lend++)
+            for (uint32_t rows = 8; rows <= H; rows += H - 8) {
+                void *mm = calloc(1, full), *state = NULL;
+                om_arena ma;
+                om_arena_init(&ma, mm, full, "method");
+                CHECK_OK(om_method_init(m, &state, &ma, &c, &hs.s, W, H, &d));
+                lent3 h;
+                const size_t sb = ps->scratch(state, &hs.s);
+                CHECK(sb > 0);
+                for (int k = 0; k < 3; k++) h.slot[k] = calloc(1, sb ? sb : 1);
+                const om__lend l = {lent_run, lent_run, &h, 3};
+                om_view v;
+                CHECK_OK(h_view(&v, &hs.s, 0.0f, W, H, &d));
+                om_target tg = {W, H, 0, H, depth, id};
+                om_strip st = {W, H, 0, H, smp, terms};
+                om__eye_pass_mark(&hs.s, &v, &tg, &st, NULL);
+                ps->lend(state, lend ? &l : NULL);
+                CHECK_OK(m->begin(state, &v, &d));
+                for (uint32_t y = 0; y < H; y += rows) {
+                    om_strip sub = {W, H, y, y + rows > H ? H - y : rows, smp + (size_t)y * W, terms + (size_t)y * W};
+                    CHECK_OK(m->observe(state, &sub, &d));
+                }
+                const om__lent *lt = i ? &((const om__spsm_state *)state)->lent : &((const om__rtw *)state)->lent;
+                CHECK_MSG(lt->used == (lend == 1), "%s: bands %s", om_method_name(m), lend ? "did not run" : "ran unlent");
+                CHECK_OK(m->build(state, &d));
+                if (i == 0) {
+                    const om__rtw *r = (const om__rtw *)state;
+                    const size_t nn = (size_t)r->n * r->n;
+                    hash[lend][rows == H] = om_hash(om_hash(0, r->imp, nn * sizeof *r->imp), r->seen, (nn + 7) / 8);
+                } else {
+                    const om__spsm_state *sp = (const om__spsm_state *)state;
+                    hash[lend][rows == H] = om_hash(0, sp->need, (size_t)sp->size * sp->words * sizeof *sp->need);
+                }
+                ps->lend(state, NULL);
+                for (int k = 0; k < 3; k++) free(h.slot[k]);
+                free(mm);
+            }
+        CHECK_MSG(hash[1][0] == hash[0][0] && hash[1][1] == hash[0][1], "%s: lent observe differs", om_method_name(m));
+    }
+    free(depth);
+    free(id);
+    free(smp);
+    free(terms);
+    h_scene_free(&hs);
+}
+
 void suite_threads(void)
 {
     RUN(same_bits);
     RUN(fewer_jobs);
     RUN(eye_halves);
     RUN(kept_ids);
+    RUN(settings_by_bands);
+    RUN(observe_lent);
 }
