@@ -109,7 +109,7 @@ static om_status check(const om_frame_desc *fd, const om_arena *fa, om_diag *d)
         return om__fail(d, OM_E_INVALID, "frame needs a frame arena, a scene, view, method and its state, "
                                          "shading and framebuffer");
     const uint32_t W = fd->view->cam.width, H = fd->view->cam.height;
-    const uint32_t rows = fd->strip_rows == 0 || fd->strip_rows > H ? H : fd->strip_rows;
+    const uint32_t rows = om__frame_strip_rows(fd, H);
     if (!om__state_for(fd->method_state, fd->method, fd->scene, W, H))
         return om__fail(d, OM_E_INVALID, "the method state was made for another method, scene or image size "
                                          "(om_method_init it for this frame's)");

@@ -78,15 +78,20 @@ static void *slot_scratch(om__job_slot *sl)
 /* The stages: each runs job b of one call of the host's parallel-for (run_stage). A
  * job writes only its own band's rows, its own slot, or the parts its index names. */
 
-/* Slot b of the pass: jobs b, b + P, ... of the method's pass (om__pass) or of a
- * stage it runs on the lent slots (om__lend.run). */
+/* Slot b of the pass: jobs b, b + P, ... of the method's pass (om__pass). */
 static void stage_pass(om__frame *c, uint32_t b)
 {
     om__job_slot *sl = &c->j.pass_slots[b];
     void *scratch = slot_scratch(sl);
     for (uint32_t k = b; k < c->j.pass_jobs; k += c->j.pass_slots_now)
-        if (c->j.lend_fn) c->j.lend_fn(c->j.lend_user, k, scratch);
-        else c->j.pass->job(c->fd->method_state, &c->strip, k, scratch, sl->counts);
+        c->j.pass->job(c->fd->method_state, &c->strip, k, scratch, sl->counts);
+}
+
+/* Slot b of the pass lent to a method's own stage: its jobs b, b + P, ... (om__lend.run). */
+static void stage_lend(om__frame *c, uint32_t b)
+{
+    void *scratch = slot_scratch(&c->j.pass_slots[b]);
+    for (uint32_t k = b; k < c->j.pass_jobs; k += c->j.pass_slots_now) c->j.lend_fn(c->j.lend_user, k, scratch);
 }
 
 /* Job b of the pass on the slot of the thread that runs it (om_frame_desc.worker). */
@@ -376,7 +381,6 @@ static void run_pass(om__frame *c)
     c->j.pass_jobs = k;
     c->j.pass_slots_now = p;
     clear_counts(c->j.pass_slots, used);
-    c->j.lend_fn = NULL;
     if (any) run_stage(c, stage_pass_any, k);
     else run_stage(c, stage_pass, p);
     merge_counts(c->j.pass_slots, used, c->j.pass->merge, state);
@@ -403,7 +407,7 @@ static void lend_run(const om__lend *l, void (*fn)(void *user, uint32_t k, void 
     c->j.lend_user = user;
     c->j.pass_jobs = n;
     c->j.pass_slots_now = n < c->j.pass_max ? n : c->j.pass_max;
-    run_stage(c, stage_pass, c->j.pass_slots_now);
+    run_stage(c, stage_lend, c->j.pass_slots_now);
 }
 
 static void table_fn(void *user, uint32_t k, void *scratch) { ((void **)user)[k] = scratch; }

@@ -67,6 +67,8 @@ typedef struct om__frame {
  * made. */
 om_status om__frame_plan(om__frame *c, const om_frame_desc *fd, const om_view *view, om_arena *fa,
                          om_diag *d);
+/* A strip's rows for fd at an image `height` rows high: strip_rows, or the whole. */
+uint32_t om__frame_strip_rows(const om_frame_desc *fd, uint32_t height);
 /* The bytes of bins for scene s; bins' memory carved from fa (false: no room). */
 size_t om__frame_bins_bytes(const om_scene *s);
 bool om__frame_carve_bins(om_arena *fa, const om_scene *s, om__bins *b);

@@ -38,7 +38,7 @@ static bool observes(const om_method *m, const void *state)
     return m && (m->flags & OM_METHOD_OBSERVES) && (!m->observes || !state || m->observes(state));
 }
 
-static uint32_t strip_rows(const om_frame_desc *fd, uint32_t height)
+uint32_t om__frame_strip_rows(const om_frame_desc *fd, uint32_t height)
 {
     return fd->strip_rows == 0 || fd->strip_rows > height ? height : fd->strip_rows;
 }
@@ -47,7 +47,7 @@ om_status om_frame_bytes(const om_frame_desc *fd, om_frame_need *out)
 {
     if (!fd || !fd->view || !out) return OM_E_INVALID;
     const om_view *v = fd->view;
-    const uint32_t W = v->cam.width, H = v->cam.height, rows = strip_rows(fd, H);
+    const uint32_t W = v->cam.width, H = v->cam.height, rows = om__frame_strip_rows(fd, H);
     const om_scene *s = fd->scene;
     const void *state = om__state_of(fd->method_state, fd->method);
     out->least = least_bytes(W, rows);
@@ -83,7 +83,7 @@ om_status om__frame_plan(om__frame *c, const om_frame_desc *fd, const om_view *v
 {
     const om_scene *s = fd->scene;
     const om_method *m = fd->method;
-    const uint32_t W = view->cam.width, H = view->cam.height, rows = strip_rows(fd, H);
+    const uint32_t W = view->cam.width, H = view->cam.height, rows = om__frame_strip_rows(fd, H);
     const size_t n = (size_t)W * rows;
     void *pd, *pi, *ps, *pt;
     om_status st;

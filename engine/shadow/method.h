@@ -149,7 +149,7 @@ om_status om__scene_check(const om_scene *s, om_diag *d);
 
 /* `state` where method m made it, else NULL (a query given another method's state
  * reads none of it). */
-static inline void *om__state_of(void *state, const om_method *m)
+static inline const void *om__state_of(const void *state, const om_method *m)
 {
     return state && m && ((const om__state_head *)state)->method == m ? state : NULL;
 }

@@ -93,7 +93,7 @@ bool om__state_for(const void *state, const om_method *m, const om_scene *s, uin
 void om_method_get_stats(const om_method *m, const void *state, om_method_stats *out)
 {
     if (!out) return;
-    if (!om__state_of((void *)(uintptr_t)state, m)) {
+    if (!om__state_of(state, m)) {
         memset(out, 0, sizeof *out);
         return;
     }
