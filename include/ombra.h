@@ -479,7 +479,8 @@ typedef struct om_frame_need {
                           through strips more than once (a method that observes, a
                           directional light), else with_jobs */
 } om_frame_need;
-/* OM_E_INVALID without fd, its view or out. */
+/* OM_E_INVALID without fd, its view or out, or for a view's side outside
+ * 1..OM_MAX_DIM. */
 om_status om_frame_bytes(const om_frame_desc *fd, om_frame_need *out);
 /* Renders one frame. The frame arena is rewound on return; the method's arena keeps
  * what the method keeps. OM_E_INVALID, before anything is drawn, for a missing piece

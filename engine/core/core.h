@@ -31,6 +31,13 @@
 static inline size_t om__size_add(size_t a, size_t b) { return a > SIZE_MAX - b ? SIZE_MAX : a + b; }
 static inline size_t om__size_mul(size_t a, size_t b) { return b && a > SIZE_MAX / b ? SIZE_MAX : a * b; }
 
+/* An image of width x height the engine takes: each side 1..OM_MAX_DIM (every byte
+ * count of a frame then fits a 32-bit size_t). */
+static inline bool om__side_ok(uint32_t width, uint32_t height)
+{
+    return width >= 1 && width <= OM_MAX_DIM && height >= 1 && height <= OM_MAX_DIM;
+}
+
 /* ---- diagnostics: a bounded string builder (no stdio in the engine) */
 typedef struct om__str { char *buf; size_t cap, len; } om__str;
 

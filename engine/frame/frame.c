@@ -110,6 +110,7 @@ static om_status check(const om_frame_desc *fd, const om_arena *fa, om_diag *d)
                                          "shading and framebuffer");
     const uint32_t W = fd->view->cam.width, H = fd->view->cam.height;
     const uint32_t rows = om__frame_strip_rows(fd, H);
+    if (!om__side_ok(W, H)) return om__fail(d, OM_E_INVALID, "image width and height must be 1..8192");
     if (!om__state_for(fd->method_state, fd->method, fd->scene, W, H))
         return om__fail(d, OM_E_INVALID, "the method state was made for another method, scene or image size "
                                          "(om_method_init it for this frame's)");

@@ -45,7 +45,7 @@ uint32_t om__frame_strip_rows(const om_frame_desc *fd, uint32_t height)
 
 om_status om_frame_bytes(const om_frame_desc *fd, om_frame_need *out)
 {
-    if (!fd || !fd->view || !out) return OM_E_INVALID;
+    if (!fd || !fd->view || !out || !om__side_ok(fd->view->cam.width, fd->view->cam.height)) return OM_E_INVALID;
     const om_view *v = fd->view;
     const uint32_t W = v->cam.width, H = v->cam.height, rows = om__frame_strip_rows(fd, H);
     const om_scene *s = fd->scene;

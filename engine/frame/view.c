@@ -63,7 +63,7 @@ om_status om_view_init(om_view *v, const om_camera *cam, const om_light *light,
     om_status st;
     if (!v || !cam || !light || !s) return om__fail(d, OM_E_INVALID, "om_view_init needs a view, a camera, a light and a scene");
     memset(v, 0, sizeof *v);
-    if (cam->width < 1 || cam->width > OM_MAX_DIM || cam->height < 1 || cam->height > OM_MAX_DIM)
+    if (!om__side_ok(cam->width, cam->height))
         return om__fail(d, OM_E_INVALID, "image size must be 1..8192 in each direction");
     if ((st = check_vec(cam->eye, d, "camera eye")) || (st = check_vec(cam->target, d, "camera target")) ||
         (st = check_vec(cam->up, d, "camera up")) ||

@@ -45,16 +45,10 @@ const om_setting *om_method_setting_at(const om_method *m, uint32_t i)
     return m && i < m->nsettings ? &m->settings[i] : NULL;
 }
 
-/* An image side the view accepts (om_view_init): 1..OM_MAX_DIM. */
-static bool side_ok(uint32_t width, uint32_t height)
-{
-    return width >= 1 && width <= OM_MAX_DIM && height >= 1 && height <= OM_MAX_DIM;
-}
-
 om_status om_method_bytes(const om_method *m, const om_method_cfg *c, const om_scene *s, uint32_t width,
                           uint32_t height, size_t *min, size_t *full)
 {
-    if (!m || !c || !s || !min || !full || !side_ok(width, height)) return OM_E_INVALID;
+    if (!m || !c || !s || !min || !full || !om__side_ok(width, height)) return OM_E_INVALID;
     return m->bytes(c, s, width, height, min, full);
 }
 
@@ -64,7 +58,7 @@ om_status om_method_init(const om_method *m, void **state, om_arena *a, const om
     if (state) *state = NULL;
     if (!m || !state || !a || !c || !s)
         return om__fail(d, OM_E_INVALID, "om_method_init needs a method, a state pointer, an arena, a configuration and a scene");
-    if (!side_ok(width, height)) return om__fail(d, OM_E_INVALID, "image width and height must be 1..8192");
+    if (!om__side_ok(width, height)) return om__fail(d, OM_E_INVALID, "image width and height must be 1..8192");
     om_status st = om__scene_check(s, d);
     if (st != OM_OK) return st;
     st = m->init(state, a, c, s, width, height, d);

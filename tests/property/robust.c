@@ -328,6 +328,10 @@ static void hostile_calls(void)
     fd.view = &v2;
     fd.fb = &fb2;
     CHECK(om_render_frame(&fd, &fa, NULL, &d) == OM_E_INVALID && strstr(d.msg, "image size"));
+    om_frame_need need;
+    v2.cam.width = OM_MAX_DIM + 1;   /* a view a host filled by hand, past what the engine takes */
+    CHECK(om_frame_bytes(&fd, &need) == OM_E_INVALID);
+    CHECK(om_render_frame(&fd, &fa, NULL, &d) == OM_E_INVALID && strstr(d.msg, "1..8192"));
     om_method_stats ms;
     om_method_get_stats(om_method_find("izb"), st, &ms);   /* another method's state: zeros */
     CHECK(ms.ncounters == 0 && ms.bytes_used == 0);
