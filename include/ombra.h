@@ -210,9 +210,20 @@ om_status om_obj_count(const char *text, size_t len, uint32_t *nverts, uint32_t 
 /* ---------------------------------------------------------------- view */
 
 /* Everything a frame needs to know about where the camera and the light are.
- * light_vp maps world space to the light's clip space; its image plane is the
+ *
+ * Every position in a view, and every matrix, is relative to `origin`: the spot
+ * light's position, or the centre of the scene's box for a directional light. cam.eye,
+ * cam.target, light.pos and light.target are their world positions less origin, and a
+ * matrix takes a point less origin. A scene's world vertices are made relative by one
+ * float subtraction before any matrix, and every sample's point (om_sample.p) is
+ * relative too: the float arithmetic then works on coordinates as large as the scene
+ * is around its light, not as large as its distance from the world's origin. The
+ * origin follows the light, not the camera, so what a method builds in the light's
+ * space stays the same while only the camera moves.
+ * light_vp maps such points to the light's clip space; its image plane is the
  * light's shadow-map plane: x, y in [-1, 1] after division by w, depth z/w in [0, 1]. */
 typedef struct om_view {
+    om_vec3 origin;        /* world position every other one is relative to */
     om_camera cam;
     om_light light;
     om_mat4 cam_view, cam_proj, cam_vp;
@@ -231,7 +242,8 @@ void om_view_fit_light(om_view *v, const om_scene *s, om_vec3 lo, om_vec3 hi);
 /* ---------------------------------------------------------------- samples */
 
 /* One visible sample per pixel: the exact point of the nearest triangle under the
- * pixel centre, its geometric normal (unit, as wound; not turned to the camera) and
+ * pixel centre (relative to the view's origin, om_view: its world position is
+ * origin + p), its geometric normal (unit, as wound; not turned to the camera) and
  * the triangle. tri == OM_NO_TRI is background. `nl` is the cosine between the normal
  * turned to the camera and the direction to the light, which the frame sets with the
  * exposure marks for an exposed sample (OM_TERM_EXPOSED; 0 for any other), so that
@@ -265,6 +277,7 @@ typedef struct om_strip {
     uint32_t width, height, y0, rows;
     om_sample *samples;    /* rows * width, row-major */
     om_term *terms;        /* rows * width */
+    om_vec3 origin;        /* the frame's view's: a sample's world point is origin + p */
 } om_strip;
 
 /* ---------------------------------------------------------------- framebuffers */

@@ -48,6 +48,13 @@ om_status h_view(om_view *v, const om_scene *s, float t, uint32_t w, uint32_t h,
     return om_view_init(v, &cam, &light, s, d);
 }
 
+om_vec3 h_origin(const om_scene *s, float t)
+{
+    om_view v;
+    if (h_view(&v, s, t, 0, 0, NULL) != OM_OK) { const om_vec3 zero = {0, 0, 0}; return zero; }
+    return v.origin;
+}
+
 void h_frame_desc(om_frame_desc *fd, om_shade_cfg *shade, const om_scene *s, const om_view *v,
                   const om_method *m, void *state, om_framebuffer *fb, uint32_t strip_rows)
 {

@@ -31,6 +31,8 @@ om_method_cfg h_cfg(const char *method, const char *list);
  * non-zero (else the scene's size); v->cam and v->light hold them. Returns
  * om_view_init's status (details in d, which may be NULL). */
 om_status h_view(om_view *v, const om_scene *s, float t, uint32_t w, uint32_t h, om_diag *d);
+/* The origin of that view at time t: a sample's point p is the world point origin + p. */
+om_vec3 h_origin(const om_scene *s, float t);
 
 /* *fd zeroed, then scene s, view v, method m with its state, default shading (written
  * to *shade, which must outlive the frame), strips of strip_rows rows (0: the whole

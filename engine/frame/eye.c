@@ -104,11 +104,11 @@ static void expo_setup(const om_view *v, const eye_frame *f, eye_tri *et)
     et->sure = true;
 }
 
-/* Triangle t's vertices. */
-static void tri_verts(const om_scene *s, uint32_t t, om_vec3 v[3])
+/* Triangle t's vertices relative to o. */
+static void tri_verts(const om_scene *s, om_vec3 o, uint32_t t, om_vec3 v[3])
 {
     const uint32_t *ix = s->idx + (size_t)t * 3;
-    for (int k = 0; k < 3; k++) v[k] = s->verts[ix[k]];
+    for (int k = 0; k < 3; k++) v[k] = om__sub(s->verts[ix[k]], o);
 }
 
 /* The setup of the triangle whose vertices are in c->v (the clip-space vertices are
@@ -133,10 +133,10 @@ static void persp_finish(const om_mat4 *vp, om__persp_tri *c)
     c->n = om__normalize(om__cross(c->d1, c->d2));
 }
 
-void om__persp_setup(const om_scene *s, const om_mat4 *vp, uint32_t t, om__persp_tri *c)
+void om__persp_setup(const om_scene *s, const om_mat4 *vp, om_vec3 o, uint32_t t, om__persp_tri *c)
 {
     c->tri = t;
-    tri_verts(s, t, c->v);
+    tri_verts(s, o, t, c->v);
     persp_finish(vp, c);
 }
 
@@ -217,7 +217,7 @@ static void resolve_run(const om_view *v, const eye_tri *et, uint32_t x0, uint32
  * triangle not yet set up, whose indices and vertices lie anywhere in the scene, and a
  * setup that waited on its own loads spent most of its time there. Returns the number
  * of runs; *xe moves past them. */
-static uint32_t fetch_batch(const om_scene *s, const uint32_t *id, uint32_t w, uint32_t *xe,
+static uint32_t fetch_batch(const om_scene *s, om_vec3 o, const uint32_t *id, uint32_t w, uint32_t *xe,
                             uint32_t *tag, uint32_t *run_end, om_vec3 (*fetched)[3])
 {
     uint32_t miss[EYE_RUNS], nr = 0, nm = 0, x = *xe;
@@ -232,7 +232,7 @@ static uint32_t fetch_batch(const om_scene *s, const uint32_t *id, uint32_t w, u
         run_end[nr++] = x1;
         x = x1;
     }
-    for (uint32_t k = 0; k < nm; k++) tri_verts(s, miss[k], fetched[k]);
+    for (uint32_t k = 0; k < nm; k++) tri_verts(s, o, miss[k], fetched[k]);
     *xe = x;
     return nr;
 }
@@ -263,7 +263,7 @@ static void resolve_ids(const om_scene *s, const om_view *v, const om_target *tg
         for (uint32_t x = 0, xe = 0; x < w;) {
             uint32_t run_end[EYE_RUNS];
             om_vec3 fetched[EYE_RUNS][3];
-            const uint32_t nr = fetch_batch(s, id, w, &xe, tag, run_end, fetched);
+            const uint32_t nr = fetch_batch(s, v->origin, id, w, &xe, tag, run_end, fetched);
             for (uint32_t r = 0, k = 0; r < nr; r++) {
                 const uint32_t t = id[x], x1 = run_end[r];
                 if (t == OM_NO_TRI) {
@@ -307,13 +307,13 @@ static void resolve_ids(const om_scene *s, const om_view *v, const om_target *tg
 static void eye_pass(const om_scene *s, const om_view *v, const om_target *tg, om_strip *st,
                      const om__bins *bins, bool mark)
 {
-    om__scene_raster(s, &v->cam_vp, tg, OM_RASTER_DEPTH_ID, true, bins);
+    om__scene_raster(s, &v->cam_vp, v->origin, tg, OM_RASTER_DEPTH_ID, true, bins);
     resolve_ids(s, v, tg, st, mark);
 }
 
 void om__eye_raster_part(const om_scene *s, const om_view *v, const om_target *tg, uint32_t t0, uint32_t t1)
 {
-    om__scene_raster_part(s, &v->cam_vp, tg, OM_RASTER_DEPTH_ID, true, t0, t1);
+    om__scene_raster_part(s, &v->cam_vp, v->origin, tg, OM_RASTER_DEPTH_ID, true, t0, t1);
 }
 
 void om__eye_resolve(const om_scene *s, const om_view *v, const om_target *tg, om_strip *st, bool mark)

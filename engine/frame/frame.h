@@ -24,11 +24,11 @@ void om__eye_pass(const om_scene *s, const om_view *v, const om_target *tg, om_s
 typedef struct om__persp_tri {
     uint32_t tri;
     float adj[9];          /* adjugate of the 3x3 matrix of (x, y, w) columns */
-    om_vec3 v[3], d1, d2;  /* world vertices, v1 - v0 and v2 - v0 */
+    om_vec3 v[3], d1, d2;  /* vertices less the view's origin, v1 - v0 and v2 - v0 */
     om_vec3 n;             /* the unit geometric normal */
 } om__persp_tri;
 
-void om__persp_setup(const om_scene *s, const om_mat4 *vp, uint32_t t, om__persp_tri *c);
+void om__persp_setup(const om_scene *s, const om_mat4 *vp, om_vec3 o, uint32_t t, om__persp_tri *c);
 om_vec3 om__persp_point(const om__persp_tri *c, float sx, float sy);
 
 /* The same for om__eye_pass_mark: the eye pass with the exposure marks of each

@@ -125,14 +125,14 @@ static void stage_pass_setup(om__frame *c, uint32_t b)
 static void stage_bin_verts(om__frame *c, uint32_t b)
 {
     const uint32_t n = c->fd->scene->nverts;
-    om__bins_make_verts(c->fd->scene, c->j.mk_vp, c->j.mk_w, c->j.mk_h, c->j.mk, part_at(c, n, b),
+    om__bins_make_verts(c->fd->scene, c->j.mk_vp, c->view->origin, c->j.mk_w, c->j.mk_h, c->j.mk, part_at(c, n, b),
                         part_at(c, n, b + 1));
 }
 
 static void stage_bin_rows(om__frame *c, uint32_t b)
 {
     const uint32_t n = c->fd->scene->ntris;
-    om__bins_make_rows(c->fd->scene, c->j.mk_vp, c->j.mk_w, c->j.mk_h, c->j.mk, part_at(c, n, b),
+    om__bins_make_rows(c->fd->scene, c->j.mk_vp, c->view->origin, c->j.mk_w, c->j.mk_h, c->j.mk, part_at(c, n, b),
                        part_at(c, n, b + 1));
 }
 
@@ -335,7 +335,7 @@ static void clear_counts(om__job_slot *sl, uint32_t n)
 void om__jobs_make_bins(om__frame *c, const om_mat4 *vp, uint32_t w, uint32_t h, const om__bins *b)
 {
     if (!OM_WITH_JOBS || c->jobs <= 1) {
-        om__bins_make(c->fd->scene, vp, w, h, b);
+        om__bins_make(c->fd->scene, vp, c->view->origin, w, h, b);
         return;
     }
     c->j.mk = b;

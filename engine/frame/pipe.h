@@ -92,7 +92,7 @@ bool om__jobs_halves(om__frame *c, om_sample *samples, size_t n);
 void om__jobs_carve_map(om__frame *c, om_arena *fa);
 /* The method's lent slots for the frame (on), taken back at its end (off). */
 void om__jobs_lend(om__frame *c, bool on);
-/* om__bins_make on the jobs. */
+/* om__bins_make on the jobs, for the frame's view (its origin). */
 void om__jobs_make_bins(om__frame *c, const om_mat4 *vp, uint32_t w, uint32_t h, const om__bins *b);
 /* The method's begin, or its pass's begin and set-up on the jobs. */
 om_status om__jobs_begin(om__frame *c, const om_view *v, om_diag *d);

@@ -109,6 +109,7 @@ om_status om__frame_plan(om__frame *c, const om_frame_desc *fd, const om_view *v
     c->tg.id = (uint32_t *)pi;
     c->strip.samples = (om_sample *)ps;
     c->strip.terms = (om_term *)pt;
+    c->strip.origin = view->origin;
 
     /* With strips the bins come before the jobs' slots; one strip needs them only for
      * its bands (and not where two jobs split its eye pass by triangles). */

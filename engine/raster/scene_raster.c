@@ -18,20 +18,24 @@
  * box, but their clip coordinates are rounded on their own. */
 #define CULL_MARGIN 1e-4f
 
-static bool solid_in_front(const om_solid *o, const om_mat4 *vp)
+static bool solid_in_front(const om_solid *so, const om_mat4 *vp, om_vec3 o)
 {
+    /* the box's corners made relative as vertices are: rounding is monotonic, so the
+     * relative vertices stay inside the relative box */
+    const om_vec3 lo = om__sub(so->lo, o), hi = om__sub(so->hi, o);
     for (int i = 0; i < 8; i++) {
-        om_vec3 p = om__v3(i & 1 ? o->hi.x : o->lo.x, i & 2 ? o->hi.y : o->lo.y, i & 4 ? o->hi.z : o->lo.z);
+        om_vec3 p = om__v3(i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z);
         om_vec4 q = om__mat_apply(vp, p);
         if (!(q.w > 0.0f && q.z >= CULL_MARGIN * q.w)) return false;
     }
     return true;
 }
 
-void om__cull_begin(om__cull *c, const om_scene *s, const om_mat4 *vp)
+void om__cull_begin(om__cull *c, const om_scene *s, const om_mat4 *vp, om_vec3 o)
 {
     c->s = s;
     c->vp = vp;
+    c->o = o;
     c->k = 0;
     c->seen = UINT32_MAX;
     c->on = false;
@@ -48,7 +52,7 @@ bool om__cull_next(om__cull *c, uint32_t t)
     if (t < o->first || (uint64_t)o->first + o->count > s->ntris) return false;
     if (c->seen != c->k) {
         c->seen = c->k;
-        c->on = solid_in_front(o, c->vp);
+        c->on = solid_in_front(o, c->vp, c->o);
     }
     return c->on;
 }
@@ -122,24 +126,24 @@ static inline uint32_t centre_rows(const om__vsnap *va, const om__vsnap *vb, con
 }
 #endif
 
-void om__bins_make(const om_scene *s, const om_mat4 *vp, uint32_t width, uint32_t height, const om__bins *b)
+void om__bins_make(const om_scene *s, const om_mat4 *vp, om_vec3 o, uint32_t width, uint32_t height, const om__bins *b)
 {
-    om__bins_make_verts(s, vp, width, height, b, 0, s->nverts);
-    om__bins_make_rows(s, vp, width, height, b, 0, s->ntris);
+    om__bins_make_verts(s, vp, o, width, height, b, 0, s->nverts);
+    om__bins_make_rows(s, vp, o, width, height, b, 0, s->ntris);
 }
 
 /* The rows of triangle t that has a vertex to clip (or outside the bins' vertices):
  * from its clip-space vertices. */
-static uint32_t rows_clipped(const om_scene *s, const om_mat4 *vp, uint32_t width, uint32_t height, uint32_t t)
+static uint32_t rows_clipped(const om_scene *s, const om_mat4 *vp, om_vec3 o, uint32_t width, uint32_t height, uint32_t t)
 {
     const uint32_t all = (height - 1) << 16;
     om_vec4 c[3];
-    om__clip_tri(s, vp, t, c);
+    om__clip_tri(s, vp, o, t, c);
     unsigned out_all = 0x3F, out_any = 0;
     for (int k = 0; k < 3; k++) {
-        unsigned o = om__outcode(&c[k], width, height);
-        out_all &= o;
-        out_any |= o;
+        unsigned oc = om__outcode(&c[k], width, height);
+        out_all &= oc;
+        out_any |= oc;
     }
     if (out_all) return 0x0000FFFFu;   /* wholly beyond one plane */
     if (out_any) return all;           /* clipped: every row */
@@ -154,7 +158,7 @@ static uint32_t rows_clipped(const om_scene *s, const om_mat4 *vp, uint32_t widt
     return rows_between(lo, hi, height);
 }
 
-void om__bins_make_rows(const om_scene *s, const om_mat4 *vp, uint32_t width, uint32_t height, const om__bins *b,
+void om__bins_make_rows(const om_scene *s, const om_mat4 *vp, om_vec3 o, uint32_t width, uint32_t height, const om__bins *b,
                         uint32_t t0, uint32_t t1)
 {
     const om__vsnap *vs = b->verts;
@@ -167,7 +171,7 @@ void om__bins_make_rows(const om_scene *s, const om_mat4 *vp, uint32_t width, ui
             const om__vsnap *va = &vs[ix[0]], *vb = &vs[ix[1]], *vc = &vs[ix[2]];
             const bool alone = (va->x != INT32_MIN) & (vb->x != INT32_MIN) & (vc->x != INT32_MIN);
             b->rows[t] = alone ? centre_rows(va, vb, vc, (int32_t)width, (int32_t)height)
-                               : rows_clipped(s, vp, width, height, t);
+                               : rows_clipped(s, vp, o, width, height, t);
         }
         return;
     }
@@ -184,14 +188,14 @@ void om__bins_make_rows(const om_scene *s, const om_mat4 *vp, uint32_t width, ui
                 continue;
             }
         }
-        b->rows[t] = rows_clipped(s, vp, width, height, t);
+        b->rows[t] = rows_clipped(s, vp, o, width, height, t);
     }
 }
 
-void om__scene_raster(const om_scene *s, const om_mat4 *vp, const om_target *tg,
+void om__scene_raster(const om_scene *s, const om_mat4 *vp, om_vec3 o, const om_target *tg,
                       om_raster_mode mode, bool cull, const om__bins *bins)
 {
-    om__scene_raster_hiz(s, vp, tg, mode, cull, bins, NULL);
+    om__scene_raster_hiz(s, vp, o, tg, mode, cull, bins, NULL);
 }
 
 /* Whether the box of three grid points holds the centre of a pixel of tg (centres_in,
@@ -299,7 +303,7 @@ static inline void lanes_depth(depths *restrict d, const lanes *restrict l)
  * it needs no clipping, its depth with it (a triangle's strips and bands share it),
  * x = INT32_MIN when it needs clipping. Every entry is written: the frame's bins are
  * not zeroed first. */
-void om__bins_make_verts(const om_scene *s, const om_mat4 *vp, uint32_t width, uint32_t height, const om__bins *b,
+void om__bins_make_verts(const om_scene *s, const om_mat4 *vp, om_vec3 o, uint32_t width, uint32_t height, const om__bins *b,
                          uint32_t v0, uint32_t v1)
 {
     om__vsnap *vs = b->verts;
@@ -316,57 +320,57 @@ void om__bins_make_verts(const om_scene *s, const om_mat4 *vp, uint32_t width, u
         const om_vec3 *p = s->verts + v;
         if (n == LANES) {   /* a loop of its own: the compiler's lanes load three lanes' worth */
             for (uint32_t i = 0; i < LANES; i++) {
-                px[i] = p[i].x;
-                py[i] = p[i].y;
-                pz[i] = p[i].z;
+                px[i] = p[i].x - o.x;
+                py[i] = p[i].y - o.y;
+                pz[i] = p[i].z - o.z;
             }
         } else {
             for (uint32_t i = 0; i < LANES; i++) {   /* a short last batch repeats its first vertex */
                 const uint32_t k = i < n ? i : 0;
-                px[i] = p[k].x;
-                py[i] = p[k].y;
-                pz[i] = p[k].z;
+                px[i] = p[k].x - o.x;
+                py[i] = p[k].y - o.y;
+                pz[i] = p[k].z - o.z;
             }
         }
         /* The lines PREFETCH_AHEAD batches on, for writing (OM_PREFETCH_WRITE): on a
          * host's threads they were last read by every thread's bands. */
         if (v1 - v > (PREFETCH_AHEAD + 1) * LANES)
-            for (uint32_t o = 0; o < LANES * sizeof *vs; o += 64)   /* a line is 64 bytes or more */
-                OM_PREFETCH_WRITE((const char *)&vs[v + PREFETCH_AHEAD * LANES] + o);
+            for (uint32_t at = 0; at < LANES * sizeof *vs; at += 64)   /* a line is 64 bytes or more */
+                OM_PREFETCH_WRITE((const char *)&vs[v + PREFETCH_AHEAD * LANES] + at);
         lanes_project(&l, px, py, pz, vp, g, sx, sy);
         lanes_depth(&d, &l);
         for (uint32_t i = 0; i < n; i++) {
-            om__vsnap *o = &vs[v + i];
+            om__vsnap *out = &vs[v + i];
             if (l.ok[i]) {
                 const uint32_t mz = d.mz[i], mw = d.mw[i];
                 const int32_t e = d.e[i];
-                o->x = l.gx[i];
-                o->y = l.gy[i];
-                o->z = d.kind[i] == 1 ? (uint32_t)(e >= 0 ? ((uint64_t)mz << e) / mw : mz / ((uint64_t)mw << -e))
+                out->x = l.gx[i];
+                out->y = l.gy[i];
+                out->z = d.kind[i] == 1 ? (uint32_t)(e >= 0 ? ((uint64_t)mz << e) / mw : mz / ((uint64_t)mw << -e))
                                       : d.kind[i] == 2 ? 0xFFFFFFFFu : 0u;
             } else {
-                o->x = INT32_MIN;
-                o->y = 0;
-                o->z = 0;
+                out->x = INT32_MIN;
+                out->y = 0;
+                out->z = 0;
             }
         }
     }
 #else
     for (uint32_t v = v0; v < v1; v++) {
-        const om_vec4 c = om__mat_apply(vp, s->verts[v]);
+        const om_vec4 c = om__mat_apply(vp, om__sub(s->verts[v], o));
         int64_t x, y;
         uint32_t z;
-        om__vsnap *o = &vs[v];
+        om__vsnap *out = &vs[v];
         /* om__raster_tri's first test (finite, inside every plane), then its projection */
         if (om__finite(c.x) && om__finite(c.y) && om__finite(c.z) && om__finite(c.w) && om__inside_band(&c, g) &&
             om__project(&c, width, height, &x, &y, &z)) {
-            o->x = (int32_t)x;   /* |x|, |y| < 2^26 after om__project */
-            o->y = (int32_t)y;
-            o->z = z;
+            out->x = (int32_t)x;   /* |x|, |y| < 2^26 after om__project */
+            out->y = (int32_t)y;
+            out->z = z;
         } else {
-            o->x = INT32_MIN;
-            o->y = 0;
-            o->z = 0;
+            out->x = INT32_MIN;
+            out->y = 0;
+            out->z = 0;
         }
     }
 #endif
@@ -383,13 +387,13 @@ typedef struct batch {
 } batch;
 
 /* The scene's triangles t0..t0 + n (n <= BATCH) through vp onto a width x height image. */
-static void batch_project(batch *b, const om_scene *s, uint32_t t0, uint32_t n, const om_mat4 *vp,
+static void batch_project(batch *b, const om_scene *s, uint32_t t0, uint32_t n, const om_mat4 *vp, om_vec3 o,
                           om__guard g, float sx, float sy)
 {
     float px[LANES], py[LANES], pz[LANES];
     for (uint32_t k = 0; k < BATCH; k++)
         for (int c = 0; c < 3; c++) {
-            const om_vec3 v = k < n ? s->verts[s->idx[((size_t)t0 + k) * 3 + c]] : om__v3(0.0f, 0.0f, 0.0f);
+            const om_vec3 v = k < n ? om__sub(s->verts[s->idx[((size_t)t0 + k) * 3 + c]], o) : om__v3(0.0f, 0.0f, 0.0f);
             px[c * BATCH + k] = v.x;
             py[c * BATCH + k] = v.y;
             pz[c * BATCH + k] = v.z;
@@ -409,7 +413,7 @@ static void batch_boxes(batch *b, const om_target *tg, bool cons)
     }
 }
 
-static void walk_batches(const om_scene *s, const om_mat4 *vp, om_raster *r, uint32_t *hiz, bool cull,
+static void walk_batches(const om_scene *s, const om_mat4 *vp, om_vec3 o, om_raster *r, uint32_t *hiz, bool cull,
                          const uint32_t *rows, uint32_t ta, uint32_t tb)
 {
     const om_target *tg = r->target;
@@ -417,11 +421,11 @@ static void walk_batches(const om_scene *s, const om_mat4 *vp, om_raster *r, uin
     const om__guard g = om__guard_band(tg->width, tg->height);
     const float sx = (float)tg->width * (OM_SUBPIX / 2), sy = (float)tg->height * (OM_SUBPIX / 2);
     om__cull cl;
-    om__cull_begin(&cl, s, vp);
+    om__cull_begin(&cl, s, vp, o);
     batch b;
     for (uint32_t t0 = ta; t0 < tb; t0 += BATCH) {
         const uint32_t n = tb - t0 < BATCH ? tb - t0 : BATCH;
-        batch_project(&b, s, t0, n, vp, g, sx, sy);
+        batch_project(&b, s, t0, n, vp, o, g, sx, sy);
         batch_boxes(&b, tg, r->mode == OM_RASTER_CONSERVATIVE);
         for (uint32_t k = 0; k < n; k++) {
             const uint32_t t = t0 + k;
@@ -448,7 +452,7 @@ static void walk_batches(const om_scene *s, const om_mat4 *vp, om_raster *r, uin
 
 /* One triangle of the walk with vertex bins (om__scene_raster_hiz), its rows reaching
  * the target's; `box`: its box is yet to be tested for a pixel centre of the target. */
-static inline void bin_tri(const om_scene *s, const om_mat4 *vp, om_raster *r, uint32_t *hiz, om__cull *cl,
+static inline void bin_tri(const om_scene *s, const om_mat4 *vp, om_vec3 o, om_raster *r, uint32_t *hiz, om__cull *cl,
                            bool cull, const om__vsnap *vs, om__guard g, bool box, uint32_t t)
 {
     const om_target *tg = r->target;
@@ -466,7 +470,7 @@ static inline void bin_tri(const om_scene *s, const om_mat4 *vp, om_raster *r, u
     }
     r->cull_back = cull && om__cull_next(cl, t);
     om_vec4 c[3];
-    om__clip_tri(s, vp, t, c);
+    om__clip_tri(s, vp, o, t, c);
     om__raster_tri_guarded(r, hiz, c, t, tg->width, tg->height, g);
 }
 
@@ -520,15 +524,15 @@ static void raster_plain(om_raster *r, const om_target *tg, om_raster_mode mode)
     r->row_shift = 0;
 }
 
-void om__scene_raster_part(const om_scene *s, const om_mat4 *vp, const om_target *tg, om_raster_mode mode,
+void om__scene_raster_part(const om_scene *s, const om_mat4 *vp, om_vec3 o, const om_target *tg, om_raster_mode mode,
                            bool cull, uint32_t t0, uint32_t t1)
 {
     om_raster r;
     raster_plain(&r, tg, mode);
-    walk_batches(s, vp, &r, NULL, cull, NULL, t0 < s->ntris ? t0 : s->ntris, t1 < s->ntris ? t1 : s->ntris);
+    walk_batches(s, vp, o, &r, NULL, cull, NULL, t0 < s->ntris ? t0 : s->ntris, t1 < s->ntris ? t1 : s->ntris);
 }
 
-void om__scene_raster_hiz(const om_scene *s, const om_mat4 *vp, const om_target *tg,
+void om__scene_raster_hiz(const om_scene *s, const om_mat4 *vp, om_vec3 o, const om_target *tg,
                           om_raster_mode mode, bool cull, const om__bins *bins, uint32_t *hiz)
 {
     om_raster r;
@@ -539,11 +543,11 @@ void om__scene_raster_hiz(const om_scene *s, const om_mat4 *vp, const om_target 
     const uint32_t *rows = bins ? bins->rows : NULL;
     const om__vsnap *vs = bins ? bins->verts : NULL;
     if (!vs) {
-        walk_batches(s, vp, &r, hiz, cull, rows, 0, s->ntris);
+        walk_batches(s, vp, o, &r, hiz, cull, rows, 0, s->ntris);
         return;
     }
     om__cull cl;
-    om__cull_begin(&cl, s, vp);
+    om__cull_begin(&cl, s, vp, o);
     const om__guard g = om__guard_band(tg->width, tg->height);
 #if VERT_LANES
     /* conservative coverage reaches pixels beyond the centres; centre rows have
@@ -555,12 +559,12 @@ void om__scene_raster_hiz(const om_scene *s, const om_mat4 *vp, const om_target 
         if (rows && (n == SCAN ? !rows_reach(rows + t0, y0, y1, hit) : !rows_reach_few(rows + t0, n, y0, y1, hit)))
             continue;
         for (uint32_t k = 0; k < n; k++)
-            if (!rows || hit[k]) bin_tri(s, vp, &r, hiz, &cl, cull, vs, g, box, t0 + k);
+            if (!rows || hit[k]) bin_tri(s, vp, o, &r, hiz, &cl, cull, vs, g, box, t0 + k);
     }
 #else
     for (uint32_t t = 0; t < s->ntris; t++) {
         if (rows && ((rows[t] & 0xFFFFu) > y1 || rows[t] >> 16 < y0)) continue;
-        bin_tri(s, vp, &r, hiz, &cl, cull, vs, g, mode != OM_RASTER_CONSERVATIVE, t);
+        bin_tri(s, vp, o, &r, hiz, &cl, cull, vs, g, mode != OM_RASTER_CONSERVATIVE, t);
     }
 #endif
 }

@@ -8,11 +8,13 @@
 
 #include "raster.h"
 
-/* A triangle of the scene through vp, in clip space. */
-static inline void om__clip_tri(const om_scene *s, const om_mat4 *vp, uint32_t t, om_vec4 c[3])
+/* A triangle of the scene through vp, in clip space. Every function here takes the
+ * view's origin o with its matrix: a world vertex v goes through vp as v - o, the float
+ * subtraction first (om_view says why). */
+static inline void om__clip_tri(const om_scene *s, const om_mat4 *vp, om_vec3 o, uint32_t t, om_vec4 c[3])
 {
     const uint32_t *ix = s->idx + (size_t)t * 3;
-    for (int k = 0; k < 3; k++) c[k] = om__mat_apply(vp, s->verts[ix[k]]);
+    for (int k = 0; k < 3; k++) c[k] = om__mat_apply(vp, om__sub(s->verts[ix[k]], o));
 }
 
 /* Back-face culling of a depth pass, exact for closed shapes: walking the triangles in
@@ -25,12 +27,13 @@ static inline void om__clip_tri(const om_scene *s, const om_mat4 *vp, uint32_t t
 typedef struct om__cull {
     const om_scene *s;
     const om_mat4 *vp;
+    om_vec3 o;
     uint32_t k;            /* the first solid that may still hold t */
     uint32_t seen;         /* the solid `on` was decided for (UINT32_MAX: none yet) */
     bool on;               /* solid k may cull */
 } om__cull;
 
-void om__cull_begin(om__cull *c, const om_scene *s, const om_mat4 *vp);
+void om__cull_begin(om__cull *c, const om_scene *s, const om_mat4 *vp, om_vec3 o);
 bool om__cull_next(om__cull *c, uint32_t t);
 
 /* Strips without repetition: the frame's bins, made once per frame through the
@@ -61,13 +64,13 @@ size_t om__bins_verts_bytes(const om_scene *s);
 /* Fills b->verts and b->rows (each when not NULL) for the matrix vp onto a width x
  * height image: the camera's for the eye pass, the light's for a light pass
  * (vertices only: om__scene_raster walks every triangle without rows). */
-void om__bins_make(const om_scene *s, const om_mat4 *vp, uint32_t width, uint32_t height, const om__bins *b);
+void om__bins_make(const om_scene *s, const om_mat4 *vp, om_vec3 o, uint32_t width, uint32_t height, const om__bins *b);
 /* om__bins_make in parts, for a host's threads: the vertices [v0, v1) of b->verts,
  * then, once every vertex is done, the triangles [t0, t1) of b->rows. Each entry
  * depends on nothing but its own inputs, so any split gives the same bins. */
-void om__bins_make_verts(const om_scene *s, const om_mat4 *vp, uint32_t width, uint32_t height, const om__bins *b,
+void om__bins_make_verts(const om_scene *s, const om_mat4 *vp, om_vec3 o, uint32_t width, uint32_t height, const om__bins *b,
                          uint32_t v0, uint32_t v1);
-void om__bins_make_rows(const om_scene *s, const om_mat4 *vp, uint32_t width, uint32_t height, const om__bins *b,
+void om__bins_make_rows(const om_scene *s, const om_mat4 *vp, om_vec3 o, uint32_t width, uint32_t height, const om__bins *b,
                         uint32_t t0, uint32_t t1);
 
 /* Clears `tg` and rasterizes every triangle of the scene through `vp` into it: the
@@ -75,7 +78,7 @@ void om__bins_make_rows(const om_scene *s, const om_mat4 *vp, uint32_t width, ui
  * `cull`, the back faces of closed shapes are skipped (om__cull). With bins (made for
  * this vp and image), triangles whose rows miss the target's are skipped before any
  * setup; NULL walks every triangle. The same pixels either way. */
-void om__scene_raster(const om_scene *s, const om_mat4 *vp, const om_target *tg,
+void om__scene_raster(const om_scene *s, const om_mat4 *vp, om_vec3 o, const om_target *tg,
                       om_raster_mode mode, bool cull, const om__bins *bins);
 /* om__scene_raster without bins of the triangles [t0, t1) alone, into a target the
  * caller has cleared: one part of a pass split by triangles. With ids, the parts drawn
@@ -83,11 +86,11 @@ void om__scene_raster(const om_scene *s, const om_mat4 *vp, const om_target *tg,
  * depth; on a tie the lower triangle), hold what one walk of every triangle gives: a
  * pixel's depth depends on its triangle alone, and the depth test gives a tie to the
  * lower triangle, which is the one a walk in order draws first. */
-void om__scene_raster_part(const om_scene *s, const om_mat4 *vp, const om_target *tg, om_raster_mode mode,
+void om__scene_raster_part(const om_scene *s, const om_mat4 *vp, om_vec3 o, const om_target *tg, om_raster_mode mode,
                            bool cull, uint32_t t0, uint32_t t1);
 /* The same with a coarse depth of tg's image (om__hiz_words; NULL: none), cleared
  * with the target: for the depth-only light passes, the same texels. */
-void om__scene_raster_hiz(const om_scene *s, const om_mat4 *vp, const om_target *tg,
+void om__scene_raster_hiz(const om_scene *s, const om_mat4 *vp, om_vec3 o, const om_target *tg,
                           om_raster_mode mode, bool cull, const om__bins *bins, uint32_t *hiz);
 
 #endif

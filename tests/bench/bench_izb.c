@@ -22,7 +22,7 @@ static void table_row(const bscene *b, uint32_t W, uint32_t H)
     if (bench_view(b, W, H, 0, &v) || om_method_bytes(m, &cfg, &b->s, W, H, &mn, &full)) return;
     void *mem = malloc(full);
     om_target tg = {W, H, 0, H, malloc(n * 4), malloc(n * 4)};
-    om_strip st = {W, H, 0, H, malloc(n * sizeof(om_sample)), malloc(n * sizeof(om_term))};
+    om_strip st = {W, H, 0, H, malloc(n * sizeof(om_sample)), malloc(n * sizeof(om_term)), v.origin};
     om__eye_pass(&b->s, &v, &tg, &st, NULL);
     for (size_t i = 0; i < n; i++) {
         st.terms[i].flags = st.samples[i].tri != OM_NO_TRI && om__exposed(&v, &st.samples[i]) ? OM_TERM_EXPOSED : 0;

@@ -20,12 +20,12 @@ static void bench_eye(const bscene *b, uint32_t W, uint32_t H)
     size_t n = (size_t)W * H;
     om_target tg = {W, H, 0, H, malloc(n * 4), malloc(n * 4)};
     om_sample *smp = malloc(n * sizeof *smp);
-    om_strip st = {W, H, 0, H, smp, NULL};
+    om_strip st = {W, H, 0, H, smp, NULL, v.origin};
     uint64_t raster[RUNS], total[RUNS];
     size_t covered = 0;
     for (int r = 0; r < RUNS; r++) {
         uint64_t t0 = om_clock_ns(NULL);
-        om__scene_raster(&b->s, &v.cam_vp, &tg, OM_RASTER_DEPTH_ID, false, NULL);
+        om__scene_raster(&b->s, &v.cam_vp, v.origin, &tg, OM_RASTER_DEPTH_ID, false, NULL);
         uint64_t t1 = om_clock_ns(NULL);
         om__eye_pass(&b->s, &v, &tg, &st, NULL);
         uint64_t t2 = om_clock_ns(NULL);
@@ -56,9 +56,9 @@ static void bench_light(const bscene *b, uint32_t size)
     uint64_t t[RUNS], th[RUNS];
     for (int r = 0; r < RUNS; r++) {
         uint64_t t0 = om_clock_ns(NULL);
-        om__scene_raster(&b->s, &v.light_vp, &tg, OM_RASTER_DEPTH, true, NULL);
+        om__scene_raster(&b->s, &v.light_vp, v.origin, &tg, OM_RASTER_DEPTH, true, NULL);
         uint64_t t1 = om_clock_ns(NULL);
-        om__scene_raster_hiz(&b->s, &v.light_vp, &tg, OM_RASTER_DEPTH, true, NULL, hiz);
+        om__scene_raster_hiz(&b->s, &v.light_vp, v.origin, &tg, OM_RASTER_DEPTH, true, NULL, hiz);
         t[r] = t1 - t0;
         th[r] = om_clock_ns(NULL) - t1;
     }
@@ -91,12 +91,12 @@ void bench_raster(void)
 }
 
 /* One pass, RUNS times: its median in ms. */
-static double time_pass(const bscene *b, const om_mat4 *vp, om_target *tg, om_raster_mode mode, bool cull)
+static double time_pass(const bscene *b, const om_mat4 *vp, om_vec3 o, om_target *tg, om_raster_mode mode, bool cull)
 {
     uint64_t t[RUNS];
     for (int r = 0; r < RUNS; r++) {
         uint64_t t0 = om_clock_ns(NULL);
-        om__scene_raster(&b->s, vp, tg, mode, cull, NULL);
+        om__scene_raster(&b->s, vp, o, tg, mode, cull, NULL);
         t[r] = om_clock_ns(NULL) - t0;
     }
     return bench_median_ns(t, RUNS);
@@ -124,20 +124,20 @@ void bench_raster_sweep(void)
         const double n = (double)b.s.ntris;
         for (uint32_t size = 1024; size <= 2048; size *= 2) {
             om_target tg = {size, size, 0, size, depth, NULL};
-            const double ms = time_pass(&b, &v.light_vp, &tg, OM_RASTER_DEPTH, true);
+            const double ms = time_pass(&b, &v.light_vp, v.origin, &tg, OM_RASTER_DEPTH, true);
             printf("sweep %-12s light depth pass %ux%u: %8.2f ms, %7.2f M tris/s\n", b.name, size, size,
                    ms, n / ms / 1e3);
         }
         om_target eye = {1024, 768, 0, 768, depth, id};
-        om_strip st = {1024, 768, 0, 768, smp, NULL};
+        om_strip st = {1024, 768, 0, 768, smp, NULL, v.origin};
         uint64_t t[RUNS];
         for (int r = 0; r < RUNS; r++) {
             uint64_t t0 = om_clock_ns(NULL);
-            om__scene_raster(&b.s, &v.cam_vp, &eye, OM_RASTER_DEPTH_ID, false, NULL);
+            om__scene_raster(&b.s, &v.cam_vp, v.origin, &eye, OM_RASTER_DEPTH_ID, false, NULL);
             om__eye_pass(&b.s, &v, &eye, &st, NULL);
             t[r] = om_clock_ns(NULL) - t0;
         }
-        const double ms = time_pass(&b, &v.cam_vp, &eye, OM_RASTER_DEPTH_ID, false), all = bench_median_ns(t, RUNS);
+        const double ms = time_pass(&b, &v.cam_vp, v.origin, &eye, OM_RASTER_DEPTH_ID, false), all = bench_median_ns(t, RUNS);
         printf("sweep %-12s eye raster 1024x768:       %8.2f ms, %7.2f M tris/s; with samples %8.2f ms, %7.2f M tris/s\n",
                b.name, ms, n / ms / 1e3, all, n / all / 1e3);
         bench_free(&b);

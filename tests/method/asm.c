@@ -547,9 +547,9 @@ static void float_bounds_hold(void)
         uint32_t placed = 0, tried = 0, decided = 0, compared = 0, finer = 0, finer_asked = 0;
         for (int i = 0; i < 20000; i++) {
             om_sample smp;
-            smp.p[0] = (float)lcg_in(&x, -5, 5);
-            smp.p[1] = (float)lcg_in(&x, 0, 2.5);
-            smp.p[2] = (float)lcg_in(&x, -5, 5);
+            smp.p[0] = (float)lcg_in(&x, -5, 5) - v.origin.x;   /* relative to the view's origin */
+            smp.p[1] = (float)lcg_in(&x, 0, 2.5) - v.origin.y;
+            smp.p[2] = (float)lcg_in(&x, -5, 5) - v.origin.z;
             double n0 = lcg_in(&x, -1, 1), n1 = lcg_in(&x, 0.05, 1), n2 = lcg_in(&x, -1, 1);
             double nl = sqrt(n0 * n0 + n1 * n1 + n2 * n2);
             smp.n[0] = (float)(n0 / nl);
@@ -826,13 +826,13 @@ static void asm_jobs_case(const om_scene *s, const char *set, uint32_t rows, flo
         cam.height = H;
         CHECK_OK(om_view_init(&v, &cam, &light, s, &d));
         om_target tg = {W, H, 0, H, depth, id};
-        om_strip st = {W, H, 0, H, smp, terms};
+        om_strip st = {W, H, 0, H, smp, terms, v.origin};
         om__eye_pass_mark(s, &v, &tg, &st, NULL);
         memcpy(kept, terms, (size_t)W * H * sizeof *terms);
         ps->lend(state, lend ? &l : NULL);
         CHECK_OK(m->begin(state, &v, &d));
         for (uint32_t y = 0; y < H; y += rows) {
-            om_strip sub = {W, H, y, y + rows > H ? H - y : rows, smp + (size_t)y * W, terms + (size_t)y * W};
+            om_strip sub = {W, H, y, y + rows > H ? H - y : rows, smp + (size_t)y * W, terms + (size_t)y * W, v.origin};
             CHECK_OK(m->observe(state, &sub, &d));
         }
         CHECK(!memcmp(kept, terms, (size_t)W * H * sizeof *terms));   /* observe leaves them */

@@ -175,7 +175,7 @@ static void hybrid_tile_lent(void)
     om_sample *smp = calloc(N, sizeof *smp);
     om_term *terms[2] = {calloc(N, sizeof(om_term)), calloc(N, sizeof(om_term))};
     om_target tg = {W, H, 0, H, depth, id};
-    om_strip st = {W, H, 0, H, smp, terms[0]};
+    om_strip st = {W, H, 0, H, smp, terms[0], v.origin};
     om__eye_pass_mark(&hs.s, &v, &tg, &st, NULL);
     memcpy(terms[1], terms[0], N * sizeof(om_term));
     CHECK_OK(m->begin(state, &v, &d));
@@ -197,7 +197,7 @@ static void hybrid_tile_lent(void)
             if ((terms[k][i].flags & OM_TERM_EXPOSED) && om__lspace_point(&hy->ls, &smp[i], &p))
                 om__hkey_put(&t[k].raw[n++], &p, i);
         }
-        om_strip sk = {W, H, 0, H, smp, terms[k]};
+        om_strip sk = {W, H, 0, H, smp, terms[k], v.origin};
         om__htile_run(&hy->h, &t[k], n, &sk, k ? &l : NULL);
     }
     const uint32_t nc = t[0].cw * t[0].ch;
@@ -284,7 +284,7 @@ static uint32_t certain_agree(const om_scene *s, const om_method_cfg *c, const c
     if (ran) {
         static om_term terms[W * H];
         for (int i = 0; i < W * H; i++) terms[i] = ref_t[i];
-        om_strip st = {W, H, 0, H, smp, terms};
+        om_strip st = {W, H, 0, H, smp, terms, v.origin};
         om_method_stats ms;
         CHECK_OK(m->resolve(state, &st, &d));
         om_method_get_stats(m, state, &ms);

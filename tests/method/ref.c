@@ -36,9 +36,10 @@ static void square_under_sun(void)
         return;
     CHECK_OK(h_render(&hs.s, "ref", NULL, 0, 0, 0, 0, mask, NULL, samples));
     int checked = 0, shadowed = 0, wrong = 0;
+    const om_vec3 o = h_origin(&hs.s, 0);
     for (int i = 0; i < W * H; i++) {
-        if (samples[i].tri == OM_NO_TRI || samples[i].p[1] > 0.5f) continue;   /* floor only */
-        float x = fabsf(samples[i].p[0]), z = fabsf(samples[i].p[2]);
+        if (samples[i].tri == OM_NO_TRI || samples[i].p[1] + o.y > 0.5f) continue;   /* floor only */
+        float x = fabsf(samples[i].p[0] + o.x), z = fabsf(samples[i].p[2] + o.z);
         if (fabsf(x - 1) < 1e-4f || fabsf(z - 1) < 1e-4f) continue;
         bool expect_shadow = x < 1 && z < 1;
         checked++;
@@ -80,12 +81,13 @@ static void sphere_under_spot(void)
         return;
     CHECK_OK(h_render(&hs.s, "ref", NULL, 0, 0, 0, 0, mask, terms, samples));
     const double L[3] = {1, 8, 0.5};
+    const om_vec3 o = h_origin(&hs.s, 0);
     int checked = 0, shadowed = 0, wrong = 0;
     for (int i = 0; i < W * H; i++) {
         /* floor samples inside the light's frustum (outside it nothing is lit) */
         if (samples[i].tri == OM_NO_TRI || samples[i].tri >= 2 || !(terms[i].flags & OM_TERM_EXPOSED))
             continue;
-        double p[3] = {samples[i].p[0], samples[i].p[1], samples[i].p[2]};
+        double p[3] = {(double)samples[i].p[0] + o.x, (double)samples[i].p[1] + o.y, (double)samples[i].p[2] + o.z};
         int verdict = -1;
         for (uint32_t t = 2; t < hs.s.ntris && verdict != 1; t++) {
             const uint32_t *ix = hs.s.idx + 3 * t;

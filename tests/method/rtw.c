@@ -265,7 +265,7 @@ static void check_exact(const om__rtw *m, void *user)
     for (uint32_t t = 0; t < m->scene->ntris; t++) {
         /* the triangle clipped and projected on the light's grid, as the predicate's */
         om_vec4 c[3];
-        for (int k = 0; k < 3; k++) c[k] = om__mat_apply(&m->view.light_vp, m->scene->verts[m->scene->idx[t * 3 + k]]);
+        for (int k = 0; k < 3; k++) c[k] = om__mat_apply(&m->view.light_vp, om__sub(m->scene->verts[m->scene->idx[t * 3 + k]], m->view.origin));
         int64_t gx[9], gy[9];
         uint32_t gz[9];
         const int n = om__clip_project(c, OM_LIGHT_GRID, OM_LIGHT_GRID, gx, gy, gz);
@@ -785,13 +785,14 @@ static void lookup_is_smlookups(const om__rtw *m, void *user)
             const float x = ((float)(rng(&s) % 20001) / 10000.0f - 1.0f) * pr->extent;
             const float z = ((float)(rng(&s) % 20001) / 10000.0f - 1.0f) * pr->extent;
             const float y = floor_pt ? 0.0f : (float)(rng(&s) % 10001) / 10000.0f * 4.0f;
-            smp[i].p[0] = x; smp[i].p[1] = y; smp[i].p[2] = z;
+            /* relative to the view's origin */
+            smp[i].p[0] = x - m->view.origin.x; smp[i].p[1] = y - m->view.origin.y; smp[i].p[2] = z - m->view.origin.z;
             smp[i].n[0] = 0.0f; smp[i].n[1] = 1.0f; smp[i].n[2] = 0.0f;
             smp[i].tri = 0;
             smp[i].nl = (float)(rng(&s) % 10001) / 10000.0f;
             a[i].flags = b[i].flags = rng(&s) % 8 ? OM_TERM_EXPOSED : 0;
         }
-        om_strip sa = {N, 1, 0, 1, smp, a}, sb = {N, 1, 0, 1, smp, b};
+        om_strip sa = {N, 1, 0, 1, smp, a, m->view.origin}, sb = {N, 1, 0, 1, smp, b, m->view.origin};
         uint32_t na = 0, sha = 0, nb = 0, shb = 0;
         om__rtw_lookup_strip(m, &sa, &na, &sha);
         om__smlook_strip(&m->look, &sb, &nb, &shb);

@@ -73,6 +73,7 @@ typedef struct oracle {
     const om_scene *s;
     om_view v;
     bool spot;
+    dv org;                         /* the view's origin, in world units */
     dv light, toward, ax, ay, az;   /* toward: unit direction to a directional light */
     double reach, step_k;           /* directional segment length; grid step per depth */
     double lo[2], hi[2];
@@ -130,7 +131,8 @@ static void oracle_init(oracle *o, const om_scene *s, uint32_t w, uint32_t h)
     dv up = fabs(o->az.y) < 0.9 ? (dv){0, 1, 0} : (dv){1, 0, 0};
     o->ax = dnorm(dcross(o->az, up));
     o->ay = dcross(o->ax, o->az);
-    o->light = fv(o->v.light.pos);
+    o->org = fv(o->v.origin);   /* the view's positions are relative to it */
+    o->light = dadd(fv(o->v.light.pos), o->org);
     o->toward = dscale(o->az, -1.0);
     dv ext = dsub(fv(s->hi), fv(s->lo));
     o->reach = 2.0 * (fabs(ext.x) + fabs(ext.y) + fabs(ext.z)) + 1.0;
@@ -218,7 +220,7 @@ static bool oracle_tie(const oracle *o, dv p, uint32_t own, bool was)
 static uint32_t eye_hit(const oracle *o, uint32_t x, uint32_t y)
 {
     const om_camera *c = &o->v.cam;
-    dv eye = fv(c->eye), f = dnorm(dsub(fv(c->target), eye));
+    dv eye = dadd(fv(c->eye), o->org), f = dnorm(dsub(dadd(fv(c->target), o->org), eye));
     dv r = dnorm(dcross(f, fv(c->up))), u = dcross(r, f);
     double ty = tan((double)c->fovy_deg * 3.14159265358979323846 / 360.0);
     double tx = ty * (double)c->width / (double)c->height;
@@ -253,7 +255,8 @@ static tally against_oracle(const om_scene *s, const char *what, uint32_t w, uin
         n.covered++;
         if (!(terms[i].flags & OM_TERM_EXPOSED)) continue;
         n.exposed++;
-        dv p = {smp[i].p[0], smp[i].p[1], smp[i].p[2]};
+        const dv rel = {smp[i].p[0], smp[i].p[1], smp[i].p[2]};
+        dv p = dadd(rel, o.org);   /* world */
         bool ob = oracle_blocked(&o, p, smp[i].tri);
         bool rb = !om_term_lit(&terms[i]);
         if (ob == rb) continue;

@@ -232,12 +232,12 @@ static void observe_lent(void)
                 om_view v;
                 CHECK_OK(h_view(&v, &hs.s, 0.0f, W, H, &d));
                 om_target tg = {W, H, 0, H, depth, id};
-                om_strip st = {W, H, 0, H, smp, terms};
+                om_strip st = {W, H, 0, H, smp, terms, v.origin};
                 om__eye_pass_mark(&hs.s, &v, &tg, &st, NULL);
                 ps->lend(state, lend ? &l : NULL);
                 CHECK_OK(m->begin(state, &v, &d));
                 for (uint32_t y = 0; y < H; y += rows) {
-                    om_strip sub = {W, H, y, y + rows > H ? H - y : rows, smp + (size_t)y * W, terms + (size_t)y * W};
+                    om_strip sub = {W, H, y, y + rows > H ? H - y : rows, smp + (size_t)y * W, terms + (size_t)y * W, v.origin};
                     CHECK_OK(m->observe(state, &sub, &d));
                 }
                 const om__lent *lt = i ? &((const om__spsm_state *)state)->lent : &((const om__rtw *)state)->lent;

@@ -141,10 +141,10 @@ static void exact_visible_points(void)
         for (uint32_t x = 0; x < 80; x++) {
             const om_sample *p = &smp_a[y * 80 + x];
             if (p->tri == OM_NO_TRI) continue;
-            om_vec3 P = om__v3(p->p[0], p->p[1], p->p[2]);
+            om_vec3 P = om__v3(p->p[0], p->p[1], p->p[2]);   /* relative to v.origin */
             const uint32_t *ix = s.idx + p->tri * 3;
             om_vec3 n = om__v3(p->n[0], p->n[1], p->n[2]);
-            if (fabsf(om__dot(n, om__sub(P, s.verts[ix[0]]))) > 1e-4f) bad++;
+            if (fabsf(om__dot(n, om__sub(P, om__sub(s.verts[ix[0]], v.origin)))) > 1e-4f) bad++;
             if (fabsf(om__dot(n, n) - 1.0f) > 1e-5f) bad++;
             /* project back: lands on the pixel centre */
             om_vec4 q = om__mat_apply(&v.cam_vp, P);
@@ -170,7 +170,8 @@ static void exposure_rule(void)
     int in = 0, out = 0, bad = 0;
     for (int i = 0; i < 80 * 60; i++) {
         if (smp_a[i].tri == OM_NO_TRI) { if (term_a[i].flags) bad++; continue; }
-        float x = smp_a[i].p[0], z = smp_a[i].p[2], y = smp_a[i].p[1];
+        /* the view's origin is the spot light's position */
+        float x = smp_a[i].p[0] + l.pos.x, z = smp_a[i].p[2] + l.pos.z, y = smp_a[i].p[1] + l.pos.y;
         float half = (10 - y) * (float)om__tan(5 * OM_PI / 180);
         bool inside = fabsf(x) < half * 0.98f && fabsf(z) < half * 0.98f;
         bool outside = fabsf(x) > half * 1.02f || fabsf(z) > half * 1.02f;

@@ -211,8 +211,8 @@ static void hiz_scene_light_map(void)
     CHECK(a && b && h);
     if (a && b && h) {
         om_target ta = {M, M, 0, M, a, NULL}, tb = {M, M, 0, M, b, NULL};
-        om__scene_raster(&p.s, &v.light_vp, &ta, OM_RASTER_DEPTH, true, NULL);
-        om__scene_raster_hiz(&p.s, &v.light_vp, &tb, OM_RASTER_DEPTH, true, NULL, h);
+        om__scene_raster(&p.s, &v.light_vp, v.origin, &ta, OM_RASTER_DEPTH, true, NULL);
+        om__scene_raster_hiz(&p.s, &v.light_vp, v.origin, &tb, OM_RASTER_DEPTH, true, NULL, h);
         int diff = 0, written = 0;
         for (size_t i = 0; i < (size_t)M * M; i++) {
             diff += a[i] != b[i];

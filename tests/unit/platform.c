@@ -26,7 +26,7 @@ static void ppm_round_trip(void)
     smp[0].tri = 1; term[0].r = term[0].g = term[0].b = 255; term[0].flags = OM_TERM_EXPOSED;
     smp[1].tri = 2; term[1].r = 255; term[1].g = term[1].b = 128; term[1].flags = OM_TERM_EXPOSED;
     smp[2].tri = OM_NO_TRI;
-    om_strip st = {3, 2, 0, 1, smp, term};
+    om_strip st = {3, 2, 0, 1, smp, term, {0, 0, 0}};
     uint16_t words[3] = {0xF800, 0x07E0, 0x001F};   /* red, green, blue */
     for (int i = 0; i < 3; i++) { px[2 * i] = (uint8_t)(words[i] & 0xFF); px[2 * i + 1] = (uint8_t)(words[i] >> 8); }
     CHECK_OK(om_ppm_strip(&k, &st, &fb));
@@ -157,7 +157,7 @@ static void grey_sink_writes_pgm(void)
     om_term term[2];
     memset(smp, 0, sizeof smp);
     memset(term, 0, sizeof term);
-    om_strip st = {2, 1, 0, 1, smp, term};
+    om_strip st = {2, 1, 0, 1, smp, term, {0, 0, 0}};
     CHECK_OK(om_ppm_strip(&k, &st, &fb));
     CHECK_OK(om_ppm_close(&k, &d));
     CHECK(file_is(img, "P5\n2 1\n255\n\x07\xc8"));

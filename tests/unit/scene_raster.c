@@ -20,7 +20,7 @@
 #include <string.h>
 
 /* Every triangle on its own, in order, as the walk did before it had batches. */
-static void walk_one_by_one(const om_scene *s, const om_mat4 *vp, const om_target *tg, om_raster_mode mode,
+static void walk_one_by_one(const om_scene *s, const om_mat4 *vp, om_vec3 o, const om_target *tg, om_raster_mode mode,
                             bool cull, uint32_t *hiz)
 {
     om_raster r;
@@ -28,14 +28,14 @@ static void walk_one_by_one(const om_scene *s, const om_mat4 *vp, const om_targe
     r.target = tg;
     r.mode = mode;
     om__cull cl;
-    om__cull_begin(&cl, s, vp);
+    om__cull_begin(&cl, s, vp, o);
     om__target_clear(tg);
     om__hiz_clear(hiz, tg);
     const om__guard g = om__guard_band(tg->width, tg->height);
     for (uint32_t t = 0; t < s->ntris; t++) {
         r.cull_back = cull && om__cull_next(&cl, t);
         om_vec4 c[3];
-        om__clip_tri(s, vp, t, c);
+        om__clip_tri(s, vp, o, t, c);
         om__raster_tri_guarded(&r, hiz, c, t, tg->width, tg->height, g);
     }
 }
@@ -43,7 +43,7 @@ static void walk_one_by_one(const om_scene *s, const om_mat4 *vp, const om_targe
 /* The walk against one by one on scene s through vp onto a W x H image: whole, and by
  * strips of `strip` rows (the coarse depth only where its tiles fit, rows from a
  * multiple of 16). Returns the number of texels either drew. */
-static size_t compare_walks(const om_scene *s, const om_mat4 *vp, uint32_t W, uint32_t H, uint32_t strip)
+static size_t compare_walks(const om_scene *s, const om_mat4 *vp, om_vec3 o, uint32_t W, uint32_t H, uint32_t strip)
 {
     size_t n = (size_t)W * H, drawn = 0;
     uint32_t *da = malloc(n * 4), *db = malloc(n * 4), *ia = malloc(n * 4), *ib = malloc(n * 4);
@@ -52,8 +52,8 @@ static size_t compare_walks(const om_scene *s, const om_mat4 *vp, uint32_t W, ui
     om__bins exact = {malloc((size_t)s->ntris * 4), bins.verts, true};
     CHECK(da && db && ia && ib && ha && hb && bins.rows && bins.verts && exact.rows);
     if (bins.rows && bins.verts && exact.rows) {
-        om__bins_make(s, vp, W, H, &bins);
-        om__bins_make_rows(s, vp, W, H, &exact, 0, s->ntris);
+        om__bins_make(s, vp, o, W, H, &bins);
+        om__bins_make_rows(s, vp, o, W, H, &exact, 0, s->ntris);
     }
     for (int mode = 0; da && db && ia && ib && ha && hb && bins.rows && bins.verts && exact.rows && mode < 12; mode++) {
         /* mode 4..7 with the bins (rows and snapped vertices), 8..11 with rows of pixel
@@ -66,8 +66,8 @@ static size_t compare_walks(const om_scene *s, const om_mat4 *vp, uint32_t W, ui
             om_target tb = {W, H, y0, rows, db + (size_t)y0 * W, id ? ib + (size_t)y0 * W : NULL};
             const bool coarse = !id && om__hiz_fits(&ta);
             const om_raster_mode m = id ? OM_RASTER_DEPTH_ID : OM_RASTER_DEPTH;
-            om__scene_raster_hiz(s, vp, &ta, m, cull, binned ? with : NULL, coarse ? ha : NULL);
-            walk_one_by_one(s, vp, &tb, m, cull, coarse ? hb : NULL);
+            om__scene_raster_hiz(s, vp, o, &ta, m, cull, binned ? with : NULL, coarse ? ha : NULL);
+            walk_one_by_one(s, vp, o, &tb, m, cull, coarse ? hb : NULL);
         }
         size_t diff = 0;
         for (size_t i = 0; i < n; i++) {
@@ -92,7 +92,7 @@ static size_t compare_walks(const om_scene *s, const om_mat4 *vp, uint32_t W, ui
  * anywhere (mid-batch, one vertex, empty): each vertex exactly what om__project gives
  * it alone when om__raster_tri would send it unclipped (finite, inside every plane),
  * x = INT32_MIN when not; the rows the same however cut. Returns how many were alone. */
-static size_t check_bins(const om_scene *s, const om_mat4 *vp, uint32_t W, uint32_t H)
+static size_t check_bins(const om_scene *s, const om_mat4 *vp, om_vec3 o, uint32_t W, uint32_t H)
 {
     om__bins a = {malloc((size_t)s->ntris * 4), malloc((size_t)s->nverts * sizeof(om__vsnap)), false};
     om__bins b = {malloc((size_t)s->ntris * 4), malloc((size_t)s->nverts * sizeof(om__vsnap)), false};
@@ -101,16 +101,16 @@ static size_t check_bins(const om_scene *s, const om_mat4 *vp, uint32_t W, uint3
     if (!(a.rows && a.verts && b.rows && b.verts)) goto out;
     memset(b.verts, 0x5A, (size_t)s->nverts * sizeof(om__vsnap));   /* not zeroed, as the frame's */
     memset(b.rows, 0x5A, (size_t)s->ntris * 4);
-    om__bins_make(s, vp, W, H, &a);
+    om__bins_make(s, vp, o, W, H, &a);
     const uint32_t cuts[] = {0, 1, 5, 29, 30, 77, s->nverts / 2, s->nverts - 1, s->nverts};
     for (int k = 0; k + 1 < 9; k++)
-        if (cuts[k] <= cuts[k + 1]) om__bins_make_verts(s, vp, W, H, &b, cuts[k], cuts[k + 1]);
-    om__bins_make_rows(s, vp, W, H, &b, 0, s->ntris / 3);
-    om__bins_make_rows(s, vp, W, H, &b, s->ntris / 3, s->ntris + 9);
+        if (cuts[k] <= cuts[k + 1]) om__bins_make_verts(s, vp, o, W, H, &b, cuts[k], cuts[k + 1]);
+    om__bins_make_rows(s, vp, o, W, H, &b, 0, s->ntris / 3);
+    om__bins_make_rows(s, vp, o, W, H, &b, s->ntris / 3, s->ntris + 9);
     size_t wrong = 0;
     const om__guard g = om__guard_band(W, H);
     for (uint32_t v = 0; v < s->nverts; v++) {
-        const om_vec4 c = om__mat_apply(vp, s->verts[v]);
+        const om_vec4 c = om__mat_apply(vp, om__sub(s->verts[v], o));
         int64_t x, y;
         uint32_t z;
         const bool in = om__finite(c.x) && om__finite(c.y) && om__finite(c.z) && om__finite(c.w) &&
@@ -166,13 +166,13 @@ static void scene_walk_same_as_one_by_one(void)
             CHECK_MSG(false, "view: %s", d.msg);
             break;
         }
-        CHECK(check_bins(s, &v.cam_vp, 96, 64) < s->nverts);   /* some need clipping */
-        check_bins(s, &v.light_vp, 256, 256);
-        const size_t eye = compare_walks(s, &v.cam_vp, 96, 64, 64);
-        compare_walks(s, &v.cam_vp, 96, 64, 7);
-        compare_walks(s, &v.cam_vp, 37, 23, 5);
-        const size_t light = compare_walks(s, &v.light_vp, 128, 128, 128);
-        compare_walks(s, &v.light_vp, 256, 256, 32);
+        CHECK(check_bins(s, &v.cam_vp, v.origin, 96, 64) < s->nverts);   /* some need clipping */
+        check_bins(s, &v.light_vp, v.origin, 256, 256);
+        const size_t eye = compare_walks(s, &v.cam_vp, v.origin, 96, 64, 64);
+        compare_walks(s, &v.cam_vp, v.origin, 96, 64, 7);
+        compare_walks(s, &v.cam_vp, v.origin, 37, 23, 5);
+        const size_t light = compare_walks(s, &v.light_vp, v.origin, 128, 128, 128);
+        compare_walks(s, &v.light_vp, v.origin, 256, 256, 32);
         /* the scenes draw: not a comparison of empty maps */
         CHECK(eye > 96 * 64 / 2);
         CHECK(light > 128 * 128 / 4);
@@ -206,7 +206,7 @@ static void bins_depths_at_the_edges(void)
     size_t wrong = 0, inside = 0;
     for (uint32_t v0 = 0; v0 < 24; v0 += 7) {   /* batches starting anywhere */
         memset(vs, 0x5A, sizeof vs);
-        om__bins_make_verts(&sc, &vp, 64, 64, &b, v0, N);
+        om__bins_make_verts(&sc, &vp, om__v3(0, 0, 0), 64, 64, &b, v0, N);
         for (uint32_t v = v0; v < N; v++) {
             const om_vec4 c = om__mat_apply(&vp, verts[v]);
             int64_t x, y;
@@ -259,22 +259,22 @@ static void centre_rows_at_the_edges(void)
     om_mat4 vp;
     memset(&vp, 0, sizeof vp);
     vp.m[0] = vp.m[5] = vp.m[10] = vp.m[15] = 1.0f;   /* clip = (x, y, z, 1) */
-    const size_t drawn = compare_walks(&sc, &vp, W, W, 1);
-    compare_walks(&sc, &vp, W, W, 2);
-    compare_walks(&sc, &vp, W, W, 3);
+    const size_t drawn = compare_walks(&sc, &vp, om__v3(0, 0, 0), W, W, 1);
+    compare_walks(&sc, &vp, om__v3(0, 0, 0), W, W, 2);
+    compare_walks(&sc, &vp, om__v3(0, 0, 0), W, W, 3);
     CHECK(drawn > W * W / 2);
 }
 
 /* Rasterizes the scene through vp without and with culling into (d0, i0) and (d1, i1)
  * (ids NULL: depth only) and counts the texels that differ; *covered counts those the
  * unculled pass reached. */
-static uint32_t cull_diff(const om_scene *s, const om_mat4 *vp, uint32_t n, uint32_t *d0, uint32_t *i0,
+static uint32_t cull_diff(const om_scene *s, const om_mat4 *vp, om_vec3 o, uint32_t n, uint32_t *d0, uint32_t *i0,
                           uint32_t *d1, uint32_t *i1, uint32_t *covered)
 {
     om_raster_mode mode = i0 ? OM_RASTER_DEPTH_ID : OM_RASTER_DEPTH;
     om_target t0 = {n, n, 0, n, d0, i0}, t1 = {n, n, 0, n, d1, i1};
-    om__scene_raster(s, vp, &t0, mode, false, NULL);
-    om__scene_raster(s, vp, &t1, mode, true, NULL);
+    om__scene_raster(s, vp, o, &t0, mode, false, NULL);
+    om__scene_raster(s, vp, o, &t1, mode, true, NULL);
     uint32_t diff = 0;
     *covered = 0;
     for (uint32_t i = 0; i < n * n; i++) {
@@ -344,12 +344,12 @@ static void light_cull_keeps_the_map(void)
         }
         om_view v;
         CHECK_OK(om_view_init(&v, &cam, &light, s, NULL));
-        uint32_t covered, diff = cull_diff(s, &v.light_vp, N, full, NULL, culled, NULL, &covered);
+        uint32_t covered, diff = cull_diff(s, &v.light_vp, v.origin, N, full, NULL, culled, NULL, &covered);
         CHECK_MSG(diff == 0, "light %d: %u of %u covered texels differ", k, diff, covered);
         CHECK(covered > N * N / 8);
         /* which solids were culled */
         om__cull cl;
-        om__cull_begin(&cl, s, &v.light_vp);
+        om__cull_begin(&cl, s, &v.light_vp, v.origin);
         unsigned on = 0;
         for (uint32_t t = 0; t < s->ntris; t++)
             if (om__cull_next(&cl, t))
@@ -375,7 +375,7 @@ static void light_cull_keeps_the_map(void)
         cam.znear = e[6];
         om_view v;
         CHECK_OK(om_view_init(&v, &cam, &light, s, NULL));
-        uint32_t covered, diff = cull_diff(s, &v.cam_vp, N, full, ids_full, culled, ids_culled, &covered);
+        uint32_t covered, diff = cull_diff(s, &v.cam_vp, v.origin, N, full, ids_full, culled, ids_culled, &covered);
         CHECK_MSG(diff == 0, "eye %d: %u of %u covered texels differ", k, diff, covered);
         CHECK(covered > N * N / 8);
     }

@@ -255,6 +255,7 @@ typedef struct om__asm_state {
     om__asm_tree tree;
     om_view view;
     om_mat4 built_vp;      /* the light the tiles hold */
+    om_vec3 built_org;     /* and the origin they are relative to */
     bool built;
     bool prepared;         /* this frame's projections are done */
     bool lean;             /* no per-vertex or per-triangle arrays: see render */

@@ -263,7 +263,7 @@ static void render(const om__asm_state *m, const om__asm_rs *rs, uint32_t level,
     /* back faces of closed shapes skipped, as in every light map (om__cull); the
      * window scales x and y by s_ > 0, so windings stay */
     om__cull cl;
-    om__cull_begin(&cl, s, &m->view.light_vp);
+    om__cull_begin(&cl, s, &m->view.light_vp, m->view.origin);
     if (m->lean) {
         /* The same triangles in the same order as the fast path below, so the same tile:
          * projections and bounds are made per tile instead of kept per frame. */
@@ -271,7 +271,7 @@ static void render(const om__asm_state *m, const om__asm_rs *rs, uint32_t level,
             const uint32_t *ix = s->idx + (size_t)t * 3;
             om__asm_dvec q[3];
             float b[4];
-            for (int i = 0; i < 3; i++) q[i] = dapply(&m->view.light_vp, s->verts[ix[i]]);
+            for (int i = 0; i < 3; i++) q[i] = dapply(&m->view.light_vp, om__sub(s->verts[ix[i]], m->view.origin));
             tri_box(q, T, b);
             if (!box_meets(b, u0, v0, u1, v1) || !box_holds_centre(b, l->scale[level])) continue;
             r.cull_back = om__cull_next(&cl, t);
@@ -296,7 +296,7 @@ static void render(const om__asm_state *m, const om__asm_rs *rs, uint32_t level,
             if (k + 8 < n) __builtin_prefetch(s->idx + (size_t)rs->cull[k + 8] * 3);
 #endif
             om__asm_dvec q[3];
-            for (int i = 0; i < 3; i++) q[i] = dapply(&m->view.light_vp, s->verts[ix[i]]);
+            for (int i = 0; i < 3; i++) q[i] = dapply(&m->view.light_vp, om__sub(s->verts[ix[i]], m->view.origin));
             r.cull_back = om__cull_next(&cl, t);
             render_tri(&r, q, s_, kx, ky, t);
         }
@@ -332,7 +332,7 @@ static void bounds(om__asm_state *m, uint32_t k0, uint32_t k1)
     for (uint32_t k = k0; k < k1; k++) {
         const uint32_t *ix = s->idx + (size_t)k * 3;
         om__asm_dvec q[3];
-        for (int i = 0; i < 3; i++) q[i] = dapply(&m->view.light_vp, s->verts[ix[i]]);
+        for (int i = 0; i < 3; i++) q[i] = dapply(&m->view.light_vp, om__sub(s->verts[ix[i]], m->view.origin));
         float *b = &m->tbox[(size_t)k * 4];
         tri_box(q, m->tree.lay.tile, b);
         m->cull[k] = cells_of(m, b);
@@ -382,10 +382,12 @@ void om__asm_prepare(om__asm_state *m)
         }
         grid_make(m);
     }
-    if (!m->built || memcmp(&m->built_vp, &m->view.light_vp, sizeof m->built_vp) != 0) {
+    if (!m->built || memcmp(&m->built_vp, &m->view.light_vp, sizeof m->built_vp) != 0 ||
+        memcmp(&m->built_org, &m->view.origin, sizeof m->built_org) != 0) {
         om__asm_tree_clear(&m->tree);
         om__asm_render_node(m, OM__ASM_ROOT);
         m->built_vp = m->view.light_vp;
+        m->built_org = m->view.origin;
         m->built = true;
         m->rebuilds++;
     }

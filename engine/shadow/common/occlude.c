@@ -37,8 +37,11 @@ static void bound_begin(om__lspace *ls, const om_view *v)
 {
     const om_scene *s = ls->scene;
     const double u10 = 10.0 / 16777216.0;   /* 10 roundings of 2^-24 each (occlude.h) */
+    /* The largest coordinate of a vertex relative to the origin: the scene's box made
+     * relative as the vertices are (rounding is monotonic, so it holds them all). */
     double big = 0.0;
-    const float c[6] = {s->lo.x, s->lo.y, s->lo.z, s->hi.x, s->hi.y, s->hi.z};
+    const om_vec3 lo = om__sub(s->lo, v->origin), hi = om__sub(s->hi, v->origin);
+    const float c[6] = {lo.x, lo.y, lo.z, hi.x, hi.y, hi.z};
     for (int i = 0; i < 6; i++)
         if (fabs((double)c[i]) > big) big = fabs((double)c[i]);
     double sx = row_mag(&ls->vp, 0, big), sy = row_mag(&ls->vp, 1, big);
@@ -75,6 +78,7 @@ static double bound(const om__lspace *ls, const om__rtri *r)
 void om__lspace_view(om__lspace *ls, const om_view *v)
 {
     ls->vp = v->light_vp;
+    ls->o = v->origin;
     bound_begin(ls, v);
 }
 
@@ -82,7 +86,7 @@ void om__lspace_project(const om__lspace *ls, uint32_t first, uint32_t end)
 {
     const om_scene *s = ls->scene;
     for (uint32_t i = first; ls->verts && i < end; i++) {
-        om_vec4 c = om__mat_apply(&ls->vp, s->verts[i]);
+        om_vec4 c = om__mat_apply(&ls->vp, om__sub(s->verts[i], ls->o));
         om__lvert *o = &ls->verts[i];
         int64_t X, Y;
         uint32_t Z;
@@ -169,7 +173,7 @@ bool om__lspace_tri(const om__lspace *ls, uint32_t t, om__ltri *lt)
     }
     ltri_begin(lt, t);
     om_vec4 clip[3];
-    for (int k = 0; k < 3; k++) clip[k] = om__mat_apply(&ls->vp, ls->scene->verts[ix[k]]);
+    for (int k = 0; k < 3; k++) clip[k] = om__mat_apply(&ls->vp, om__sub(ls->scene->verts[ix[k]], ls->o));
     for (int k = 0; k < 3; k++)
         if (!om__finite(clip[k].x) || !om__finite(clip[k].y) || !om__finite(clip[k].z) ||
             !om__finite(clip[k].w))

@@ -31,9 +31,14 @@
  *   - in depth: the float rounding of z and w in the light's clip space (the float
  *     matrix product: 4 roundings, the clipper's cut: 2 more, the sample's point made
  *     in float from its triangle's vertices (eye.c: a difference, a product and a sum
- *     a term): 3, and the vertices' rounding to float: 1; 10 units of 2^-24 on the sum
- *     of the terms' magnitudes, bounded with the scene box), over w; and the depth's
- *     truncation to a whole unit (om__zdepth), below one unit each.
+ *     a term): 3, and each vertex made relative to the view's origin, a float
+ *     subtraction: 1; 10 units of 2^-24 on the sum of the terms' magnitudes, bounded
+ *     with the scene's box relative to the origin), over w; and the depth's truncation
+ *     to a whole unit (om__zdepth), below one unit each.
+ * Every coordinate is relative to the view's origin, which follows the light (om_view):
+ * the rounding terms scale with the scene's extent around its light, not with its
+ * distance from the world's origin, so a scene moved far away keeps the bound it has
+ * at the origin (the float vertex data itself is what loses precision there).
  * Each rounding term grows with 1/w, so the sample's own is at most the triangle's at
  * its nearest vertex whenever the triangle is nearer at all; the bound is therefore
  * twice the triangle's own (om__lspace_tri sets it per sub-triangle). A
@@ -42,7 +47,7 @@
  * from the grid and the number formats, not tuned. Laterally it is about ten grid
  * steps, more where the grid is finer than float positions resolve (a directional
  * light fitted to a small view of a large scene: 20 to 70 steps, a few tens of float
- * roundings of the scene's largest coordinate); in depth, that times the triangle's
+ * roundings of the scene's largest coordinate about the origin); in depth, that times the triangle's
  * slope, plus the depth rounding. */
 #ifndef OM_OCCLUDE_H
 #define OM_OCCLUDE_H
@@ -84,7 +89,8 @@ static inline om__lvbox om__lvert_box(const om__lvert *a, const om__lvert *b, co
 
 typedef struct om__lspace {
     const om_scene *scene;
-    om_mat4 vp;            /* the light's world -> clip */
+    om_mat4 vp;            /* the light's clip space of a point less o */
+    om_vec3 o;             /* the view's origin */
     om__lvert *verts;      /* scene->nverts projected once per frame; NULL: lean mode */
     /* The snapping bound's parts for this frame (occlude.c, bound()): 1/w as an affine
      * function of light depth, and the lateral (grid units) and depth rounding per

@@ -122,8 +122,13 @@ static uint32_t begin_view(ref_state *r, const om_view *v)
         span = 2.0f * v->light.zfar * (float)om__tan((double)v->light.fov_deg * OM_PI / 360.0);
     else
         span = 2.0f / fminf(fabsf(v->light_proj.m[0]), fabsf(v->light_proj.m[5]));
+    /* and the rounding of a sample's world position (shade_sample: the BVH's boxes are
+     * in world units), a few units in the last place of the scene's largest coordinate */
+    const float big = fmaxf(fmaxf(fmaxf(fabsf(r->scene->lo.x), fabsf(r->scene->hi.x)),
+                                  fmaxf(fabsf(r->scene->lo.y), fabsf(r->scene->hi.y))),
+                            fmaxf(fabsf(r->scene->lo.z), fabsf(r->scene->hi.z)));
     r->margin = 4.0f * span / (float)(OM_LIGHT_GRID * OM_SUBPIX) +
-                1e-6f * (fabsf(ext.x) + fabsf(ext.y) + fabsf(ext.z));
+                1e-6f * (fabsf(ext.x) + fabsf(ext.y) + fabsf(ext.z) + big);
     r->samples = r->candidates = r->blocked = 0;
     return r->ls.verts ? r->scene->nverts : 0;
 }
@@ -273,10 +278,12 @@ static void shade_sample(ref_job *j, const om_sample *smp, om_term *t)
         finish(&w, t);
         return;
     }
-    om_vec3 p = om__v3(smp->p[0], smp->p[1], smp->p[2]), dir;
+    /* the BVH is in world units: the segment too (begin_view's margin covers the
+     * rounding of the sum) */
+    om_vec3 p = om__add(om__v3(smp->p[0], smp->p[1], smp->p[2]), r->view.origin), dir;
     float tmax;
     if (r->view.light.kind == OM_LIGHT_SPOT) {
-        dir = om__sub(r->view.light.pos, p);
+        dir = om__sub(om__add(r->view.light.pos, r->view.origin), p);
         tmax = 1.0f;
     } else {
         om_vec3 ext = om__sub(r->scene->hi, r->scene->lo);

@@ -411,7 +411,7 @@ static uint32_t render_exact(const om__rtw *m, om_raster *r, const om__bins *bin
     const int64_t unit_num = (int64_t)OM_LIGHT_GRID * OM_SUBPIX, unit_den = m->size;
     const uint32_t *rows = bins ? bins->rows : NULL;
     om__cull cl;
-    om__cull_begin(&cl, s, &m->view.light_vp);
+    om__cull_begin(&cl, s, &m->view.light_vp, m->view.origin);
     uint32_t drawn = 0;
     for (uint32_t t = 0; t < s->ntris; t++) {
         if (OM_WITH_JOBS && rows) {
@@ -422,7 +422,7 @@ static uint32_t render_exact(const om__rtw *m, om_raster *r, const om__bins *bin
             if (r1 + 1 < m->size && ((int64_t)r1 + 1) * unit_num / unit_den + 1 < g0) continue;
         }
         om_vec4 c[3];
-        om__clip_tri(s, &m->view.light_vp, t, c);
+        om__clip_tri(s, &m->view.light_vp, m->view.origin, t, c);
         r->cull_back = om__cull_next(&cl, t);
         bool ok = true;
         for (int k = 0; k < 3; k++)
@@ -463,7 +463,7 @@ static uint32_t render_tess(const om__rtw *m, om_raster *r)
         x.cap = cap < 4294967295.0 ? (uint32_t)cap : UINT32_MAX;
     }
     om__cull cl;
-    om__cull_begin(&cl, s, &m->view.light_vp);
+    om__cull_begin(&cl, s, &m->view.light_vp, m->view.origin);
     const float g = 1.0f + 4.0f / (float)m->size;
     for (uint32_t t = 0; t < s->ntris; t++) {
         const uint32_t *ix = s->idx + (size_t)t * 3;
@@ -473,7 +473,7 @@ static uint32_t render_tess(const om__rtw *m, om_raster *r)
         om_vec4 c[3], poly[9];
         bool ok = true;
         for (int k = 0; k < 3; k++) {
-            c[k] = om__mat_apply(&m->view.light_vp, s->verts[ix[k]]);
+            c[k] = om__mat_apply(&m->view.light_vp, om__sub(s->verts[ix[k]], m->view.origin));
             ok = ok && om__finite(c[k].x) && om__finite(c[k].y) && om__finite(c[k].z) && om__finite(c[k].w);
         }
         if (!ok) continue;

@@ -330,7 +330,7 @@ static void forward(om__rtw *m)
     const bool hybrid = m->cfg.rtw_analysis == OM_RTW_HYBRID;
     /* hybrid needs only the depths (for edges); forward also the triangle under a texel */
     om_target tg = {n, n, 0, n, m->fdepth, hybrid ? NULL : m->fid};
-    om__scene_raster(m->scene, &m->view.light_vp, &tg, hybrid ? OM_RASTER_DEPTH : OM_RASTER_DEPTH_ID, false, NULL);
+    om__scene_raster(m->scene, &m->view.light_vp, m->view.origin, &tg, hybrid ? OM_RASTER_DEPTH : OM_RASTER_DEPTH_ID, false, NULL);
     om__persp_tri cache;
     memset(&cache, 0, sizeof cache);
     cache.tri = OM_NO_TRI;
@@ -346,7 +346,7 @@ static void forward(om__rtw *m)
             float edge = (funcs & OM_RTW_EDGE) && !is_edge(m, i, j) ? OM_RTW_ALPHA : 1.0f;
             uint32_t t = m->fid[c];
             if (t == OM_NO_TRI) { m->imp[c] = 0.0f; continue; }
-            if (cache.tri != t) om__persp_setup(m->scene, &m->view.light_vp, t, &cache);
+            if (cache.tri != t) om__persp_setup(m->scene, &m->view.light_vp, m->view.origin, t, &cache);
             float sx = ((float)i + 0.5f) * (2.0f / (float)n) - 1.0f;
             float sy = 1.0f - ((float)j + 0.5f) * (2.0f / (float)n);
             om_vec3 p = om__persp_point(&cache, sx, sy);

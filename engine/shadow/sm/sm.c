@@ -122,7 +122,7 @@ static om_status sm_build(void *state, om_diag *d)
     (void)d;
     sm_state *m = (sm_state *)state;
     const om__bins b = {NULL, m->verts, false};
-    if (m->verts) om__bins_make(m->scene, &m->view.light_vp, m->size, m->size, &b);
+    if (m->verts) om__bins_make(m->scene, &m->view.light_vp, m->view.origin, m->size, m->size, &b);
     uint32_t counts[8] = {0};
     sm_build_rows(state, m->verts ? &b : NULL, 0, m->size, counts);
     return OM_OK;
@@ -164,7 +164,7 @@ static void sm_build_rows(const void *state, const om__bins *bins, uint32_t y0, 
     (void)counts;   /* the map counts nothing */
     const sm_state *m = (const sm_state *)state;
     om_target tg = {m->size, m->size, y0, rows, m->depth + (size_t)y0 * m->size, NULL};
-    om__scene_raster_hiz(m->scene, &m->view.light_vp, &tg, OM_RASTER_DEPTH, true, bins, m->hiz);
+    om__scene_raster_hiz(m->scene, &m->view.light_vp, m->view.origin, &tg, OM_RASTER_DEPTH, true, bins, m->hiz);
 }
 
 const om__bands om__bands_sm = {sm_band, sm_merge, 0, sm_map_of, sm_build_rows, NULL};

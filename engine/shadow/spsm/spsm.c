@@ -539,7 +539,7 @@ static void pixel_steps(const om__spsm_state *m, const om_strip *st, size_t i, o
     const om_sample *s = &st->samples[i];
     const uint32_t x = (uint32_t)(i % st->width), y = st->y0 + (uint32_t)(i / st->width);
     om__persp_tri c;
-    om__persp_setup(m->scene, &m->view.cam_vp, s->tri, &c);
+    om__persp_setup(m->scene, &m->view.cam_vp, m->view.origin, s->tri, &c);
     const float kx = 2.0f / (float)st->width, ky = 2.0f / (float)st->height;
     const float fx = ((float)x + 0.5f) * kx - 1.0f, fy = 1.0f - ((float)y + 0.5f) * ky;
     const om_vec3 p = om__v3(s->p[0], s->p[1], s->p[2]);

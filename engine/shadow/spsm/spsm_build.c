@@ -281,7 +281,7 @@ static void raster_scene(const om__spsm_state *m, om_raster *r, const om__bins *
     const uint32_t *rows = OM_WITH_JOBS && bins ? bins->rows : NULL;   /* (config.h) */
     const om__vsnap *vs = OM_WITH_JOBS && bins && fine == 1 ? bins->verts : NULL;
     om__cull cl;
-    om__cull_begin(&cl, s, &m->view.light_vp);
+    om__cull_begin(&cl, s, &m->view.light_vp, m->view.origin);
     for (uint32_t t = 0; t < s->ntris; t++) {
         if (rows && ((rows[t] & 0xFFFFu) * fine > y1 || (rows[t] >> 16) * fine + fine - 1 < y0)) continue;
         r->cull_back = om__cull_next(&cl, t);
@@ -294,7 +294,7 @@ static void raster_scene(const om__spsm_state *m, om_raster *r, const om__bins *
             continue;
         }
         om_vec4 c[3];
-        om__clip_tri(s, &m->view.light_vp, t, c);
+        om__clip_tri(s, &m->view.light_vp, m->view.origin, t, c);
         om__raster_tri(r, c, t);
     }
 }
