@@ -59,6 +59,17 @@ static void bound_begin(om__lspace *ls, const om_view *v)
         ls->iw0 = 1.0;
         ls->iw1 = 0.0;
     }
+    /* the sample's facet (sample_slack): z/w = -p10 + p11 / w (spot) or p10 z + p11
+     * (directional) over x/w = p0 x / w, y/w = p5 y / w; the grid has 2^20 units per unit
+     * of x/w and 2^32 of depth per unit of z/w, hence 2^12 */
+    const om_mat4 *lv = &v->light_view, *lp = &v->light_proj;
+    ls->spot = v->light.kind == OM_LIGHT_SPOT;
+    ls->row0 = om__v3(lv->m[0], lv->m[1], lv->m[2]);
+    ls->row1 = om__v3(lv->m[4], lv->m[5], lv->m[6]);
+    ls->row2 = om__v3(lv->m[8], lv->m[9], lv->m[10]);
+    const double coef = fabs((double)(ls->spot ? lp->m[11] : lp->m[10])) * 4096.0;
+    ls->kx = (float)(coef / fabs((double)lp->m[0]));
+    ls->ky = (float)(coef / fabs((double)lp->m[5]));
     ls->iw0f = (float)ls->iw0;
     ls->iw1f = (float)ls->iw1;
     ls->latf = (float)ls->lat;
@@ -110,14 +121,57 @@ void om__lspace_begin(om__lspace *ls, const om_view *v)
     om__lspace_project(ls, 0, ls->scene->nverts);
 }
 
+/* The sample's own facet's slack (occlude.h), in depth units: its depth slope on the
+ * grid, |dD/dX| + |dD/dY|, times the lateral error (1.5 + lat iw) that bound() takes
+ * for a blocker. For the plane n . (X - L) = c (n the facet's unit normal, L the spot
+ * light, view coordinates along the light's rows) the slope is
+ *   2^12 |p11| (|n0| / |p0| + |n1| / |p5|) / |c|   (spot: 1/w is affine in x/w, y/w),
+ *   2^12 |p10| (|n0| / |p0| + |n1| / |p5|) / |n2|  (directional),
+ * n0, n1, n2 the normal's view coordinates. In float: the sample's point and normal
+ * are within a few roundings of its facet's (eye.c), so c and n2 are taken smaller
+ * by 2^-18 of their terms' magnitudes and n0, n1 larger by 2^-18, and the result, a
+ * chain of a dozen roundings, is made 2^-10 larger and rounded up: at least the
+ * exact slack. A facet edge-on to within those (c or n2 not above 0) gets no blocker
+ * at all. */
+static double sample_slack(const om__lspace *ls, const om_sample *smp, double z)
+{
+    const om_vec3 n = om__v3(smp->n[0], smp->n[1], smp->n[2]);
+    const float e = 0x1p-18f;
+    const float n0 = om__fabsf(om__dot(n, ls->row0)) + e, n1 = om__fabsf(om__dot(n, ls->row1)) + e;
+    float den, iw;
+    if (ls->spot) {
+        const float a = n.x * smp->p[0], b = n.y * smp->p[1], c = n.z * smp->p[2];
+        const float big = om__fabsf(smp->p[0]) + om__fabsf(smp->p[1]) + om__fabsf(smp->p[2]);
+        den = om__fabsf(a + b + c) - e * (om__fabsf(a) + om__fabsf(b) + om__fabsf(c) + big);
+        iw = ls->iw0f + ls->iw1f * (float)z;
+        if (!(iw > 0.0f)) iw = 0.0f;
+    } else {
+        den = om__fabsf(om__dot(n, ls->row2)) - e;
+        iw = 1.0f;
+    }
+    if (!(den > 0.0f)) return OM_DEPTH_ONE;
+    const float slope = (ls->kx * n0 + ls->ky * n1) / den;
+    const float k = slope * (1.5f + ls->latf * iw) * (1.0f + 0x1p-10f) + 1.0f;
+    if (!(k < 4294967040.0f)) return OM_DEPTH_ONE;   /* the largest float below 2^32 */
+    const uint32_t u = (uint32_t)k;
+    return (double)u + ((float)u < k);
+}
+
 bool om__lspace_point_z(const om__lspace *ls, const om_sample *smp, om__lpoint *out, uint32_t *z)
 {
     om_vec4 c = om__mat_apply(&ls->vp, om__v3(smp->p[0], smp->p[1], smp->p[2]));
     *z = 0;
     out->tri = smp->tri;
     const bool ok = om__project(&c, OM_LIGHT_GRID, OM_LIGHT_GRID, &out->x, &out->y, z);
+    *z = (uint32_t)om__lspace_pull(ls, smp, *z);
     out->z = *z;
     return ok;
+}
+
+double om__lspace_pull(const om__lspace *ls, const om_sample *smp, double z)
+{
+    const double k = sample_slack(ls, smp, z);
+    return k < z ? z - k : 0.0;
 }
 
 bool om__lspace_point(const om__lspace *ls, const om_sample *smp, om__lpoint *out)

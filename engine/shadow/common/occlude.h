@@ -41,7 +41,14 @@
  * at the origin (the float vertex data itself is what loses precision there).
  * Each rounding term grows with 1/w, so the sample's own is at most the triangle's at
  * its nearest vertex whenever the triangle is nearer at all; the bound is therefore
- * twice the triangle's own (om__lspace_tri sets it per sub-triangle). A
+ * twice the triangle's own (om__lspace_tri sets it per sub-triangle).
+ * The sample's own facet: the lateral error moves the sample's grid point off the
+ * true point of its surface, and where that surface is steep on the grid (a facet
+ * almost edge-on to the light, at a convex solid's terminator) the surface next to it
+ * there, its neighbour, is nearer the light by that error times the facet's own slope,
+ * far more than the blocker's slope covers. The sample's depth is therefore pulled
+ * towards the light by its facet's slope (from its normal, occlude.c) times the same
+ * lateral error (om__lspace_point): a facet edge-on to the light is lit by a tie. A
  * blocker must be nearer than the sample by more than that: depths closer than the
  * grid and the float positions resolve are a tie, and a tie is lit. This is derived
  * from the grid and the number formats, not tuned. Laterally it is about ten grid
@@ -98,6 +105,12 @@ typedef struct om__lspace {
     double iw0, iw1, lat, dep;
     /* The same in float for om__blocks_f, and |iw0|, |iw1| for its error bound. */
     float iw0f, iw1f, latf, depf, iw0a, iw1a;
+    /* The sample's own facet (om__lspace_point): the light's view rows, and its depth
+     * slope on the grid per unit of the normal's view x and y over the plane's distance
+     * from the light (spot) or over the normal's view z (directional). */
+    om_vec3 row0, row1, row2;
+    float kx, ky;
+    bool spot;
 } om__lspace;
 
 /* Bytes of the per-frame vertex projection (om__lspace_init). */
@@ -115,8 +128,12 @@ void om__lspace_begin(om__lspace *ls, const om_view *v);
  * after the view). */
 void om__lspace_view(om__lspace *ls, const om_view *v);
 void om__lspace_project(const om__lspace *ls, uint32_t first, uint32_t end);
-/* Projects a sample; false when it is not in front of the light. */
+/* Projects a sample; false when it is not in front of the light. Its depth is pulled
+ * towards the light by its own facet's slack (occlude.c, sample_slack), as a whole
+ * number: what a blocker must be nearer than. */
 bool om__lspace_point(const om__lspace *ls, const om_sample *smp, om__lpoint *out);
+/* A sample's whole depth z pulled towards the light by its facet's slack. */
+double om__lspace_pull(const om__lspace *ls, const om_sample *smp, double z);
 /* The same, with the depth also as the whole number it is (*z == out->z). */
 bool om__lspace_point_z(const om__lspace *ls, const om_sample *smp, om__lpoint *out, uint32_t *z);
 

@@ -442,6 +442,7 @@ static uint32_t look_up(const hybrid_state *m, om_strip *st, size_t *i, size_t n
         p.y = gy[j];
         p.z = om__zdepth(cz[j], cw[j]);
         p.tri = tri[j];
+        p.z = om__lspace_pull(&m->ls, &st->samples[at[j]], p.z);   /* as om__lspace_point */
         const int a = classify_at(m, &p, tx[j], ty[j], &st->terms[at[j]], &tex);
         counts[a == 1 ? 0 : a == 2 ? 1 : 2]++;
         if (a == 0) om__hkey_put(&q[u++], &p, at[j]);
