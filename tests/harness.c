@@ -39,6 +39,75 @@ void h_scene_free(h_scene *hs)
     hs->mem = NULL;
 }
 
+static om_vec3 v3_scaled(om_vec3 v, float k)
+{
+    om_vec3 r = {v.x * k, v.y * k, v.z * k};
+    return r;
+}
+
+void h_scene_scale(om_scene *s, float k)
+{
+    for (uint32_t i = 0; i < s->nverts; i++) s->verts[i] = v3_scaled(s->verts[i], k);
+    s->lo = v3_scaled(s->lo, k);
+    s->hi = v3_scaled(s->hi, k);
+    for (uint32_t i = 0; i < s->nsolids; i++) {
+        s->solids[i].lo = v3_scaled(s->solids[i].lo, k);
+        s->solids[i].hi = v3_scaled(s->solids[i].hi, k);
+    }
+    om_camera *c = &s->camera;
+    c->eye = v3_scaled(c->eye, k);
+    c->target = v3_scaled(c->target, k);
+    c->znear *= k;
+    c->zfar *= k;
+    om_light *l = &s->light;
+    l->pos = v3_scaled(l->pos, k);   /* a directional light's dir keeps its direction */
+    l->target = v3_scaled(l->target, k);
+    l->znear *= k;
+    l->zfar *= k;
+    for (uint32_t i = 0; i < s->ncam_keys; i++) {
+        s->cam_keys[i].eye = v3_scaled(s->cam_keys[i].eye, k);
+        s->cam_keys[i].target = v3_scaled(s->cam_keys[i].target, k);
+    }
+    for (uint32_t i = 0; i < s->nlight_keys; i++) {
+        s->light_keys[i].pos = v3_scaled(s->light_keys[i].pos, k);
+        s->light_keys[i].target = v3_scaled(s->light_keys[i].target, k);
+    }
+}
+
+uint64_t h_scaled_mismatches(const char *text, float k, const char *name, const om_method_cfg *cfg,
+                             uint32_t w, uint32_t h)
+{
+    h_scene hs;
+    if (!h_scene_parse(&hs, text)) return UINT64_MAX;
+    h_scene_scale(&hs.s, k);
+    uint8_t *ref = malloc((size_t)w * h), *got = malloc((size_t)w * h);
+    uint64_t bad = UINT64_MAX;
+    if (ref && got && h_render(&hs.s, "ref", NULL, w, h, 0, 0, ref, NULL, NULL) == OM_OK &&
+        h_render(&hs.s, name, cfg, w, h, 0, 0, got, NULL, NULL) == OM_OK) {
+        om_metrics m;
+        om_compare_masks(ref, got, w, h, &m);
+        bad = m.false_lit + m.false_shadowed;
+    }
+    free(ref);
+    free(got);
+    h_scene_free(&hs);
+    return bad;
+}
+
+void h_check_scale_free(const char *name, uint32_t w, uint32_t h)
+{
+    const char *text = om_scene_default_text();
+    const uint64_t at1 = h_scaled_mismatches(text, 1.0f, name, NULL, w, h);
+    CHECK_MSG(at1 != UINT64_MAX, "%s: the scene at x1 did not render", name);
+    static const float scales[] = {0.001f, 1000.0f};
+    for (int i = 0; i < 2; i++) {
+        const uint64_t got = h_scaled_mismatches(text, scales[i], name, NULL, w, h);
+        CHECK_MSG(got != UINT64_MAX && got * 10 <= at1 * 11 && got * 10 >= at1 * 9,
+                  "%s: %llu samples disagree with ref at x%g, %llu at x1", name, (unsigned long long)got,
+                  (double)scales[i], (unsigned long long)at1);
+    }
+}
+
 om_status h_view(om_view *v, const om_scene *s, float t, uint32_t w, uint32_t h, om_diag *d)
 {
     om_camera cam;

@@ -21,6 +21,20 @@ extern const char h_cloud_bar[];
 /* The same with a loader for the scene's `mesh` files (NULL: none). */
 bool h_scene_parse_ld(h_scene *hs, const char *text, const om_loader *ld);
 void h_scene_free(h_scene *hs);
+/* Scales scene s about the origin by k, in place: its vertices, bounds, closed shapes'
+ * boxes, camera, light and paths, near and far included, so that it draws the same
+ * picture at another size. */
+void h_scene_scale(om_scene *s, float k);
+/* Method `name`'s samples that disagree with ref's (false lit + false shadowed) on
+ * the scene `text` scaled by k, w x h, at t 0, with `cfg` (NULL: the method's
+ * defaults): what a test of settings that must not depend on the scene's size compares
+ * across sizes. UINT64_MAX where the scene or a render fails. */
+uint64_t h_scaled_mismatches(const char *text, float k, const char *name, const om_method_cfg *cfg,
+                             uint32_t w, uint32_t h);
+/* Checks that method `name` at its defaults disagrees with ref on the default scene
+ * scaled by 0.001 and by 1000 within 10% as often as at its own size, w x h: its
+ * settings are in units that scale with the scene. */
+void h_check_scale_free(const char *name, uint32_t w, uint32_t h);
 
 /* Method `method`'s defaults with those settings of `list` ("map=256 asm.cap=1048576")
  * that it takes, so that one list serves a test that loops over the methods. A value

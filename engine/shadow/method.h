@@ -209,8 +209,8 @@ om_status om__method_cfg_of(const om_method_cfg *c, const om_method *m, void *ou
 #define OM__SET_MAP(T) \
     OM__SETTING(T, map_size, "map", OM_SETTING_U32, 1, OM_MAX_DIM, 2048, "shadow-map side in texels")
 #define OM__SET_BIAS(T) \
-    OM__SETTING(T, bias_const, "bias", OM_SETTING_F32, 0, 1e6, 0.01, \
-                "constant bias, world units along the light ray (0.01: 1 cm)")
+    OM__SETTING(T, bias_const, "bias", OM_SETTING_F32, 0, 1, 6e-5, \
+                "constant bias along the light ray, a fraction of the light's depth range (far - near)")
 #define OM__SET_SLOPE(T) \
     OM__SETTING(T, bias_slope, "slope", OM_SETTING_F32, 0, 1e3, 1.5, \
                 "slope-scaled bias in texels: a plane's depth across that many texels")

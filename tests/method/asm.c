@@ -533,7 +533,7 @@ static void float_bounds_hold(void)
         om__asm_cfg c;
         memset(&c, 0, sizeof c);
         c.asm_cap = 16u << 20;
-        c.bias_const = 0.01f;
+        c.bias_const = 2.5e-4f;   /* of the light's depth range: 1 cm for the spot */
         c.bias_slope = 1.5f;
         c.asm_tile = 64;
         c.asm_cells = 8;
@@ -878,8 +878,13 @@ static void asm_jobs_tree(void)
     h_scene_free(&hs);
 }
 
+/* The default scene drawn a thousand times smaller or larger keeps its shadows: the
+ * settings' units scale with the scene. */
+static void asm_bias_is_scale_free(void) { h_check_scale_free("asm", 320, 240); }
+
 void suite_asm(void)
 {
+    RUN(asm_bias_is_scale_free);
     RUN(tree_layout);
     RUN(tree_rules);
     RUN(tree_candidates_order);

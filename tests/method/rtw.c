@@ -826,8 +826,13 @@ static void float_lookup_is_smlookups(void)
     }
 }
 
+/* The default scene drawn a thousand times smaller or larger keeps its shadows: the
+ * settings' units scale with the scene. */
+static void rtw_bias_is_scale_free(void) { h_check_scale_free("rtw", 320, 240); }
+
 void suite_rtw(void)
 {
+    RUN(rtw_bias_is_scale_free);
     RUN(uniform_is_identity);
     RUN(warps_monotonic_with_fixed_ends);
     RUN(important_cell_gets_more);

@@ -64,8 +64,13 @@ static void budgets_name_the_minimum(void)
     h_scene_free(&hs);
 }
 
+/* The default scene drawn a thousand times smaller or larger keeps its shadows: the
+ * settings' units scale with the scene. */
+static void sm_bias_is_scale_free(void) { h_check_scale_free("sm", 320, 240); }
+
 void suite_sm(void)
 {
+    RUN(sm_bias_is_scale_free);
     RUN(sm_improves_with_resolution);
     RUN(budgets_name_the_minimum);
 }

@@ -838,8 +838,13 @@ static void build_plane_is_the_double_one(void)
     CHECK(near_sure > 0 && near_sure < near_tris);
 }
 
+/* The default scene drawn a thousand times smaller or larger keeps its shadows: the
+ * settings' units scale with the scene. */
+static void spsm_bias_is_scale_free(void) { h_check_scale_free("spsm", 320, 240); }
+
 void suite_spsm(void)
 {
+    RUN(spsm_bias_is_scale_free);
     RUN(conservative_is_exact_overlap);
     RUN(o16_round_trips);
     RUN(texel_packs_and_unpacks);

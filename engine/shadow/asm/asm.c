@@ -36,9 +36,10 @@
  * base answers: one tile over the whole frustum, coarse but never absent, so every
  * cap from the smallest (the base and one tile) renders.
  *
- * Bias: the constant and slope-scaled bias of the conventional map (cfg bias_const,
- * bias_slope in texels of the node the sample is tested in); the paper notes the ID
- * test does not remove the bias problem. pcf and normal_offset do not apply. */
+ * Bias: the constant and slope-scaled bias of the conventional map (cfg bias_const a
+ * fraction of the light's depth range, bias_slope in texels of the node the sample is
+ * tested in); the paper notes the ID test does not remove the bias problem. pcf and
+ * normal_offset do not apply. */
 #include "../method.h"
 #include "asm.h"
 

@@ -33,8 +33,9 @@
 /* What asm's settings (asm.c) set. */
 typedef struct om__asm_cfg {
     uint64_t asm_cap;      /* bytes the node structure may hold, at most */
-    float bias_const;      /* the conventional map's bias (sm.c), in the node's texels */
-    float bias_slope;
+    float bias_const;      /* the conventional map's bias (smlookup.h): a fraction of
+                            * the light's depth range */
+    float bias_slope;      /* ... and its slope-scaled bias, in the node's texels */
     uint32_t asm_tile;     /* texels per side of every node's tile */
     uint32_t asm_cells;    /* cells per side of a node; a cell may hold a child node */
     uint32_t asm_root;     /* texels per side of the root's view of the light frustum */
@@ -171,7 +172,8 @@ uint64_t om__asm_cand_max(const om__asm_layout *l);
 typedef struct om__asm_pctx {
     const om_view *view;
     double R;              /* the base's texels per side (asm.tile) */
-    float bias_const, bias_slope;
+    float bias_const;      /* world units along the light ray: cfg's times far - near */
+    float bias_slope;
     float span_per_dist;   /* spot: frustum width per unit of distance */
     float pix_per_dist;    /* eye: pixel height per unit of distance */
     float dir_texel, dir_dz;   /* directional: texel and depth scale, in float */

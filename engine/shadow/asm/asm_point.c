@@ -38,7 +38,7 @@ void om__asm_pctx_begin(om__asm_pctx *c, const om__asm_layout *l, const om__asm_
     memset(c, 0, sizeof *c);
     c->view = v;
     c->R = l->tile;
-    c->bias_const = cfg->bias_const;
+    c->bias_const = cfg->bias_const * (v->light.zfar - v->light.znear);   /* world units */
     c->bias_slope = cfg->bias_slope;
     c->span_per_dist = 2.0f * (float)om__tan((double)v->light.fov_deg * OM_PI / 360.0);
     c->pix_per_dist = 2.0f * (float)om__tan((double)v->cam.fovy_deg * OM_PI / 360.0) / (float)v->cam.height;

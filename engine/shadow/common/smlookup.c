@@ -2,11 +2,13 @@
  * that the RTW map uses the very same rules; for the conventional map (warp_x == NULL)
  * every operation is the one sm.c always did, so its frames are unchanged.
  *
- * The bias is given in world units along the light ray and converted to depth units at
+ * The bias is made in world units along the light ray and converted to depth units at
  * the sample:
- *     bias = bias_const + bias_slope * texel * tan(angle between normal and light)
- * (texel = the world size of one texel at the sample; tan clamped at 10), so the slope
- * term is in texels. k x k PCF averages the binary tests; a sample is lit only when
+ *     bias = bias_const * (far - near) + bias_slope * texel * tan(angle between normal and light)
+ * (far - near: the light's depth range, a directional light's the scene's extent
+ * along it; texel = the world size of one texel at the sample; tan clamped at 10), so
+ * the constant term is a fraction of the range and the slope term is in texels: both
+ * scale with the scene. k x k PCF averages the binary tests; a sample is lit only when
  * every tap is. */
 #include "smlookup.h"
 
@@ -17,6 +19,7 @@ void om__smlook_begin(om__smlook *L, const om_view *v)
     L->dz_num = v->light.zfar * v->light.znear;   /* the same roundings as per sample */
     L->dz_den = v->light.zfar - v->light.znear;
     L->half_near = v->light.znear * 0.5f;
+    L->bias_world = L->bias_const * L->dz_den;   /* a fraction of the depth range */
 }
 
 /* World size of one (unwarped) texel at distance `dist` along the light's axis. */
@@ -101,7 +104,7 @@ static bool locate(const om__smlook *L, const om_sample *smp, tap *out)
     }
     float cosang = smp->nl;   /* n . l, kept by the exposure marks (om__exposed) */
     float tanang = cosang > 0.0995f ? om__sqrtf(1.0f - cosang * cosang) / cosang : 10.0f;
-    float bias = L->bias_const + L->bias_slope * texel * tanang;
+    float bias = L->bias_world + L->bias_slope * texel * tanang;
     om_vec4 q;
     if (L->warp_x && L->normal_offset == 0.0f) {
         q = q0;   /* the point did not move: its projection and warp are done */
@@ -210,7 +213,7 @@ typedef struct plain {
     om_vec3 lpos, axis;
     bool spot;
     uint32_t size;
-    float fsize, half, span_per_dist, half_near, dz_num, dz_den, bias_const, bias_slope;
+    float fsize, half, span_per_dist, half_near, dz_num, dz_den, bias_world, bias_slope;
     float texel_dir, dz_dir;   /* a directional light's: as texel_world and locate make them */
 } plain;
 
@@ -227,7 +230,7 @@ OM_INLINE bool plain_locate(const plain *P, const bool spot, const om_sample *sm
     }
     const float cosang = smp->nl;
     const float tanang = cosang > 0.0995f ? om__sqrtf(1.0f - cosang * cosang) / cosang : 10.0f;
-    const float bias = P->bias_const + P->bias_slope * texel * tanang;
+    const float bias = P->bias_world + P->bias_slope * texel * tanang;
     const om_vec4 q = om__mat_apply(&P->vp, p);
     if (!(q.w > 0.0f)) return false;
     const float iw = 1.0f / q.w;
@@ -285,7 +288,7 @@ static void strip_plain(const om__smlook *L, om_strip *st, uint32_t *samples, ui
     P.half_near = L->half_near;
     P.dz_num = L->dz_num;
     P.dz_den = L->dz_den;
-    P.bias_const = L->bias_const;
+    P.bias_world = L->bias_world;
     P.bias_slope = L->bias_slope;
     P.texel_dir = P.spot ? 0.0f : 2.0f / om__fabsf(v->light_proj.m[0]) / P.fsize;
     P.dz_dir = P.spot ? 0.0f : OM_DEPTH_ONE_F * om__fabsf(v->light_proj.m[10]);

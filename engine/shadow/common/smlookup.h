@@ -1,6 +1,8 @@
 /* smlookup.h — the biased depth test of a shadow map, shared by the conventional map
- * (sm.c) and the warped one (rtw.c). It owns the bias rules: constant bias in world
- * units along the light ray, slope-scaled bias and normal offset in texels, k x k PCF.
+ * (sm.c) and the warped one (rtw.c). It owns the bias rules: constant bias as a
+ * fraction of the light's depth range, slope-scaled bias and normal offset in texels,
+ * k x k PCF: units that scale with the scene, so one setting serves a scene drawn in
+ * millimetres or in kilometres.
  *
  * A map is a size x size uint32 depth image in the rasterizer's depth format (z/w *
  * 2^32, sampled at texel centres) over the light's image plane. A warped map (RTW) adds
@@ -37,8 +39,11 @@ typedef struct om__smlook {
     const om_view *view;
     const uint32_t *depth;     /* size * size, row 0 at the top (v = 0) */
     uint32_t size;
-    float bias_const, bias_slope, normal_offset;
+    float bias_const;          /* fraction of the light's depth range (far - near) */
+    float bias_slope, normal_offset;   /* texels */
     uint32_t pcf;              /* k for k x k, 1 = a single tap */
+    float bias_world;          /* this frame's constant bias, world units along the
+                                * light ray: bias_const (far - near) */
     float span_per_dist;       /* spot: frustum width per unit of distance */
     float dz_num, dz_den, half_near;   /* spot: far * near, far - near, near / 2 */
     /* A warped map's tables (n + 1 entries each), NULL for the conventional map: u
@@ -51,7 +56,7 @@ typedef struct om__smlook {
     bool unwarped_pcf;
 } om__smlook;
 
-/* Fills the frame-dependent part (view, span) for this frame's light. */
+/* Fills the frame-dependent part (view, span, bias_world) for this frame's light. */
 void om__smlook_begin(om__smlook *L, const om_view *v);
 /* The terms of a strip. Each exposed sample's is 255 lit, 0 shadowed, between for
  * partial PCF (never 255 unless every tap is lit); 255 where the sample is not exposed

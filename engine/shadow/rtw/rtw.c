@@ -654,7 +654,7 @@ static int locate_f(const om__rtw *m, const om_view *v, const om_sample *smp, ui
     if (texel < 0.0f) return -1;
     const float cosang = smp->nl;
     const float tanang = cosang > 0.0995f ? om__sqrtf(1.0f - cosang * cosang) / cosang : 10.0f;
-    const float bias = L->bias_const + L->bias_slope * texel * tanang;
+    const float bias = L->bias_world + L->bias_slope * texel * tanang;
     const float z = q.z * iw * OM_DEPTH_ONE_F;
     float dz;
     if (spot) {

@@ -291,12 +291,13 @@ static bool in_camera(const om_view *v, om_vec3 p)
            q.z <= q.w;
 }
 
-/* The shadow bias in depth units at light depth d (0..2^32): the threshold of a depth
+/* The shadow bias's constant term (the lookup's, smlookup.h: a fraction of the light's
+ * depth range) in depth units at light depth d (0..2^32): the threshold of a depth
  * discontinuity (section 5.3 compares texel differences with the shadow bias). */
 static double bias_depth(const om__rtw *m, double d)
 {
     const om_view *v = &m->view;
-    double b = (double)m->cfg.bias_const;
+    double b = (double)m->look.bias_world;
     if (v->light.kind != OM_LIGHT_SPOT) return b * OM_DEPTH_ONE * fabs((double)v->light_proj.m[10]) + 1.0;
     double f = v->light.zfar, nn = v->light.znear, zn = d / OM_DEPTH_ONE;
     double dist = f * nn / (f - zn * (f - nn));
