@@ -60,8 +60,11 @@ static void light_box(const om_view *v, const om_scene *s, om_vec3 *lo, om_vec3 
 
 static void ortho_from(om_view *v, float x0, float x1, float y0, float y1, float zn, float zf)
 {
-    /* A little margin keeps samples on the box's faces strictly inside. */
-    float mx = (x1 - x0) * 1e-3f + 1e-4f, my = (y1 - y0) * 1e-3f + 1e-4f;
+    /* A little margin keeps samples on the box's faces strictly inside: a share of the
+     * box and of its coordinates (their rounding), so the same at any scale; the last
+     * term only keeps a box of no extent open. */
+    float mx = (x1 - x0) * 1e-3f + (om__fabsf(x0) + om__fabsf(x1)) * 1e-6f + 1e-30f;
+    float my = (y1 - y0) * 1e-3f + (om__fabsf(y0) + om__fabsf(y1)) * 1e-6f + 1e-30f;
     v->light_proj = om__mat_ortho(x0 - mx, x1 + mx, y0 - my, y1 + my, zn, zf);
     v->light_vp = om__mat_mul(&v->light_proj, &v->light_view);
 }
@@ -122,13 +125,15 @@ om_status om_view_init(om_view *v, const om_camera *cam, const om_light *light,
     /* Stand the light outside the scene's bounding sphere, looking along dir at its
      * centre (the origin). */
     const om_vec3 c = om__v3(0, 0, 0), h = om__sub(s->hi, v->origin);
-    float r = om__sqrtf(om__dot(h, h)) + 1.0f;
-    om__mat_look_at(&v->light_view, om__sub(c, om__scale(dir, 2.0f * r)), c, om__v3(0, 1, 0));
+    const float r = om__sqrtf(om__dot(h, h)) * 1.001f;   /* at any scale */
+    /* a scene of no extent (or none at all) has its light a unit away */
+    if (!(r > 1e-30f) || !om__mat_look_at(&v->light_view, om__sub(c, om__scale(dir, 2.0f * r)), c, om__v3(0, 1, 0)))
+        om__mat_look_at(&v->light_view, om__sub(c, dir), c, om__v3(0, 1, 0));
     om_vec3 lo, hi;
     light_box(v, s, &lo, &hi);
     v->light.znear = -hi.z;
     v->light.zfar = -lo.z;
-    ortho_from(v, lo.x, hi.x, lo.y, hi.y, -hi.z * 0.999f, -lo.z * 1.001f + 1e-3f);
+    ortho_from(v, lo.x, hi.x, lo.y, hi.y, -hi.z * 0.999f, -lo.z * 1.001f);
     return OM_OK;
 }
 
@@ -137,5 +142,5 @@ void om_view_fit_light(om_view *v, const om_scene *s, om_vec3 lo, om_vec3 hi)
     if (!v || !s || v->light.kind != OM_LIGHT_DIRECTIONAL || !(lo.x <= hi.x && lo.y <= hi.y)) return;
     om_vec3 slo, shi;
     light_box(v, s, &slo, &shi);
-    ortho_from(v, lo.x, hi.x, lo.y, hi.y, -shi.z * 0.999f, -slo.z * 1.001f + 1e-3f);
+    ortho_from(v, lo.x, hi.x, lo.y, hi.y, -shi.z * 0.999f, -slo.z * 1.001f);
 }
