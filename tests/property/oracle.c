@@ -71,7 +71,10 @@ static bool seg_hits(const om_scene *s, uint32_t t, dv o, dv d, double eps, doub
 #define G 96
 typedef struct oracle {
     const om_scene *s;
-    om_view v;
+    om_view v;             /* for the light's projection only (its grid step) */
+    om_camera cam;         /* the scene's camera and light at time 0, in world space, */
+    om_light lt;           /* as the scene gives them: not the view's copies */
+    dv origin;             /* where the samples' points are relative to (smp_world) */
     bool spot;
     dv light, toward, ax, ay, az;   /* toward: unit direction to a directional light */
     double reach, step_k;           /* directional segment length; grid step per depth */
@@ -125,12 +128,18 @@ static void oracle_init(oracle *o, const om_scene *s, uint32_t w, uint32_t h)
     memset(o, 0, sizeof *o);
     o->s = s;
     CHECK_OK(h_view(&o->v, s, 0, w, h, &d));
-    o->spot = o->v.light.kind == OM_LIGHT_SPOT;
-    o->az = dnorm(fv(o->v.light_axis));
+    om_scene_at(s, 0.0f, &o->cam, &o->lt);
+    o->cam.width = w;
+    o->cam.height = h;
+    /* om_sample.p is in world space; where the frame makes it relative to an origin,
+     * this is that origin (the view's) */
+    o->origin = (dv){0, 0, 0};
+    o->spot = o->lt.kind == OM_LIGHT_SPOT;
+    o->light = fv(o->lt.pos);
+    o->az = dnorm(o->spot ? dsub(fv(o->lt.target), o->light) : fv(o->lt.dir));
     dv up = fabs(o->az.y) < 0.9 ? (dv){0, 1, 0} : (dv){1, 0, 0};
     o->ax = dnorm(dcross(o->az, up));
     o->ay = dcross(o->ax, o->az);
-    o->light = fv(o->v.light.pos);
     o->toward = dscale(o->az, -1.0);
     dv ext = dsub(fv(s->hi), fv(s->lo));
     o->reach = 2.0 * (fabs(ext.x) + fabs(ext.y) + fabs(ext.z)) + 1.0;
@@ -181,6 +190,13 @@ static void oracle_free(oracle *o)
     free(o->always);
 }
 
+/* A sample's point in world space, in double: the one place that reads om_sample.p. */
+static dv smp_world(const oracle *o, const om_sample *smp)
+{
+    dv p = {smp->p[0], smp->p[1], smp->p[2]};
+    return dadd(o->origin, p);
+}
+
 /* The oracle: does anything but triangle `own` lie on the segment from p to the light? */
 static bool oracle_blocked(const oracle *o, dv p, uint32_t own)
 {
@@ -217,7 +233,7 @@ static bool oracle_tie(const oracle *o, dv p, uint32_t own, bool was)
 /* The triangle the exact ray through pixel (x, y) meets first (OM_NO_TRI: none). */
 static uint32_t eye_hit(const oracle *o, uint32_t x, uint32_t y)
 {
-    const om_camera *c = &o->v.cam;
+    const om_camera *c = &o->cam;
     dv eye = fv(c->eye), f = dnorm(dsub(fv(c->target), eye));
     dv r = dnorm(dcross(f, fv(c->up))), u = dcross(r, f);
     double ty = tan((double)c->fovy_deg * 3.14159265358979323846 / 360.0);
@@ -253,7 +269,7 @@ static tally against_oracle(const om_scene *s, const char *what, uint32_t w, uin
         n.covered++;
         if (!(terms[i].flags & OM_TERM_EXPOSED)) continue;
         n.exposed++;
-        dv p = {smp[i].p[0], smp[i].p[1], smp[i].p[2]};
+        dv p = smp_world(&o, &smp[i]);
         bool ob = oracle_blocked(&o, p, smp[i].tri);
         bool rb = !om_term_lit(&terms[i]);
         if (ob == rb) continue;
