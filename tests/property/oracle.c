@@ -208,23 +208,39 @@ static dv smp_world(const oracle *o, const om_sample *smp)
 }
 
 /* The oracle: does anything but triangle `own` lie on the segment from p to the light? */
-static bool oracle_blocked(const oracle *o, dv p, uint32_t own)
+/* With `gap`, every triangle is tried and *gap is the distance from p to the nearest
+ * blocker (INFINITY: none). */
+static bool oracle_blocked_gap(const oracle *o, dv p, uint32_t own, double *gap)
 {
     dv d = o->spot ? dsub(o->light, p) : dscale(o->toward, o->reach);
     /* four half-units in the last place of p's largest coordinate: p's own rounding to
      * float and that of the vertices of the surface it lies on */
     double big = fabs(p.x) > fabs(p.y) ? fabs(p.x) : fabs(p.y);
     double eps = (fabs(p.z) > big ? fabs(p.z) : big) * (4.0 / 16777216.0);
+    double near = INFINITY, t;
+    bool hit = false;
+    if (gap) *gap = INFINITY;
     for (uint32_t i = 0; i < o->nalways; i++)
-        if (o->always[i] != own && seg_hits(o->s, o->always[i], p, d, eps, NULL)) return true;
+        if (o->always[i] != own && seg_hits(o->s, o->always[i], p, d, eps, &t)) {
+            if (!gap) return true;
+            hit = true;
+            if (t < near) near = t;
+        }
     double xy[2];
-    if (!light_xy(o, p, xy)) return false;
-    if (xy[0] < o->lo[0] || xy[0] > o->hi[0] || xy[1] < o->lo[1] || xy[1] > o->hi[1]) return false;
-    int c = cell(o, xy[1], 1) * G + cell(o, xy[0], 0);
-    for (uint32_t i = o->start[c]; i < o->start[c + 1]; i++)
-        if (o->list[i] != own && seg_hits(o->s, o->list[i], p, d, eps, NULL)) return true;
-    return false;
+    if (light_xy(o, p, xy) && !(xy[0] < o->lo[0] || xy[0] > o->hi[0] || xy[1] < o->lo[1] || xy[1] > o->hi[1])) {
+        int c = cell(o, xy[1], 1) * G + cell(o, xy[0], 0);
+        for (uint32_t i = o->start[c]; i < o->start[c + 1]; i++)
+            if (o->list[i] != own && seg_hits(o->s, o->list[i], p, d, eps, &t)) {
+                if (!gap) return true;
+                hit = true;
+                if (t < near) near = t;
+            }
+    }
+    if (gap && hit) *gap = near * sqrt(ddot(d, d));
+    return hit;
 }
+
+static bool oracle_blocked(const oracle *o, dv p, uint32_t own) { return oracle_blocked_gap(o, p, own, NULL); }
 
 /* Does the oracle change its answer when p moves by TIE_STEPS grid steps? */
 static bool oracle_tie(const oracle *o, dv p, uint32_t own, bool was)
@@ -276,7 +292,7 @@ static uint32_t eye_hit(const oracle *o, uint32_t x, uint32_t y)
     return best;
 }
 
-typedef struct tally { uint32_t covered, exposed, differ, eye, tie, other; } tally;
+typedef struct tally { uint32_t covered, exposed, differ, eye, tie, other, other_lit; } tally;
 
 /* Renders `ref` at w x h and holds every exposed sample against the oracle. */
 static tally against_oracle(const om_scene *s, const char *what, uint32_t w, uint32_t h)
@@ -302,13 +318,19 @@ static tally against_oracle(const om_scene *s, const char *what, uint32_t w, uin
         else if (oracle_tie(&o, p, smp[i].tri, ob)) n.tie++;
         else {
             n.other++;
-            if (n.other <= 5)
-                fprintf(stderr, "  %s: pixel (%u,%u) tri %u: ref %s, oracle %s\n", what, i % w, i / w,
-                        smp[i].tri, rb ? "shadowed" : "lit", ob ? "shadowed" : "lit");
+            n.other_lit += !rb;
+            if (n.other <= 5) {
+                double gap;
+                oracle_blocked_gap(&o, p, smp[i].tri, &gap);
+                fprintf(stderr, "  %s: pixel (%u,%u) tri %u: ref %s, oracle %s (nearest blocker %.3g away)\n",
+                        what, i % w, i / w, smp[i].tri, rb ? "shadowed" : "lit", ob ? "shadowed" : "lit", gap);
+            }
         }
     }
-    printf("  oracle %-16s %ux%u: %u covered, %u exposed; %u disagree (%u eye pass, %u ties, %u other)\n",
+    printf("  oracle %-16s %ux%u: %u covered, %u exposed; %u disagree (%u eye pass, %u ties, %u other",
            what, w, h, n.covered, n.exposed, n.differ, n.eye, n.tie, n.other);
+    if (n.other) printf(": %u lit by ref", n.other_lit);
+    printf(")\n");
     CHECK_MSG(n.other == 0, "%s: %u disagreements the oracle cannot explain", what, n.other);
     /* at least 99.995% agree */
     CHECK_MSG((double)n.differ <= 5e-5 * n.covered, "%s: %u of %u covered samples disagree", what,
@@ -699,7 +721,11 @@ static tally oracle_moved(const char *text, const om_loader *ld, const char *wha
 static const double offsets[] = {1e2, 1e3, 3e3, 1e4, 1e5};
 #define NOFFSETS (sizeof offsets / sizeof offsets[0])
 
-/* The default scene and the deformed sphere on its floor, moved by (d, d, d). */
+/* The default scene and the deformed sphere on its floor, moved by (d, d, d). Where
+ * the engine's snapping bound grows with the coordinates' size, ref lights samples
+ * the oracle finds shadowed by a blocker a few hundredths of a unit away (1e3) to a
+ * few units (1e5); those are "other". As in oracle_scaled, the quick mode leaves the
+ * deformed sphere out. */
 static void oracle_far(void)
 {
     if (!large_world("oracle_far")) return;
@@ -707,7 +733,7 @@ static void oracle_far(void)
     om_loader ld = {blob_load, &b};
     for (size_t i = 0; i < NOFFSETS; i++) {
         oracle_moved(om_scene_default_text(), NULL, "default", 1.0, offsets[i], 320, 240);
-        oracle_moved(blob_scene, &ld, "deformed sphere", 1.0, offsets[i], 320, 240);
+        if (!quick()) oracle_moved(blob_scene, &ld, "deformed sphere", 1.0, offsets[i], 320, 240);
     }
     free(b.text);
 }
