@@ -1005,17 +1005,17 @@ static ptally sample_points(const char *text, const om_loader *ld, const char *w
         double slack = big * (16.0 / 16777216.0), out_px = pix > 0.0 ? out / pix : INFINITY;
         bool far_ray = !(ray <= 1.0 / 256.0), off_tri = !(out <= slack);
         if (!(ray <= n.ray_px)) n.ray_px = ray;
-        if (off_tri && !(out_px <= n.out_px)) n.out_px = out_px;
-        if (off_tri && !(out <= n.out)) n.out = out;
+        if (!(out_px <= n.out_px)) n.out_px = out_px;
+        if (!(out <= n.out)) n.out = out;
         n.off_ray += far_ray;
         n.outside += off_tri;
         if ((far_ray || off_tri) && n.off_ray + n.outside <= 3)
             fprintf(stderr, "  %s: pixel (%u,%u) tri %u: %.5f px off its ray, %.3g px outside its triangle "
                     "(rounding %.3g px)\n", what, i % w, i / w, t, ray, out_px, slack / pix);
     }
-    printf("  points %-22s %ux%u: %u covered; off the ray by up to %.5f px, %u beyond 1/256; %u outside "
-           "their triangle, by up to %.3g px (%.3g units)\n", what, w, h, n.covered, n.ray_px, n.off_ray,
-           n.outside, n.out_px, n.out);
+    printf("  points %-22s %ux%u: %u covered; off the ray by up to %.5f px, %u beyond 1/256; outside their "
+           "triangle by up to %.3g px (%.3g units), %u beyond rounding\n", what, w, h, n.covered, n.ray_px,
+           n.off_ray, n.out_px, n.out, n.outside);
     CHECK_MSG(n.off_ray == 0, "%s: %u of %u points more than 1/256 px off their pixel's ray (up to %.5f px)",
               what, n.off_ray, n.covered, n.ray_px);
     CHECK_MSG(n.outside == 0, "%s: %u of %u points outside their own triangle (up to %.3g px, %.3g units)",
