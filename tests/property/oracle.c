@@ -207,8 +207,8 @@ static dv smp_world(const oracle *o, const om_sample *smp)
     return dadd(o->origin, p);
 }
 
-/* The oracle: does anything but triangle `own` lie on the segment from p to the light? */
-/* With `gap`, every triangle is tried and *gap is the distance from p to the nearest
+/* The oracle: does anything but triangle `own` lie on the segment from p to the light?
+ * With `gap`, every triangle is tried and *gap is the distance from p to the nearest
  * blocker (INFINITY: none). */
 static bool oracle_blocked_gap(const oracle *o, dv p, uint32_t own, double *gap)
 {
@@ -256,7 +256,6 @@ static bool oracle_tie(const oracle *o, dv p, uint32_t own, bool was)
     return false;
 }
 
-/* The triangle the exact ray through pixel (x, y) meets first (OM_NO_TRI: none). */
 /* The ray through the centre of pixel (x, y) from the camera's eye: its direction d
  * (unnormalised: a unit step along the view axis f), f, and one pixel's size per unit
  * of depth along f. */
@@ -277,6 +276,7 @@ static pray pixel_ray(const oracle *o, uint32_t x, uint32_t y)
     return r;
 }
 
+/* The triangle the exact ray through pixel (x, y) meets first (OM_NO_TRI: none). */
 static uint32_t eye_hit(const oracle *o, uint32_t x, uint32_t y)
 {
     pray r = pixel_ray(o, x, y);
