@@ -242,7 +242,8 @@ void om_view_fit_light(om_view *v, const om_scene *s, om_vec3 lo, om_vec3 hi);
 /* ---------------------------------------------------------------- samples */
 
 /* One visible sample per pixel: the exact point of the nearest triangle under the
- * pixel centre (relative to the view's origin, om_view: its world position is
+ * pixel centre (within 1/256 px of the centre's ray and on the triangle, edges
+ * included; relative to the view's origin, om_view: its world position is
  * origin + p), its geometric normal (unit, as wound; not turned to the camera) and
  * the triangle. tri == OM_NO_TRI is background. `nl` is the cosine between the normal
  * turned to the camera and the direction to the light, which the frame sets with the

@@ -1,12 +1,16 @@
 /* eye.c — the eye pass: rasterize the scene from the camera (depth + triangle id),
- * then give every covered pixel its visible point. The point comes from
- * perspective-correct barycentrics of the pixel centre in homogeneous clip space
- * (no division by w, so triangles crossing the camera plane are handled), applied as
- * v0 + w1 (v1 - v0) + w2 (v2 - v0): an error in the weights moves the point within the
- * triangle's plane, not off it, whatever the depth buffer's precision. All in float:
- * per pixel it is a handful of single-precision operations, which a Cortex-M4F does in
- * hardware (double there is a software routine per operation); off the plane the
- * point is within a few float roundings of its coordinates (occlude.h counts them).
+ * then give every covered pixel its visible point. The point comes from the
+ * perspective-correct weights of the pixel centre's ray on its triangle (eye_finish:
+ * from the camera's ray and the triangle's edges, no division by w, so triangles
+ * crossing the camera plane are handled), applied as v0 + w1 (v1 - v0) + w2 (v2 - v0):
+ * an error in the weights moves the point within the triangle's plane, not off it,
+ * whatever the depth buffer's precision. A centre that the rasterizer's snapped edges
+ * gave a triangle though it lies just outside it gets the triangle's point nearest it
+ * on the image (eye_clamp): every point is on its triangle and within 1/256 px of its
+ * centre's ray. All in float: per pixel it is a handful of single-precision
+ * operations, which a Cortex-M4F does in hardware (double there is a software routine
+ * per operation); off the plane the point is within a few float roundings of its
+ * coordinates (occlude.h counts them).
  * The pixels are taken a run of one triangle at a time, and where the frame asks for
  * it (om__eye_pass_mark) each pixel's exposure marks are made in the same loop; where
  * a triangle is, with room to spare, wholly inside the light's frustum and seen from
@@ -111,6 +115,66 @@ static void tri_verts(const om_scene *s, om_vec3 o, uint32_t t, om_vec3 v[3])
     for (int k = 0; k < 3; k++) v[k] = om__sub(s->verts[ix[k]], o);
 }
 
+/* The eye pass's setup of the triangle whose vertices (relative to the view's
+ * origin) are in c->v: the same weights as persp_finish's, from the camera's ray
+ * instead of clip space. The ray through NDC (sx, sy) runs from the eye e along
+ * d = F + sx/p0 R + sy/p5 U (R, U, F: the camera's right, up and forward, p0, p5 its
+ * projection's scales, the inverse of cam_vp); it meets the triangle's plane where
+ * (Moller-Trumbore, with e1, e2 its edges from v0 and s = e - v0)
+ *   det = d . (e2 x e1),  w1 det = d . (e2 x s),  w2 det = d . (s x e1),
+ * three linear functions of (sx, sy) whose coefficients are set up here (om__persp_tri's
+ * rows: the denominator's first, made whole rather than summed per pixel, which cancels
+ * where a pixel lies beyond a sliver's edge). Clip space would take them as 2x2 minors of the vertices'
+ * projected coordinates, which cancel for a small triangle far away (the minors'
+ * terms grow with the square of the distance, their value with the square of the
+ * size); here every product is of the edges, exact differences of nearby floats, and
+ * the eye's offset, so the weights keep their precision at any size and distance. */
+static void eye_finish(const om_view *v, om__persp_tri *c)
+{
+    /* The vertices turned (winding kept) so that v0 faces the longest edge: its edges
+     * then meet at the triangle's largest angle, 60 degrees or more, and their cross
+     * product keeps its precision for a needle of a triangle, whose two long edges are
+     * almost parallel (the weights' common denominator would carry their cancellation
+     * along the needle's length). */
+    const float l0 = om__dot(om__sub(c->v[2], c->v[1]), om__sub(c->v[2], c->v[1]));
+    const float l1 = om__dot(om__sub(c->v[0], c->v[2]), om__sub(c->v[0], c->v[2]));
+    const float l2 = om__dot(om__sub(c->v[1], c->v[0]), om__sub(c->v[1], c->v[0]));
+    if (l1 > l0 && l1 >= l2) {
+        const om_vec3 t = c->v[0];
+        c->v[0] = c->v[1];
+        c->v[1] = c->v[2];
+        c->v[2] = t;
+    } else if (l2 > l0 && l2 > l1) {
+        const om_vec3 t = c->v[2];
+        c->v[2] = c->v[1];
+        c->v[1] = c->v[0];
+        c->v[0] = t;
+    }
+    const float *m = v->cam_view.m;
+    const om_vec3 R = om__v3(m[0], m[1], m[2]), U = om__v3(m[4], m[5], m[6]), F = om__v3(-m[8], -m[9], -m[10]);
+    const float kx = 1.0f / v->cam_proj.m[0], ky = 1.0f / v->cam_proj.m[5];
+    c->d1 = om__sub(c->v[1], c->v[0]);
+    c->d2 = om__sub(c->v[2], c->v[0]);
+    const om_vec3 s = om__sub(v->cam.eye, c->v[0]);
+    const om_vec3 g = om__cross(c->d2, c->d1), h = om__cross(c->d2, s), q = om__cross(s, c->d1);
+    const float det[3] = {kx * om__dot(g, R), ky * om__dot(g, U), om__dot(g, F)};
+    const float b1[3] = {kx * om__dot(h, R), ky * om__dot(h, U), om__dot(h, F)};
+    const float b2[3] = {kx * om__dot(q, R), ky * om__dot(q, U), om__dot(q, F)};
+    for (int k = 0; k < 3; k++) {
+        c->adj[k] = det[k];
+        c->adj[3 + k] = b1[k];
+        c->adj[6 + k] = b2[k];
+    }
+    c->n = om__normalize(om__cross(c->d1, c->d2));
+}
+
+void om__eye_setup(const om_scene *s, const om_view *v, uint32_t t, om__persp_tri *c)
+{
+    c->tri = t;
+    tri_verts(s, v->origin, t, c->v);
+    eye_finish(v, c);
+}
+
 /* The setup of the triangle whose vertices are in c->v (the clip-space vertices are
  * om__clip_tri's, made from those copies). */
 static void persp_finish(const om_mat4 *vp, om__persp_tri *c)
@@ -128,6 +192,7 @@ static void persp_finish(const om_mat4 *vp, om__persp_tri *c)
     c->adj[6] = m[3] * m[7] - m[4] * m[6];
     c->adj[7] = m[1] * m[6] - m[0] * m[7];
     c->adj[8] = m[0] * m[4] - m[1] * m[3];
+    for (int k = 0; k < 3; k++) c->adj[k] += c->adj[3 + k] + c->adj[6 + k];   /* the weights' sum */
     c->d1 = om__sub(c->v[1], c->v[0]);
     c->d2 = om__sub(c->v[2], c->v[0]);
     c->n = om__normalize(om__cross(c->d1, c->d2));
@@ -142,19 +207,70 @@ void om__persp_setup(const om_scene *s, const om_mat4 *vp, om_vec3 o, uint32_t t
 
 om_vec3 om__persp_point(const om__persp_tri *c, float sx, float sy)
 {
-    float b0 = c->adj[0] * sx + c->adj[1] * sy + c->adj[2];
+    float sum = c->adj[0] * sx + c->adj[1] * sy + c->adj[2];
     float b1 = c->adj[3] * sx + c->adj[4] * sy + c->adj[5];
     float b2 = c->adj[6] * sx + c->adj[7] * sy + c->adj[8];
-    float sum = b0 + b1 + b2;
     float inv = sum != 0.0f ? 1.0f / sum : 0.0f;
     float w1 = b1 * inv, w2 = b2 * inv;
     return om__v3(c->v[0].x + w1 * c->d1.x + w2 * c->d2.x, c->v[0].y + w1 * c->d1.y + w2 * c->d2.y,
                   c->v[0].z + w1 * c->d1.z + w2 * c->d2.z);
 }
 
+/* The point of triangle c nearest, on the image, to NDC (sx, sy), for a pixel whose
+ * centre the rasterizer's snapped edges gave to c though it lies just outside it (p
+ * then on c's plane beyond an edge, where a triangle seen at a grazing angle takes a
+ * point far along its plane for a fraction of a pixel): on the edge nearest the centre
+ * on the image, at the point of it nearest the centre there, carried back to the
+ * edge in 3-D with 1/w, which the projection keeps linear along it. Within the
+ * snapping of the centre's ray, on the triangle. p as it is where a vertex is not in
+ * front of the camera. Out of line: few pixels take it. */
+static om_vec3 eye_clamp(const om_view *v, const om__persp_tri *c, float sx, float sy, om_vec3 p)
+{
+    const float *m = v->cam_view.m;
+    const om_vec3 R = om__v3(m[0], m[1], m[2]), U = om__v3(m[4], m[5], m[6]), F = om__v3(-m[8], -m[9], -m[10]);
+    float ax[3], ay[3], w[3];
+    for (int k = 0; k < 3; k++) {
+        const om_vec3 r = om__sub(c->v[k], v->cam.eye);
+        w[k] = om__dot(F, r);
+        if (!(w[k] > 0.0f)) return p;
+        ax[k] = v->cam_proj.m[0] * om__dot(R, r) / w[k];
+        ay[k] = v->cam_proj.m[5] * om__dot(U, r) / w[k];
+    }
+    float best = -1.0f, bt = 0.0f;
+    int bi = 0;
+    for (int i = 0; i < 3; i++) {
+        const int j = i == 2 ? 0 : i + 1;
+        const float ex = ax[j] - ax[i], ey = ay[j] - ay[i], e2 = ex * ex + ey * ey;
+        float t = e2 > 0.0f ? ((sx - ax[i]) * ex + (sy - ay[i]) * ey) / e2 : 0.0f;
+        t = t < 0.0f ? 0.0f : t > 1.0f ? 1.0f : t;
+        const float qx = ax[i] + t * ex - sx, qy = ay[i] + t * ey - sy, d2 = qx * qx + qy * qy;
+        if (best < 0.0f || d2 < best) {
+            best = d2;
+            bt = t;
+            bi = i;
+        }
+    }
+    const int bj = bi == 2 ? 0 : bi + 1;
+    const float den = (1.0f - bt) * w[bj] + bt * w[bi];
+    const float tau = den > 0.0f ? bt * w[bi] / den : bt;
+    return om__add(c->v[bi], om__scale(om__sub(c->v[bj], c->v[bi]), tau));
+}
+
+om_vec3 om__eye_point(const om_view *v, const om__persp_tri *c, float sx, float sy)
+{
+    const float sum = c->adj[0] * sx + c->adj[1] * sy + c->adj[2];
+    const float b1 = c->adj[3] * sx + c->adj[4] * sy + c->adj[5];
+    const float b2 = c->adj[6] * sx + c->adj[7] * sy + c->adj[8];
+    const float inv = sum != 0.0f ? 1.0f / sum : 0.0f;
+    const float w1 = b1 * inv, w2 = b2 * inv;
+    const om_vec3 p = om__v3(c->v[0].x + w1 * c->d1.x + w2 * c->d2.x, c->v[0].y + w1 * c->d1.y + w2 * c->d2.y,
+                             c->v[0].z + w1 * c->d1.z + w2 * c->d2.z);
+    return w1 >= 0.0f && w2 >= 0.0f && w1 + w2 <= 1.0f ? p : eye_clamp(v, c, sx, sy, p);
+}
+
 /* The pixels [x0, x1) of one row that triangle c covers: the run's constants sit in
  * locals (registers) rather than being loaded again per pixel, and the products with
- * the row's sy are made once; each is the very product om__persp_point makes, so the
+ * the row's sy are made once; each is the very product om__eye_point makes, so the
  * points are the same bits. With `terms`, each pixel's exposure marks too: where the
  * triangle is `sure` and the pixel's weights within EYE_SLACK, only the light-facing
  * test, with the operations om__exposed_at makes for it. */
@@ -176,14 +292,14 @@ static void resolve_run(const om_view *v, const eye_tri *et, uint32_t x0, uint32
     float xc = (float)x0 + 0.5f;
     for (uint32_t x = x0; x < x1; x++, xc += 1.0f) {
         const float sx = xc * sxk - 1.0f;
-        const float b0 = a0 * sx + r0 + a2;
+        const float sum = a0 * sx + r0 + a2;
         const float b1 = a3 * sx + r1 + a5;
         const float b2 = a6 * sx + r2 + a8;
-        const float sum = b0 + b1 + b2;
         const float inv = sum != 0.0f ? 1.0f / sum : 0.0f;
         const float w1 = b1 * inv, w2 = b2 * inv;
-        const om_vec3 p = om__v3(o.x + w1 * d1.x + w2 * d2.x, o.y + w1 * d1.y + w2 * d2.y,
-                                 o.z + w1 * d1.z + w2 * d2.z);
+        om_vec3 p = om__v3(o.x + w1 * d1.x + w2 * d2.x, o.y + w1 * d1.y + w2 * d2.y,
+                           o.z + w1 * d1.z + w2 * d2.z);
+        if (!(w1 >= 0.0f && w2 >= 0.0f && w1 + w2 <= 1.0f)) p = eye_clamp(v, c, sx, sy, p);
         om_sample *out = &smp[x];
         out->p[0] = p.x;
         out->p[1] = p.y;
@@ -284,7 +400,7 @@ static void resolve_ids(const om_scene *s, const om_view *v, const om_target *tg
                     et->t.tri = t;
                     for (int j = 0; j < 3; j++) et->t.v[j] = fetched[k][j];
                     k++;
-                    persp_finish(&v->cam_vp, &et->t);
+                    eye_finish(v, &et->t);
                     et->sure = et->tried = false;
                     et->seen = 0;
                 }

@@ -23,12 +23,20 @@ void om__eye_pass(const om_scene *s, const om_view *v, const om_target *tg, om_s
  * NDC positions (sx, sy) of the image that `vp` projects onto. */
 typedef struct om__persp_tri {
     uint32_t tri;
-    float adj[9];          /* adjugate of the 3x3 matrix of (x, y, w) columns */
+    float adj[9];          /* weights w1, w2 and their sum as linear functions of NDC:
+                              rows of (sx, sy, 1): the sum, then w1 and w2 times it */
     om_vec3 v[3], d1, d2;  /* vertices less the view's origin, v1 - v0 and v2 - v0 */
     om_vec3 n;             /* the unit geometric normal */
 } om__persp_tri;
 
 void om__persp_setup(const om_scene *s, const om_mat4 *vp, om_vec3 o, uint32_t t, om__persp_tri *c);
+/* The same for the camera of view v, as the eye pass sets it up (eye.c: from the
+ * camera's ray, which keeps small triangles far away precise). */
+void om__eye_setup(const om_scene *s, const om_view *v, uint32_t t, om__persp_tri *c);
+/* The eye pass's point of such a triangle at NDC (sx, sy): om__persp_point's, or where
+ * that lies beyond the triangle (a centre its snapped edges took), the triangle's point
+ * nearest the centre on the image. */
+om_vec3 om__eye_point(const om_view *v, const om__persp_tri *c, float sx, float sy);
 om_vec3 om__persp_point(const om__persp_tri *c, float sx, float sy);
 
 /* The same for om__eye_pass_mark: the eye pass with the exposure marks of each

@@ -648,15 +648,6 @@ static void convex_lit_side(void)
  * its own float geometry at the origin; no lone sphere's lit side shadowed; every
  * sample's point within 1/256 px of its pixel's ray, on its own triangle. */
 
-/* A test of a target the engine does not meet yet: run with OM_TEST_LARGE_WORLD=1. */
-static bool large_world(const char *test)
-{
-    const char *e = getenv("OM_TEST_LARGE_WORLD");
-    if (e && !strcmp(e, "1")) return true;
-    printf("  %s: skipped (OM_TEST_LARGE_WORLD=1 runs it)\n", test);
-    return false;
-}
-
 typedef struct sbuf { char *p; size_t len, cap; } sbuf;
 
 static void sb_put(sbuf *b, const char *fmt, ...)
@@ -1064,7 +1055,6 @@ static ptally sample_points(const char *text, const om_loader *ld, const char *w
  * 16 rings), a wide floor to the horizon; and the default scene far out. */
 static void sliver_points(void)
 {
-    if (!large_world("sliver_points")) return;
     static const char cloud[] = "camera eye 0 0.4 12 target 0 0.3 0 fov 55\n"
                                 "light spot pos 4 12 3 target 0 0 0 fov 70 near 1 far 60\n"
                                 "plane size 14 14 divisions 4\n"

@@ -539,12 +539,12 @@ static void pixel_steps(const om__spsm_state *m, const om_strip *st, size_t i, o
     const om_sample *s = &st->samples[i];
     const uint32_t x = (uint32_t)(i % st->width), y = st->y0 + (uint32_t)(i / st->width);
     om__persp_tri c;
-    om__persp_setup(m->scene, &m->view.cam_vp, m->view.origin, s->tri, &c);
+    om__eye_setup(m->scene, &m->view, s->tri, &c);
     const float kx = 2.0f / (float)st->width, ky = 2.0f / (float)st->height;
     const float fx = ((float)x + 0.5f) * kx - 1.0f, fy = 1.0f - ((float)y + 0.5f) * ky;
     const om_vec3 p = om__v3(s->p[0], s->p[1], s->p[2]);
-    *sx = om__sub(om__persp_point(&c, ((float)x + 1.5f) * kx - 1.0f, fy), p);
-    *sy = om__sub(om__persp_point(&c, fx, 1.0f - ((float)y + 1.5f) * ky), p);
+    *sx = om__sub(om__eye_point(&m->view, &c, ((float)x + 1.5f) * kx - 1.0f, fy), p);
+    *sy = om__sub(om__eye_point(&m->view, &c, fx, 1.0f - ((float)y + 1.5f) * ky), p);
 }
 
 /* The occluders the pattern `keep` keeps in the 3x3 of texel (tx, ty) (distinct
