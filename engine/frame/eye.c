@@ -18,12 +18,10 @@
  * same). */
 #include "frame.h"
 
-/* A pixel whose weights are within EYE_SLACK of its triangle (w1, w2 >= -EYE_SLACK,
- * w1 + w2 <= 1 + EYE_SLACK: every pixel but those that the rasterizer's snapped edges
- * take a little beyond the float weights) lies in the triangle grown by EYE_GROW
- * (below); EYE_MARGIN is the room, relative to the size of the values, that
- * expo_setup asks of that grown triangle: 256 float roundings. */
-#define EYE_SLACK (1.0f / 1024.0f)
+/* Every pixel's point lies on its triangle (eye_clamp), so in the triangle grown by
+ * EYE_GROW (below) with room for its rounding; EYE_MARGIN is the room, relative to the
+ * size of the values, that expo_setup asks of that grown triangle: 256 float
+ * roundings. */
 #define EYE_WAYS 16
 #define EYE_RUNS 32
 #define EYE_LAZY 16
@@ -64,11 +62,11 @@ static void eye_frame_of(const om_view *v, eye_frame *f)
 }
 
 /* Whether the exposure tests of om__exposed_at, but for the light-facing one, give
- * every pixel of triangle c whose weights are within EYE_SLACK the same answers: the
- * normal turned the same way, inside the frustum. The pixel's point is
- * p = o + w1 d1 + w2 d2 rounded (o = v0, d1, d2 as the setup has them), so with the
- * weights in slack it lies within 4u R (u = 2^-24, per coordinate) of the triangle
- * grown by EYE_GROW, whose corners e_j are worked out here, R = max|o| + 2 (max|d1| +
+ * every pixel of triangle c the same answers: the normal turned the same way, inside
+ * the frustum. The pixel's point is p = o + w1 d1 + w2 d2 rounded (o = v0, d1, d2 as
+ * the setup has them) with weights in [0, 1], or a point of an edge v_i + t (v_j - v_i)
+ * rounded (eye_clamp, clamp_weights), so it lies within 4u R (u = 2^-24, per
+ * coordinate) of the triangle grown by EYE_GROW, whose corners e_j are worked out here, R = max|o| + 2 (max|d1| +
  * max|d2|) bounding every coordinate. Each test is of the sign of an affine function of
  * the point (q.w - |q.x| is the lesser of two), so it holds over the grown triangle
  * when it holds at its corners; computed at a pixel, such a function's value is within
@@ -216,23 +214,44 @@ om_vec3 om__persp_point(const om__persp_tri *c, float sx, float sy)
                   c->v[0].z + w1 * c->d1.z + w2 * c->d2.z);
 }
 
+/* A point of triangle c from p's weights made to lie on it (NaN ones as 0): for a
+ * triangle with a vertex not in front of the camera, which has no nearest point on
+ * the image. */
+static om_vec3 clamp_weights(const om__persp_tri *c, om_vec3 p)
+{
+    const om_vec3 r = om__sub(p, c->v[0]);
+    /* the weights again, from p: the least-squares solution on the edges' plane */
+    const float a = om__dot(c->d1, c->d1), b = om__dot(c->d1, c->d2), d = om__dot(c->d2, c->d2);
+    const float e = om__dot(c->d1, r), f = om__dot(c->d2, r), det = a * d - b * b;
+    float w1 = det != 0.0f ? (d * e - b * f) / det : 0.0f, w2 = det != 0.0f ? (a * f - b * e) / det : 0.0f;
+    w1 = w1 > 0.0f ? w1 : 0.0f;   /* NaN too */
+    w2 = w2 > 0.0f ? w2 : 0.0f;
+    const float s = w1 + w2;
+    if (s > 1.0f) {
+        w1 /= s;
+        w2 /= s;
+    }
+    return om__add(c->v[0], om__add(om__scale(c->d1, w1), om__scale(c->d2, w2)));
+}
+
 /* The point of triangle c nearest, on the image, to NDC (sx, sy), for a pixel whose
  * centre the rasterizer's snapped edges gave to c though it lies just outside it (p
  * then on c's plane beyond an edge, where a triangle seen at a grazing angle takes a
  * point far along its plane for a fraction of a pixel): on the edge nearest the centre
  * on the image, at the point of it nearest the centre there, carried back to the
  * edge in 3-D with 1/w, which the projection keeps linear along it. Within the
- * snapping of the centre's ray, on the triangle. p as it is where a vertex is not in
- * front of the camera. Out of line: few pixels take it. */
+ * snapping of the centre's ray, on the triangle (clamp_weights where a vertex is not
+ * in front of the camera). Out of line: few pixels take it. */
 static om_vec3 eye_clamp(const om_view *v, const om__persp_tri *c, float sx, float sy, om_vec3 p)
 {
+    (void)p;
     const float *m = v->cam_view.m;
     const om_vec3 R = om__v3(m[0], m[1], m[2]), U = om__v3(m[4], m[5], m[6]), F = om__v3(-m[8], -m[9], -m[10]);
     float ax[3], ay[3], w[3];
     for (int k = 0; k < 3; k++) {
         const om_vec3 r = om__sub(c->v[k], v->cam.eye);
         w[k] = om__dot(F, r);
-        if (!(w[k] > 0.0f)) return p;
+        if (!(w[k] > 0.0f)) return clamp_weights(c, p);
         ax[k] = v->cam_proj.m[0] * om__dot(R, r) / w[k];
         ay[k] = v->cam_proj.m[5] * om__dot(U, r) / w[k];
     }
@@ -272,8 +291,8 @@ om_vec3 om__eye_point(const om_view *v, const om__persp_tri *c, float sx, float 
  * locals (registers) rather than being loaded again per pixel, and the products with
  * the row's sy are made once; each is the very product om__eye_point makes, so the
  * points are the same bits. With `terms`, each pixel's exposure marks too: where the
- * triangle is `sure` and the pixel's weights within EYE_SLACK, only the light-facing
- * test, with the operations om__exposed_at makes for it. */
+ * triangle is `sure`, only the light-facing test, with the operations om__exposed_at
+ * makes for it. */
 static void resolve_run(const om_view *v, const eye_tri *et, uint32_t x0, uint32_t x1,
                         float sy, float sxk, om_sample *smp, om_term *terms)
 {
@@ -310,7 +329,7 @@ static void resolve_run(const om_view *v, const eye_tri *et, uint32_t x0, uint32
         out->tri = tri;
         if (terms) {
             bool exposed;
-            if (sure && w1 >= -EYE_SLACK && w2 >= -EYE_SLACK && w1 + w2 <= 1.0f + EYE_SLACK) {
+            if (sure) {   /* every point is on its triangle (eye_clamp) */
                 const float cs = om__dot(nf, dir ? ldir : om__to_point(lpos, p));
                 exposed = cs > 0.0f;
                 out->nl = exposed ? cs : 0.0f;

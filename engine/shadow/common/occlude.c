@@ -133,7 +133,7 @@ void om__lspace_begin(om__lspace *ls, const om_view *v)
  * chain of a dozen roundings, is made 2^-10 larger and rounded up: at least the
  * exact slack. A facet edge-on to within those (c or n2 not above 0) gets no blocker
  * at all. */
-static double sample_slack(const om__lspace *ls, const om_sample *smp, double z)
+static uint32_t sample_slack(const om__lspace *ls, const om_sample *smp, uint32_t z)
 {
     const om_vec3 n = om__v3(smp->n[0], smp->n[1], smp->n[2]);
     const float e = 0x1p-18f;
@@ -149,29 +149,36 @@ static double sample_slack(const om__lspace *ls, const om_sample *smp, double z)
         den = om__fabsf(om__dot(n, ls->row2)) - e;
         iw = 1.0f;
     }
-    if (!(den > 0.0f)) return OM_DEPTH_ONE;
+    if (!(den > 0.0f)) return 0xFFFFFFFFu;
     const float slope = (ls->kx * n0 + ls->ky * n1) / den;
     const float k = slope * (1.5f + ls->latf * iw) * (1.0f + 0x1p-10f) + 1.0f;
-    if (!(k < 4294967040.0f)) return OM_DEPTH_ONE;   /* the largest float below 2^32 */
+    if (!(k < 4294967040.0f)) return 0xFFFFFFFFu;   /* the largest float below 2^32 */
     const uint32_t u = (uint32_t)k;
-    return (double)u + ((float)u < k);
+    return u + ((float)u < k);
 }
 
-bool om__lspace_point_z(const om__lspace *ls, const om_sample *smp, om__lpoint *out, uint32_t *z)
+bool om__lspace_point_at(const om__lspace *ls, const om_sample *smp, om__lpoint *out, uint32_t *z)
 {
     om_vec4 c = om__mat_apply(&ls->vp, om__v3(smp->p[0], smp->p[1], smp->p[2]));
     *z = 0;
     out->tri = smp->tri;
     const bool ok = om__project(&c, OM_LIGHT_GRID, OM_LIGHT_GRID, &out->x, &out->y, z);
-    *z = (uint32_t)om__lspace_pull(ls, smp, *z);
     out->z = *z;
     return ok;
 }
 
-double om__lspace_pull(const om__lspace *ls, const om_sample *smp, double z)
+bool om__lspace_point_z(const om__lspace *ls, const om_sample *smp, om__lpoint *out, uint32_t *z)
 {
-    const double k = sample_slack(ls, smp, z);
-    return k < z ? z - k : 0.0;
+    const bool ok = om__lspace_point_at(ls, smp, out, z);
+    *z = om__lspace_pull(ls, smp, *z);
+    out->z = *z;
+    return ok;
+}
+
+uint32_t om__lspace_pull(const om__lspace *ls, const om_sample *smp, uint32_t z)
+{
+    const uint32_t k = sample_slack(ls, smp, z);
+    return k < z ? z - k : 0;
 }
 
 bool om__lspace_point(const om__lspace *ls, const om_sample *smp, om__lpoint *out)

@@ -133,7 +133,12 @@ void om__lspace_project(const om__lspace *ls, uint32_t first, uint32_t end);
  * number: what a blocker must be nearer than. */
 bool om__lspace_point(const om__lspace *ls, const om_sample *smp, om__lpoint *out);
 /* A sample's whole depth z pulled towards the light by its facet's slack. */
-double om__lspace_pull(const om__lspace *ls, const om_sample *smp, double z);
+uint32_t om__lspace_pull(const om__lspace *ls, const om_sample *smp, uint32_t z);
+/* The projection alone, its depth not yet pulled, for a caller that pulls it where a
+ * triangle first blocks the unpulled depth (a triangle that blocks the pulled depth
+ * blocks the unpulled one: the same answers, the pull's work only where a blocker is
+ * near). */
+bool om__lspace_point_at(const om__lspace *ls, const om_sample *smp, om__lpoint *out, uint32_t *z);
 /* The same, with the depth also as the whole number it is (*z == out->z). */
 bool om__lspace_point_z(const om__lspace *ls, const om_sample *smp, om__lpoint *out, uint32_t *z);
 

@@ -440,10 +440,17 @@ static uint32_t look_up(const hybrid_state *m, om_strip *st, size_t *i, size_t n
         int64_t tex;
         p.x = gx[j];
         p.y = gy[j];
-        p.z = om__zdepth(cz[j], cw[j]);
+        const uint32_t z = om__zdepth(cz[j], cw[j]);
+        p.z = z;
         p.tri = tri[j];
-        p.z = om__lspace_pull(&m->ls, &st->samples[at[j]], p.z);   /* as om__lspace_point */
-        const int a = classify_at(m, &p, tx[j], ty[j], &st->terms[at[j]], &tex);
+        /* lit at the unpulled depth is lit at the pulled one (om__lspace_point_at):
+         * else the depth as om__lspace_point pulls it, and the map asked again */
+        int a = classify_at(m, &p, tx[j], ty[j], &st->terms[at[j]], &tex);
+        if (a != 1) {
+            st->terms[at[j]].r = st->terms[at[j]].g = st->terms[at[j]].b = 255;
+            p.z = om__lspace_pull(&m->ls, &st->samples[at[j]], z);
+            a = classify_at(m, &p, tx[j], ty[j], &st->terms[at[j]], &tex);
+        }
         counts[a == 1 ? 0 : a == 2 ? 1 : 2]++;
         if (a == 0) om__hkey_put(&q[u++], &p, at[j]);
     }

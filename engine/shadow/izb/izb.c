@@ -276,11 +276,14 @@ uint32_t om__izb_transform(om__izb *z, const om_strip *st, size_t *next, size_t 
 {
     size_t i = *next;
     uint32_t n = 0, taken = 0;
+    z->samples = st->samples;
     for (; i < end && taken < take; i++) {
         if (!(st->terms[i].flags & OM_TERM_EXPOSED)) continue;
         taken++;
         om__lpoint p;
-        if (!om__lspace_point(&z->ls, &st->samples[i], &p)) continue;   /* behind the light */
+        uint32_t pz;
+        /* unpulled: izb_raster.c pulls a key's depth where a triangle first blocks it */
+        if (!om__lspace_point_at(&z->ls, &st->samples[i], &p, &pz)) continue;   /* behind the light */
         /* the sample's key for the BSP, and the tile's bounds, while it is at hand */
         om__izb_key *k = &z->keys[n];
         k->x = (int32_t)p.x;   /* the light grid fits in 27 bits */
@@ -464,7 +467,7 @@ void om__izb_build(om__izb *z)
 
 void om__izb_write(const om__izb *z, const om_strip *st)
 {
-    for (uint32_t i = 0; i < z->n; i++) om__odepth_term(&z->od[i], &st->terms[z->keys[i].s & ~OM_IZB_DONE]);
+    for (uint32_t i = 0; i < z->n; i++) om__odepth_term(&z->od[i], &st->terms[z->keys[i].s & OM_IZB_INDEX]);
 }
 
 uint32_t om__izb_tiles(const om__izb *z, uint32_t exposed)

@@ -17,7 +17,9 @@
  * whole sample, so the leaves read nothing else; its optical depth sits at the same
  * index of z->od once the build has sorted the keys. */
 typedef struct om__izb_key { int32_t x, y; uint32_t z, tri, s, code; } om__izb_key;
-#define OM_IZB_DONE 0x80000000u
+#define OM_IZB_DONE 0x80000000u     /* in s: opaquely shadowed */
+#define OM_IZB_PULLED 0x40000000u   /* in s: z pulled (om__lspace_pull) */
+#define OM_IZB_INDEX 0x3FFFFFFFu    /* in s: the sample's place in the strip */
 
 /* A BSP node: the bounds of its samples on the light grid, their largest light depth,
  * and how many of them are not yet fully (opaquely) shadowed. Leaves have count > 0
@@ -36,6 +38,7 @@ typedef struct om__izb_stats {
 
 typedef struct om__izb {
     const om_scene *scene;
+    const om_sample *samples;   /* the strip's, while its tiles are resolved */
     om__lspace ls;
     om__odepth *mat_od;
     om__izb_key *keys;

@@ -58,9 +58,15 @@ static uint32_t visit(om__izb *z, uint32_t ni, const tjob *j)
             if ((k->s & OM_IZB_DONE) || k->x < lt->lox || k->x > lt->hix || k->y < lt->loy ||
                 k->y > lt->hiy)
                 continue;
-            const om__lpoint p = {k->x, k->y, (double)k->z, k->tri};
+            om__lpoint p = {k->x, k->y, (double)k->z, k->tri};
             z->st.tested++;
             if (!om__blocks(lt, &p)) continue;
+            if (!(k->s & OM_IZB_PULLED)) {   /* the first blocker of the unpulled depth */
+                k->s |= OM_IZB_PULLED;
+                k->z = om__lspace_pull(&z->ls, &z->samples[k->s & OM_IZB_INDEX], k->z);
+                p.z = k->z;
+                if (!om__blocks(lt, &p)) continue;
+            }
             z->st.blocked++;
             om__odepth_add(&z->od[i], j->od);
             if (om__odepth_opaque(&z->od[i])) {

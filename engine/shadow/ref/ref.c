@@ -193,6 +193,8 @@ typedef struct walk_ctx {
     om__lpoint p;
     uint32_t z;            /* p.z, the whole number it is */
     om__odepth od;
+    const om_sample *smp;  /* the sample: its depth is pulled (om__lspace_pull) where */
+    bool pulled;           /* a triangle first blocks it unpulled */
 } walk_ctx;
 
 /* Whether triangle t's edges hold p, where that settles it: a triangle whose three
@@ -236,15 +238,25 @@ static bool covers(const om__lspace *ls, uint32_t t, const om__lpoint *p)
  * misses p or whose vertices are all farther; ref_light.h). Where double arithmetic
  * is a library routine, single precision answers first (om__blocks_f: the same
  * answer, or none). */
+static bool blocks(const walk_ctx *w, uint32_t tri)
+{
+    om__ltri lt;
+    const int f = OM_FAST_FLOAT ? om__blocks_f(&w->r->ls, tri, &w->p, w->z) : -1;
+    return !(f == 0 || (f < 0 && (tri == w->p.tri || !covers(&w->r->ls, tri, &w->p) ||
+                                  !om__lspace_tri(&w->r->ls, tri, &lt) || !om__blocks(&lt, &w->p))));
+}
+
 static bool visit(void *user, uint32_t tri)
 {
     walk_ctx *w = (walk_ctx *)user;
-    om__ltri lt;
     w->j->candidates++;
-    const int f = OM_FAST_FLOAT ? om__blocks_f(&w->r->ls, tri, &w->p, w->z) : -1;
-    if (f == 0 || (f < 0 && (tri == w->p.tri || !covers(&w->r->ls, tri, &w->p) ||
-                             !om__lspace_tri(&w->r->ls, tri, &lt) || !om__blocks(&lt, &w->p))))
-        return false;
+    if (!blocks(w, tri)) return false;
+    if (!w->pulled) {   /* the first blocker of the unpulled depth: pull it, ask again */
+        w->pulled = true;
+        w->z = om__lspace_pull(&w->r->ls, w->smp, w->z);
+        w->p.z = w->z;
+        if (!blocks(w, tri)) return false;
+    }
     om__odepth_add(&w->od, &w->r->mat_od[w->r->scene->tri_mat[tri]]);
     return om__odepth_opaque(&w->od);
 }
@@ -272,7 +284,9 @@ static void shade_sample(ref_job *j, const om_sample *smp, om_term *t)
     w.r = r;
     w.j = j;
     memset(&w.od, 0, sizeof w.od);
-    if (!om__lspace_point_z(&r->ls, smp, &w.p, &w.z)) return;
+    w.smp = smp;
+    w.pulled = false;
+    if (!om__lspace_point_at(&r->ls, smp, &w.p, &w.z)) return;
     if (r->mode == CACHE) {
         om__bvh_walk_grid(&r->bvh, &r->ls, &w.p, w.z, visit, &w);
         finish(&w, t);
@@ -334,7 +348,9 @@ static void shade_block(ref_job *j, om_strip *st, uint32_t x0, uint32_t y0, uint
             w.r = r;
             w.j = j;
             w.p = pk->p[y * TILE + x];
-            w.z = (uint32_t)w.p.z;   /* a whole number below 2^32 (om__lspace_point) */
+            w.z = (uint32_t)w.p.z;   /* a whole number below 2^32 (om__lspace_point_at) */
+            w.smp = &st->samples[(size_t)(y0 + y) * st->width + x0 + x];
+            w.pulled = false;
             memset(&w.od, 0, sizeof w.od);
             om__lbvh_walk_list(&r->lb, &r->bvh, list, n, &w.p, visit, &w);
             finish(&w, &st->terms[(size_t)(y0 + y) * st->width + x0 + x]);
@@ -355,7 +371,8 @@ static void shade_tile(ref_job *j, om_strip *st, uint32_t x0, uint32_t y0)
             t->r = t->g = t->b = 255;
             if (!(t->flags & OM_TERM_EXPOSED)) continue;
             j->samples++;
-            pk->on[y * TILE + x] = om__lspace_point(&r->ls, &st->samples[i], &pk->p[y * TILE + x]);
+            uint32_t z;
+            pk->on[y * TILE + x] = om__lspace_point_at(&r->ls, &st->samples[i], &pk->p[y * TILE + x], &z);
         }
     const uint32_t root = 0;
     shade_block(j, st, x0, y0, 0, 0, TILE, &root, r->bvh.nnodes ? 1 : 0, 0);
