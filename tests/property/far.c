@@ -93,6 +93,18 @@ static const char spot_scene[] =
     "triangles count 300 seed 5 area 4 in -5 0.5 -5 5 3 0\n"
     "box size 0.3 0.7 0.3 rotate 0 17 0 translate 15.37 0.35 -14.91\n";   /* an odd box */
 
+/* Scene s moved by t (a) and its data rounded so at the origin (b), by method `name`. */
+static void render_pair(const om_scene *s, float t, const char *name, frame *a, frame *b)
+{
+    moved far, near;
+    move_scene(&far, s, t, false);
+    move_scene(&near, s, t, true);
+    CHECK_OK(h_render(&far.s, name, NULL, W, H, 0, 0, a->mask, a->terms, a->smp));
+    CHECK_OK(h_render(&near.s, name, NULL, W, H, 0, 0, b->mask, b->terms, b->smp));
+    moved_free(&far);
+    moved_free(&near);
+}
+
 /* Every method gives the moved scene's frame that of the scene with its data rounded
  * as the move rounds it. */
 static void spot_far_away(void)
@@ -101,14 +113,10 @@ static void spot_far_away(void)
     h_scene hs;
     if (!h_scene_parse(&hs, spot_scene)) return;
     frame *a = malloc(sizeof *a), *b = malloc(sizeof *b), *o = malloc(sizeof *o);
-    for (size_t k = 0; k < sizeof moves / sizeof moves[0]; k++) {
-        moved far, near;
-        move_scene(&far, &hs.s, moves[k], false);
-        move_scene(&near, &hs.s, moves[k], true);
+    for (size_t k = 0; k < sizeof moves / sizeof moves[0]; k++)
         for (size_t i = 0; i < om_method_count(); i++) {
             const char *name = om_method_name(om_method_at(i));
-            CHECK_OK(h_render(&far.s, name, NULL, W, H, 0, 0, a->mask, a->terms, a->smp));
-            CHECK_OK(h_render(&near.s, name, NULL, W, H, 0, 0, b->mask, b->terms, b->smp));
+            render_pair(&hs.s, moves[k], name, a, b);
             CHECK_MSG(same_frame(a, b), "%s moved by %g: not the frame of its rounded data at the origin "
                       "(%u mask samples differ)", name, (double)moves[k], mask_diff(a, b));
             if (strcmp(name, "ref")) continue;
@@ -117,9 +125,6 @@ static void spot_far_away(void)
             printf("  far: ref moved by %-8g %u of %u samples differ from the unmoved scene's\n",
                    (double)moves[k], mask_diff(a, o), W * H);
         }
-        moved_free(&far);
-        moved_free(&near);
-    }
     free(a);
     free(b);
     free(o);
@@ -140,22 +145,15 @@ static void directional_far_away(void)
     h_scene hs;
     if (!h_scene_parse(&hs, text)) return;
     frame *a = malloc(sizeof *a), *b = malloc(sizeof *b);
-    for (size_t k = 0; k < sizeof moves / sizeof moves[0]; k++) {
-        moved far, near;
-        move_scene(&far, &hs.s, moves[k], false);
-        move_scene(&near, &hs.s, moves[k], true);
+    for (size_t k = 0; k < sizeof moves / sizeof moves[0]; k++)
         for (size_t i = 0; i < om_method_count(); i++) {
             const char *name = om_method_name(om_method_at(i));
-            CHECK_OK(h_render(&far.s, name, NULL, W, H, 0, 0, a->mask, a->terms, a->smp));
-            CHECK_OK(h_render(&near.s, name, NULL, W, H, 0, 0, b->mask, b->terms, b->smp));
+            render_pair(&hs.s, moves[k], name, a, b);
             const uint32_t n = mask_diff(a, b);
             if (n) printf("  far: %s moved by %g under a sun: %u samples differ\n", name, (double)moves[k], n);
             CHECK_MSG(n <= W * H / 2000, "%s moved by %g under a sun: %u mask samples differ", name,
                       (double)moves[k], n);
         }
-        moved_free(&far);
-        moved_free(&near);
-    }
     free(a);
     free(b);
     h_scene_free(&hs);

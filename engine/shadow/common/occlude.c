@@ -59,7 +59,7 @@ static void bound_begin(om__lspace *ls, const om_view *v)
         ls->iw0 = 1.0;
         ls->iw1 = 0.0;
     }
-    /* the sample's facet (sample_slack): z/w = -p10 + p11 / w (spot) or p10 z + p11
+    /* the sample's facet (facet_slope): z/w = -p10 + p11 / w (spot) or p10 z + p11
      * (directional) over x/w = p0 x / w, y/w = p5 y / w; the grid has 2^20 units per unit
      * of x/w and 2^32 of depth per unit of z/w, hence 2^12 */
     const om_mat4 *lv = &v->light_view, *lp = &v->light_proj;
@@ -67,6 +67,7 @@ static void bound_begin(om__lspace *ls, const om_view *v)
     ls->row0 = om__v3(lv->m[0], lv->m[1], lv->m[2]);
     ls->row1 = om__v3(lv->m[4], lv->m[5], lv->m[6]);
     ls->row2 = om__v3(lv->m[8], lv->m[9], lv->m[10]);
+    ls->lpos = v->light.pos;
     const double coef = fabs((double)(ls->spot ? lp->m[11] : lp->m[10])) * 4096.0;
     ls->kx = (float)(coef / fabs((double)lp->m[0]));
     ls->ky = (float)(coef / fabs((double)lp->m[5]));
@@ -121,36 +122,46 @@ void om__lspace_begin(om__lspace *ls, const om_view *v)
     om__lspace_project(ls, 0, ls->scene->nverts);
 }
 
-/* The sample's own facet's slack (occlude.h), in depth units: its depth slope on the
- * grid, |dD/dX| + |dD/dY|, times the lateral error (1.5 + lat iw) that bound() takes
- * for a blocker. For the plane n . (X - L) = c (n the facet's unit normal, L the spot
- * light, view coordinates along the light's rows) the slope is
+/* A facet's depth slope on the grid, |dD/dX| + |dD/dY|, which the sample's own
+ * facet's slack (occlude.h) multiplies by the lateral error (1.5 + lat iw) that bound()
+ * takes for a blocker. For triangle t's plane n . (X - L) = c (n = e1 x e2 from its
+ * vertices relative to the origin, L the spot light, in view coordinates along the
+ * light's rows) the slope is
  *   2^12 |p11| (|n0| / |p0| + |n1| / |p5|) / |c|   (spot: 1/w is affine in x/w, y/w),
  *   2^12 |p10| (|n0| / |p0| + |n1| / |p5|) / |n2|  (directional),
- * n0, n1, n2 the normal's view coordinates. In float: the sample's point and normal
- * are within a few roundings of its facet's (eye.c), so c and n2 are taken smaller
- * by 2^-18 of their terms' magnitudes and n0, n1 larger by 2^-18, and the result, a
- * chain of a dozen roundings, is made 2^-10 larger and rounded up: at least the
- * exact slack. A facet edge-on to within those (c or n2 not above 0) gets no blocker
- * at all. */
-static uint32_t sample_slack(const om__lspace *ls, const om_sample *smp, uint32_t z)
+ * n0, n1, n2 the normal's view coordinates (any length: the ratios are the same). In
+ * float, with M the product of the edges' component sums (each of n's components is
+ * within 3u M of the exact one): c and n2 are taken smaller by 2^-19 of M (times the
+ * vertex's component sum for c) and n0, n1 larger by 2^-19 M, so the slope is at least
+ * the exact one; a facet edge-on to within that has an infinite slope. A function of
+ * the triangle and the frame alone, so any cache of it gives the same bits. */
+static float facet_slope(const om__lspace *ls, uint32_t t)
 {
-    const om_vec3 n = om__v3(smp->n[0], smp->n[1], smp->n[2]);
-    const float e = 0x1p-18f;
-    const float n0 = om__fabsf(om__dot(n, ls->row0)) + e, n1 = om__fabsf(om__dot(n, ls->row1)) + e;
-    float den, iw;
+    const om_scene *s = ls->scene;
+    const uint32_t *ix = s->idx + (size_t)t * 3;
+    const om_vec3 a = om__sub(s->verts[ix[0]], ls->o), b = om__sub(s->verts[ix[1]], ls->o);
+    const om_vec3 c3 = om__sub(s->verts[ix[2]], ls->o);
+    const om_vec3 e1 = om__sub(b, a), e2 = om__sub(c3, a), n = om__cross(e1, e2);
+    const float m = (om__fabsf(e1.x) + om__fabsf(e1.y) + om__fabsf(e1.z)) *
+                    (om__fabsf(e2.x) + om__fabsf(e2.y) + om__fabsf(e2.z)) * 0x1p-19f;
+    const float n0 = om__fabsf(om__dot(n, ls->row0)) + m, n1 = om__fabsf(om__dot(n, ls->row1)) + m;
+    float den;
     if (ls->spot) {
-        const float a = n.x * smp->p[0], b = n.y * smp->p[1], c = n.z * smp->p[2];
-        const float big = om__fabsf(smp->p[0]) + om__fabsf(smp->p[1]) + om__fabsf(smp->p[2]);
-        den = om__fabsf(a + b + c) - e * (om__fabsf(a) + om__fabsf(b) + om__fabsf(c) + big);
-        iw = ls->iw0f + ls->iw1f * (float)z;
-        if (!(iw > 0.0f)) iw = 0.0f;
+        const om_vec3 d = om__sub(a, ls->lpos);
+        den = om__fabsf(om__dot(n, d)) - m * (om__fabsf(d.x) + om__fabsf(d.y) + om__fabsf(d.z) + 1.0f);
     } else {
-        den = om__fabsf(om__dot(n, ls->row2)) - e;
-        iw = 1.0f;
+        den = om__fabsf(om__dot(n, ls->row2)) - m;
     }
-    if (!(den > 0.0f)) return 0xFFFFFFFFu;
     const float slope = (ls->kx * n0 + ls->ky * n1) / den;
+    return den > 0.0f && slope < 1e30f ? slope : 1e30f;
+}
+
+/* The slack itself, a whole number of depth units, at least the exact one: the float
+ * chain is made 2^-10 larger and rounded up. */
+static uint32_t facet_slack(const om__lspace *ls, float slope, uint32_t z)
+{
+    float iw = ls->spot ? ls->iw0f + ls->iw1f * (float)z : 1.0f;
+    if (!(iw > 0.0f)) iw = 0.0f;
     const float k = slope * (1.5f + ls->latf * iw) * (1.0f + 0x1p-10f) + 1.0f;
     if (!(k < 4294967040.0f)) return 0xFFFFFFFFu;   /* the largest float below 2^32 */
     const uint32_t u = (uint32_t)k;
@@ -170,14 +181,19 @@ bool om__lspace_point_at(const om__lspace *ls, const om_sample *smp, om__lpoint 
 bool om__lspace_point_z(const om__lspace *ls, const om_sample *smp, om__lpoint *out, uint32_t *z)
 {
     const bool ok = om__lspace_point_at(ls, smp, out, z);
-    *z = om__lspace_pull(ls, smp, *z);
+    om__facet f = {OM_NO_TRI, 0.0f};
+    *z = om__lspace_pull(ls, &f, smp->tri, *z);
     out->z = *z;
     return ok;
 }
 
-uint32_t om__lspace_pull(const om__lspace *ls, const om_sample *smp, uint32_t z)
+uint32_t om__lspace_pull(const om__lspace *ls, om__facet *f, uint32_t tri, uint32_t z)
 {
-    const uint32_t k = sample_slack(ls, smp, z);
+    if (f->tri != tri) {
+        f->tri = tri;
+        f->slope = facet_slope(ls, tri);
+    }
+    const uint32_t k = facet_slack(ls, f->slope, z);
     return k < z ? z - k : 0;
 }
 

@@ -47,8 +47,10 @@
  * almost edge-on to the light, at a convex solid's terminator) the surface next to it
  * there, its neighbour, is nearer the light by that error times the facet's own slope,
  * far more than the blocker's slope covers. The sample's depth is therefore pulled
- * towards the light by its facet's slope (from its normal, occlude.c) times the same
- * lateral error (om__lspace_point): a facet edge-on to the light is lit by a tie. A
+ * towards the light by its facet's slope (from its vertices, occlude.c) times the same
+ * lateral error (om__lspace_point): a facet edge-on to the light is lit by a tie.
+ * The slope is the triangle's own, from its vertices, so the same for every sample on
+ * it. A
  * blocker must be nearer than the sample by more than that: depths closer than the
  * grid and the float positions resolve are a tie, and a tie is lit. This is derived
  * from the grid and the number formats, not tuned. Laterally it is about ten grid
@@ -108,7 +110,7 @@ typedef struct om__lspace {
     /* The sample's own facet (om__lspace_point): the light's view rows, and its depth
      * slope on the grid per unit of the normal's view x and y over the plane's distance
      * from the light (spot) or over the normal's view z (directional). */
-    om_vec3 row0, row1, row2;
+    om_vec3 row0, row1, row2, lpos;
     float kx, ky;
     bool spot;
 } om__lspace;
@@ -129,11 +131,14 @@ void om__lspace_begin(om__lspace *ls, const om_view *v);
 void om__lspace_view(om__lspace *ls, const om_view *v);
 void om__lspace_project(const om__lspace *ls, uint32_t first, uint32_t end);
 /* Projects a sample; false when it is not in front of the light. Its depth is pulled
- * towards the light by its own facet's slack (occlude.c, sample_slack), as a whole
+ * towards the light by its own facet's slack (occlude.c, facet_slope), as a whole
  * number: what a blocker must be nearer than. */
 bool om__lspace_point(const om__lspace *ls, const om_sample *smp, om__lpoint *out);
-/* A sample's whole depth z pulled towards the light by its facet's slack. */
-uint32_t om__lspace_pull(const om__lspace *ls, const om_sample *smp, uint32_t z);
+/* A sample's whole depth z pulled towards the light by its own facet's slack, its
+ * facet triangle tri, f a cache of the last triangle's slope (tri OM_NO_TRI: empty;
+ * it changes no bit, only the work). */
+typedef struct om__facet { uint32_t tri; float slope; } om__facet;
+uint32_t om__lspace_pull(const om__lspace *ls, om__facet *f, uint32_t tri, uint32_t z);
 /* The projection alone, its depth not yet pulled, for a caller that pulls it where a
  * triangle first blocks the unpulled depth (a triangle that blocks the pulled depth
  * blocks the unpulled one: the same answers, the pull's work only where a blocker is

@@ -351,6 +351,7 @@ static uint32_t look_up(const hybrid_state *m, om_strip *st, size_t *i, size_t n
     float zf[LANES], hz[LANES], hgx[LANES], hgy[LANES];   /* surely_lit's */
 #endif
     int32_t gx[LANES], gy[LANES], tx[LANES], ty[LANES], ok[LANES], lit[LANES];
+    om__facet facet = {OM_NO_TRI, 0.0f};   /* om__lspace_pull's */
     uint32_t at[LANES], tri[LANES], k = 0, u = 0;
     for (; *i < n && k < LANES; ++*i) {
         om_term *t = &st->terms[*i];
@@ -448,7 +449,7 @@ static uint32_t look_up(const hybrid_state *m, om_strip *st, size_t *i, size_t n
         int a = classify_at(m, &p, tx[j], ty[j], &st->terms[at[j]], &tex);
         if (a != 1) {
             st->terms[at[j]].r = st->terms[at[j]].g = st->terms[at[j]].b = 255;
-            p.z = om__lspace_pull(&m->ls, &st->samples[at[j]], z);
+            p.z = om__lspace_pull(&m->ls, &facet, tri[j], z);
             a = classify_at(m, &p, tx[j], ty[j], &st->terms[at[j]], &tex);
         }
         counts[a == 1 ? 0 : a == 2 ? 1 : 2]++;

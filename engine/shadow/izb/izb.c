@@ -276,7 +276,8 @@ uint32_t om__izb_transform(om__izb *z, const om_strip *st, size_t *next, size_t 
 {
     size_t i = *next;
     uint32_t n = 0, taken = 0;
-    z->samples = st->samples;
+    z->facet.tri = OM_NO_TRI;
+    z->facet.slope = 0.0f;
     for (; i < end && taken < take; i++) {
         if (!(st->terms[i].flags & OM_TERM_EXPOSED)) continue;
         taken++;

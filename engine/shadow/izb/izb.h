@@ -38,7 +38,7 @@ typedef struct om__izb_stats {
 
 typedef struct om__izb {
     const om_scene *scene;
-    const om_sample *samples;   /* the strip's, while its tiles are resolved */
+    om__facet facet;       /* the last key's facet (om__lspace_pull) */
     om__lspace ls;
     om__odepth *mat_od;
     om__izb_key *keys;

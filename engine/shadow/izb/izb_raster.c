@@ -63,7 +63,7 @@ static uint32_t visit(om__izb *z, uint32_t ni, const tjob *j)
             if (!om__blocks(lt, &p)) continue;
             if (!(k->s & OM_IZB_PULLED)) {   /* the first blocker of the unpulled depth */
                 k->s |= OM_IZB_PULLED;
-                k->z = om__lspace_pull(&z->ls, &z->samples[k->s & OM_IZB_INDEX], k->z);
+                k->z = om__lspace_pull(&z->ls, &z->facet, k->tri, k->z);
                 p.z = k->z;
                 if (!om__blocks(lt, &p)) continue;
             }

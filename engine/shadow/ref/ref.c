@@ -185,6 +185,7 @@ typedef struct ref_job {
      * channel's term is a power of two in double (om__odepth_term). */
     om__odepth last_od;
     om_term last_term;
+    om__facet facet;       /* the last sample's facet (om__lspace_pull) */
 } ref_job;
 
 typedef struct walk_ctx {
@@ -193,8 +194,8 @@ typedef struct walk_ctx {
     om__lpoint p;
     uint32_t z;            /* p.z, the whole number it is */
     om__odepth od;
-    const om_sample *smp;  /* the sample: its depth is pulled (om__lspace_pull) where */
-    bool pulled;           /* a triangle first blocks it unpulled */
+    bool pulled;           /* p's depth pulled (om__lspace_pull): where a triangle first
+                              blocks it unpulled */
 } walk_ctx;
 
 /* Whether triangle t's edges hold p, where that settles it: a triangle whose three
@@ -238,24 +239,28 @@ static bool covers(const om__lspace *ls, uint32_t t, const om__lpoint *p)
  * misses p or whose vertices are all farther; ref_light.h). Where double arithmetic
  * is a library routine, single precision answers first (om__blocks_f: the same
  * answer, or none). */
-static bool blocks(const walk_ctx *w, uint32_t tri)
+/* Whether triangle tri blocks w's point: 1 yes, 0 no; lt set up where the double
+ * predicate was asked (*set), for asking it again. */
+static bool blocks(const walk_ctx *w, uint32_t tri, om__ltri *lt, bool *set)
 {
-    om__ltri lt;
     const int f = OM_FAST_FLOAT ? om__blocks_f(&w->r->ls, tri, &w->p, w->z) : -1;
-    return !(f == 0 || (f < 0 && (tri == w->p.tri || !covers(&w->r->ls, tri, &w->p) ||
-                                  !om__lspace_tri(&w->r->ls, tri, &lt) || !om__blocks(&lt, &w->p))));
+    if (f >= 0) return f == 1;
+    *set = tri != w->p.tri && covers(&w->r->ls, tri, &w->p) && om__lspace_tri(&w->r->ls, tri, lt);
+    return *set && om__blocks(lt, &w->p);
 }
 
 static bool visit(void *user, uint32_t tri)
 {
     walk_ctx *w = (walk_ctx *)user;
+    om__ltri lt;
+    bool set = false;
     w->j->candidates++;
-    if (!blocks(w, tri)) return false;
+    if (!blocks(w, tri, &lt, &set)) return false;
     if (!w->pulled) {   /* the first blocker of the unpulled depth: pull it, ask again */
         w->pulled = true;
-        w->z = om__lspace_pull(&w->r->ls, w->smp, w->z);
+        w->z = om__lspace_pull(&w->r->ls, &w->j->facet, w->p.tri, w->z);
         w->p.z = w->z;
-        if (!blocks(w, tri)) return false;
+        if (set ? !om__blocks(&lt, &w->p) : !blocks(w, tri, &lt, &set)) return false;
     }
     om__odepth_add(&w->od, &w->r->mat_od[w->r->scene->tri_mat[tri]]);
     return om__odepth_opaque(&w->od);
@@ -284,7 +289,6 @@ static void shade_sample(ref_job *j, const om_sample *smp, om_term *t)
     w.r = r;
     w.j = j;
     memset(&w.od, 0, sizeof w.od);
-    w.smp = smp;
     w.pulled = false;
     if (!om__lspace_point_at(&r->ls, smp, &w.p, &w.z)) return;
     if (r->mode == CACHE) {
@@ -349,7 +353,6 @@ static void shade_block(ref_job *j, om_strip *st, uint32_t x0, uint32_t y0, uint
             w.j = j;
             w.p = pk->p[y * TILE + x];
             w.z = (uint32_t)w.p.z;   /* a whole number below 2^32 (om__lspace_point_at) */
-            w.smp = &st->samples[(size_t)(y0 + y) * st->width + x0 + x];
             w.pulled = false;
             memset(&w.od, 0, sizeof w.od);
             om__lbvh_walk_list(&r->lb, &r->bvh, list, n, &w.p, visit, &w);
@@ -384,6 +387,8 @@ static void job_init(ref_job *j, const ref_state *r, packet *pk)
     j->r = r;
     j->pk = pk;
     j->last_term.r = j->last_term.g = j->last_term.b = 255;   /* the term of depth 0 */
+    j->facet.tri = OM_NO_TRI;
+    j->facet.slope = 0.0f;
 }
 
 static void resolve_job(ref_job *j, om_strip *st)
