@@ -553,6 +553,109 @@ static bool in_range(const int64_t x[3], const int64_t y[3])
     return true;
 }
 
+/* ---- tiny triangles
+ *
+ * Most triangles of a detailed scene that reach a pixel centre at all hold one or a
+ * few: their box spans at most TINY centres each way. For those the general path's
+ * work is mostly branches on the data (the box, the setup's orientation and tie
+ * rule, each row's span) that a random triangle mispredicts. Here every coordinate is
+ * taken relative to vertex 0 (the box is below (TINY + 1) * 256 units a side, so
+ * products fit 32 bits), each centre of the box is tested with the edge functions
+ * om__tri2_setup would build (the same values: dx (py - yi) - dy (px - xi), less one
+ * off the top and left edges), and a covered centre gets the depth fill gives it:
+ * om__rtri_zplane's plane from the same origin, vertex 0, which no orientation moves
+ * (perm[0] is always 0). The same texels and bits; the plane's divisions still come
+ * only with the first covered centre. */
+#define TINY 4
+
+/* 1 or 0, what snapped returns for such a triangle (whether its box holds a centre of
+ * the target and it has area), or -1 when its box is not tiny. x, y are within
+ * om__tri2's range (2^29), so the biased shifts below see non-negative values. */
+static int tiny(const om_raster *r, const int64_t x[3], const int64_t y[3], const uint32_t *z, const om_vec4 *zc,
+                uint32_t id)
+{
+    const om_target *tg = r->target;
+    const int32_t xa = (int32_t)x[0], xb = (int32_t)x[1], xc = (int32_t)x[2];
+    const int32_t ya = (int32_t)y[0], yb = (int32_t)y[1], yc = (int32_t)y[2];
+    int32_t lx = xa < xb ? xa : xb, hx = xa < xb ? xb : xa, ly = ya < yb ? ya : yb, hy = ya < yb ? yb : ya;
+    lx = xc < lx ? xc : lx;
+    hx = xc > hx ? xc : hx;
+    ly = yc < ly ? yc : ly;
+    hy = yc > hy ? yc : hy;
+    /* bounds' centres, floor((lo + 127) / 256) to floor((hi - 128) / 256), by shifts
+     * of values made non-negative by a bias of 2^30 (a multiple of 256) */
+    const int32_t B = 1 << 30, b = B >> OM_SUBPIX_BITS;
+    int32_t x0 = ((lx + 127 + B) >> OM_SUBPIX_BITS) - b, x1 = ((hx - 128 + B) >> OM_SUBPIX_BITS) - b;
+    int32_t y0 = ((ly + 127 + B) >> OM_SUBPIX_BITS) - b, y1 = ((hy - 128 + B) >> OM_SUBPIX_BITS) - b;
+    if (x1 - x0 >= TINY || y1 - y0 >= TINY) return -1;
+    x0 = x0 < 0 ? 0 : x0;
+    x1 = x1 > (int32_t)tg->width - 1 ? (int32_t)tg->width - 1 : x1;
+    y0 = y0 < (int32_t)tg->y0 ? (int32_t)tg->y0 : y0;
+    y1 = y1 > (int32_t)(tg->y0 + tg->rows) - 1 ? (int32_t)(tg->y0 + tg->rows) - 1 : y1;
+    if (x0 > x1 || y0 > y1) return 0;
+    /* the box is below (TINY + 1) * 256 a side: so is every offset below */
+    int32_t X[3] = {0, xb - xa, xc - xa}, Y[3] = {0, yb - ya, yc - ya};
+    int32_t area2 = X[1] * Y[2] - X[2] * Y[1];
+    int perm1 = 1;
+    if (area2 == 0) return 0;
+    if (area2 < 0) {   /* om__tri2_setup's order: vertices 1 and 2 swapped */
+        int32_t t = X[1]; X[1] = X[2]; X[2] = t;
+        t = Y[1]; Y[1] = Y[2]; Y[2] = t;
+        area2 = -area2;
+        perm1 = 2;
+    }
+    /* edge i, from stored vertex i to the next, at the first centre, and its steps */
+    const int32_t S = OM_SUBPIX, P0 = x0 * S + S / 2 - xa, Q0 = y0 * S + S / 2 - ya;
+    int32_t E[3], sx[3], sy[3];
+    for (int i = 0; i < 3; i++) {
+        const int j = i == 2 ? 0 : i + 1;
+        const int32_t dx = X[j] - X[i], dy = Y[j] - Y[i];
+        /* top_left(-dy, dx): a left edge runs upwards, a top one in +x */
+        E[i] = dx * (Q0 - Y[i]) - dy * (P0 - X[i]) - !(dy < 0 || (dy == 0 && dx > 0));
+        sx[i] = -dy * S;
+        sy[i] = dx * S;
+    }
+    om__rtri t;
+    bool plane = false;
+    for (int32_t py = y0; py <= y1; py++) {
+        int32_t e0 = E[0], e1 = E[1], e2 = E[2];
+        uint32_t *dep = tg->depth + (size_t)(py - (int32_t)tg->y0) * tg->width;
+        for (int32_t px = x0; px <= x1; px++, e0 += sx[0], e1 += sx[1], e2 += sx[2]) {
+            if ((e0 | e1 | e2) < 0) continue;
+            if (!plane) {
+                uint32_t zb[3];
+                t.e.x[0] = xa;
+                t.e.y[0] = ya;
+                t.e.x[1] = x[perm1];
+                t.e.y[1] = y[perm1];
+                t.e.x[2] = x[3 - perm1];
+                t.e.y[2] = y[3 - perm1];
+                t.e.perm[0] = 0;
+                t.e.perm[1] = perm1;
+                t.e.perm[2] = 3 - perm1;
+                t.e.area2 = area2;
+                om__rtri_zplane(&t, z ? z : zdepths(zc, zb));
+                plane = true;
+            }
+            const uint32_t d = (uint32_t)((t.zq0 + t.zqx * (uint64_t)(int64_t)(px * S + S / 2 - xa) +
+                                           t.zqy * (uint64_t)(int64_t)(py * S + S / 2 - ya)) >> 32);
+            if (r->mode == OM_RASTER_DEPTH_ID) {
+                uint32_t *ids = tg->id + (size_t)(py - (int32_t)tg->y0) * tg->width;
+                if (d < dep[px] || (d == dep[px] && id < ids[px] && d != 0xFFFFFFFFu)) {
+                    dep[px] = d;
+                    ids[px] = id;
+                }
+            } else if (d < dep[px]) {
+                dep[px] = d;
+            }
+        }
+        E[0] += sy[0];
+        E[1] += sy[1];
+        E[2] += sy[2];
+    }
+    return 1;
+}
+
 /* A triangle on the grid (x, y) into r's target. Its depths are z, or when z is NULL
  * those of clip-space vertices zc (om__zdepth, as om__project gives them), worked out
  * only once the triangle is known to reach a pixel: most of a detailed scene's
@@ -571,6 +674,10 @@ static bool snapped(const om_raster *r, uint32_t *hiz, const int64_t x[3], const
         return false;
     om__rtri t;
     if (r->mode != OM_RASTER_DEPTH || (hiz && !om__hiz_fits(r->target))) hiz = NULL;
+    if (!cons && !r->grid_x && (ranged || in_range(x, y))) {
+        const int got = tiny(r, x, y, z, zc, id);
+        if (got >= 0) return got;
+    }
     if (r->grid_x) {
         if (!om__tri2_setup(&t.e, x, y, !cons) || !bounds_grid(&t, r)) return false;
         if (!z) z = zdepths(zc, zb);
