@@ -404,6 +404,13 @@ static void batch_boxes(batch *b, const om_target *tg, bool cons)
         const int32_t *gx = b->v.gx + k, *gy = b->v.gy + k, *ok = b->v.ok + k;
         const int32_t in = holds_centre(gx[0], gx[BATCH], gx[2 * BATCH], gy[0], gy[BATCH], gy[2 * BATCH], tg);
         const int32_t all = ok[0] & ok[BATCH] & ok[2 * BATCH];
+#if VERT_LANES
+        if (in & all & !cons) {   /* the line of its first centre, for writing */
+            const centre_box c = centres_in(gx[0], gx[BATCH], gx[2 * BATCH], gy[0], gy[BATCH], gy[2 * BATCH]);
+            const int32_t px = c.x0 < 0 ? 0 : c.x0, py = c.y0 < (int32_t)tg->y0 ? (int32_t)tg->y0 : c.y0;
+            OM_PREFETCH_WRITE(tg->depth + (size_t)(py - (int32_t)tg->y0) * tg->width + px);
+        }
+#endif
         /* conservative coverage reaches pixels beyond the centres: no skipping there */
         b->go[k] = all ? 2 * (in | (int32_t)cons) : 1;
     }
@@ -418,26 +425,35 @@ static void walk_batches(const om_scene *s, const om_mat4 *vp, om_raster *r, uin
     const float sx = (float)tg->width * (OM_SUBPIX / 2), sy = (float)tg->height * (OM_SUBPIX / 2);
     om__cull cl;
     om__cull_begin(&cl, s, vp);
-    batch b;
-    for (uint32_t t0 = ta; t0 < tb; t0 += BATCH) {
+    /* a batch ahead: its texels are asked for while this one is drawn (batch_boxes) */
+    batch bb[2];
+    if (ta < tb) {
+        batch_project(&bb[0], s, ta, tb - ta < BATCH ? tb - ta : BATCH, vp, g, sx, sy);
+        batch_boxes(&bb[0], tg, r->mode == OM_RASTER_CONSERVATIVE);
+    }
+    for (uint32_t t0 = ta, h = 0; t0 < tb; t0 += BATCH, h ^= 1) {
         const uint32_t n = tb - t0 < BATCH ? tb - t0 : BATCH;
-        batch_project(&b, s, t0, n, vp, g, sx, sy);
-        batch_boxes(&b, tg, r->mode == OM_RASTER_CONSERVATIVE);
+        const batch *b = &bb[h];
+        if (tb - t0 > BATCH) {
+            const uint32_t t1 = t0 + BATCH;
+            batch_project(&bb[h ^ 1], s, t1, tb - t1 < BATCH ? tb - t1 : BATCH, vp, g, sx, sy);
+            batch_boxes(&bb[h ^ 1], tg, r->mode == OM_RASTER_CONSERVATIVE);
+        }
         for (uint32_t k = 0; k < n; k++) {
             const uint32_t t = t0 + k;
-            if (!b.go[k] || (rows && ((rows[t] & 0xFFFFu) > y1 || rows[t] >> 16 < y0))) continue;
+            if (!b->go[k] || (rows && ((rows[t] & 0xFFFFu) > y1 || rows[t] >> 16 < y0))) continue;
             r->cull_back = cull && om__cull_next(&cl, t);
             om_vec4 c[3];
             for (int j = 0; j < 3; j++) {
                 const uint32_t i = (uint32_t)j * BATCH + k;
-                c[j].x = b.v.x[i];
-                c[j].y = b.v.y[i];
-                c[j].z = b.v.z[i];
-                c[j].w = b.v.w[i];
+                c[j].x = b->v.x[i];
+                c[j].y = b->v.y[i];
+                c[j].z = b->v.z[i];
+                c[j].w = b->v.w[i];
             }
-            if (b.go[k] == 2) {
-                const int64_t x[3] = {b.v.gx[k], b.v.gx[BATCH + k], b.v.gx[2 * BATCH + k]};
-                const int64_t y[3] = {b.v.gy[k], b.v.gy[BATCH + k], b.v.gy[2 * BATCH + k]};
+            if (b->go[k] == 2) {
+                const int64_t x[3] = {b->v.gx[k], b->v.gx[BATCH + k], b->v.gx[2 * BATCH + k]};
+                const int64_t y[3] = {b->v.gy[k], b->v.gy[BATCH + k], b->v.gy[2 * BATCH + k]};
                 om__raster_projected(r, hiz, x, y, NULL, c, t);
             } else {
                 om__raster_tri_guarded(r, hiz, c, t, tg->width, tg->height, g);
