@@ -564,9 +564,36 @@ static bool in_range(const int64_t x[3], const int64_t y[3])
  * om__tri2_setup would build (the same values: dx (py - yi) - dy (px - xi), less one
  * off the top and left edges), and a covered centre gets the depth fill gives it:
  * om__rtri_zplane's plane from the same origin, vertex 0, which no orientation moves
- * (perm[0] is always 0). The same texels and bits; the plane's divisions still come
- * only with the first covered centre. */
+ * (perm[0] is always 0), or at the first covered centre, most often the only one,
+ * the same depth from one division (tiny_depth). The same texels and bits; the
+ * vertex depths are still worked out only once a centre is covered. */
 #define TINY 4
+
+/* The depth fill gives the point at offsets P, Q from vertex 0 inside a triangle of
+ * vertex depths z0, z0 + dz1, z0 + dz2 at offsets (X[i], Y[i]) from vertex 0 (stored
+ * order, area2 > 0 below 2^22, offsets below 2^11), with one division rather than
+ * om__rtri_zplane's four, when it can tell; false when it cannot.
+ *
+ * Why: fill's sum A = zq0 + zqx P + zqy Q is the exact plane's
+ * V = 2^32 (z0 + 1/2 + M / area2), M = Nx P + Ny Q with Nx, Ny om__rtri_zplane's
+ * numerators, but for the slopes' roundings, each within 1/2: |A - V| <= (|P| + |Q|)
+ * / 2 < 2^11. And A's top half is floor(A / 2^32), as the sum never wraps inside the
+ * triangle (the rule in raster.h). With k = floor((2M + area2) / (2 area2)) and rem
+ * the remainder, V = 2^32 (z0 + k) + 2^32 rem / (2 area2): when rem and 2 area2 - rem
+ * are both at least 4, V lies at least 2^33 / area2 > 2^11 from either end of
+ * its unit, so A's floor is z0 + k; otherwise (about 8 in 2^32) fill's own sum
+ * decides. Magnitudes: |Nx|, |Ny| < 2^44, |M| < 2^56. */
+static inline bool tiny_depth(uint32_t z0, int64_t dz1, int64_t dz2, const int32_t X[3], const int32_t Y[3],
+                              int32_t area2, int64_t P, int64_t Q, uint32_t *d)
+{
+    const int64_t Nx = dz1 * Y[2] - dz2 * Y[1], Ny = dz2 * X[1] - dz1 * X[2];
+    const int64_t num = 2 * (Nx * P + Ny * Q) + area2, den = 2 * (int64_t)area2;
+    /* the floor of num / den, by a division of non-negative values */
+    const int64_t k = num >= 0 ? num / den : -((-num - 1) / den) - 1, rem = num - k * den;
+    if (rem < 4 || den - rem < 4) return false;
+    *d = (uint32_t)((int64_t)z0 + k);
+    return true;
+}
 
 /* 1 or 0, what snapped returns for such a triangle (whether its box holds a centre of
  * the target and it has area), or -1 when its box is not tiny. x, y are within
@@ -599,8 +626,8 @@ static int tiny(const om_raster *r, const int64_t x[3], const int64_t y[3], cons
     int perm1 = 1;
     if (area2 == 0) return 0;
     if (area2 < 0) {   /* om__tri2_setup's order: vertices 1 and 2 swapped */
-        int32_t t = X[1]; X[1] = X[2]; X[2] = t;
-        t = Y[1]; Y[1] = Y[2]; Y[2] = t;
+        int32_t w = X[1]; X[1] = X[2]; X[2] = w;
+        w = Y[1]; Y[1] = Y[2]; Y[2] = w;
         area2 = -area2;
         perm1 = 2;
     }
@@ -617,28 +644,38 @@ static int tiny(const om_raster *r, const int64_t x[3], const int64_t y[3], cons
     }
     om__rtri t;
     bool plane = false;
+    uint32_t zb[3];
+    const uint32_t *zs = NULL;   /* the vertex depths, once a centre is covered */
     for (int32_t py = y0; py <= y1; py++) {
         int32_t e0 = E[0], e1 = E[1], e2 = E[2];
         uint32_t *dep = tg->depth + (size_t)(py - (int32_t)tg->y0) * tg->width;
         for (int32_t px = x0; px <= x1; px++, e0 += sx[0], e1 += sx[1], e2 += sx[2]) {
             if ((e0 | e1 | e2) < 0) continue;
-            if (!plane) {
-                uint32_t zb[3];
-                t.e.x[0] = xa;
-                t.e.y[0] = ya;
-                t.e.x[1] = x[perm1];
-                t.e.y[1] = y[perm1];
-                t.e.x[2] = x[3 - perm1];
-                t.e.y[2] = y[3 - perm1];
-                t.e.perm[0] = 0;
-                t.e.perm[1] = perm1;
-                t.e.perm[2] = 3 - perm1;
-                t.e.area2 = area2;
-                om__rtri_zplane(&t, z ? z : zdepths(zc, zb));
-                plane = true;
+            const int64_t P = (int64_t)px * S + S / 2 - xa, Q = (int64_t)py * S + S / 2 - ya;
+            uint32_t d = 0;
+            bool known = false;
+            if (!zs) {   /* the first covered centre: the depths, and one division */
+                zs = z ? z : zdepths(zc, zb);
+                known = tiny_depth(zs[0], (int64_t)zs[perm1] - zs[0], (int64_t)zs[3 - perm1] - zs[0], X, Y, area2,
+                                   P, Q, &d);
             }
-            const uint32_t d = (uint32_t)((t.zq0 + t.zqx * (uint64_t)(int64_t)(px * S + S / 2 - xa) +
-                                           t.zqy * (uint64_t)(int64_t)(py * S + S / 2 - ya)) >> 32);
+            if (!known) {
+                if (!plane) {
+                    t.e.x[0] = xa;
+                    t.e.y[0] = ya;
+                    t.e.x[1] = x[perm1];
+                    t.e.y[1] = y[perm1];
+                    t.e.x[2] = x[3 - perm1];
+                    t.e.y[2] = y[3 - perm1];
+                    t.e.perm[0] = 0;
+                    t.e.perm[1] = perm1;
+                    t.e.perm[2] = 3 - perm1;
+                    t.e.area2 = area2;
+                    om__rtri_zplane(&t, zs);
+                    plane = true;
+                }
+                d = (uint32_t)((t.zq0 + t.zqx * (uint64_t)P + t.zqy * (uint64_t)Q) >> 32);
+            }
             if (r->mode == OM_RASTER_DEPTH_ID) {
                 uint32_t *ids = tg->id + (size_t)(py - (int32_t)tg->y0) * tg->width;
                 if (d < dep[px] || (d == dep[px] && id < ids[px] && d != 0xFFFFFFFFu)) {

@@ -585,6 +585,70 @@ static void fill_matches_point_tests(void)
     CHECK(covered > 30 * W * H / 2);
 }
 
+/* Tiny triangles, whose box holds a few pixel centres (raster.c's own path for them),
+ * and a few just past that size, all over a small image and across its sides, with
+ * depths flat, random or from one end of the range to the other: every texel holds
+ * what the point test and the fixed-point plane give, with ids and without. */
+static void tiny_matches_point_tests(void)
+{
+    enum { W = 23, H = 19, NT = 400 };
+    static om__rtri tris[NT];
+    static uint32_t ids[NT];
+    static int64_t vx[NT][3], vy[NT][3];
+    static uint32_t vz[NT][3];
+    static const uint32_t flat[] = {2147483647u, 2147483648u, 4294967294u, 4294967295u, 0u, 1u};
+    rng_state = 57;
+    int bad = 0, covered = 0;
+    for (int round = 0; round < 40; round++) {
+        const bool with_id = round % 2;
+        om_target t = target(W, H);
+        if (!with_id) t.id = NULL;
+        om_raster r = {&t, with_id ? OM_RASTER_DEPTH_ID : OM_RASTER_DEPTH, NULL, NULL, NULL, NULL, 0, false,
+                       NULL, NULL, NULL, NULL, 0, 0, NULL, 0};
+        om__target_clear(&t);
+        int nt = 0;
+        for (int k = 0; k < NT; k++) {
+            int64_t *x = vx[nt], *y = vy[nt];
+            uint32_t *z = vz[nt];
+            const int kind = k % 4;
+            const uint32_t zf = flat[(size_t)(rnd() % (sizeof flat / sizeof flat[0]))];
+            /* a box up to 1.5, 3, 6 or 12 pixels a side, anywhere on the image or off
+             * it; every other one with vertices on a grid of half pixels, so that
+             * edges pass through centres (the tie rule) and, with depths a few units
+             * apart (kind 3), the plane lands on halves of a unit at some */
+            const int64_t reach = (int64_t)256 << (rnd() % 4), cx = (int64_t)(rnd() % ((W + 4) * 256)) - 512,
+                          cy = (int64_t)(rnd() % ((H + 4) * 256)) - 512;
+            const int64_t q = rnd() % 2 ? 128 : 1;
+            for (int i = 0; i < 3; i++) {
+                x[i] = (cx + (int64_t)(rnd() % (uint64_t)(reach * 3 / 2 + 1))) / q * q;
+                y[i] = (cy + (int64_t)(rnd() % (uint64_t)(reach * 3 / 2 + 1))) / q * q;
+                z[i] = kind == 0 ? zf : kind == 1 ? (uint32_t)(rnd() % 4294967) * 1000u + (uint32_t)(rnd() % 1000)
+                                      : kind == 2 ? (rnd() % 2 ? 0xFFFFFFFFu : 0u)
+                                                  : zf / 2 + rnd() % 4;
+            }
+            if (om__raster_snapped(&r, x, y, z, (uint32_t)k)) {
+                CHECK(om__tri2_setup(&tris[nt].e, x, y, true));
+                om__rtri_zplane(&tris[nt], z);
+                ids[nt++] = (uint32_t)k;
+            }
+        }
+        for (int j = 0; j < H; j++)
+            for (int i = 0; i < W; i++) {
+                const int64_t px = i * 256 + 128, py = j * 256 + 128;
+                uint32_t d = 0xFFFFFFFFu, id = OM_NO_TRI;
+                for (int k = 0; k < nt; k++)
+                    if (om__tri2_covers(&tris[k].e, px, py)) {
+                        const uint32_t z = om__rtri_zat(&tris[k], px, py);
+                        if (z < d) { d = z; id = ids[k]; }
+                    }
+                covered += id != OM_NO_TRI;
+                bad += depth_buf[j * W + i] != d || (with_id && id_buf[j * W + i] != id);
+            }
+    }
+    CHECK_EQ_U(bad, 0);
+    CHECK(covered > 40 * W * H / 2);
+}
+
 /* The fixed-point plane at the ends of its range: triangles with coordinates up to
  * om__tri2's limit (areas far beyond 2^32, where the steps' fractions come bit by
  * bit), slivers whose steps wrap modulo 2^64, depths from 0 to 2^32 - 1; at random
@@ -892,6 +956,7 @@ void suite_raster(void)
     RUN(snapped_matches_clipped);
     RUN(grid_matches_point_tests);
     RUN(fill_matches_point_tests);
+    RUN(tiny_matches_point_tests);
     RUN(plane_nearest_at_extremes);
     RUN(conservative_superset);
     RUN(conservative_row_mask);
