@@ -595,6 +595,18 @@ static inline bool tiny_depth(uint32_t z0, int64_t dz1, int64_t dz2, const int32
     return true;
 }
 
+/* The edge from (xi, yi) to (xj, yj) of a triangle in om__tri2_setup's order, at
+ * offsets (P, Q): its value there, less one off an edge that is neither top nor left
+ * (top_left(-dy, dx), without branches), and its steps a pixel along and down. */
+static inline void tiny_edge(int32_t xi, int32_t yi, int32_t xj, int32_t yj, int32_t P, int32_t Q, int32_t *e,
+                             int32_t *sx, int32_t *sy)
+{
+    const int32_t dx = xj - xi, dy = yj - yi;
+    *e = dx * (Q - yi) - dy * (P - xi) - (int32_t)!((dy < 0) | ((dy == 0) & (dx > 0)));
+    *sx = -dy * OM_SUBPIX;
+    *sy = dx * OM_SUBPIX;
+}
+
 /* 1 or 0, what snapped returns for such a triangle (whether its box holds a centre of
  * the target and it has area), or -1 when its box is not tiny. x, y are within
  * om__tri2's range (2^29), so the biased shifts below see non-negative values. */
@@ -621,27 +633,19 @@ static int tiny(const om_raster *r, const int64_t x[3], const int64_t y[3], cons
     y1 = y1 > (int32_t)(tg->y0 + tg->rows) - 1 ? (int32_t)(tg->y0 + tg->rows) - 1 : y1;
     if (x0 > x1 || y0 > y1) return 0;
     /* the box is below (TINY + 1) * 256 a side: so is every offset below */
-    int32_t X[3] = {0, xb - xa, xc - xa}, Y[3] = {0, yb - ya, yc - ya};
-    int32_t area2 = X[1] * Y[2] - X[2] * Y[1];
-    int perm1 = 1;
-    if (area2 == 0) return 0;
-    if (area2 < 0) {   /* om__tri2_setup's order: vertices 1 and 2 swapped */
-        int32_t w = X[1]; X[1] = X[2]; X[2] = w;
-        w = Y[1]; Y[1] = Y[2]; Y[2] = w;
-        area2 = -area2;
-        perm1 = 2;
-    }
-    /* edge i, from stored vertex i to the next, at the first centre, and its steps */
+    const int32_t X1 = xb - xa, Y1 = yb - ya, X2 = xc - xa, Y2 = yc - ya, a2 = X1 * Y2 - X2 * Y1;
+    if (a2 == 0) return 0;
+    /* om__tri2_setup's order, vertices 1 and 2 swapped where the area is negative, by
+     * selects: the orientation of a random triangle is a coin toss to a branch */
+    const int perm1 = a2 < 0 ? 2 : 1;
+    const int32_t area2 = a2 < 0 ? -a2 : a2;
+    const int32_t X[3] = {0, a2 < 0 ? X2 : X1, a2 < 0 ? X1 : X2}, Y[3] = {0, a2 < 0 ? Y2 : Y1, a2 < 0 ? Y1 : Y2};
+    /* the edges at the first centre, and their steps a centre along and down */
     const int32_t S = OM_SUBPIX, P0 = x0 * S + S / 2 - xa, Q0 = y0 * S + S / 2 - ya;
     int32_t E[3], sx[3], sy[3];
-    for (int i = 0; i < 3; i++) {
-        const int j = i == 2 ? 0 : i + 1;
-        const int32_t dx = X[j] - X[i], dy = Y[j] - Y[i];
-        /* top_left(-dy, dx): a left edge runs upwards, a top one in +x */
-        E[i] = dx * (Q0 - Y[i]) - dy * (P0 - X[i]) - !(dy < 0 || (dy == 0 && dx > 0));
-        sx[i] = -dy * S;
-        sy[i] = dx * S;
-    }
+    tiny_edge(X[0], Y[0], X[1], Y[1], P0, Q0, &E[0], &sx[0], &sy[0]);
+    tiny_edge(X[1], Y[1], X[2], Y[2], P0, Q0, &E[1], &sx[1], &sy[1]);
+    tiny_edge(X[2], Y[2], X[0], Y[0], P0, Q0, &E[2], &sx[2], &sy[2]);
     om__rtri t;
     bool plane = false;
     uint32_t zb[3];
