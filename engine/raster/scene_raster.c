@@ -404,16 +404,23 @@ static void batch_boxes(batch *b, const om_target *tg, bool cons)
         const int32_t *gx = b->v.gx + k, *gy = b->v.gy + k, *ok = b->v.ok + k;
         const int32_t in = holds_centre(gx[0], gx[BATCH], gx[2 * BATCH], gy[0], gy[BATCH], gy[2 * BATCH], tg);
         const int32_t all = ok[0] & ok[BATCH] & ok[2 * BATCH];
-#if VERT_LANES
-        if (in & all & !cons) {   /* the line of its first centre, for writing */
-            const centre_box c = centres_in(gx[0], gx[BATCH], gx[2 * BATCH], gy[0], gy[BATCH], gy[2 * BATCH]);
-            const int32_t px = c.x0 < 0 ? 0 : c.x0, py = c.y0 < (int32_t)tg->y0 ? (int32_t)tg->y0 : c.y0;
-            OM_PREFETCH_WRITE(tg->depth + (size_t)(py - (int32_t)tg->y0) * tg->width + px);
-        }
-#endif
         /* conservative coverage reaches pixels beyond the centres: no skipping there */
         b->go[k] = all ? 2 * (in | (int32_t)cons) : 1;
     }
+#if VERT_LANES && (defined(__GNUC__) || defined(__clang__))
+    /* The line of the first pixel centre of each triangle that holds one, asked for a
+     * batch before it is drawn (walk_batches): a small triangle's texel is most often
+     * a cache miss on a large map. A read: the line comes with no other copy, and its
+     * store then needs no more. Where the CPU has lanes, and so caches worth asking. */
+    if (!cons)
+        for (int k = 0; k < BATCH; k++) {
+            if (b->go[k] != 2) continue;
+            const int32_t *gx = b->v.gx + k, *gy = b->v.gy + k;
+            const centre_box c = centres_in(gx[0], gx[BATCH], gx[2 * BATCH], gy[0], gy[BATCH], gy[2 * BATCH]);
+            const int32_t px = c.x0 < 0 ? 0 : c.x0, py = c.y0 < (int32_t)tg->y0 ? (int32_t)tg->y0 : c.y0;
+            __builtin_prefetch(tg->depth + (size_t)(py - (int32_t)tg->y0) * tg->width + px);
+        }
+#endif
 }
 
 static void walk_batches(const om_scene *s, const om_mat4 *vp, om_raster *r, uint32_t *hiz, bool cull,
