@@ -559,30 +559,39 @@ static bool in_range(const int64_t x[3], const int64_t y[3])
  * few: their box spans at most TINY centres each way. For those the general path's
  * work is mostly branches on the data (the box, the setup's orientation and tie
  * rule, each row's span) that a random triangle mispredicts. Here every coordinate is
- * taken relative to vertex 0 (the box is below (TINY + 1) * 256 units a side, so
- * products fit 32 bits), each centre of the box is tested with the edge functions
+ * taken relative to vertex 0 (the box is below (TINY + 1) * 256 < 2^13 units a side,
+ * so products fit 32 bits), each centre of the box is tested with the edge functions
  * om__tri2_setup would build (the same values: dx (py - yi) - dy (px - xi), less one
  * off the top and left edges), and a covered centre gets the depth fill gives it:
  * om__rtri_zplane's plane from the same origin, vertex 0, which no orientation moves
  * (perm[0] is always 0), or at the first covered centre, most often the only one,
  * the same depth from one division (tiny_depth). The same texels and bits; the
  * vertex depths are still worked out only once a centre is covered. */
-#define TINY 4
+/* On a CPU with lanes (SSE2, NEON: deep pipelines that a mispredicted branch drains)
+ * boxes up to 16 centres a side gain, on one without (a Cortex-M) up to 8: past that
+ * its spans cost less than testing every centre. The bounds below hold up to 16. */
+#if defined(__SSE2__) || defined(__ARM_NEON)
+#define TINY 16
+#else
+#define TINY 8
+#endif
+typedef char om__tiny_within_bounds[TINY <= 16 ? 1 : -1];
 
 /* The depth fill gives the point at offsets P, Q from vertex 0 inside a triangle of
  * vertex depths z0, z0 + dz1, z0 + dz2 at offsets (X[i], Y[i]) from vertex 0 (stored
- * order, area2 > 0 below 2^22, offsets below 2^11), with one division rather than
+ * order, area2 > 0 below 2^26, offsets below 2^13), with one division rather than
  * om__rtri_zplane's four, when it can tell; false when it cannot.
  *
  * Why: fill's sum A = zq0 + zqx P + zqy Q is the exact plane's
  * V = 2^32 (z0 + 1/2 + M / area2), M = Nx P + Ny Q with Nx, Ny om__rtri_zplane's
  * numerators, but for the slopes' roundings, each within 1/2: |A - V| <= (|P| + |Q|)
- * / 2 < 2^11. And A's top half is floor(A / 2^32), as the sum never wraps inside the
+ * / 2 < 2^13. And A's top half is floor(A / 2^32), as the sum never wraps inside the
  * triangle (the rule in raster.h). With k = floor((2M + area2) / (2 area2)) and rem
  * the remainder, V = 2^32 (z0 + k) + 2^32 rem / (2 area2): when rem and 2 area2 - rem
- * are both at least 4, V lies at least 2^33 / area2 > 2^11 from either end of
- * its unit, so A's floor is z0 + k; otherwise (about 8 in 2^32) fill's own sum
- * decides. Magnitudes: |Nx|, |Ny| < 2^44, |M| < 2^56. */
+ * both pass m = area2 (|P| + |Q|) / 2^32, V lies farther than (|P| + |Q|) / 2 from
+ * either end of its unit, so A's floor is z0 + k; otherwise (some 2m + 1 in 2 area2)
+ * fill's own sum decides. Magnitudes: |Nx|, |Ny| < 2^46, |M| < 2^60, area2 (|P| +
+ * |Q|) < 2^39. */
 static inline bool tiny_depth(uint32_t z0, int64_t dz1, int64_t dz2, const int32_t X[3], const int32_t Y[3],
                               int32_t area2, int64_t P, int64_t Q, uint32_t *d)
 {
@@ -590,7 +599,8 @@ static inline bool tiny_depth(uint32_t z0, int64_t dz1, int64_t dz2, const int32
     const int64_t num = 2 * (Nx * P + Ny * Q) + area2, den = 2 * (int64_t)area2;
     /* the floor of num / den, by a division of non-negative values */
     const int64_t k = num >= 0 ? num / den : -((-num - 1) / den) - 1, rem = num - k * den;
-    if (rem < 4 || den - rem < 4) return false;
+    const int64_t m = (int64_t)(((uint64_t)area2 * (uint64_t)((P < 0 ? -P : P) + (Q < 0 ? -Q : Q))) >> 32);
+    if (rem <= m || den - rem <= m) return false;
     *d = (uint32_t)((int64_t)z0 + k);
     return true;
 }

@@ -612,11 +612,11 @@ static void tiny_matches_point_tests(void)
             uint32_t *z = vz[nt];
             const int kind = k % 4;
             const uint32_t zf = flat[(size_t)(rnd() % (sizeof flat / sizeof flat[0]))];
-            /* a box up to 1.5, 3, 6 or 12 pixels a side, anywhere on the image or off
+            /* a box up to 1.5, 3, 6, 12 or 24 pixels a side, anywhere on the image or off
              * it; every other one with vertices on a grid of half pixels, so that
              * edges pass through centres (the tie rule) and, with depths a few units
              * apart (kind 3), the plane lands on halves of a unit at some */
-            const int64_t reach = (int64_t)256 << (rnd() % 4), cx = (int64_t)(rnd() % ((W + 4) * 256)) - 512,
+            const int64_t reach = (int64_t)256 << (rnd() % 5), cx = (int64_t)(rnd() % ((W + 4) * 256)) - 512,
                           cy = (int64_t)(rnd() % ((H + 4) * 256)) - 512;
             const int64_t q = rnd() % 2 ? 128 : 1;
             for (int i = 0; i < 3; i++) {
@@ -647,6 +647,39 @@ static void tiny_matches_point_tests(void)
     }
     CHECK_EQ_U(bad, 0);
     CHECK(covered > 40 * W * H / 2);
+    /* Planes whose exact value at a centre is a half unit, where the slopes' roundings
+     * decide which way the depth goes: vertices on half pixels, depths a unit or two
+     * apart, one triangle at a time against the point test. */
+    int ties = 0;
+    for (int k = 0; k < 20000; k++) {
+        om_target t = target(8, 8);
+        t.id = NULL;
+        om_raster r = {&t, OM_RASTER_DEPTH, NULL, NULL, NULL, NULL, 0, false, NULL, NULL, NULL, NULL, 0, 0, NULL, 0};
+        om__target_clear(&t);
+        int64_t x[3], y[3];
+        uint32_t z[3];
+        const uint32_t z0 = rnd() * 2u;
+        for (int i = 0; i < 3; i++) {
+            x[i] = (int64_t)(rnd() % 9) * 128 + 512;
+            y[i] = (int64_t)(rnd() % 9) * 128 + 512;
+            z[i] = z0 + rnd() % 3;
+        }
+        om__rtri tr;
+        if (!om__raster_snapped(&r, x, y, z, 0)) continue;
+        CHECK(om__tri2_setup(&tr.e, x, y, true));
+        om__rtri_zplane(&tr, z);
+        for (int j = 0; j < 8; j++)
+            for (int i = 0; i < 8; i++) {
+                const int64_t px = i * 256 + 128, py = j * 256 + 128;
+                const bool in = om__tri2_covers(&tr.e, px, py);
+                const uint32_t want = in ? om__rtri_zat(&tr, px, py) : 0xFFFFFFFFu;
+                bad += depth_buf[j * 8 + i] != want;
+                ties += in && ((tr.zq0 + tr.zqx * (uint64_t)(px - tr.e.x[0]) + tr.zqy * (uint64_t)(py - tr.e.y[0])) &
+                               0xFFFFFFFFu) > 0xFFFFFF00u;
+            }
+    }
+    CHECK_EQ_U(bad, 0);
+    CHECK(ties > 100);
 }
 
 /* The fixed-point plane at the ends of its range: triangles with coordinates up to
