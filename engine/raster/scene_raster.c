@@ -380,6 +380,7 @@ void om__bins_make_verts(const om_scene *s, const om_mat4 *vp, uint32_t width, u
 typedef struct batch {
     lanes v;
     int32_t go[BATCH];       /* 0: passed over, 1: to be clipped, 2: projected, in the target's box */
+    int32_t todo[BATCH], ntodo;   /* the k whose go is not 0, in order */
 } batch;
 
 /* The scene's triangles t0..t0 + n (n <= BATCH) through vp onto a width x height image. */
@@ -397,8 +398,10 @@ static void batch_project(batch *b, const om_scene *s, uint32_t t0, uint32_t n, 
     lanes_project(&b->v, px, py, pz, vp, g, sx, sy);
 }
 
-/* What each triangle of the batch needs (batch.go). */
-static void batch_boxes(batch *b, const om_target *tg, bool cons)
+/* What each of the batch's first n triangles needs (batch.go), and which need
+ * anything (batch.todo): a list made without branches, as whether a small triangle's
+ * box holds a centre is a coin toss to a branch predictor. */
+static void batch_boxes(batch *b, uint32_t n, const om_target *tg, bool cons)
 {
     for (int k = 0; k < BATCH; k++) {
         const int32_t *gx = b->v.gx + k, *gy = b->v.gy + k, *ok = b->v.ok + k;
@@ -407,13 +410,19 @@ static void batch_boxes(batch *b, const om_target *tg, bool cons)
         /* conservative coverage reaches pixels beyond the centres: no skipping there */
         b->go[k] = all ? 2 * (in | (int32_t)cons) : 1;
     }
+    b->ntodo = 0;
+    for (int k = 0; k < (int)n; k++) {
+        b->todo[b->ntodo] = k;
+        b->ntodo += b->go[k] != 0;
+    }
 #if VERT_LANES && (defined(__GNUC__) || defined(__clang__))
     /* The line of the first pixel centre of each triangle that holds one, asked for a
      * batch before it is drawn (walk_batches): a small triangle's texel is most often
      * a cache miss on a large map. A read: the line comes with no other copy, and its
      * store then needs no more. Where the CPU has lanes, and so caches worth asking. */
     if (!cons)
-        for (int k = 0; k < BATCH; k++) {
+        for (int j = 0; j < b->ntodo; j++) {
+            const int k = b->todo[j];
             if (b->go[k] != 2) continue;
             const int32_t *gx = b->v.gx + k, *gy = b->v.gy + k;
             const centre_box c = centres_in(gx[0], gx[BATCH], gx[2 * BATCH], gy[0], gy[BATCH], gy[2 * BATCH]);
@@ -435,20 +444,20 @@ static void walk_batches(const om_scene *s, const om_mat4 *vp, om_raster *r, uin
     /* a batch ahead: its texels are asked for while this one is drawn (batch_boxes) */
     batch bb[2];
     if (ta < tb) {
-        batch_project(&bb[0], s, ta, tb - ta < BATCH ? tb - ta : BATCH, vp, g, sx, sy);
-        batch_boxes(&bb[0], tg, r->mode == OM_RASTER_CONSERVATIVE);
+        const uint32_t n = tb - ta < BATCH ? tb - ta : BATCH;
+        batch_project(&bb[0], s, ta, n, vp, g, sx, sy);
+        batch_boxes(&bb[0], n, tg, r->mode == OM_RASTER_CONSERVATIVE);
     }
     for (uint32_t t0 = ta, h = 0; t0 < tb; t0 += BATCH, h ^= 1) {
-        const uint32_t n = tb - t0 < BATCH ? tb - t0 : BATCH;
         const batch *b = &bb[h];
         if (tb - t0 > BATCH) {
-            const uint32_t t1 = t0 + BATCH;
-            batch_project(&bb[h ^ 1], s, t1, tb - t1 < BATCH ? tb - t1 : BATCH, vp, g, sx, sy);
-            batch_boxes(&bb[h ^ 1], tg, r->mode == OM_RASTER_CONSERVATIVE);
+            const uint32_t t1 = t0 + BATCH, n = tb - t1 < BATCH ? tb - t1 : BATCH;
+            batch_project(&bb[h ^ 1], s, t1, n, vp, g, sx, sy);
+            batch_boxes(&bb[h ^ 1], n, tg, r->mode == OM_RASTER_CONSERVATIVE);
         }
-        for (uint32_t k = 0; k < n; k++) {
-            const uint32_t t = t0 + k;
-            if (!b->go[k] || (rows && ((rows[t] & 0xFFFFu) > y1 || rows[t] >> 16 < y0))) continue;
+        for (int q = 0; q < b->ntodo; q++) {
+            const uint32_t k = (uint32_t)b->todo[q], t = t0 + k;
+            if (rows && ((rows[t] & 0xFFFFu) > y1 || rows[t] >> 16 < y0)) continue;
             r->cull_back = cull && om__cull_next(&cl, t);
             om_vec4 c[3];
             for (int j = 0; j < 3; j++) {
