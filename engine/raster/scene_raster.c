@@ -441,20 +441,19 @@ static void walk_batches(const om_scene *s, const om_mat4 *vp, om_raster *r, uin
     const float sx = (float)tg->width * (OM_SUBPIX / 2), sy = (float)tg->height * (OM_SUBPIX / 2);
     om__cull cl;
     om__cull_begin(&cl, s, vp);
-    /* a batch ahead: its texels are asked for while this one is drawn (batch_boxes) */
+    /* a batch ahead: batch t1 is projected, and its texels asked for (batch_boxes),
+     * before batch t1 - BATCH is drawn; one call of each, which a compiler puts in line */
     batch bb[2];
-    if (ta < tb) {
-        const uint32_t n = tb - ta < BATCH ? tb - ta : BATCH;
-        batch_project(&bb[0], s, ta, n, vp, g, sx, sy);
-        batch_boxes(&bb[0], n, tg, r->mode == OM_RASTER_CONSERVATIVE);
-    }
-    for (uint32_t t0 = ta, h = 0; t0 < tb; t0 += BATCH, h ^= 1) {
-        const batch *b = &bb[h];
-        if (tb - t0 > BATCH) {
-            const uint32_t t1 = t0 + BATCH, n = tb - t1 < BATCH ? tb - t1 : BATCH;
-            batch_project(&bb[h ^ 1], s, t1, n, vp, g, sx, sy);
-            batch_boxes(&bb[h ^ 1], n, tg, r->mode == OM_RASTER_CONSERVATIVE);
+    for (uint32_t t1 = ta, h = 0;; t1 += BATCH, h ^= 1) {
+        if (t1 < tb) {
+            const uint32_t n = tb - t1 < BATCH ? tb - t1 : BATCH;
+            batch_project(&bb[h], s, t1, n, vp, g, sx, sy);
+            batch_boxes(&bb[h], n, tg, r->mode == OM_RASTER_CONSERVATIVE);
         }
+        if (t1 == ta) continue;
+        if (t1 - BATCH >= tb) break;
+        const uint32_t t0 = t1 - BATCH;
+        const batch *b = &bb[h ^ 1];
         for (int q = 0; q < b->ntodo; q++) {
             const uint32_t k = (uint32_t)b->todo[q], t = t0 + k;
             if (rows && ((rows[t] & 0xFFFFu) > y1 || rows[t] >> 16 < y0)) continue;
