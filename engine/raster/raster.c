@@ -567,14 +567,9 @@ static bool in_range(const int64_t x[3], const int64_t y[3])
  * (perm[0] is always 0), or at the first covered centre, most often the only one,
  * the same depth from one division (tiny_depth). The same texels and bits; the
  * vertex depths are still worked out only once a centre is covered. */
-/* On a CPU with lanes (SSE2, NEON: deep pipelines that a mispredicted branch drains)
- * boxes up to 16 centres a side gain, on one without (a Cortex-M) up to 8: past that
- * its spans cost less than testing every centre. The bounds below hold up to 16. */
-#if defined(__SSE2__) || defined(__ARM_NEON)
-#define TINY 16
-#else
+/* Past 8 centres a side the spans cost less than testing every centre (a Cortex-M's
+ * light pass, the eye pass of larger triangles). The bounds below hold up to 16. */
 #define TINY 8
-#endif
 typedef char om__tiny_within_bounds[TINY <= 16 ? 1 : -1];
 
 /* The depth fill gives the point at offsets P, Q from vertex 0 inside a triangle of
