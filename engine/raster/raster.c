@@ -553,6 +553,155 @@ static bool in_range(const int64_t x[3], const int64_t y[3])
     return true;
 }
 
+/* ---- tiny triangles
+ *
+ * Most triangles of a detailed scene that reach a pixel centre at all hold one or a
+ * few: their box spans at most TINY centres each way. For those the general path's
+ * work is mostly branches on the data (the box, the setup's orientation and tie
+ * rule, each row's span) that a random triangle mispredicts. Here every coordinate is
+ * taken relative to vertex 0 (the box is below (TINY + 1) * 256 < 2^13 units a side,
+ * so products fit 32 bits), each centre of the box is tested with the edge functions
+ * om__tri2_setup would build (the same values: dx (py - yi) - dy (px - xi), less one
+ * off the top and left edges), and a covered centre gets the depth fill gives it:
+ * om__rtri_zplane's plane from the same origin, vertex 0, which no orientation moves
+ * (perm[0] is always 0), or at the first covered centre, most often the only one,
+ * the same depth from one division (tiny_depth). The same texels and bits; the
+ * vertex depths are still worked out only once a centre is covered. */
+/* Past 8 centres a side the spans cost less than testing every centre (a Cortex-M's
+ * light pass, the eye pass of larger triangles). The bounds below hold up to 16. */
+#define TINY 8
+typedef char om__tiny_within_bounds[TINY <= 16 ? 1 : -1];
+
+/* The depth fill gives the point at offsets P, Q from vertex 0 inside a triangle of
+ * vertex depths z0, z0 + dz1, z0 + dz2 at offsets (X[i], Y[i]) from vertex 0 (stored
+ * order, area2 > 0 below 2^26, offsets below 2^13), with one division rather than
+ * om__rtri_zplane's four, when it can tell; false when it cannot.
+ *
+ * Why: fill's sum A = zq0 + zqx P + zqy Q is the exact plane's
+ * V = 2^32 (z0 + 1/2 + M / area2), M = Nx P + Ny Q with Nx, Ny om__rtri_zplane's
+ * numerators, but for the slopes' roundings, each within 1/2: |A - V| <= (|P| + |Q|)
+ * / 2 < 2^13. And A's top half is floor(A / 2^32), as the sum never wraps inside the
+ * triangle (the rule in raster.h). With k = floor((2M + area2) / (2 area2)) and rem
+ * the remainder, V = 2^32 (z0 + k) + 2^32 rem / (2 area2): when rem and 2 area2 - rem
+ * both pass m = area2 (|P| + |Q|) / 2^32, V lies farther than (|P| + |Q|) / 2 from
+ * either end of its unit, so A's floor is z0 + k; otherwise (some 2m + 1 in 2 area2)
+ * fill's own sum decides. Magnitudes: |Nx|, |Ny| < 2^46, |M| < 2^60, area2 (|P| +
+ * |Q|) < 2^39. */
+static inline bool tiny_depth(uint32_t z0, int64_t dz1, int64_t dz2, const int32_t X[3], const int32_t Y[3],
+                              int32_t area2, int64_t P, int64_t Q, uint32_t *d)
+{
+    const int64_t Nx = dz1 * Y[2] - dz2 * Y[1], Ny = dz2 * X[1] - dz1 * X[2];
+    const int64_t num = 2 * (Nx * P + Ny * Q) + area2, den = 2 * (int64_t)area2;
+    /* the floor of num / den, by a division of non-negative values */
+    const int64_t k = num >= 0 ? num / den : -((-num - 1) / den) - 1, rem = num - k * den;
+    const int64_t m = (int64_t)(((uint64_t)area2 * (uint64_t)((P < 0 ? -P : P) + (Q < 0 ? -Q : Q))) >> 32);
+    if (rem <= m || den - rem <= m) return false;
+    *d = (uint32_t)((int64_t)z0 + k);
+    return true;
+}
+
+/* The edge from (xi, yi) to (xj, yj) of a triangle in om__tri2_setup's order, at
+ * offsets (P, Q): its value there, less one off an edge that is neither top nor left
+ * (top_left(-dy, dx), without branches), and its steps a pixel along and down. */
+static inline void tiny_edge(int32_t xi, int32_t yi, int32_t xj, int32_t yj, int32_t P, int32_t Q, int32_t *e,
+                             int32_t *sx, int32_t *sy)
+{
+    const int32_t dx = xj - xi, dy = yj - yi;
+    *e = dx * (Q - yi) - dy * (P - xi) - (int32_t)!((dy < 0) | ((dy == 0) & (dx > 0)));
+    *sx = -dy * OM_SUBPIX;
+    *sy = dx * OM_SUBPIX;
+}
+
+/* 1 or 0, what snapped returns for such a triangle (whether its box holds a centre of
+ * the target and it has area), or -1 when its box is not tiny. x, y are within
+ * om__tri2's range (2^29), so the biased shifts below see non-negative values. */
+static int tiny(const om_raster *r, const int64_t x[3], const int64_t y[3], const uint32_t *z, const om_vec4 *zc,
+                uint32_t id)
+{
+    const om_target *tg = r->target;
+    const int32_t xa = (int32_t)x[0], xb = (int32_t)x[1], xc = (int32_t)x[2];
+    const int32_t ya = (int32_t)y[0], yb = (int32_t)y[1], yc = (int32_t)y[2];
+    int32_t lx = xa < xb ? xa : xb, hx = xa < xb ? xb : xa, ly = ya < yb ? ya : yb, hy = ya < yb ? yb : ya;
+    lx = xc < lx ? xc : lx;
+    hx = xc > hx ? xc : hx;
+    ly = yc < ly ? yc : ly;
+    hy = yc > hy ? yc : hy;
+    /* bounds' centres, floor((lo + 127) / 256) to floor((hi - 128) / 256), by shifts
+     * of values made non-negative by a bias of 2^30 (a multiple of 256) */
+    const int32_t B = 1 << 30, b = B >> OM_SUBPIX_BITS;
+    int32_t x0 = ((lx + 127 + B) >> OM_SUBPIX_BITS) - b, x1 = ((hx - 128 + B) >> OM_SUBPIX_BITS) - b;
+    int32_t y0 = ((ly + 127 + B) >> OM_SUBPIX_BITS) - b, y1 = ((hy - 128 + B) >> OM_SUBPIX_BITS) - b;
+    if (x1 - x0 >= TINY || y1 - y0 >= TINY) return -1;
+    x0 = x0 < 0 ? 0 : x0;
+    x1 = x1 > (int32_t)tg->width - 1 ? (int32_t)tg->width - 1 : x1;
+    y0 = y0 < (int32_t)tg->y0 ? (int32_t)tg->y0 : y0;
+    y1 = y1 > (int32_t)(tg->y0 + tg->rows) - 1 ? (int32_t)(tg->y0 + tg->rows) - 1 : y1;
+    if (x0 > x1 || y0 > y1) return 0;
+    /* the box is below (TINY + 1) * 256 a side: so is every offset below */
+    const int32_t X1 = xb - xa, Y1 = yb - ya, X2 = xc - xa, Y2 = yc - ya, a2 = X1 * Y2 - X2 * Y1;
+    if (a2 == 0) return 0;
+    /* om__tri2_setup's order, vertices 1 and 2 swapped where the area is negative, by
+     * selects: the orientation of a random triangle is a coin toss to a branch */
+    const int perm1 = a2 < 0 ? 2 : 1;
+    const int32_t area2 = a2 < 0 ? -a2 : a2;
+    const int32_t X[3] = {0, a2 < 0 ? X2 : X1, a2 < 0 ? X1 : X2}, Y[3] = {0, a2 < 0 ? Y2 : Y1, a2 < 0 ? Y1 : Y2};
+    /* the edges at the first centre, and their steps a centre along and down */
+    const int32_t S = OM_SUBPIX, P0 = x0 * S + S / 2 - xa, Q0 = y0 * S + S / 2 - ya;
+    int32_t E[3], sx[3], sy[3];
+    tiny_edge(X[0], Y[0], X[1], Y[1], P0, Q0, &E[0], &sx[0], &sy[0]);
+    tiny_edge(X[1], Y[1], X[2], Y[2], P0, Q0, &E[1], &sx[1], &sy[1]);
+    tiny_edge(X[2], Y[2], X[0], Y[0], P0, Q0, &E[2], &sx[2], &sy[2]);
+    om__rtri t;
+    bool plane = false;
+    uint32_t zb[3];
+    const uint32_t *zs = NULL;   /* the vertex depths, once a centre is covered */
+    for (int32_t py = y0; py <= y1; py++) {
+        int32_t e0 = E[0], e1 = E[1], e2 = E[2];
+        uint32_t *dep = tg->depth + (size_t)(py - (int32_t)tg->y0) * tg->width;
+        for (int32_t px = x0; px <= x1; px++, e0 += sx[0], e1 += sx[1], e2 += sx[2]) {
+            if ((e0 | e1 | e2) < 0) continue;
+            const int64_t P = (int64_t)px * S + S / 2 - xa, Q = (int64_t)py * S + S / 2 - ya;
+            uint32_t d = 0;
+            bool known = false;
+            if (!zs) {   /* the first covered centre: the depths, and one division */
+                zs = z ? z : zdepths(zc, zb);
+                known = tiny_depth(zs[0], (int64_t)zs[perm1] - zs[0], (int64_t)zs[3 - perm1] - zs[0], X, Y, area2,
+                                   P, Q, &d);
+            }
+            if (!known) {
+                if (!plane) {
+                    t.e.x[0] = xa;
+                    t.e.y[0] = ya;
+                    t.e.x[1] = x[perm1];
+                    t.e.y[1] = y[perm1];
+                    t.e.x[2] = x[3 - perm1];
+                    t.e.y[2] = y[3 - perm1];
+                    t.e.perm[0] = 0;
+                    t.e.perm[1] = perm1;
+                    t.e.perm[2] = 3 - perm1;
+                    t.e.area2 = area2;
+                    om__rtri_zplane(&t, zs);
+                    plane = true;
+                }
+                d = (uint32_t)((t.zq0 + t.zqx * (uint64_t)P + t.zqy * (uint64_t)Q) >> 32);
+            }
+            if (r->mode == OM_RASTER_DEPTH_ID) {
+                uint32_t *ids = tg->id + (size_t)(py - (int32_t)tg->y0) * tg->width;
+                if (d < dep[px] || (d == dep[px] && id < ids[px] && d != 0xFFFFFFFFu)) {
+                    dep[px] = d;
+                    ids[px] = id;
+                }
+            } else if (d < dep[px]) {
+                dep[px] = d;
+            }
+        }
+        E[0] += sy[0];
+        E[1] += sy[1];
+        E[2] += sy[2];
+    }
+    return 1;
+}
+
 /* A triangle on the grid (x, y) into r's target. Its depths are z, or when z is NULL
  * those of clip-space vertices zc (om__zdepth, as om__project gives them), worked out
  * only once the triangle is known to reach a pixel: most of a detailed scene's
@@ -571,6 +720,10 @@ static bool snapped(const om_raster *r, uint32_t *hiz, const int64_t x[3], const
         return false;
     om__rtri t;
     if (r->mode != OM_RASTER_DEPTH || (hiz && !om__hiz_fits(r->target))) hiz = NULL;
+    if (!cons && !r->grid_x && (ranged || in_range(x, y))) {
+        const int got = tiny(r, x, y, z, zc, id);
+        if (got >= 0) return got;
+    }
     if (r->grid_x) {
         if (!om__tri2_setup(&t.e, x, y, !cons) || !bounds_grid(&t, r)) return false;
         if (!z) z = zdepths(zc, zb);

@@ -384,6 +384,7 @@ void om__bins_make_verts(const om_scene *s, const om_mat4 *vp, om_vec3 o, uint32
 typedef struct batch {
     lanes v;
     int32_t go[BATCH];       /* 0: passed over, 1: to be clipped, 2: projected, in the target's box */
+    int32_t todo[BATCH], ntodo;   /* the k whose go is not 0, in order */
 } batch;
 
 /* The scene's triangles t0..t0 + n (n <= BATCH) through vp onto a width x height image. */
@@ -401,8 +402,10 @@ static void batch_project(batch *b, const om_scene *s, uint32_t t0, uint32_t n, 
     lanes_project(&b->v, px, py, pz, vp, g, sx, sy);
 }
 
-/* What each triangle of the batch needs (batch.go). */
-static void batch_boxes(batch *b, const om_target *tg, bool cons)
+/* What each of the batch's first n triangles needs (batch.go), and which need
+ * anything (batch.todo): a list made without branches, as whether a small triangle's
+ * box holds a centre is a coin toss to a branch predictor. */
+static void batch_boxes(batch *b, uint32_t n, const om_target *tg, bool cons)
 {
     for (int k = 0; k < BATCH; k++) {
         const int32_t *gx = b->v.gx + k, *gy = b->v.gy + k, *ok = b->v.ok + k;
@@ -411,6 +414,26 @@ static void batch_boxes(batch *b, const om_target *tg, bool cons)
         /* conservative coverage reaches pixels beyond the centres: no skipping there */
         b->go[k] = all ? 2 * (in | (int32_t)cons) : 1;
     }
+    b->ntodo = 0;
+    for (int k = 0; k < (int)n; k++) {
+        b->todo[b->ntodo] = k;
+        b->ntodo += b->go[k] != 0;
+    }
+#if VERT_LANES && (defined(__GNUC__) || defined(__clang__))
+    /* The line of the first pixel centre of each triangle that holds one, asked for a
+     * batch before it is drawn (walk_batches): a small triangle's texel is most often
+     * a cache miss on a large map. A read: the line comes with no other copy, and its
+     * store then needs no more. Where the CPU has lanes, and so caches worth asking. */
+    if (!cons)
+        for (int j = 0; j < b->ntodo; j++) {
+            const int k = b->todo[j];
+            if (b->go[k] != 2) continue;
+            const int32_t *gx = b->v.gx + k, *gy = b->v.gy + k;
+            const centre_box c = centres_in(gx[0], gx[BATCH], gx[2 * BATCH], gy[0], gy[BATCH], gy[2 * BATCH]);
+            const int32_t px = c.x0 < 0 ? 0 : c.x0, py = c.y0 < (int32_t)tg->y0 ? (int32_t)tg->y0 : c.y0;
+            __builtin_prefetch(tg->depth + (size_t)(py - (int32_t)tg->y0) * tg->width + px);
+        }
+#endif
 }
 
 static void walk_batches(const om_scene *s, const om_mat4 *vp, om_vec3 o, om_raster *r, uint32_t *hiz, bool cull,
@@ -422,26 +445,34 @@ static void walk_batches(const om_scene *s, const om_mat4 *vp, om_vec3 o, om_ras
     const float sx = (float)tg->width * (OM_SUBPIX / 2), sy = (float)tg->height * (OM_SUBPIX / 2);
     om__cull cl;
     om__cull_begin(&cl, s, vp, o);
-    batch b;
-    for (uint32_t t0 = ta; t0 < tb; t0 += BATCH) {
-        const uint32_t n = tb - t0 < BATCH ? tb - t0 : BATCH;
-        batch_project(&b, s, t0, n, vp, o, g, sx, sy);
-        batch_boxes(&b, tg, r->mode == OM_RASTER_CONSERVATIVE);
-        for (uint32_t k = 0; k < n; k++) {
-            const uint32_t t = t0 + k;
-            if (!b.go[k] || (rows && ((rows[t] & 0xFFFFu) > y1 || rows[t] >> 16 < y0))) continue;
+    /* a batch ahead: batch t1 is projected, and its texels asked for (batch_boxes),
+     * before batch t1 - BATCH is drawn; one call of each, which a compiler puts in line */
+    batch bb[2];
+    for (uint32_t t1 = ta, h = 0;; t1 += BATCH, h ^= 1) {
+        if (t1 < tb) {
+            const uint32_t n = tb - t1 < BATCH ? tb - t1 : BATCH;
+            batch_project(&bb[h], s, t1, n, vp, o, g, sx, sy);
+            batch_boxes(&bb[h], n, tg, r->mode == OM_RASTER_CONSERVATIVE);
+        }
+        if (t1 == ta) continue;
+        if (t1 - BATCH >= tb) break;
+        const uint32_t t0 = t1 - BATCH;
+        const batch *b = &bb[h ^ 1];
+        for (int q = 0; q < b->ntodo; q++) {
+            const uint32_t k = (uint32_t)b->todo[q], t = t0 + k;
+            if (rows && ((rows[t] & 0xFFFFu) > y1 || rows[t] >> 16 < y0)) continue;
             r->cull_back = cull && om__cull_next(&cl, t);
             om_vec4 c[3];
             for (int j = 0; j < 3; j++) {
                 const uint32_t i = (uint32_t)j * BATCH + k;
-                c[j].x = b.v.x[i];
-                c[j].y = b.v.y[i];
-                c[j].z = b.v.z[i];
-                c[j].w = b.v.w[i];
+                c[j].x = b->v.x[i];
+                c[j].y = b->v.y[i];
+                c[j].z = b->v.z[i];
+                c[j].w = b->v.w[i];
             }
-            if (b.go[k] == 2) {
-                const int64_t x[3] = {b.v.gx[k], b.v.gx[BATCH + k], b.v.gx[2 * BATCH + k]};
-                const int64_t y[3] = {b.v.gy[k], b.v.gy[BATCH + k], b.v.gy[2 * BATCH + k]};
+            if (b->go[k] == 2) {
+                const int64_t x[3] = {b->v.gx[k], b->v.gx[BATCH + k], b->v.gx[2 * BATCH + k]};
+                const int64_t y[3] = {b->v.gy[k], b->v.gy[BATCH + k], b->v.gy[2 * BATCH + k]};
                 om__raster_projected(r, hiz, x, y, NULL, c, t);
             } else {
                 om__raster_tri_guarded(r, hiz, c, t, tg->width, tg->height, g);

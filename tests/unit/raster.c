@@ -585,6 +585,103 @@ static void fill_matches_point_tests(void)
     CHECK(covered > 30 * W * H / 2);
 }
 
+/* Tiny triangles, whose box holds a few pixel centres (raster.c's own path for them),
+ * and a few just past that size, all over a small image and across its sides, with
+ * depths flat, random or from one end of the range to the other: every texel holds
+ * what the point test and the fixed-point plane give, with ids and without. */
+static void tiny_matches_point_tests(void)
+{
+    enum { W = 23, H = 19, NT = 400 };
+    static om__rtri tris[NT];
+    static uint32_t ids[NT];
+    static int64_t vx[NT][3], vy[NT][3];
+    static uint32_t vz[NT][3];
+    static const uint32_t flat[] = {2147483647u, 2147483648u, 4294967294u, 4294967295u, 0u, 1u};
+    rng_state = 57;
+    int bad = 0, covered = 0;
+    for (int round = 0; round < 40; round++) {
+        const bool with_id = round % 2;
+        om_target t = target(W, H);
+        if (!with_id) t.id = NULL;
+        om_raster r = {&t, with_id ? OM_RASTER_DEPTH_ID : OM_RASTER_DEPTH, NULL, NULL, NULL, NULL, 0, false,
+                       NULL, NULL, NULL, NULL, 0, 0, NULL, 0};
+        om__target_clear(&t);
+        int nt = 0;
+        for (int k = 0; k < NT; k++) {
+            int64_t *x = vx[nt], *y = vy[nt];
+            uint32_t *z = vz[nt];
+            const int kind = k % 4;
+            const uint32_t zf = flat[(size_t)(rnd() % (sizeof flat / sizeof flat[0]))];
+            /* a box up to 1.5, 3, 6, 12 or 24 pixels a side, anywhere on the image or off
+             * it; every other one with vertices on a grid of half pixels, so that
+             * edges pass through centres (the tie rule) and, with depths a few units
+             * apart (kind 3), the plane lands on halves of a unit at some */
+            const int64_t reach = (int64_t)256 << (rnd() % 5), cx = (int64_t)(rnd() % ((W + 4) * 256)) - 512,
+                          cy = (int64_t)(rnd() % ((H + 4) * 256)) - 512;
+            const int64_t q = rnd() % 2 ? 128 : 1;
+            for (int i = 0; i < 3; i++) {
+                x[i] = (cx + (int64_t)(rnd() % (uint64_t)(reach * 3 / 2 + 1))) / q * q;
+                y[i] = (cy + (int64_t)(rnd() % (uint64_t)(reach * 3 / 2 + 1))) / q * q;
+                z[i] = kind == 0 ? zf : kind == 1 ? (uint32_t)(rnd() % 4294967) * 1000u + (uint32_t)(rnd() % 1000)
+                                      : kind == 2 ? (rnd() % 2 ? 0xFFFFFFFFu : 0u)
+                                                  : zf / 2 + rnd() % 4;
+            }
+            if (om__raster_snapped(&r, x, y, z, (uint32_t)k)) {
+                CHECK(om__tri2_setup(&tris[nt].e, x, y, true));
+                om__rtri_zplane(&tris[nt], z);
+                ids[nt++] = (uint32_t)k;
+            }
+        }
+        for (int j = 0; j < H; j++)
+            for (int i = 0; i < W; i++) {
+                const int64_t px = i * 256 + 128, py = j * 256 + 128;
+                uint32_t d = 0xFFFFFFFFu, id = OM_NO_TRI;
+                for (int k = 0; k < nt; k++)
+                    if (om__tri2_covers(&tris[k].e, px, py)) {
+                        const uint32_t z = om__rtri_zat(&tris[k], px, py);
+                        if (z < d) { d = z; id = ids[k]; }
+                    }
+                covered += id != OM_NO_TRI;
+                bad += depth_buf[j * W + i] != d || (with_id && id_buf[j * W + i] != id);
+            }
+    }
+    CHECK_EQ_U(bad, 0);
+    CHECK(covered > 40 * W * H / 2);
+    /* Planes whose exact value at a centre is a half unit, where the slopes' roundings
+     * decide which way the depth goes: vertices on half pixels, depths a unit or two
+     * apart, one triangle at a time against the point test. */
+    int ties = 0;
+    for (int k = 0; k < 20000; k++) {
+        om_target t = target(8, 8);
+        t.id = NULL;
+        om_raster r = {&t, OM_RASTER_DEPTH, NULL, NULL, NULL, NULL, 0, false, NULL, NULL, NULL, NULL, 0, 0, NULL, 0};
+        om__target_clear(&t);
+        int64_t x[3], y[3];
+        uint32_t z[3];
+        const uint32_t z0 = rnd() * 2u;
+        for (int i = 0; i < 3; i++) {
+            x[i] = (int64_t)(rnd() % 9) * 128 + 512;
+            y[i] = (int64_t)(rnd() % 9) * 128 + 512;
+            z[i] = z0 + rnd() % 3;
+        }
+        om__rtri tr;
+        if (!om__raster_snapped(&r, x, y, z, 0)) continue;
+        CHECK(om__tri2_setup(&tr.e, x, y, true));
+        om__rtri_zplane(&tr, z);
+        for (int j = 0; j < 8; j++)
+            for (int i = 0; i < 8; i++) {
+                const int64_t px = i * 256 + 128, py = j * 256 + 128;
+                const bool in = om__tri2_covers(&tr.e, px, py);
+                const uint32_t want = in ? om__rtri_zat(&tr, px, py) : 0xFFFFFFFFu;
+                bad += depth_buf[j * 8 + i] != want;
+                ties += in && ((tr.zq0 + tr.zqx * (uint64_t)(px - tr.e.x[0]) + tr.zqy * (uint64_t)(py - tr.e.y[0])) &
+                               0xFFFFFFFFu) > 0xFFFFFF00u;
+            }
+    }
+    CHECK_EQ_U(bad, 0);
+    CHECK(ties > 100);
+}
+
 /* The fixed-point plane at the ends of its range: triangles with coordinates up to
  * om__tri2's limit (areas far beyond 2^32, where the steps' fractions come bit by
  * bit), slivers whose steps wrap modulo 2^64, depths from 0 to 2^32 - 1; at random
@@ -892,6 +989,7 @@ void suite_raster(void)
     RUN(snapped_matches_clipped);
     RUN(grid_matches_point_tests);
     RUN(fill_matches_point_tests);
+    RUN(tiny_matches_point_tests);
     RUN(plane_nearest_at_extremes);
     RUN(conservative_superset);
     RUN(conservative_row_mask);
