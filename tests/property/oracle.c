@@ -370,11 +370,15 @@ static tally against_oracle(const om_scene *s, const char *what, uint32_t w, uin
     printf(")\n");
     CHECK_MSG(n.other == 0, "%s: %u disagreements the oracle cannot explain", what, n.other);
     /* at least 99.995% agree but for edge-on facets and the data's spacing (above);
-     * at most 0.02% on edge-on facets */
-    CHECK_MSG((double)(n.differ - n.edge_on - n.data) <= 5e-5 * n.covered, "%s: %u of %u covered samples disagree",
-              what, n.differ - n.edge_on - n.data, n.covered);
-    CHECK_MSG((double)n.edge_on <= 2e-4 * n.covered, "%s: %u of %u covered samples disagree on edge-on facets",
-              what, n.edge_on, n.covered);
+     * at most 0.02% on edge-on facets. A share can only be held where one sample is
+     * within it: from 20,000 covered samples (every size but OM_TEST_QUICK's, whose
+     * runs are for memory checkers; every other build holds the shares at full size) */
+    if (n.covered >= 20000) {
+        CHECK_MSG((double)(n.differ - n.edge_on - n.data) <= 5e-5 * n.covered,
+                  "%s: %u of %u covered samples disagree", what, n.differ - n.edge_on - n.data, n.covered);
+        CHECK_MSG((double)n.edge_on <= 2e-4 * n.covered, "%s: %u of %u covered samples disagree on edge-on "
+                  "facets", what, n.edge_on, n.covered);
+    }
     oracle_free(&o);
     free(terms);
     free(smp);
