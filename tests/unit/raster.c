@@ -521,6 +521,35 @@ static void grid_matches_point_tests(void)
     CHECK(covered > 20 * GW * GH / 4);
 }
 
+/* Draws triangle k (vertices x, y, z, kept at tris[nt]'s row of the callers' arrays)
+ * and, where it filled anything, keeps its setup for the point tests: nt + 1, else nt. */
+static int draw_kept(const om_raster *r, om__rtri *tris, uint32_t *ids, int nt, const int64_t x[3],
+                     const int64_t y[3], const uint32_t z[3], uint32_t k)
+{
+    if (!om__raster_snapped(r, x, y, z, k)) return nt;
+    CHECK(om__tri2_setup(&tris[nt].e, x, y, true));
+    om__rtri_zplane(&tris[nt], z);
+    ids[nt] = k;
+    return nt + 1;
+}
+
+/* What the point tests give at (px, py) over the kept triangles: the nearest depth
+ * (0xFFFFFFFF: none) and in *id its triangle, the first kept at that depth; with vx,
+ * each covering triangle's depth also held against its exact plane (*inexact). */
+static uint32_t nearest_at(const om__rtri *tris, const uint32_t *ids, int nt, int64_t px, int64_t py, uint32_t *id,
+                           int64_t (*vx)[3], int64_t (*vy)[3], uint32_t (*vz)[3], int *inexact)
+{
+    uint32_t d = 0xFFFFFFFFu;
+    *id = OM_NO_TRI;
+    for (int k = 0; k < nt; k++)
+        if (om__tri2_covers(&tris[k].e, px, py)) {
+            const uint32_t z = om__rtri_zat(&tris[k], px, py);
+            if (vx) *inexact += !depth_near_plane(vx[k], vy[k], vz[k], px, py, z);
+            if (z < d) { d = z; *id = ids[k]; }
+        }
+    return d;
+}
+
 /* The plain fill (depth and id, as the eye pass) gives every pixel the nearest depth
  * of the triangles covering its centre, by the point-in-triangle test and the plane
  * (as near the exact plane as raster.h promises), and the id of the first triangle drawn at
@@ -554,22 +583,13 @@ static void fill_matches_point_tests(void)
                 z[i] = kind == 0 ? zf : kind == 1 ? (uint32_t)(rnd() % 4294967) * 1000u + (uint32_t)(rnd() % 1000)
                                                   : (rnd() % 2 ? 0xFFFFFFFFu : 0u);
             }
-            if (om__raster_snapped(&r, x, y, z, (uint32_t)k)) {
-                CHECK(om__tri2_setup(&tris[nt].e, x, y, true));
-                om__rtri_zplane(&tris[nt], z);
-                ids[nt++] = (uint32_t)k;
-            }
+            nt = draw_kept(&r, tris, ids, nt, x, y, z, (uint32_t)k);
         }
         for (int j = 0; j < H; j++)
             for (int i = 0; i < W; i++) {
-                const int64_t px = i * 256 + 128, py = j * 256 + 128;
-                uint32_t d = 0xFFFFFFFFu, id = OM_NO_TRI;
-                for (int k = 0; k < nt; k++)
-                    if (om__tri2_covers(&tris[k].e, px, py)) {
-                        uint32_t z = om__rtri_zat(&tris[k], px, py);
-                        inexact += !depth_near_plane(vx[k], vy[k], vz[k], px, py, z);
-                        if (z < d) { d = z; id = ids[k]; }
-                    }
+                uint32_t id;
+                const uint32_t d = nearest_at(tris, ids, nt, i * 256 + 128, j * 256 + 128, &id, vx, vy, vz,
+                                              &inexact);
                 covered += id != OM_NO_TRI;
                 bad += depth_buf[j * W + i] != d || id_buf[j * W + i] != id;
             }
@@ -626,21 +646,13 @@ static void tiny_matches_point_tests(void)
                                       : kind == 2 ? (rnd() % 2 ? 0xFFFFFFFFu : 0u)
                                                   : zf / 2 + rnd() % 4;
             }
-            if (om__raster_snapped(&r, x, y, z, (uint32_t)k)) {
-                CHECK(om__tri2_setup(&tris[nt].e, x, y, true));
-                om__rtri_zplane(&tris[nt], z);
-                ids[nt++] = (uint32_t)k;
-            }
+            nt = draw_kept(&r, tris, ids, nt, x, y, z, (uint32_t)k);
         }
         for (int j = 0; j < H; j++)
             for (int i = 0; i < W; i++) {
-                const int64_t px = i * 256 + 128, py = j * 256 + 128;
-                uint32_t d = 0xFFFFFFFFu, id = OM_NO_TRI;
-                for (int k = 0; k < nt; k++)
-                    if (om__tri2_covers(&tris[k].e, px, py)) {
-                        const uint32_t z = om__rtri_zat(&tris[k], px, py);
-                        if (z < d) { d = z; id = ids[k]; }
-                    }
+                uint32_t id;
+                const uint32_t d = nearest_at(tris, ids, nt, i * 256 + 128, j * 256 + 128, &id, NULL, NULL, NULL,
+                                              NULL);
                 covered += id != OM_NO_TRI;
                 bad += depth_buf[j * W + i] != d || (with_id && id_buf[j * W + i] != id);
             }
