@@ -244,7 +244,6 @@ static om_vec3 clamp_weights(const om__persp_tri *c, om_vec3 p)
  * in front of the camera). Out of line: few pixels take it. */
 static om_vec3 eye_clamp(const om_view *v, const om__persp_tri *c, float sx, float sy, om_vec3 p)
 {
-    (void)p;
     const float *m = v->cam_view.m;
     const om_vec3 R = om__v3(m[0], m[1], m[2]), U = om__v3(m[4], m[5], m[6]), F = om__v3(-m[8], -m[9], -m[10]);
     float ax[3], ay[3], w[3];
