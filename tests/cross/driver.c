@@ -68,11 +68,12 @@ static const char cloud_text[] =
 
 static unsigned char scene_mem[OM_CROSS_SCENE_MEM];
 static unsigned char method_mem[OM_CROSS_METHOD_MEM];
-/* counting: strips of 160 pixels, and room for the default scene's bins (4 bytes a
- * triangle, 12 a vertex), without which every strip would walk the whole scene */
+/* counting: strips up to 320 pixels wide, and room for the default scene's bins (4
+ * bytes a triangle, 12 a vertex), without which every strip would walk the whole
+ * scene */
 #ifdef OM_CROSS_COUNT
-static unsigned char frame_mem[160 * OM_CROSS_ROWS * 48 + (320u << 10)];
-static uint8_t pixels[160 * OM_CROSS_ROWS * 2];   /* one strip: part of the footprint */
+static unsigned char frame_mem[320 * OM_CROSS_ROWS * 48 + (320u << 10)];
+static uint8_t pixels[320 * OM_CROSS_ROWS * 2];   /* one strip: part of the footprint */
 #else
 static unsigned char frame_mem[FRAME_PIXELS * 48];
 static uint8_t pixels[FRAME_PIXELS * 2];
@@ -170,28 +171,32 @@ static void method_cfg(om_method_cfg *c, const om_method *m, const size_cfg *sz,
 }
 
 #ifdef OM_CROSS_COUNT
-/* Instructions per frame on the Cortex-M4 board (`make cross-test`, OM_CROSS_COUNT):
- * each method renders the small and the default scene at 160x120 through strips of
- * OM_CROSS_ROWS rows into RGB565, with the embedded configuration, and prints
- *   count SCENE METHOD INSTRUCTIONS EYE OBSERVE BUILD RESOLVE SHADE METHOD_B FRAME_B
+/* Instructions per frame on the Cortex-M boards (`make cross-test`, OM_CROSS_COUNT):
+ * each method renders the small scene at 160x120 and 320x240 and the default scene at
+ * 160x120 through strips of OM_CROSS_ROWS rows into RGB565, with the embedded
+ * configuration, and prints
+ *   count SCENE W H METHOD INSTRUCTIONS EYE OBSERVE BUILD RESOLVE SHADE METHOD_B FRAME_B
  *         SCENE_B MIN_B STATIC_B STACK_B WHOLE_B
  * (instructions of the frame and of its stages; the arenas' peak bytes, the method's
- * minimum by its bytes query, the firmware's other static data, the stack's deepest
- * point and the sum of all these: the whole footprint). asm is counted on its second
- * frame, when its tiles are cached, as a frame of a running application would be.
+ * minimum by its bytes query, the firmware's other static data with the strip's
+ * pixels, the stack's deepest point and the sum of all these: the whole footprint).
+ * asm is counted on its second frame, when its tiles are cached, as a frame of a
+ * running application would be.
  *
- * On the small scene the whole footprint must stay within WHOLE (256 KiB): the frame arena gets what om_frame_bytes calls with_bins, and the method
+ * On the small scene at 160x120 the whole footprint must stay within WHOLE (256 KiB): the frame arena gets what om_frame_bytes calls with_bins, and the method
  * what its bytes query calls full where that fits the rest, else the rest (it
  * then works in smaller pieces); a method whose minimum does not fit prints "too big",
- * one whose footprint ends over prints "over its whole budget", and both fail the run. The default
- * scene (a 462 KB scene arena) is beyond that; there a method gets up to 256 KiB.
+ * one whose footprint ends over prints "over its whole budget", and both fail the run.
+ * The other rows (the default scene, a 462 KB scene arena; 320x240, whose strips
+ * alone take 112 KB) are beyond that; there a method gets up to 256 KiB.
  *
  * Under qemu-system-arm -icount shift=0 the board's clock ticks one nanosecond per
  * instruction; the MPS2's CMSDK timer 0 (0x40000000) counts down at 25 MHz, so one
- * tick is 40 instructions. For profiling, OM_CROSS_COUNT_ONLY="sm" counts one method
- * and OM_CROSS_COUNT_SMALL the small scene alone (then qemu's `-d exec,nochain,in_asm`
- * log, summed per function, says where they go). The strips go nowhere: a device
- * would send them to its display, and the count is the engine's. */
+ * tick is 40 instructions. OM_CROSS_COUNT_ONLY="none sm" counts the methods it names
+ * (the Cortex-M7 count) and OM_CROSS_COUNT_SMALL the small scene alone; for profiling,
+ * qemu's `-d exec,nochain,in_asm` log, summed per function, says where they go. The
+ * strips go nowhere: a device would send them to its display, and the count is the
+ * engine's. */
 #define CMSDK_TIMER0 ((volatile uint32_t *)0x40000000u)
 #ifndef OM_CROSS_WHOLE
 #define OM_CROSS_WHOLE (256u << 10)
@@ -212,13 +217,35 @@ static uint64_t count_now(void *user)
     return (uint64_t)(0xFFFFFFFFu - CMSDK_TIMER0[1]) * 40u;
 }
 
-/* .data and .bss but for the three arenas' buffers: the strip's pixels, the C
- * library's and the driver's own (the engine has none: tests/sh/freestanding.sh). */
-static size_t static_bytes(void)
+/* .data and .bss but for the three arenas' buffers: one strip's pixels at width w
+ * (the buffer has room for the widest), the C library's and the driver's own (the
+ * engine has none: tests/sh/freestanding.sh). */
+static size_t static_bytes(uint32_t w)
 {
     const size_t all = (size_t)((uintptr_t)&__data_end - (uintptr_t)&__data_start) +
                        (size_t)((uintptr_t)&__bss_end - (uintptr_t)&__bss_start);
-    return all - sizeof scene_mem - sizeof method_mem - sizeof frame_mem;
+    return all - sizeof scene_mem - sizeof method_mem - sizeof frame_mem - sizeof pixels +
+           (size_t)w * OM_CROSS_ROWS * 2;
+}
+
+/* Whether the method is counted: every one, or those OM_CROSS_COUNT_ONLY names. */
+static int counted(const char *name)
+{
+#ifdef OM_CROSS_COUNT_ONLY
+    const char *l = OM_CROSS_COUNT_ONLY;
+    const size_t n = strlen(name);
+    for (;;) {
+        while (*l == ' ') l++;
+        if (!*l) return 0;
+        size_t k = 0;
+        while (l[k] && l[k] != ' ') k++;
+        if (k == n && !strncmp(l, name, n)) return 1;
+        l += k;
+    }
+#else
+    (void)name;
+    return 1;
+#endif
 }
 
 /* The stack's lowest STACK_PAINT bytes, up to just below the caller, filled with PAINT;
@@ -250,9 +277,9 @@ static void say(const char *what, const char *tag, const char *method)
     om_host_puts(l.buf);
 }
 
-static void count_scene(const char *tag, const char *text, int whole, int *bad)
+static void count_scene(const char *tag, const char *text, uint32_t w, uint32_t h, int whole, int *bad)
 {
-    static const size_cfg sz = {160, 120, OM_CROSS_ROWS, 1, "@160x120"};
+    const size_cfg sz = {w, h, OM_CROSS_ROWS, 1, ""};
     om_arena sa;
     om_scene s;
     om_diag d;
@@ -270,7 +297,7 @@ static void count_scene(const char *tag, const char *text, int whole, int *bad)
     memset(&q, 0, sizeof q);
     q.scene = &s; q.view = &v; q.strip_rows = sz.rows;
     if (om_frame_bytes(&q, &need) != OM_OK) { *bad |= fail(tag, "-", "frame bytes", &d); return; }
-    const size_t frame_need = need.with_bins, ids = need.with_ids - need.with_jobs, stat = static_bytes();
+    const size_t frame_need = need.with_bins, ids = need.with_ids - need.with_jobs, stat = static_bytes(w);
     /* what a method may take: all that is left of WHOLE, or (default scene) 256 KiB */
     size_t room = sizeof method_mem;
     if (whole) {
@@ -280,9 +307,7 @@ static void count_scene(const char *tag, const char *text, int whole, int *bad)
     }
     for (size_t k = 0; k < om_method_count(); k++) {
         const om_method *m = om_method_at(k);
-#ifdef OM_CROSS_COUNT_ONLY
-        if (strcmp(om_method_name(m), OM_CROSS_COUNT_ONLY)) continue;
-#endif
+        if (!counted(om_method_name(m))) continue;
         om_method_cfg cfg;
         method_cfg(&cfg, m, &sz, 0);
         size_t mn, full;
@@ -327,6 +352,10 @@ static void count_scene(const char *tag, const char *text, int whole, int *bad)
         put_s(&l, "count ");
         put_s(&l, tag);
         put_s(&l, " ");
+        put_dec(&l, w);
+        put_s(&l, " ");
+        put_dec(&l, h);
+        put_s(&l, " ");
         put_s(&l, om_method_name(m));
         for (size_t i = 0; i < sizeof fig / sizeof fig[0]; i++) {
             put_s(&l, " ");
@@ -346,9 +375,10 @@ int om_cross_main(void)
     CMSDK_TIMER0[2] = 0xFFFFFFFFu;   /* reload */
     CMSDK_TIMER0[1] = 0xFFFFFFFFu;   /* value */
     CMSDK_TIMER0[0] = 1;             /* enable */
-    count_scene("small", om_scene_small_text(), 1, &bad);
+    count_scene("small", om_scene_small_text(), 160, 120, 1, &bad);
+    count_scene("small", om_scene_small_text(), 320, 240, 0, &bad);
 #ifndef OM_CROSS_COUNT_SMALL
-    count_scene("default", om_scene_default_text(), 0, &bad);
+    count_scene("default", om_scene_default_text(), 160, 120, 0, &bad);
 #endif
     return bad;
 }

@@ -300,41 +300,50 @@ IFS='
 '
 
 # Instructions per frame on the Cortex-M4 (driver.c's OM_CROSS_COUNT): every method on
-# the small and the default scene at 160x120, strips of 8 rows, counted under
-# qemu-system-arm -icount shift=0, with each method's least arena and whole footprint
-# (the driver fails when a footprint on the small scene passes 256 KiB). Written to
-# out/cross/m4.csv (the report reads it) with the firmware's sizes in
-# out/cross/m4-size.csv; a table here.
-count_m4() {
-    csv=out/cross/m4.csv
+# the small scene at 160x120 and 320x240 and the default scene at 160x120, strips of 8
+# rows, counted under qemu-system-arm -icount shift=0, with each method's least arena
+# and whole footprint (the driver fails when a footprint on the small scene at 160x120
+# passes 256 KiB). Written to out/cross/m4.csv (the report reads it) with the
+# firmware's sizes in out/cross/m4-size.csv; a table here. Then the Cortex-M7
+# (mps2-an500, double FPU) on the small scene for none, sm and hybrid, in
+# out/cross/m7.csv: what an M7-class chip runs.
+count_cpu() {   # count_cpu NAME FLAGS BOARD [METHODS]
+    cpu=$1 cflags=$2 board=$3 only=${4:+-DOM_CROSS_COUNT_ONLY=\"$4\"}
+    csv=out/cross/$cpu.csv
     mkdir -p out/cross
     # shellcheck disable=SC2086
-    arm-none-eabi-gcc $BFLAGS -O2 $M4 -DOM_CROSS_COUNT -DOM_CROSS_ROWS=8 $BSRC -T platform/cortex-m/mps2.ld \
-        -nostartfiles -Wl,--gc-sections -lm -lc -lgcc -o "$out/m4-count" 2>"$out/m4-count.err" || {
-        echo "cross: FAIL the Cortex-M4 counting firmware does not build: $(head -c 600 "$out/m4-count.err")"
+    arm-none-eabi-gcc $BFLAGS -O2 $cflags -DOM_CROSS_COUNT -DOM_CROSS_ROWS=8 ${only:+"$only"} $BSRC -T platform/cortex-m/mps2.ld \
+        -nostartfiles -Wl,--gc-sections -lm -lc -lgcc -o "$out/$cpu-count" 2>"$out/$cpu-count.err" || {
+        echo "cross: FAIL the $cpu counting firmware does not build: $(head -c 600 "$out/$cpu-count.err")"
         return 1
     }
     rm -f "$csv"
     ok=true
-    timeout 900 qemu-system-arm -M mps2-an386 -icount shift=0 -nographic -monitor none -serial none \
-        -semihosting-config enable=on,target=native -kernel "$out/m4-count" >"$out/m4-count.txt" 2>&1 || ok=false
+    timeout 900 qemu-system-arm -M "$board" -icount shift=0 -nographic -monitor none -serial none \
+        -semihosting-config enable=on,target=native -kernel "$out/$cpu-count" >"$out/$cpu-count.txt" 2>&1 || ok=false
     { echo "scene,method,width,height,strip_rows,instructions,eye,observe,build,resolve,shade,method_bytes,frame_bytes,scene_bytes,min_bytes,static_bytes,stack_bytes,whole_bytes"
-      awk '$1 == "count" {printf "%s,%s,160,120,8", $2, $3; for (i = 4; i <= 16; i++) printf ",%s", $i; print ""}' \
-          "$out/m4-count.txt"; } >"$csv.tmp" && mv "$csv.tmp" "$csv"
-    arm-none-eabi-size "$out/m4-count" | awk 'NR == 2 {print "build,text,data,bss"; print "cortex-m4-gcc-O2," $1 "," $2 "," $3}' \
-        >out/cross/m4-size.csv
-    echo "cross: Cortex-M4 instructions per frame, 160x120, strips of 8 rows (out/cross/m4.csv); bytes:"
-    echo "    the method's least arena, and the whole footprint (scene, frame and method arenas' peaks, other"
-    echo "    .data/.bss, the stack's deepest point), at most 256 KiB on the small scene:"
+      awk '$1 == "count" {printf "%s,%s,%s,%s,8", $2, $5, $3, $4; for (i = 6; i <= 18; i++) printf ",%s", $i; print ""}' \
+          "$out/$cpu-count.txt"; } >"$csv.tmp" && mv "$csv.tmp" "$csv"
+    echo "cross: $cpu ($board) instructions per frame, strips of 8 rows ($csv); fps at a clock and CPI in"
+    echo "    platform/cortex-m/README.md; bytes: the method's least arena, and the whole footprint (scene,"
+    echo "    frame and method arenas' peaks, other .data/.bss, the stack's deepest point), at most 256 KiB"
+    echo "    on the small scene at 160x120:"
     awk -F, 'function k(n,  s) { s = sprintf("%.0f", n); while (s ~ /[0-9][0-9][0-9][0-9]/) sub(/[0-9][0-9][0-9]($|,)/, ",&", s); return s }
         NR > 1 {
-        if ($1 != last) { printf "    %-8s %-7s %14s %12s %12s %12s %10s %10s\n", "scene", "method", "instructions", "eye", "shadow", "shade", "least", "whole"; last = $1 }
-        printf "    %-8s %-7s %14s %12s %12s %12s %10s %10s\n", $1, $2, k($6), k($7), k($8 + $9 + $10), k($11), k($15), k($18) }' "$csv"
-    awk -F, 'NR == 2 {printf "    firmware (every method, both scenes): .text %d, .data %d, .bss %d bytes\n", $2, $3, $4}' out/cross/m4-size.csv
+        g = $1 "@" $3 "x" $4
+        if (g != last) { printf "    %-16s %-7s %14s %12s %12s %12s %10s %10s\n", "scene", "method", "instructions", "eye", "shadow", "shade", "least", "whole"; last = g }
+        printf "    %-16s %-7s %14s %12s %12s %12s %10s %10s\n", g, $2, k($6), k($7), k($8 + $9 + $10), k($11), k($15), k($18) }' "$csv"
     $ok || {
-        echo "cross: FAIL the Cortex-M4 counting firmware: $(grep -v '^count' "$out/m4-count.txt" | tail -c 600)"
+        echo "cross: FAIL the $cpu counting firmware: $(grep -v '^count' "$out/$cpu-count.txt" | tail -c 600)"
         return 1
     }
+}
+count_m4() {
+    count_cpu m4 "$M4" mps2-an386 || return 1
+    arm-none-eabi-size "$out/m4-count" | awk 'NR == 2 {print "build,text,data,bss"; print "cortex-m4-gcc-O2," $1 "," $2 "," $3}' \
+        >out/cross/m4-size.csv
+    awk -F, 'NR == 2 {printf "    firmware (every method, both scenes): .text %d, .data %d, .bss %d bytes\n", $2, $3, $4}' out/cross/m4-size.csv
+    count_cpu m7 "$M7 -DOM_CROSS_COUNT_SMALL" mps2-an500 "none sm hybrid"
 }
 if [ -z "${CROSS_ONLY:-}" ] || echo "m4-count" | grep -Eq -- "$CROSS_ONLY"; then
     if command -v arm-none-eabi-gcc >/dev/null 2>&1 && command -v qemu-system-arm >/dev/null 2>&1; then
@@ -410,9 +419,9 @@ if command -v arm-none-eabi-gcc >/dev/null 2>&1; then
         awk -F, 'FNR == 1 { for (i = 1; i <= NF; i++) col[FILENAME, $i] = i; next }
             FILENAME ~ /code-size/ { text[$1] = $2; next }
             { c = col[FILENAME, "method"]; m = $c
-              if ($1 == "small") { order[++n] = m; mn[m] = $col[FILENAME, "min_bytes"]
+              if ($1 == "small" && $col[FILENAME, "width"] == 160) { order[++n] = m; mn[m] = $col[FILENAME, "min_bytes"]
                                    whole[m] = $col[FILENAME, "whole_bytes"]; small[m] = $col[FILENAME, "instructions"] }
-              else big[m] = $col[FILENAME, "instructions"] }
+              else if ($1 == "default") big[m] = $col[FILENAME, "instructions"] }
             END { print "method,text,min_bytes,whole_bytes,instructions_small,instructions_default"
                   for (i = 1; i <= n; i++) { m = order[i]; print m "," text[m] "," mn[m] "," whole[m] "," small[m] "," big[m] } }' \
             out/cross/code-size.csv out/cross/m4.csv >out/cross/m4-methods.csv
