@@ -286,14 +286,17 @@ om_vec3 om__eye_point(const om_view *v, const om__persp_tri *c, float sx, float 
     return w1 >= 0.0f && w2 >= 0.0f && w1 + w2 <= 1.0f ? p : eye_clamp(v, c, sx, sy, p);
 }
 
-/* The pixels [x0, x1) of one row that triangle c covers: the run's constants sit in
+/* The pixels [x0, x1) of one row that triangle c covers (mark: with terms; sure:
+ * et->sure; dir: a directional light; constants where resolve_one calls it, so that
+ * each of its loops is without their tests): the run's constants sit in
  * locals (registers) rather than being loaded again per pixel, and the products with
  * the row's sy are made once; each is the very product om__eye_point makes, so the
  * points are the same bits. With `terms`, each pixel's exposure marks too: where the
  * triangle is `sure`, only the light-facing test, with the operations om__exposed_at
  * makes for it. */
-static void resolve_run(const om_view *v, const eye_tri *et, uint32_t x0, uint32_t x1,
-                        float sy, float sxk, om_sample *smp, om_term *terms)
+OM_INLINE void resolve_run(const om_view *v, const eye_tri *et, uint32_t x0, uint32_t x1,
+                          float sy, float sxk, om_sample *smp, om_term *terms, const bool mark,
+                          const bool sure, const bool dir)
 {
     const om__persp_tri *c = &et->t;
     const float a0 = c->adj[0], a3 = c->adj[3], a6 = c->adj[6];
@@ -301,10 +304,8 @@ static void resolve_run(const om_view *v, const eye_tri *et, uint32_t x0, uint32
     const float a2 = c->adj[2], a5 = c->adj[5], a8 = c->adj[8];
     const om_vec3 o = c->v[0], d1 = c->d1, d2 = c->d2, n = c->n;
     const uint32_t tri = c->tri;
-    const bool sure = et->sure;
     /* the light's and the turned normal's values in locals too: the samples' stores
      * may alias them, and the compiler would load them again per pixel */
-    const bool dir = v->light.kind == OM_LIGHT_DIRECTIONAL;
     const om_vec3 lpos = v->light.pos, ldir = om__scale(v->light_axis, -1.0f), nf = et->nf;
     /* (float)x + 0.5f, stepped by one: exact below 2^22, and images are narrower */
     float xc = (float)x0 + 0.5f;
@@ -326,7 +327,7 @@ static void resolve_run(const om_view *v, const eye_tri *et, uint32_t x0, uint32
         out->n[1] = n.y;
         out->n[2] = n.z;
         out->tri = tri;
-        if (terms) {
+        if (mark) {
             bool exposed;
             if (sure) {   /* every point is on its triangle (eye_clamp) */
                 const float cs = om__dot(nf, dir ? ldir : om__to_point(lpos, p));
@@ -341,6 +342,16 @@ static void resolve_run(const om_view *v, const eye_tri *et, uint32_t x0, uint32
             out->nl = 0.0f;   /* set with the exposure marks */
         }
     }
+}
+
+/* resolve_run with its flags made constants. */
+static void resolve_one(const om_view *v, const eye_tri *et, uint32_t x0, uint32_t x1,
+                        float sy, float sxk, om_sample *smp, om_term *terms)
+{
+    if (!terms) resolve_run(v, et, x0, x1, sy, sxk, smp, terms, false, false, false);
+    else if (!et->sure) resolve_run(v, et, x0, x1, sy, sxk, smp, terms, true, false, false);
+    else if (v->light.kind == OM_LIGHT_DIRECTIONAL) resolve_run(v, et, x0, x1, sy, sxk, smp, terms, true, true, true);
+    else resolve_run(v, et, x0, x1, sy, sxk, smp, terms, true, true, false);
 }
 
 /* The next batch of a row's runs, from *xe on: at most EYE_RUNS runs, their ends in
@@ -429,7 +440,7 @@ static void resolve_ids(const om_scene *s, const om_view *v, const om_target *tg
                     expo_setup(v, &fr, et);
                     et->tried = true;
                 }
-                resolve_run(v, et, x, x1, sy, sxk, smp, terms);
+                resolve_one(v, et, x, x1, sy, sxk, smp, terms);
                 x = x1;
             }
         }
