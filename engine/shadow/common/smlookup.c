@@ -20,6 +20,16 @@ void om__smlook_begin(om__smlook *L, const om_view *v)
     L->dz_den = v->light.zfar - v->light.znear;
     L->half_near = v->light.znear * 0.5f;
     L->bias_world = L->bias_const * L->dz_den;   /* a fraction of the depth range */
+    const float fsize = (float)L->size;
+    if (v->light.kind == OM_LIGHT_SPOT) {
+        const float k = L->dz_num / L->dz_den * OM_DEPTH_ONE_F;
+        L->bias_c1 = L->bias_world * k;
+        L->bias_c2 = L->bias_slope * (L->span_per_dist / fsize) * k;
+    } else {
+        const float k = OM_DEPTH_ONE_F * om__fabsf(v->light_proj.m[10]);
+        L->bias_c1 = L->bias_world * k;
+        L->bias_c2 = L->bias_slope * (2.0f / om__fabsf(v->light_proj.m[0]) / fsize) * k;
+    }
 }
 
 /* World size of one (unwarped) texel at distance `dist` along the light's axis. */
@@ -102,9 +112,8 @@ static bool locate(const om__smlook *L, const om_sample *smp, tap *out)
         if (!(L->unwarped_pcf && L->pcf > 1) || dens < 1.0)
             texel = (float)((double)texel / dens);
     }
-    float cosang = smp->nl;   /* n . l, kept by the exposure marks (om__exposed) */
-    float tanang = cosang > 0.0995f ? om__sqrtf(1.0f - cosang * cosang) / cosang : 10.0f;
-    float bias = L->bias_world + L->bias_slope * texel * tanang;
+    const float tanang = om__smlook_tan(smp->nl);   /* nl: kept by the exposure marks */
+    const float bias = L->bias_world + L->bias_slope * texel * tanang;   /* warped maps' */
     om_vec4 q;
     if (L->warp_x && L->normal_offset == 0.0f) {
         q = q0;   /* the point did not move: its projection and warp are done */
@@ -150,7 +159,18 @@ static bool locate(const om__smlook *L, const om_sample *smp, tap *out)
         }
     }
     float z = q.z * iw * OM_DEPTH_ONE_F;
-    /* bias from world units to depth units: d(z/w)/d(distance) at this sample */
+    if (!L->warp_x) {   /* the distance as plain_locate takes it: the unmoved point's w */
+        const bool spot = v->light.kind == OM_LIGHT_SPOT;
+        float r = 0.0f;
+        if (spot) {
+            const float w = om__mat_apply(&v->light_vp, om__v3(smp->p[0], smp->p[1], smp->p[2])).w;
+            r = 1.0f / (w > L->half_near ? w : L->half_near);
+        }
+        out->zlit = om__smlook_threshold(om__smlook_biased(L->bias_c1, L->bias_c2, spot, z, r, tanang));
+        return true;
+    }
+    /* a warped map's bias from world units to depth units, d(z/w)/d(distance) at this
+     * sample, in the order rtw.c's float lookup repeats bit for bit */
     float dz;
     if (v->light.kind == OM_LIGHT_SPOT) {
         const float e = dist > L->half_near ? dist : L->half_near;
@@ -210,27 +230,20 @@ static uint8_t test(const om__smlook *L, const tap *tp)
  * directional light's texel and depth slope) worked out once rather than per sample. */
 typedef struct plain {
     om_mat4 vp;
-    om_vec3 lpos, axis;
     bool spot;
     uint32_t size;
-    float fsize, half, span_per_dist, half_near, dz_num, dz_den, bias_world, bias_slope;
-    float texel_dir, dz_dir;   /* a directional light's: as texel_world and locate make them */
+    float half, half_near, inv_half_near, c1, c2;
 } plain;
 
 /* A sample's biased depth (om__smlook_lit tests it) and texel index; false when it is
- * behind the light. `spot` is P->spot, a constant where the callers are inlined. */
+ * behind the light. `spot` is P->spot, a constant where the callers are inlined. A
+ * spot light's distance along its axis is the projection's w, so its 1 / w serves
+ * the bias too (om__smlook_biased). */
 OM_INLINE bool plain_locate(const plain *P, const bool spot, const om_sample *smp,
                           float *zb, uint32_t *at)
 {
     const om_vec3 p = om__v3(smp->p[0], smp->p[1], smp->p[2]);
-    float dist = 1.0f, texel = P->texel_dir, dz = P->dz_dir;
-    if (spot) {
-        dist = om__dot(om__sub(p, P->lpos), P->axis);
-        texel = dist * P->span_per_dist / P->fsize;
-    }
-    const float cosang = smp->nl;
-    const float tanang = cosang > 0.0995f ? om__sqrtf(1.0f - cosang * cosang) / cosang : 10.0f;
-    const float bias = P->bias_world + P->bias_slope * texel * tanang;
+    const float tanang = om__smlook_tan(smp->nl);
     const om_vec4 q = om__mat_apply(&P->vp, p);
     if (!(q.w > 0.0f)) return false;
     const float iw = 1.0f / q.w;
@@ -238,11 +251,8 @@ OM_INLINE bool plain_locate(const plain *P, const bool spot, const om_sample *sm
     const float wf = (1.0f - q.y * iw) * P->half;
     *at = texel_clamped(wf, P->size) * P->size + texel_clamped(uf, P->size);
     const float z = q.z * iw * OM_DEPTH_ONE_F;
-    if (spot) {
-        const float e = dist > P->half_near ? dist : P->half_near;
-        dz = P->dz_num / (P->dz_den * e * e) * OM_DEPTH_ONE_F;
-    }
-    *zb = z - bias * dz;
+    const float r = spot ? (q.w > P->half_near ? iw : P->inv_half_near) : 0.0f;
+    *zb = om__smlook_biased(P->c1, P->c2, spot, z, r, tanang);
     return true;
 }
 
@@ -278,20 +288,13 @@ static void strip_plain(const om__smlook *L, om_strip *st, uint32_t *samples, ui
     const om_view *v = L->view;
     plain P;
     P.vp = v->light_vp;
-    P.lpos = v->light.pos;
-    P.axis = v->light_axis;
     P.spot = v->light.kind == OM_LIGHT_SPOT;
     P.size = L->size;
-    P.fsize = (float)L->size;
-    P.half = 0.5f * P.fsize;
-    P.span_per_dist = L->span_per_dist;
+    P.half = 0.5f * (float)L->size;
     P.half_near = L->half_near;
-    P.dz_num = L->dz_num;
-    P.dz_den = L->dz_den;
-    P.bias_world = L->bias_world;
-    P.bias_slope = L->bias_slope;
-    P.texel_dir = P.spot ? 0.0f : 2.0f / om__fabsf(v->light_proj.m[0]) / P.fsize;
-    P.dz_dir = P.spot ? 0.0f : OM_DEPTH_ONE_F * om__fabsf(v->light_proj.m[10]);
+    P.inv_half_near = 1.0f / L->half_near;   /* as locate's 1 / max(w, half_near) */
+    P.c1 = L->bias_c1;
+    P.c2 = L->bias_c2;
     const uint32_t *depth = L->depth;
     const size_t n = (size_t)st->rows * st->width;
     uint32_t nsamples = 0, nshadowed = 0;

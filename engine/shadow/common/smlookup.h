@@ -46,6 +46,10 @@ typedef struct om__smlook {
                                 * light ray: bias_const (far - near) */
     float span_per_dist;       /* spot: frustum width per unit of distance */
     float dz_num, dz_den, half_near;   /* spot: far * near, far - near, near / 2 */
+    /* The bias in depth units for an unwarped map (om__smlook_biased): a spot light's
+     * c1 / e^2 + c2 tan / e at distance e along its axis, a directional light's
+     * c1 + c2 tan. */
+    float bias_c1, bias_c2;
     /* A warped map's tables (n + 1 entries each), NULL for the conventional map: u
      * and v are warped by them, and "a texel" in the bias rules is a warped one. */
     const int32_t *warp_x, *warp_y;
@@ -63,6 +67,25 @@ void om__smlook_begin(om__smlook *L, const om_view *v);
  * or lies behind the light. Counts the exposed samples and the shadowed ones (term
  * below 255) into *samples, *shadowed. */
 void om__smlook_strip(const om__smlook *L, om_strip *st, uint32_t *samples, uint32_t *shadowed);
+
+/* The tangent of the angle between a sample's normal and the light, from their
+ * cosine (the sample's nl), at most 10. */
+static inline float om__smlook_tan(float cosang)
+{
+    return cosang > 0.0995f ? om__sqrtf(1.0f - cosang * cosang) / cosang : 10.0f;
+}
+
+/* The biased depth of a sample of an unwarped map: its light depth z (z/w * 2^32)
+ * less the bias in depth units, for a spot light at r = 1 / e (e: its distance along
+ * the light's axis, at least half the near plane's), tanang the tangent of its angle
+ * to the light. The world bias bias_const (far - near) + bias_slope texel tan, with a
+ * texel's world size e span / size, times d(z/w)/de = f n / ((f - n) e^2) makes
+ * c1 / e^2 + c2 tan / e: one reciprocal, which the projection's 1 / w gives where
+ * e is w. */
+static inline float om__smlook_biased(float c1, float c2, bool spot, float z, float r, float tanang)
+{
+    return spot ? z - r * (c1 * r + c2 * tanang) : z - (c1 + c2 * tanang);
+}
 
 /* A texel coordinate clamped to a map of `size` texels. */
 static inline uint32_t om__smlook_clamp(int32_t x, uint32_t size)

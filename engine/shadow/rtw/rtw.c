@@ -652,8 +652,7 @@ static int locate_f(const om__rtw *m, const om_view *v, const om_sample *smp, ui
     const bool by_x = om__rtw_dens(m->px, m->n, kx) <= om__rtw_dens(m->py, m->n, ky);
     const float texel = div_dens(span / (float)L->size, by_x ? m->rcp_x + 2 * kx : m->rcp_y + 2 * ky);
     if (texel < 0.0f) return -1;
-    const float cosang = smp->nl;
-    const float tanang = cosang > 0.0995f ? om__sqrtf(1.0f - cosang * cosang) / cosang : 10.0f;
+    const float tanang = om__smlook_tan(smp->nl);
     const float bias = L->bias_world + L->bias_slope * texel * tanang;
     const float z = q.z * iw * OM_DEPTH_ONE_F;
     float dz;
