@@ -33,7 +33,8 @@
  * turned to the camera they then use. */
 typedef struct eye_tri {
     om__persp_tri t;
-    om_vec3 nf;
+    om_vec3 nf, anchor;   /* anchor: the first vertex as the scene lists it */
+    float h;              /* with `sure`: the light's height, om__light_height(nf, anchor) */
     bool sure, tried;
     uint32_t seen;   /* pixels resolved since the setup, until expo_setup is tried */
 } eye_tri;
@@ -103,6 +104,7 @@ static void expo_setup(const om_view *v, const eye_frame *f, eye_tri *et)
     if (front == 3) et->nf = c->n;
     else if (back == 3) et->nf = om__scale(c->n, -1.0f);   /* as om__exposed_at turns it */
     else return;
+    et->h = om__light_height(v, et->nf, et->anchor);
     et->sure = true;
 }
 
@@ -287,16 +289,18 @@ om_vec3 om__eye_point(const om_view *v, const om__persp_tri *c, float sx, float 
 }
 
 /* The pixels [x0, x1) of one row that triangle c covers (mark: with terms; sure:
- * et->sure; dir: a directional light; constants where resolve_one calls it, so that
- * each of its loops is without their tests): the run's constants sit in
- * locals (registers) rather than being loaded again per pixel, and the products with
- * the row's sy are made once; each is the very product om__eye_point makes, so the
- * points are the same bits. With `terms`, each pixel's exposure marks too: where the
- * triangle is `sure`, only the light-facing test, with the operations om__exposed_at
- * makes for it. */
+ * et->sure; dir: a directional light; dark: sure and the light not above its plane;
+ * constants where resolve_one calls it, so that each of its loops is without their
+ * tests): the run's constants sit in locals (registers) rather than being loaded
+ * again per pixel, and the products with the row's sy are made once; each is the very
+ * product om__eye_point makes, so the points are the same bits. With `terms`, each
+ * pixel's exposure marks too: where the triangle is `sure`, only the light-facing
+ * test, with the operations om__exposed_at makes for it and the light's height over
+ * the plane made once (expo_setup): the cosine is that height (directional) or it over
+ * the point's distance to the light, never above 0 where the height is not (dark). */
 OM_INLINE void resolve_run(const om_view *v, const eye_tri *et, uint32_t x0, uint32_t x1,
                           float sy, float sxk, om_sample *smp, om_term *terms, const bool mark,
-                          const bool sure, const bool dir)
+                          const bool sure, const bool dir, const bool dark)
 {
     const om__persp_tri *c = &et->t;
     const float a0 = c->adj[0], a3 = c->adj[3], a6 = c->adj[6];
@@ -306,7 +310,8 @@ OM_INLINE void resolve_run(const om_view *v, const eye_tri *et, uint32_t x0, uin
     const uint32_t tri = c->tri;
     /* the light's and the turned normal's values in locals too: the samples' stores
      * may alias them, and the compiler would load them again per pixel */
-    const om_vec3 lpos = v->light.pos, ldir = om__scale(v->light_axis, -1.0f), nf = et->nf;
+    const om_vec3 lpos = v->light.pos, anchor = et->anchor;
+    const float h = et->h;
     /* (float)x + 0.5f, stepped by one: exact below 2^22, and images are narrower */
     float xc = (float)x0 + 0.5f;
     for (uint32_t x = x0; x < x1; x++, xc += 1.0f) {
@@ -330,11 +335,11 @@ OM_INLINE void resolve_run(const om_view *v, const eye_tri *et, uint32_t x0, uin
         if (mark) {
             bool exposed;
             if (sure) {   /* every point is on its triangle (eye_clamp) */
-                const float cs = om__dot(nf, dir ? ldir : om__to_point(lpos, p));
+                const float cs = dark ? 0.0f : dir ? h : om__spot_cos(lpos, p, h);
                 exposed = cs > 0.0f;
                 out->nl = exposed ? cs : 0.0f;
             } else {
-                exposed = om__exposed_at(v, p, n, &out->nl);
+                exposed = om__exposed_at(v, p, n, anchor, &out->nl);
             }
             const om_term t = {255, 255, 255, exposed ? OM_TERM_EXPOSED : 0};
             terms[x] = t;   /* whole: one store where the compiler can */
@@ -348,10 +353,11 @@ OM_INLINE void resolve_run(const om_view *v, const eye_tri *et, uint32_t x0, uin
 static void resolve_one(const om_view *v, const eye_tri *et, uint32_t x0, uint32_t x1,
                         float sy, float sxk, om_sample *smp, om_term *terms)
 {
-    if (!terms) resolve_run(v, et, x0, x1, sy, sxk, smp, terms, false, false, false);
-    else if (!et->sure) resolve_run(v, et, x0, x1, sy, sxk, smp, terms, true, false, false);
-    else if (v->light.kind == OM_LIGHT_DIRECTIONAL) resolve_run(v, et, x0, x1, sy, sxk, smp, terms, true, true, true);
-    else resolve_run(v, et, x0, x1, sy, sxk, smp, terms, true, true, false);
+    if (!terms) resolve_run(v, et, x0, x1, sy, sxk, smp, terms, false, false, false, false);
+    else if (!et->sure) resolve_run(v, et, x0, x1, sy, sxk, smp, terms, true, false, false, false);
+    else if (!(et->h > 0.0f)) resolve_run(v, et, x0, x1, sy, sxk, smp, terms, true, true, false, true);
+    else if (v->light.kind == OM_LIGHT_DIRECTIONAL) resolve_run(v, et, x0, x1, sy, sxk, smp, terms, true, true, true, false);
+    else resolve_run(v, et, x0, x1, sy, sxk, smp, terms, true, true, false, false);
 }
 
 /* The next batch of a row's runs, from *xe on: at most EYE_RUNS runs, their ends in
@@ -428,6 +434,7 @@ static void resolve_ids(const om_scene *s, const om_view *v, const om_target *tg
                 if (et->t.tri != t) {   /* fetch_batch's next triangle */
                     et->t.tri = t;
                     for (int j = 0; j < 3; j++) et->t.v[j] = fetched[k][j];
+                    et->anchor = fetched[k][0];   /* before eye_finish turns the vertices */
                     k++;
                     eye_finish(v, &et->t);
                     et->sure = et->tried = false;

@@ -17,13 +17,13 @@ static uint64_t now(const om_frame_desc *fd)
 }
 
 /* Geometric part of the lit rule, set once for every method alike. */
-void om__frame_mark(const om_view *v, om_strip *st)
+void om__frame_mark(const om_scene *s, const om_view *v, om_strip *st)
 {
     size_t n = (size_t)st->rows * st->width;
     for (size_t i = 0; i < n; i++) {
         om_term *t = &st->terms[i];
         t->r = t->g = t->b = 255;
-        t->flags = st->samples[i].tri != OM_NO_TRI && om__exposed(v, &st->samples[i])
+        t->flags = st->samples[i].tri != OM_NO_TRI && om__exposed(s, v, &st->samples[i])
                        ? OM_TERM_EXPOSED : 0;
     }
 }
@@ -83,7 +83,7 @@ static void eye(om__frame *c, bool samples, bool marks, om_frame_stats *fs)
     const uint64_t t0 = now(c->fd);
     if (c->jobs > 1) om__jobs_eye(c, !samples, !marks);
     else if (!samples) om__frame_eye_rows(c, &c->tg, &c->strip, !marks);
-    else if (!marks) om__frame_mark(c->view, &c->strip);
+    else if (!marks) om__frame_mark(c->fd->scene, c->view, &c->strip);
     if (!samples) {
         fs->ns_eye += now(c->fd) - t0;
         fs->eye_passes++;

@@ -67,22 +67,36 @@ static inline om_vec3 om__to_point(om_vec3 pos, om_vec3 p)
     return om__scale(a, 1.0f / om__sqrtf(l2));
 }
 
-/* om__to_light in line (the exposure marks run it for every covered pixel). */
-static inline om_vec3 om__to_light_in(const om_view *v, om_vec3 p)
+/* The light's height over the plane of a triangle with normal nf (unit, turned to
+ * the camera) through `anchor` (its first vertex as the scene lists it, relative to
+ * the view's origin): nf . (pos - anchor) for a spot light at pos, and the cosine
+ * itself, nf . -axis, for a directional one. The same for every point of the plane,
+ * so a triangle's pixels share it. */
+static inline float om__light_height(const om_view *v, om_vec3 nf, om_vec3 anchor)
 {
-    if (v->light.kind == OM_LIGHT_DIRECTIONAL) return om__scale(v->light_axis, -1.0f);
-    return om__to_point(v->light.pos, p);
+    if (v->light.kind == OM_LIGHT_DIRECTIONAL) return om__dot(nf, om__scale(v->light_axis, -1.0f));
+    return om__dot(nf, om__sub(v->light.pos, anchor));
+}
+
+/* The cosine between the normal and the direction to a spot light from p on the
+ * plane whose height is h (om__light_height): h / |pos - p|, 0 at the light. */
+static inline float om__spot_cos(om_vec3 pos, om_vec3 p, float h)
+{
+    const om_vec3 a = om__sub(pos, p);
+    const float l2 = om__dot(a, a);
+    return l2 > 0.0f ? h / om__sqrtf(l2) : 0.0f;
 }
 
 /* The parts of the lit rule that no occluder decides, the same for every method:
  * the normal turned towards the camera faces the light, and the point p (with the
- * normal n, as wound) lies inside the light's frustum. *nl: the cosine between them
- * where exposed, else 0. */
-static inline bool om__exposed_at(const om_view *v, om_vec3 p, om_vec3 n, float *nl)
+ * normal n, as wound, of a triangle through `anchor`: om__light_height) lies inside
+ * the light's frustum. *nl: the cosine between them where exposed, else 0. */
+static inline bool om__exposed_at(const om_view *v, om_vec3 p, om_vec3 n, om_vec3 anchor, float *nl)
 {
     *nl = 0.0f;
     if (om__dot(n, om__sub(v->cam.eye, p)) < 0.0f) n = om__scale(n, -1.0f);
-    const float c = om__dot(n, om__to_light_in(v, p));
+    const float h = om__light_height(v, n, anchor);
+    const float c = v->light.kind == OM_LIGHT_DIRECTIONAL ? h : om__spot_cos(v->light.pos, p, h);
     if (!(c > 0.0f)) return false;
     /* inside the frustum: -w <= x <= w is |x| <= w (both false for a NaN) */
     const om_vec4 q = om__mat_apply(&v->light_vp, p);
@@ -92,8 +106,8 @@ static inline bool om__exposed_at(const om_view *v, om_vec3 p, om_vec3 n, float 
     return true;
 }
 
-/* om__exposed_at for a sample; sets smp->nl. */
-bool om__exposed(const om_view *v, om_sample *smp);
+/* om__exposed_at for a sample of scene s; sets smp->nl. */
+bool om__exposed(const om_scene *s, const om_view *v, om_sample *smp);
 
 /* Shades a strip into fb rows 0..st->rows-1. */
 void om__shade_strip(const om_scene *s, const om_view *v, const om_shade_cfg *c,

@@ -214,7 +214,7 @@ static void stage_eye(om__frame *c, uint32_t b)
         if (c->j.half_depth) om__eye_resolve(c->fd->scene, c->view, &tg, &st, c->j.mark);
         else om__frame_eye_rows(c, &tg, &st, c->j.mark);
     } else if (c->j.mark) {
-        om__frame_mark(c->view, &st);
+        om__frame_mark(c->fd->scene, c->view, &st);
     }
 }
 

@@ -76,7 +76,7 @@ bool om__frame_carve_bins(om_arena *fa, const om_scene *s, om__bins *b);
 /* frame.c: the eye pass of rows [st->y0, + st->rows) into tg (with kept ids, the first
  * pass stores them and later ones resolve from them), and the exposure marks alone. */
 void om__frame_eye_rows(const om__frame *c, const om_target *tg, om_strip *st, bool mark);
-void om__frame_mark(const om_view *v, om_strip *st);
+void om__frame_mark(const om_scene *s, const om_view *v, om_strip *st);
 
 /* jobs.c. Each runs inline, or does nothing where it says so, when c->jobs is 1 (always
  * so where the engine carries no jobs code: config.h). */

@@ -5,13 +5,15 @@
 
 om_vec3 om__to_light(const om_view *v, om_vec3 p)
 {
-    return om__to_light_in(v, p);
+    if (v->light.kind == OM_LIGHT_DIRECTIONAL) return om__scale(v->light_axis, -1.0f);
+    return om__to_point(v->light.pos, p);
 }
 
-bool om__exposed(const om_view *v, om_sample *smp)
+bool om__exposed(const om_scene *s, const om_view *v, om_sample *smp)
 {
+    const om_vec3 anchor = om__sub(s->verts[s->idx[(size_t)smp->tri * 3]], v->origin);
     return om__exposed_at(v, om__v3(smp->p[0], smp->p[1], smp->p[2]),
-                          om__v3(smp->n[0], smp->n[1], smp->n[2]), &smp->nl);
+                          om__v3(smp->n[0], smp->n[1], smp->n[2]), anchor, &smp->nl);
 }
 
 void om_shade_cfg_default(om_shade_cfg *c)

@@ -25,7 +25,7 @@ static void table_row(const bscene *b, uint32_t W, uint32_t H)
     om_strip st = {W, H, 0, H, malloc(n * sizeof(om_sample)), malloc(n * sizeof(om_term)), v.origin};
     om__eye_pass(&b->s, &v, &tg, &st, NULL);
     for (size_t i = 0; i < n; i++) {
-        st.terms[i].flags = st.samples[i].tri != OM_NO_TRI && om__exposed(&v, &st.samples[i]) ? OM_TERM_EXPOSED : 0;
+        st.terms[i].flags = st.samples[i].tri != OM_NO_TRI && om__exposed(&b->s, &v, &st.samples[i]) ? OM_TERM_EXPOSED : 0;
     }
     double ti[3], tt[3], tb[3], tr[3], ts[3];
     om__izb_stats stats;
