@@ -158,9 +158,9 @@ static bool locate(const om__smlook *L, const om_sample *smp, tap *out)
             out->cx = out->cy = 0;   /* one tap: `at` is all the test reads */
         }
     }
-    float z = q.z * iw * OM_DEPTH_ONE_F;
     if (!L->warp_x) {   /* the distance as plain_locate takes it: the unmoved point's w */
         const bool spot = v->light.kind == OM_LIGHT_SPOT;
+        const float z = om__smlook_depth(&v->light_proj, spot, q, iw);
         float r = 0.0f;
         if (spot) {
             const float w = om__mat_apply(&v->light_vp, om__v3(smp->p[0], smp->p[1], smp->p[2])).w;
@@ -169,8 +169,10 @@ static bool locate(const om__smlook *L, const om_sample *smp, tap *out)
         out->zlit = om__smlook_threshold(om__smlook_biased(L->bias_c1, L->bias_c2, spot, z, r, tanang));
         return true;
     }
-    /* a warped map's bias from world units to depth units, d(z/w)/d(distance) at this
-     * sample, in the order rtw.c's float lookup repeats bit for bit */
+    /* a warped map's depth, and its bias from world units to depth units,
+     * d(z/w)/d(distance) at this sample, in the order rtw.c's float lookup repeats bit
+     * for bit */
+    const float z = q.z * iw * OM_DEPTH_ONE_F;
     float dz;
     if (v->light.kind == OM_LIGHT_SPOT) {
         const float e = dist > L->half_near ? dist : L->half_near;
@@ -233,6 +235,7 @@ typedef struct plain {
     bool spot;
     uint32_t size;
     float half, half_near, inv_half_near, c1, c2;
+    om_mat4 proj;   /* the light's projection: om__smlook_depth reads two of its values */
 } plain;
 
 /* A sample's biased depth (om__smlook_lit tests it) and texel index; false when it is
@@ -250,7 +253,7 @@ OM_INLINE bool plain_locate(const plain *P, const bool spot, const om_sample *sm
     const float uf = (q.x * iw + 1.0f) * P->half;
     const float wf = (1.0f - q.y * iw) * P->half;
     *at = texel_clamped(wf, P->size) * P->size + texel_clamped(uf, P->size);
-    const float z = q.z * iw * OM_DEPTH_ONE_F;
+    const float z = om__smlook_depth(&P->proj, spot, q, iw);
     const float r = spot ? (q.w > P->half_near ? iw : P->inv_half_near) : 0.0f;
     *zb = om__smlook_biased(P->c1, P->c2, spot, z, r, tanang);
     return true;
@@ -295,6 +298,7 @@ static void strip_plain(const om__smlook *L, om_strip *st, uint32_t *samples, ui
     P.inv_half_near = 1.0f / L->half_near;   /* as locate's 1 / max(w, half_near) */
     P.c1 = L->bias_c1;
     P.c2 = L->bias_c2;
+    P.proj = v->light_proj;
     const uint32_t *depth = L->depth;
     const size_t n = (size_t)st->rows * st->width;
     uint32_t nsamples = 0, nshadowed = 0;

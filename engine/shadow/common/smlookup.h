@@ -87,6 +87,15 @@ static inline float om__smlook_biased(float c1, float c2, bool spot, float z, fl
     return spot ? z - r * (c1 * r + c2 * tanang) : z - (c1 + c2 * tanang);
 }
 
+/* The light depth z/w * 2^32 of a point whose projection through the view's light_vp
+ * is q (iw = 1 / q.w) on an unwarped map; proj: the view's light_proj. A spot light's perspective makes z = m10
+ * zv + m11 and w = -zv of the point's view depth zv (om__mat_perspective), so z/w is
+ * m11 / w - m10: from the 1 / w at hand, without the matrix's z row. */
+static inline float om__smlook_depth(const om_mat4 *proj, bool spot, om_vec4 q, float iw)
+{
+    return spot ? (proj->m[11] * iw - proj->m[10]) * OM_DEPTH_ONE_F : q.z * iw * OM_DEPTH_ONE_F;
+}
+
 /* A texel coordinate clamped to a map of `size` texels. */
 static inline uint32_t om__smlook_clamp(int32_t x, uint32_t size)
 {
