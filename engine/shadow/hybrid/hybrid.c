@@ -294,17 +294,15 @@ const om__lspace *om__hybrid_lspace(const void *state) { return &((const hybrid_
  * (om__mat_apply's and om__project_xy's float operations in their order, as
  * om__lspace_point's: the same bits), then the float test that proves most of them
  * lit (surely_lit), and only for the rest each one's exact depth (om__zdepth: an
- * integer division) and lookup. One lane where a double is a software routine
- * (OM_FAST_FLOAT): no vector unit there, and om__project_xy itself. Else 64 lanes:
- * each batch sets up the light's matrix and constants in vector registers again, so
- * wider batches set them up fewer times. */
+ * integer division) and lookup. Each batch sets up the light's matrix and constants
+ * again, so wider batches set them up fewer times; 32 where a double is a software
+ * routine (OM_FAST_FLOAT: no vector unit, and a small stack), else 64. */
 #if OM_FAST_FLOAT
-#define LANES 1
+#define LANES 32
 #else
 #define LANES 64
 #endif
 
-#if LANES > 1
 /* Is the sample certainly lit, decided in single precision without its exact depth:
  * the answer classify_at's first test would give (the texel's plane, in double, at or
  * beyond om__zdepth of the sample's clip z and w), where this says so; 0 where it
@@ -337,7 +335,6 @@ static inline int32_t surely_lit(float hz, float gx, float gy, int32_t dx, int32
     const float e = (om__fabsf(hz) + om__fabsf(a) + om__fabsf(b) + om__fabsf(zh)) * 0x1p-20f + 1.0f, d = v - e;
     return (hz == FLT_MAX) | ((d >= zh) & (d >= 0.0f));
 }
-#endif
 
 /* The next batch of the strip's samples from *i on: every term set to 255 on the way,
  * up to LANES exposed samples projected and looked up, counts[0], [1], [2] counting
@@ -347,9 +344,7 @@ static uint32_t look_up(const hybrid_state *m, om_strip *st, size_t *i, size_t n
                         om__hkey q[LANES])
 {
     float px[LANES], py[LANES], pz[LANES], cz[LANES], cw[LANES];
-#if LANES > 1
     float zf[LANES], hz[LANES], hgx[LANES], hgy[LANES];   /* surely_lit's */
-#endif
     int32_t gx[LANES], gy[LANES], tx[LANES], ty[LANES], ok[LANES], lit[LANES];
     om__facet facet = {OM_NO_TRI, 0.0f};   /* om__lspace_pull's */
     uint32_t at[LANES], tri[LANES], k = 0, u = 0;
@@ -368,7 +363,6 @@ static uint32_t look_up(const hybrid_state *m, om_strip *st, size_t *i, size_t n
         px[j] = py[j] = pz[j] = 0.0f;
         at[j] = tri[j] = 0;
     }
-#if LANES > 1
     /* om__project_xy's operations in its order, lane by lane, with no branch on the
      * data: the same bits where ok (a lane that fails, where X and Y may be infinite
      * or NaN, converts 0 instead: one mask, where clamps cost a blend each) */
@@ -417,20 +411,6 @@ static uint32_t look_up(const hybrid_state *m, om_strip *st, size_t *i, size_t n
     }
     for (uint32_t j = 0; j < LANES; j++)
         lit[j] = surely_lit(hz[j], hgx[j], hgy[j], gx[j] - (tx[j] * T + T / 2), gy[j] - (ty[j] * T + T / 2), zf[j]);
-#else
-    for (uint32_t j = 0; j < k; j++) {   /* one lane: om__project itself */
-        const om_vec4 c = om__mat_apply(&m->ls.vp, om__v3(px[j], py[j], pz[j]));
-        int64_t x = 0, y = 0;
-        ok[j] = om__project_xy(&c, OM_LIGHT_GRID, OM_LIGHT_GRID, &x, &y);
-        gx[j] = (int32_t)x;   /* within 2^26 where ok */
-        gy[j] = (int32_t)y;
-        cz[j] = c.z;
-        cw[j] = c.w;
-        tx[j] = (int32_t)texel_of(m, gx[j]);
-        ty[j] = (int32_t)texel_of(m, gy[j]);
-        lit[j] = 0;   /* classify_at's float test instead (plane_at_or_beyond) */
-    }
-#endif
     for (uint32_t j = 0; j < k; j++) {
         if (!ok[j]) continue;
         if (lit[j]) {   /* the term is already 255 */
