@@ -24,7 +24,7 @@
  * roundings. */
 #define EYE_WAYS 16
 #define EYE_RUNS 32
-#define EYE_LAZY 16
+#define EYE_LAZY 8
 #define EYE_GROW (1.0f / 512.0f)
 #define EYE_MARGIN (1.0f / 65536.0f)
 
