@@ -1,9 +1,9 @@
 /* report_machines.c — the report's "small machines" section (see report.h): what
  * `make cross-test` measured on the Cortex-M4 firmware under QEMU, read from the CSVs
  * it writes (never typed in): per method its code, least arena, whole footprint and
- * instructions a frame at 160x120 (m4-methods.csv); per method and scene the
- * instructions of a frame and the bytes of each arena; the firmware's size; the
- * engine's code per part.
+ * instructions a frame at 160x120 (m4-methods.csv); per method, scene and size the
+ * instructions of a frame and the bytes of each arena, on the Cortex-M7 too (m7.csv);
+ * the firmware's size; the engine's code per part.
  * Where the files are not there, the page says which command writes them. */
 #define _POSIX_C_SOURCE 200809L
 #include "cli.h"
@@ -82,7 +82,8 @@ static void chart(FILE *f, const rcsv *c)
         if (s[k].n == MAXP) continue;
         xs[k][s[k].n] = rcsv_num(c, r, "whole_bytes");
         ys[k][s[k].n] = ins;
-        snprintf(text[k][s[k].n], sizeof text[k][s[k].n], "%s", rcsv_get(c, r, "scene"));
+        snprintf(text[k][s[k].n], sizeof text[k][s[k].n], "%s@%sx%s", rcsv_get(c, r, "scene"),
+                 rcsv_get(c, r, "width"), rcsv_get(c, r, "height"));
         labels[k][s[k].n] = text[k][s[k].n];
         s[k].n++;
     }
@@ -103,7 +104,7 @@ void report_machines(FILE *f, const char *cross)
                "into Cortex-M4 firmware and run under QEMU by <code>make cross-test</code>: per "
                "method and scene the instructions of one frame and the bytes of each arena (strips "
                "keep the frame's small), and the firmware's size.</p>\n");
-    char *m4 = cli_path(cross, "m4.csv"), *size = cli_path(cross, "m4-size.csv");
+    char *m4 = cli_path(cross, "m4.csv"), *m7 = cli_path(cross, "m7.csv"), *size = cli_path(cross, "m4-size.csv");
     char *per = cli_path(cross, "m4-methods.csv");
     rcsv c;
     if (per && rcsv_load(&c, per)) {
@@ -123,6 +124,15 @@ void report_machines(FILE *f, const char *cross)
         rcsv_free(&c);
     } else if (m4) {
         missing(f, m4, "instructions a frame and arena bytes per method on the Cortex-M4 build");
+    }
+    if (m7 && rcsv_load(&c, m7)) {
+        fprintf(f, "<p>The same firmware for a Cortex-M7 (QEMU's mps2-an500, a double FPU: "
+                   "what a Teensy 4 or an STM32H7 runs), <code>none</code>, <code>sm</code> and "
+                   "<code>hybrid</code> on the small scene:</p>\n");
+        report_table(f, &c, m4_cols, sizeof m4_cols / sizeof m4_cols[0], NULL, NULL);
+        rcsv_free(&c);
+    } else if (m7) {
+        missing(f, m7, "instructions a frame on the Cortex-M7 build");
     }
     if (size && rcsv_load(&c, size)) {
         fprintf(f, "<p>The firmware's size (every method and both scenes linked in; the "
@@ -145,6 +155,7 @@ void report_machines(FILE *f, const char *cross)
         missing(f, code, "the code size of each method and part of the engine");
     }
     free(m4);
+    free(m7);
     free(per);
     free(size);
     free(code);
