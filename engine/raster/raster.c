@@ -296,11 +296,18 @@ static void depth_row(const om__rtri *t, const om_target *tg, int32_t y, int32_t
                  t->zqy * (uint64_t)((int64_t)y * S + H - t->e.y[0]);
     const uint64_t step = t->zqx * (uint64_t)S;
     uint32_t *dep = tg->depth + (size_t)(y - (int32_t)tg->y0) * tg->width;
+    if (!id_row) {   /* a loop of its own: the depth passes' texels, one test each */
+        for (int32_t x = x0; x <= x1; x++, z += step) {
+            const uint32_t d = (uint32_t)(z >> 32);
+            if (d < dep[x]) dep[x] = d;
+        }
+        return;
+    }
     for (int32_t x = x0; x <= x1; x++, z += step) {
         const uint32_t d = (uint32_t)(z >> 32);
-        if (d < dep[x] || (id_row && d == dep[x] && id < id_row[x] && d != 0xFFFFFFFFu)) {
+        if (d < dep[x] || (d == dep[x] && id < id_row[x] && d != 0xFFFFFFFFu)) {
             dep[x] = d;
-            if (id_row) id_row[x] = id;
+            id_row[x] = id;
         }
     }
 }
