@@ -297,7 +297,17 @@ static void depth_row(const om__rtri *t, const om_target *tg, int32_t y, int32_t
     const uint64_t step = t->zqx * (uint64_t)S;
     uint32_t *dep = tg->depth + (size_t)(y - (int32_t)tg->y0) * tg->width;
     if (!id_row) {   /* a loop of its own: the depth passes' texels, one test each */
-        for (int32_t x = x0; x <= x1; x++, z += step) {
+        /* four texels a step, each given the lesser of its depth and the fill's, the
+         * value the test below leaves, stored whether or not it changed: no branch, so
+         * that a compiler with lanes takes the four together; the rest one at a time */
+        int32_t x = x0;
+        for (; x + 3 <= x1; x += 4, z += 4 * step) {
+            for (int i = 0; i < 4; i++) {
+                const uint32_t d = (uint32_t)((z + (uint64_t)i * step) >> 32);
+                dep[x + i] = d < dep[x + i] ? d : dep[x + i];
+            }
+        }
+        for (; x <= x1; x++, z += step) {
             const uint32_t d = (uint32_t)(z >> 32);
             if (d < dep[x]) dep[x] = d;
         }
