@@ -482,9 +482,10 @@ static void walk_batches(const om_scene *s, const om_mat4 *vp, om_vec3 o, om_ras
 }
 
 /* One triangle of the walk with vertex bins (om__scene_raster_hiz), its rows reaching
- * the target's; `box`: its box is yet to be tested for a pixel centre of the target. */
+ * the target's; `box`: its box is yet to be tested for a pixel centre of the target;
+ * `cbox`: the centres its box holds when the caller has them (block_list), or NULL. */
 OM_INLINE void bin_tri(const om_scene *s, const om_mat4 *vp, om_vec3 o, om_raster *r, uint32_t *hiz, om__cull *cl,
-                           bool cull, const om__vsnap *vs, om__guard g, bool box, uint32_t t)
+                       bool cull, const om__vsnap *vs, om__guard g, bool box, uint32_t t, const int32_t *cbox)
 {
     const om_target *tg = r->target;
     const uint32_t *ix = s->idx + (size_t)t * 3;
@@ -493,10 +494,10 @@ OM_INLINE void bin_tri(const om_scene *s, const om_mat4 *vp, om_vec3 o, om_raste
         /* in 32 bits first: most triangles a strip's rows reach hold none of its
          * pixel centres (conservative coverage reaches beyond them) */
         if (box && !holds_centre(va->x, vb->x, vc->x, va->y, vb->y, vc->y, tg)) return;
-        r->cull_back = cull && om__cull_next(cl, t);
-        const int64_t x[3] = {va->x, vb->x, vc->x}, y[3] = {va->y, vb->y, vc->y};
+        r->cull_back = cull && s->solids && om__cull_next(cl, t);   /* its first test, without a call */
+        const int32_t x[3] = {va->x, vb->x, vc->x}, y[3] = {va->y, vb->y, vc->y};
         const uint32_t z[3] = {va->z, vb->z, vc->z};
-        om__raster_projected(r, hiz, x, y, z, NULL, t);
+        om__raster_projected32(r, hiz, x, y, z, t, cbox);
         return;
     }
     r->cull_back = cull && om__cull_next(cl, t);
@@ -539,8 +540,10 @@ static uint32_t rows_reach_few(const uint32_t *rows, uint32_t n, uint32_t y0, ui
 
 #if VERT_LANES
 /* A block of SCAN triangles of the walk with vertex bins and no rows: the ones to draw,
- * in order (list, n), and the first texel of each whose box holds a centre (at, m). */
-typedef struct block { int32_t list[SCAN], n, at[SCAN], m; } block;
+ * in order (list, n), with the pixel centres their box holds (centres_in's, for
+ * om__raster_projected32), and the first texel of each whose box holds a centre of the
+ * target (at, m). */
+typedef struct block { int32_t list[SCAN], n, at[SCAN], m, cb[4][SCAN]; } block;
 
 /* The block of the n <= SCAN triangles from t0: those of three snapped vertices whose
  * box holds a pixel centre of tg (bin_tri's test), and those to clip, listed without
@@ -571,6 +574,10 @@ static inline void block_list(const om_scene *s, const om__vsnap *vs, const om_t
         const int32_t px0 = c.x0 < 0 ? 0 : c.x0, px1 = c.x1 > xe ? xe : c.x1;
         const int32_t py0 = c.y0 < ya0 ? ya0 : c.y0, py1 = c.y1 > ye ? ye : c.y1;
         const int32_t h = sn & (px0 <= px1) & (py0 <= py1);
+        b->cb[0][k] = c.x0;
+        b->cb[1][k] = c.x1;
+        b->cb[2][k] = c.y0;
+        b->cb[3][k] = c.y1;
         holds[k] = h;
         go[k] = (sn ^ 1) | h;
         px[k] = px0;
@@ -655,8 +662,10 @@ void om__scene_raster_hiz(const om_scene *s, const om_mat4 *vp, om_vec3 o, const
             if (t1 == 0) continue;
             if (t1 - SCAN >= s->ntris) break;
             const block *b = &bl[h ^ 1];
-            for (int32_t j = 0; j < b->n; j++)
-                bin_tri(s, vp, o, &r, hiz, &cl, cull, vs, g, false, t1 - SCAN + (uint32_t)b->list[j]);
+            for (int32_t j = 0; j < b->n; j++) {
+                const int32_t k = b->list[j], cb[4] = {b->cb[0][k], b->cb[1][k], b->cb[2][k], b->cb[3][k]};
+                bin_tri(s, vp, o, &r, hiz, &cl, cull, vs, g, false, t1 - SCAN + (uint32_t)k, cb);
+            }
         }
         return;
     }
@@ -666,12 +675,12 @@ void om__scene_raster_hiz(const om_scene *s, const om_mat4 *vp, om_vec3 o, const
         if (rows && (n == SCAN ? !rows_reach(rows + t0, y0, y1, hit) : !rows_reach_few(rows + t0, n, y0, y1, hit)))
             continue;
         for (uint32_t k = 0; k < n; k++)
-            if (!rows || hit[k]) bin_tri(s, vp, o, &r, hiz, &cl, cull, vs, g, box, t0 + k);
+            if (!rows || hit[k]) bin_tri(s, vp, o, &r, hiz, &cl, cull, vs, g, box, t0 + k, NULL);
     }
 #else
     for (uint32_t t = 0; t < s->ntris; t++) {
         if (rows && ((rows[t] & 0xFFFFu) > y1 || rows[t] >> 16 < y0)) continue;
-        bin_tri(s, vp, o, &r, hiz, &cl, cull, vs, g, mode != OM_RASTER_CONSERVATIVE, t);
+        bin_tri(s, vp, o, &r, hiz, &cl, cull, vs, g, mode != OM_RASTER_CONSERVATIVE, t, NULL);
     }
 #endif
 }
