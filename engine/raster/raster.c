@@ -296,11 +296,28 @@ static void depth_row(const om__rtri *t, const om_target *tg, int32_t y, int32_t
                  t->zqy * (uint64_t)((int64_t)y * S + H - t->e.y[0]);
     const uint64_t step = t->zqx * (uint64_t)S;
     uint32_t *dep = tg->depth + (size_t)(y - (int32_t)tg->y0) * tg->width;
+    if (!id_row) {   /* a loop of its own: the depth passes' texels, one test each */
+        /* four texels a step, each given the lesser of its depth and the fill's, the
+         * value the test below leaves, stored whether or not it changed: no branch, so
+         * that a compiler with lanes takes the four together; the rest one at a time */
+        int32_t x = x0;
+        for (; x + 3 <= x1; x += 4, z += 4 * step) {
+            for (int i = 0; i < 4; i++) {
+                const uint32_t d = (uint32_t)((z + (uint64_t)i * step) >> 32);
+                dep[x + i] = d < dep[x + i] ? d : dep[x + i];
+            }
+        }
+        for (; x <= x1; x++, z += step) {
+            const uint32_t d = (uint32_t)(z >> 32);
+            if (d < dep[x]) dep[x] = d;
+        }
+        return;
+    }
     for (int32_t x = x0; x <= x1; x++, z += step) {
         const uint32_t d = (uint32_t)(z >> 32);
-        if (d < dep[x] || (id_row && d == dep[x] && id < id_row[x] && d != 0xFFFFFFFFu)) {
+        if (d < dep[x] || (d == dep[x] && id < id_row[x] && d != 0xFFFFFFFFu)) {
             dep[x] = d;
-            if (id_row) id_row[x] = id;
+            id_row[x] = id;
         }
     }
 }
@@ -614,23 +631,35 @@ static inline void tiny_edge(int32_t xi, int32_t yi, int32_t xj, int32_t yj, int
 
 /* 1 or 0, what snapped returns for such a triangle (whether its box holds a centre of
  * the target and it has area), or -1 when its box is not tiny. x, y are within
- * om__tri2's range (2^29), so the biased shifts below see non-negative values. */
-static int tiny(const om_raster *r, const int64_t x[3], const int64_t y[3], const uint32_t *z, const om_vec4 *zc,
-                uint32_t id)
+ * om__tri2's range (2^29), so the biased shifts below see non-negative values; `box`,
+ * when given, their centres as the caller found them (om__raster_projected32). In line:
+ * snapped and om__raster_projected32 each take it without a call. */
+OM_INLINE int tiny(const om_raster *r, const int32_t x[3], const int32_t y[3], const uint32_t *z, const om_vec4 *zc,
+                   uint32_t id, const int32_t *box)
 {
     const om_target *tg = r->target;
-    const int32_t xa = (int32_t)x[0], xb = (int32_t)x[1], xc = (int32_t)x[2];
-    const int32_t ya = (int32_t)y[0], yb = (int32_t)y[1], yc = (int32_t)y[2];
-    int32_t lx = xa < xb ? xa : xb, hx = xa < xb ? xb : xa, ly = ya < yb ? ya : yb, hy = ya < yb ? yb : ya;
-    lx = xc < lx ? xc : lx;
-    hx = xc > hx ? xc : hx;
-    ly = yc < ly ? yc : ly;
-    hy = yc > hy ? yc : hy;
-    /* bounds' centres, floor((lo + 127) / 256) to floor((hi - 128) / 256), by shifts
-     * of values made non-negative by a bias of 2^30 (a multiple of 256) */
-    const int32_t B = 1 << 30, b = B >> OM_SUBPIX_BITS;
-    int32_t x0 = ((lx + 127 + B) >> OM_SUBPIX_BITS) - b, x1 = ((hx - 128 + B) >> OM_SUBPIX_BITS) - b;
-    int32_t y0 = ((ly + 127 + B) >> OM_SUBPIX_BITS) - b, y1 = ((hy - 128 + B) >> OM_SUBPIX_BITS) - b;
+    const int32_t xa = x[0], xb = x[1], xc = x[2];
+    const int32_t ya = y[0], yb = y[1], yc = y[2];
+    int32_t x0, x1, y0, y1;
+    if (box) {   /* the caller's: the same centres */
+        x0 = box[0];
+        x1 = box[1];
+        y0 = box[2];
+        y1 = box[3];
+    } else {
+        int32_t lx = xa < xb ? xa : xb, hx = xa < xb ? xb : xa, ly = ya < yb ? ya : yb, hy = ya < yb ? yb : ya;
+        lx = xc < lx ? xc : lx;
+        hx = xc > hx ? xc : hx;
+        ly = yc < ly ? yc : ly;
+        hy = yc > hy ? yc : hy;
+        /* bounds' centres, floor((lo + 127) / 256) to floor((hi - 128) / 256), by
+         * shifts of values made non-negative by a bias of 2^30 (a multiple of 256) */
+        const int32_t B = 1 << 30, b = B >> OM_SUBPIX_BITS;
+        x0 = ((lx + 127 + B) >> OM_SUBPIX_BITS) - b;
+        x1 = ((hx - 128 + B) >> OM_SUBPIX_BITS) - b;
+        y0 = ((ly + 127 + B) >> OM_SUBPIX_BITS) - b;
+        y1 = ((hy - 128 + B) >> OM_SUBPIX_BITS) - b;
+    }
     if (x1 - x0 >= TINY || y1 - y0 >= TINY) return -1;
     x0 = x0 < 0 ? 0 : x0;
     x1 = x1 > (int32_t)tg->width - 1 ? (int32_t)tg->width - 1 : x1;
@@ -721,7 +750,9 @@ static bool snapped(const om_raster *r, uint32_t *hiz, const int64_t x[3], const
     om__rtri t;
     if (r->mode != OM_RASTER_DEPTH || (hiz && !om__hiz_fits(r->target))) hiz = NULL;
     if (!cons && !r->grid_x && (ranged || in_range(x, y))) {
-        const int got = tiny(r, x, y, z, zc, id);
+        const int32_t x32[3] = {(int32_t)x[0], (int32_t)x[1], (int32_t)x[2]};
+        const int32_t y32[3] = {(int32_t)y[0], (int32_t)y[1], (int32_t)y[2]};
+        const int got = tiny(r, x32, y32, z, zc, id, NULL);
         if (got >= 0) return got;
     }
     if (r->grid_x) {
@@ -757,6 +788,19 @@ bool om__raster_projected(const om_raster *r, uint32_t *hiz, const int64_t x[3],
                           const uint32_t *z, const om_vec4 *clip, uint32_t id)
 {
     return snapped(r, hiz, x, y, z, clip, id, true);
+}
+
+bool om__raster_projected32(const om_raster *r, uint32_t *hiz, const int32_t x[3], const int32_t y[3],
+                            const uint32_t z[3], uint32_t id, const int32_t *box)
+{
+    /* snapped's first tests, then its tiny fill straight from the 32-bit vertices */
+    const int64_t X[3] = {x[0], x[1], x[2]}, Y[3] = {y[0], y[1], y[2]};
+    if (r->cull_back && (X[1] - X[0]) * (Y[2] - Y[0]) - (X[2] - X[0]) * (Y[1] - Y[0]) > 0) return false;
+    if (r->mode != OM_RASTER_CONSERVATIVE && !r->grid_x) {
+        const int got = tiny(r, x, y, z, NULL, id, box);
+        if (got >= 0) return got;
+    }
+    return snapped(r, hiz, X, Y, z, NULL, id, true);
 }
 
 bool om__raster_snapped(const om_raster *r, const int64_t x[3], const int64_t y[3], const uint32_t z[3],

@@ -253,6 +253,14 @@ int om__raster_tri_guarded(const om_raster *r, uint32_t *hiz, const om_vec4 clip
 bool om__raster_projected(const om_raster *r, uint32_t *hiz, const int64_t x[3], const int64_t y[3],
                           const uint32_t *z, const om_vec4 *clip, uint32_t id);
 
+/* om__raster_projected of vertices given in 32 bits with their depths (the bins'
+ * om__vsnap), which sends a tiny triangle to its fill with no 64-bit setup on the way:
+ * the same texels and bits. `box`, when given: the columns and rows of the pixel
+ * centres the vertices' box holds, first and last, not clamped to the target (the
+ * caller has them already), as {x0, x1, y0, y1}. */
+bool om__raster_projected32(const om_raster *r, uint32_t *hiz, const int32_t x[3], const int32_t y[3],
+                            const uint32_t z[3], uint32_t id, const int32_t *box);
+
 /* Which of the six clip planes (near, far, four guard-band sides) a vertex is outside
  * of, as a bit mask; 0 means it needs no clipping. */
 unsigned om__outcode(const om_vec4 *v, uint32_t width, uint32_t height);

@@ -482,9 +482,10 @@ static void walk_batches(const om_scene *s, const om_mat4 *vp, om_vec3 o, om_ras
 }
 
 /* One triangle of the walk with vertex bins (om__scene_raster_hiz), its rows reaching
- * the target's; `box`: its box is yet to be tested for a pixel centre of the target. */
-static inline void bin_tri(const om_scene *s, const om_mat4 *vp, om_vec3 o, om_raster *r, uint32_t *hiz, om__cull *cl,
-                           bool cull, const om__vsnap *vs, om__guard g, bool box, uint32_t t)
+ * the target's; `box`: its box is yet to be tested for a pixel centre of the target;
+ * `cbox`: the centres its box holds when the caller has them (block_list), or NULL. */
+OM_INLINE void bin_tri(const om_scene *s, const om_mat4 *vp, om_vec3 o, om_raster *r, uint32_t *hiz, om__cull *cl,
+                       bool cull, const om__vsnap *vs, om__guard g, bool box, uint32_t t, const int32_t *cbox)
 {
     const om_target *tg = r->target;
     const uint32_t *ix = s->idx + (size_t)t * 3;
@@ -493,10 +494,10 @@ static inline void bin_tri(const om_scene *s, const om_mat4 *vp, om_vec3 o, om_r
         /* in 32 bits first: most triangles a strip's rows reach hold none of its
          * pixel centres (conservative coverage reaches beyond them) */
         if (box && !holds_centre(va->x, vb->x, vc->x, va->y, vb->y, vc->y, tg)) return;
-        r->cull_back = cull && om__cull_next(cl, t);
-        const int64_t x[3] = {va->x, vb->x, vc->x}, y[3] = {va->y, vb->y, vc->y};
+        r->cull_back = cull && s->solids && om__cull_next(cl, t);   /* its first test, without a call */
+        const int32_t x[3] = {va->x, vb->x, vc->x}, y[3] = {va->y, vb->y, vc->y};
         const uint32_t z[3] = {va->z, vb->z, vc->z};
-        om__raster_projected(r, hiz, x, y, z, NULL, t);
+        om__raster_projected32(r, hiz, x, y, z, t, cbox);
         return;
     }
     r->cull_back = cull && om__cull_next(cl, t);
@@ -534,6 +535,63 @@ static uint32_t rows_reach_few(const uint32_t *rows, uint32_t n, uint32_t y0, ui
         any |= hit[k];
     }
     return any;
+}
+#endif
+
+#if VERT_LANES
+/* A block of SCAN triangles of the walk with vertex bins and no rows: the ones to draw,
+ * in order (list, n), with the pixel centres their box holds (centres_in's, for
+ * om__raster_projected32), and the first texel of each whose box holds a centre of the
+ * target (at, m). */
+typedef struct block { int32_t list[SCAN], n, at[SCAN], m, cb[4][SCAN]; } block;
+
+/* The block of the n <= SCAN triangles from t0: those of three snapped vertices whose
+ * box holds a pixel centre of tg (bin_tri's test), and those to clip, listed without
+ * a branch, as whether a small triangle's box holds a centre is a coin toss to a
+ * branch predictor. The boxes in a loop over lanes of their own (a compiler tests
+ * four an instruction), after the vertices are gathered; a vertex to clip counts as
+ * at 0 there, a short block's missing triangles as triangle t0's. */
+static inline void block_list(const om_scene *s, const om__vsnap *vs, const om_target *tg, uint32_t t0, uint32_t n,
+                              block *b)
+{
+    int32_t x[3][SCAN], y[3][SCAN], px[SCAN], py[SCAN], go[SCAN], holds[SCAN];
+    for (uint32_t k = 0; k < SCAN; k++) {
+        const uint32_t *ix = s->idx + (size_t)(t0 + (k < n ? k : 0)) * 3;
+        const om__vsnap *va = &vs[ix[0]], *vb = &vs[ix[1]], *vc = &vs[ix[2]];
+        x[0][k] = va->x;
+        y[0][k] = va->y;
+        x[1][k] = vb->x;
+        y[1][k] = vb->y;
+        x[2][k] = vc->x;
+        y[2][k] = vc->y;
+    }
+    const int32_t xe = (int32_t)tg->width - 1, ya0 = (int32_t)tg->y0, ye = (int32_t)(tg->y0 + tg->rows) - 1;
+    for (int k = 0; k < SCAN; k++) {
+        const int32_t sn = (x[0][k] != INT32_MIN) & (x[1][k] != INT32_MIN) & (x[2][k] != INT32_MIN);
+        const int32_t xa = sn ? x[0][k] : 0, xb = sn ? x[1][k] : 0, xc = sn ? x[2][k] : 0;
+        const int32_t ya = sn ? y[0][k] : 0, yb = sn ? y[1][k] : 0, yc = sn ? y[2][k] : 0;
+        const centre_box c = centres_in(xa, xb, xc, ya, yb, yc);
+        const int32_t px0 = c.x0 < 0 ? 0 : c.x0, px1 = c.x1 > xe ? xe : c.x1;
+        const int32_t py0 = c.y0 < ya0 ? ya0 : c.y0, py1 = c.y1 > ye ? ye : c.y1;
+        const int32_t h = sn & (px0 <= px1) & (py0 <= py1);
+        b->cb[0][k] = c.x0;
+        b->cb[1][k] = c.x1;
+        b->cb[2][k] = c.y0;
+        b->cb[3][k] = c.y1;
+        holds[k] = h;
+        go[k] = (sn ^ 1) | h;
+        px[k] = px0;
+        py[k] = py0 - ya0;
+    }
+    int32_t k1 = 0, m = 0;
+    for (int32_t k = 0; k < (int32_t)n; k++) {
+        b->list[k1] = k;
+        k1 += go[k];
+        b->at[m] = py[k] * (int32_t)tg->width + px[k];   /* within the target where it holds a centre */
+        m += holds[k];
+    }
+    b->n = k1;
+    b->m = m;
 }
 #endif
 
@@ -584,18 +642,45 @@ void om__scene_raster_hiz(const om_scene *s, const om_mat4 *vp, om_vec3 o, const
     /* conservative coverage reaches pixels beyond the centres; centre rows have
      * tested the boxes already (om__bins.centres) */
     const bool box = mode != OM_RASTER_CONSERVATIVE && !(rows && bins->centres);
+    if (box && !rows) {
+        /* Block t1 is listed before block t1 - SCAN is drawn. Where few of a block's
+         * triangles hold a centre (a scene of many triangles below a texel each), the
+         * walk's bins stream through the caches between two draws and a texel is most
+         * often a miss: the block's first texels are then asked for, a block before
+         * they are drawn. Where most of them draw, the draws' own misses overlap, and
+         * a burst of requests would only wait for the ones before it. */
+        block bl[2];
+        for (uint32_t t1 = 0, h = 0;; t1 += SCAN, h ^= 1) {
+            if (t1 < s->ntris) {
+                block *nb = &bl[h];
+                block_list(s, vs, tg, t1, s->ntris - t1 < SCAN ? s->ntris - t1 : SCAN, nb);
+#if defined(__GNUC__) || defined(__clang__)
+                if (nb->m <= SCAN / 2)
+                    for (int32_t j = 0; j < nb->m; j++) __builtin_prefetch(tg->depth + nb->at[j]);
+#endif
+            }
+            if (t1 == 0) continue;
+            if (t1 - SCAN >= s->ntris) break;
+            const block *b = &bl[h ^ 1];
+            for (int32_t j = 0; j < b->n; j++) {
+                const int32_t k = b->list[j], cb[4] = {b->cb[0][k], b->cb[1][k], b->cb[2][k], b->cb[3][k]};
+                bin_tri(s, vp, o, &r, hiz, &cl, cull, vs, g, false, t1 - SCAN + (uint32_t)k, cb);
+            }
+        }
+        return;
+    }
     uint32_t hit[SCAN];
     for (uint32_t t0 = 0; t0 < s->ntris; t0 += SCAN) {
         const uint32_t n = s->ntris - t0 < SCAN ? s->ntris - t0 : SCAN;
         if (rows && (n == SCAN ? !rows_reach(rows + t0, y0, y1, hit) : !rows_reach_few(rows + t0, n, y0, y1, hit)))
             continue;
         for (uint32_t k = 0; k < n; k++)
-            if (!rows || hit[k]) bin_tri(s, vp, o, &r, hiz, &cl, cull, vs, g, box, t0 + k);
+            if (!rows || hit[k]) bin_tri(s, vp, o, &r, hiz, &cl, cull, vs, g, box, t0 + k, NULL);
     }
 #else
     for (uint32_t t = 0; t < s->ntris; t++) {
         if (rows && ((rows[t] & 0xFFFFu) > y1 || rows[t] >> 16 < y0)) continue;
-        bin_tri(s, vp, o, &r, hiz, &cl, cull, vs, g, mode != OM_RASTER_CONSERVATIVE, t);
+        bin_tri(s, vp, o, &r, hiz, &cl, cull, vs, g, mode != OM_RASTER_CONSERVATIVE, t, NULL);
     }
 #endif
 }
