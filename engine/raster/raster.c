@@ -301,12 +301,14 @@ static void depth_row(const om__rtri *t, const om_target *tg, int32_t y, int32_t
          * value the test below leaves, stored whether or not it changed: no branch, so
          * that a compiler with lanes takes the four together; the rest one at a time */
         int32_t x = x0;
+#if defined(__SSE2__) || defined(__ARM_NEON)   /* without lanes, one at a time is less */
         for (; x + 3 <= x1; x += 4, z += 4 * step) {
             for (int i = 0; i < 4; i++) {
                 const uint32_t d = (uint32_t)((z + (uint64_t)i * step) >> 32);
                 dep[x + i] = d < dep[x + i] ? d : dep[x + i];
             }
         }
+#endif
         for (; x <= x1; x++, z += step) {
             const uint32_t d = (uint32_t)(z >> 32);
             if (d < dep[x]) dep[x] = d;

@@ -495,9 +495,17 @@ OM_INLINE void bin_tri(const om_scene *s, const om_mat4 *vp, om_vec3 o, om_raste
          * pixel centres (conservative coverage reaches beyond them) */
         if (box && !holds_centre(va->x, vb->x, vc->x, va->y, vb->y, vc->y, tg)) return;
         r->cull_back = cull && s->solids && om__cull_next(cl, t);   /* its first test, without a call */
-        const int32_t x[3] = {va->x, vb->x, vc->x}, y[3] = {va->y, vb->y, vc->y};
         const uint32_t z[3] = {va->z, vb->z, vc->z};
+#if VERT_LANES
+        const int32_t x[3] = {va->x, vb->x, vc->x}, y[3] = {va->y, vb->y, vc->y};
         om__raster_projected32(r, hiz, x, y, z, t, cbox);
+#else
+        /* without lanes there are no block lists (cbox), and the 64-bit vertices
+         * snapped takes cost a Cortex-M less than the 32-bit entry's own tests */
+        (void)cbox;
+        const int64_t x[3] = {va->x, vb->x, vc->x}, y[3] = {va->y, vb->y, vc->y};
+        om__raster_projected(r, hiz, x, y, z, NULL, t);
+#endif
         return;
     }
     r->cull_back = cull && om__cull_next(cl, t);
