@@ -121,6 +121,9 @@ if [ -s "$dir/bench/ok.scene-time.svg" ] && [ -s "$dir/bench/ok.scene-bytes.svg"
 has "$dir/out" "^machine *compute *[0-9.]* *[0-9.]* *[0-9.]*x" "bench scaling table has the machine's compute row"
 has "$dir/out" "^machine *memory *[0-9.]* *[0-9.]* *[0-9.]*x" "bench scaling table has the machine's memory row"
 has "$dir/out" "^ok.scene *izb *[0-9.]* *[0-9.]* *[0-9.]*x" "bench scaling table has a method's row"
+# the footnote on '*' only under a starred row
+if grep -q '[0-9]x\*' "$dir/out"; then has "$dir/out" "^(\* fewer jobs" "a starred row has its footnote"
+elif grep -q "fewer jobs ran" "$dir/out"; then bad "bench prints the '*' footnote with no starred row"; else ok; fi
 if command -v xmllint >/dev/null 2>&1; then
     xmllint --noout "$dir"/bench/*.svg && ok || bad "bench SVG is not well-formed"
 fi
