@@ -464,7 +464,8 @@ static const char compare_help[] =
     "Compares two shadow masks of the same frame (255 lit, 0 shadowed, 128 background),\n"
     "the first taken as the reference: match share, false lit and false shadowed, the\n"
     "same near the reference's shadow edges, and optionally a difference image (false\n"
-    "lit red, false shadowed blue).\n";
+    "lit red, false shadowed blue). Masks whose background differs are of different\n"
+    "frames (another scene, camera, time or size): an error, exit status 1.\n";
 
 int cmd_compare(int argc, char **argv)
 {
@@ -499,10 +500,19 @@ int cmd_compare(int argc, char **argv)
     } else {
         om_metrics m;
         om_compare_masks(ma, mb, wa, ha, &m);
+        /* Two methods' masks of one frame share its background (the eye pass decides
+         * it, not the method): where they do not, they are masks of different frames
+         * and the figures would mean nothing. */
+        if (m.mismatched_bg) {
+            fprintf(stderr, "ombra: %s and %s are not masks of one frame: %llu pixels are background "
+                    "(128) in one only, so the scene, camera, --time or --size differ; render both "
+                    "with the same SCENE, --size and --time, changing only --method\n",
+                    a_path, b_path, (unsigned long long)m.mismatched_bg);
+            free(ma);
+            free(mb);
+            return 1;
+        }
         print_metrics(stdout, b_path, a_path, &m);
-        if (m.mismatched_bg)
-            printf("warning: %llu pixels are background in one mask only: not the same frame?\n",
-                   (unsigned long long)m.mismatched_bg);
         if (diff) {
             uint8_t *rgb = malloc((size_t)wa * ha * 3);
             if (rgb) {

@@ -111,6 +111,13 @@ expect 1 "compare masks of different sizes" -- "$OMBRA" compare "$dir/ref.pgm" "
 has "$dir/err" "one size" "size mismatch explained"
 expect 1 "compare a non-PGM" -- "$OMBRA" compare "$dir/ref.pgm" "$dir/ok.scene"
 has "$dir/err" "ok.scene" "bad mask file named"
+# masks of different frames (here another scene) are refused, not compared
+expect 0 "mask of another scene" -- "$OMBRA" render "$dir/ok.scene" --size 160x120 --mask "$dir/other.pgm" --out "$dir/other.ppm"
+expect 1 "compare masks of different scenes" -- "$OMBRA" compare "$dir/ref.pgm" "$dir/other.pgm" --diff "$dir/other-diff.ppm"
+has "$dir/err" "not masks of one frame" "different frames explained"
+has "$dir/err" "same SCENE, --size and --time" "different frames: the fix named"
+[ -e "$dir/other-diff.ppm" ] && bad "compare of different frames wrote a diff" || ok
+if [ -s "$dir/out" ]; then bad "compare of different frames printed figures: $(head -c 200 "$dir/out")"; else ok; fi
 
 # A small sweep: one CSV row per point with every column filled, well-formed SVG.
 expect 0 "bench sweep" -- "$OMBRA" bench --scenes "$dir/ok.scene" --runs 1 --methods ref,izb --out "$dir/bench"
@@ -309,8 +316,8 @@ expect 0 "the same mesh without a budget" -- "$OMBRA" render "$dir/bigmesh.scene
 rss_ok 2048 "the default scene at --budget 2M" "$OMBRA" render --map 512 --budget 2M --out "$dir/z.ppm" --mask "$dir/z.pgm"
 rss_ok 1024 "izb at --budget 1M" "$OMBRA" render --method izb --budget 1M --out "$dir/z.ppm"
 # a mask is read as far as its header says, not to the end of the file
-{ printf 'P5\n16 12\n255\n'; head -c 192 /dev/zero; head -c 50000000 /dev/zero; } >"$dir/long.pgm"
 "$OMBRA" render --size 16x12 --mask "$dir/m16.pgm" --out "$dir/z.ppm" -q
+{ cat "$dir/m16.pgm"; head -c 50000000 /dev/zero; } >"$dir/long.pgm"
 expect 0 "compare a mask with 50 MB after its pixels" -- "$OMBRA" compare "$dir/m16.pgm" "$dir/long.pgm"
 rss_ok 0 "compare reads a mask's stated size only" "$OMBRA" compare "$dir/m16.pgm" "$dir/long.pgm"
 rm -f "$dir/long.pgm"
