@@ -100,6 +100,8 @@ has "$dir/err" "x.ppm" "unwritable output named"
 # Accuracy against the reference, in one run and from two mask files: the same figures.
 expect 0 "render --against ref" -- "$OMBRA" render --size 160x120 --map 512 --against ref --mask "$dir/sm.pgm" --diff "$dir/diff.ppm" --out "$dir/sm.ppm"
 has "$dir/out" "accuracy of sm against ref: match" "--against prints the match share"
+has "$dir/out" "match [0-9.]*% of [0-9]* covered samples" "the accuracy line counts covered samples"
+has "$dir/out" "^samples: [0-9]* covered (not background), [0-9]* of them exposed" "render tells covered from exposed samples"
 against=$(grep '^accuracy' "$dir/out" | sed 's/.*match/match/')
 if [ "$(head -c 2 "$dir/diff.ppm")" = "P6" ]; then ok; else bad "diff image written"; fi
 expect 0 "reference mask" -- "$OMBRA" render --size 160x120 --method ref --mask "$dir/ref.pgm" --out "$dir/ref.ppm"
