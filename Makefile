@@ -126,6 +126,8 @@ check: $(O)/run-tests $(O)/ombra $(FUZZ_TARGETS:%=$(O)/fuzz-replay-%) $(O)/embed
 	$(O)/embed-render-once
 	sh tests/embed/sized.sh $(O)
 	sh tests/embed/readme.sh
+	sh tests/embed/figures.sh $(O)
+	sh tests/sh/links.sh
 	sh tests/sh/methods.sh $(O)
 	SIZE=160x120 sh tests/sh/pairs.sh $(O)/ombra 100 $(O)/pairs
 

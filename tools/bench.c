@@ -554,8 +554,10 @@ typedef struct scale_row {
     bool fewer[3];   /* fewer jobs ran than threads asked, in some round */
 } scale_row;
 
-static void scale_print(const char *scene, const char *name, scale_row *r, int nc)
+/* Prints one row; true when a column of it is starred. */
+static bool scale_print(const char *scene, const char *name, scale_row *r, int nc)
 {
+    bool starred = false;
     printf("%-12s %-6s", scene, name);
     for (int c = 0; c < nc; c++) {
         double ratio[SCALING_ROUNDS], ms[SCALING_ROUNDS];
@@ -565,8 +567,10 @@ static void scale_print(const char *scene, const char *name, scale_row *r, int n
         }
         printf(" %10.2f", median(ms, SCALING_ROUNDS));
         if (c) printf(" %6.2fx%c", median(ratio, SCALING_ROUNDS), r->fewer[c] ? '*' : ' ');
+        starred |= c && r->fewer[c];
     }
     printf("\n");
+    return starred;
 }
 
 /* Starts the pool of `n` threads; false when it would not start (said). */
@@ -627,6 +631,7 @@ static int scaling(const char *cmd, char **names, size_t nn, const uint32_t *sw,
     }
     printf("\n");
     int rc = calib_rows(cmd, counts, nc, runs) ? 0 : 1;
+    bool starred = false;   /* the footnote only under a starred row */
     for (size_t si = 0; si < nn && !rc; si++) {
         om_diag d;
         memset(&d, 0, sizeof d);
@@ -661,16 +666,16 @@ static int scaling(const char *cmd, char **names, size_t nn, const uint32_t *sw,
                     }
                 }
             if (st != OM_OK || rc) break;
-            scale_print(cli_base_name(names[si]), om_method_name(m), &r, nc);
+            starred |= scale_print(cli_base_name(names[si]), om_method_name(m), &r, nc);
             fflush(stdout);
             have_eye = true;
         }
-        if (have_eye && st == OM_OK && !rc) scale_print(cli_base_name(names[si]), "eye", &eye, nc);
+        if (have_eye && st == OM_OK && !rc) starred |= scale_print(cli_base_name(names[si]), "eye", &eye, nc);
         if (st != OM_OK && !rc) rc = cli_error(names[si], &d, st);
         free(mask);
         cli_scene_free(&cs);
     }
-    if (!rc) printf("(* fewer jobs ran than threads asked)\n");
+    if (!rc && starred) printf("(* fewer jobs ran than threads asked)\n");
     if (!rc && !cli_threads_start(cmd, threads)) rc = 1;
     return rc;
 }

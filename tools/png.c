@@ -44,12 +44,17 @@ static uint8_t *chunk(uint8_t *o, const char *type, const uint8_t *data, size_t 
 
 uint8_t *png_encode(const uint8_t *rgb, uint32_t w, uint32_t h, size_t *len)
 {
+    return png_encode_px(rgb, 3, w, h, len);
+}
+
+uint8_t *png_encode_px(const uint8_t *px, unsigned ch, uint32_t w, uint32_t h, size_t *len)
+{
     crc_init();
-    size_t raw = (size_t)h * (1 + (size_t)w * 3);
+    size_t raw = (size_t)h * (1 + (size_t)w * ch);
     size_t blocks = raw / 65535 + 1;
     size_t zlen = 2 + raw + blocks * 5 + 4;
     uint8_t *z = malloc(zlen), *out = malloc(8 + 25 + 12 + zlen + 12);
-    uint8_t *line = malloc(1 + (size_t)w * 3);
+    uint8_t *line = malloc(1 + (size_t)w * ch);
     if (!z || !out || !line) { free(z); free(out); free(line); return NULL; }
     /* zlib stream: header, stored blocks, Adler-32 of the raw data */
     uint8_t *q = z;
@@ -64,8 +69,8 @@ uint8_t *png_encode(const uint8_t *rgb, uint32_t w, uint32_t h, size_t *len)
         *q++ = (uint8_t)(n & 0xFF); *q++ = (uint8_t)(n >> 8);
         *q++ = (uint8_t)(~n & 0xFF); *q++ = (uint8_t)((~n >> 8) & 0xFF);
         for (size_t i = 0; i < n; i++) {
-            uint8_t v = col == 0 ? 0 : rgb[row * w * 3 + col - 1];
-            if (++col == 1 + (size_t)w * 3) { col = 0; row++; }
+            uint8_t v = col == 0 ? 0 : px[row * w * ch + col - 1];
+            if (++col == 1 + (size_t)w * ch) { col = 0; row++; }
             *q++ = v;
             a = (a + v) % 65521;
             b = (b + a) % 65521;
@@ -76,7 +81,8 @@ uint8_t *png_encode(const uint8_t *rgb, uint32_t w, uint32_t h, size_t *len)
     uint8_t ihdr[13];
     put32(ihdr, w);
     put32(ihdr + 4, h);
-    ihdr[8] = 8; ihdr[9] = 2; ihdr[10] = 0; ihdr[11] = 0; ihdr[12] = 0;
+    /* 8 bits, colour type 0 (grey) or 2 (RGB), no interlace */
+    ihdr[8] = 8; ihdr[9] = ch == 1 ? 0 : 2; ihdr[10] = 0; ihdr[11] = 0; ihdr[12] = 0;
     uint8_t *o = out;
     memcpy(o, "\x89PNG\r\n\x1a\n", 8);
     o += 8;

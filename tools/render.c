@@ -2,6 +2,7 @@
  * from the engine's bytes-needed queries for this scene, view and method; --budget caps
  * the total, and the frame is then rendered through strips small enough to fit. */
 #include "cli.h"
+#include "imgfile.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -14,11 +15,14 @@ static const char render_help[] =
     "  --method NAME     shadow method (default sm; 'ombra methods' lists them)\n"
     "  --against NAME    also render NAME (usually ref) on the same visible samples and\n"
     "                    print the method's accuracy against it\n"
-    "  --out FILE.ppm    shaded frame, binary PPM (default ombra.ppm; a PGM, ombra.pgm,\n"
-    "                    with --format l8); '-' is standard output. Every file replaces\n"
-    "                    the old one only once it is whole\n"
-    "  --mask FILE.pgm   shadow mask: 255 lit, 0 shadowed, 128 background\n"
-    "  --diff FILE.ppm   with --against: false lit red, false shadowed blue\n"
+    "  --out FILE        shaded frame, in the format its extension names: .ppm (binary\n"
+    "                    PPM), .png, or .pgm for a grey frame (--format l8); default\n"
+    "                    ombra.ppm (ombra.pgm with --format l8); '-' is standard output\n"
+    "                    (PPM, or PGM for l8). Every file replaces the old one only once\n"
+    "                    it is whole\n"
+    "  --mask FILE       shadow mask, .pgm or .png (grey): 255 lit, 0 shadowed, 128\n"
+    "                    background\n"
+    "  --diff FILE       with --against, .ppm or .png: false lit red, false shadowed blue\n"
     "  --size WxH        image size, 1..8192 each (default: the scene's camera)\n"
     "  --time T          time along the scene's camera and light paths (default 0)\n"
     "  --format F        framebuffer format: rgb888 (default), rgb565, l8\n"
@@ -62,15 +66,31 @@ static om_status run_init(run *r, const cli_scene *cs, uint32_t W, uint32_t H, o
     return st;
 }
 
-/* Where each strip goes: the PPM sink, and a whole-frame mask when asked. */
+/* Where each strip goes: the PPM sink, a whole-frame mask and a whole-frame image
+ * (img_ch channels: 1 for a grey frame, else RGB888) when asked; and the
+ * frame's samples counted: covered (not background) and, of those, exposed (facing
+ * the light, inside its frustum: the ones a method decides; the others are shadowed
+ * by the lit rule whatever the method says). */
 typedef struct strip_out {
     om_ppm_sink *ppm;
-    uint8_t *mask;
+    uint8_t *mask, *img;
+    unsigned img_ch;
+    uint64_t covered, exposed;
 } strip_out;
 
 static om_status on_strip(void *user, const om_strip *st, const om_framebuffer *fb)
 {
     strip_out *o = (strip_out *)user;
+    for (size_t i = 0; i < (size_t)st->rows * st->width; i++) {
+        o->covered += st->samples[i].tri != OM_NO_TRI;
+        o->exposed += st->samples[i].tri != OM_NO_TRI && (st->terms[i].flags & OM_TERM_EXPOSED);
+    }
+    if (o->img)
+        for (uint32_t y = 0; y < st->rows; y++) {
+            uint8_t *row = o->img + (size_t)(st->y0 + y) * st->width * o->img_ch;
+            if (o->img_ch == 1) memcpy(row, fb->pixels + (size_t)y * fb->stride, st->width);
+            else om_row_to_rgb(fb, y, row);
+        }
     if (o->mask)
         for (uint32_t y = 0; y < st->rows; y++)
             for (uint32_t x = 0; x < st->width; x++) {
@@ -141,12 +161,12 @@ static int parse_format(const char *s, om_format *f)
 static void print_metrics(FILE *f, const char *name, const char *against, const om_metrics *m)
 {
     double n = m->samples ? (double)m->samples : 1.0, e = m->edge_samples ? (double)m->edge_samples : 1.0;
-    fprintf(f, "accuracy of %s against %s: match %.4f%% of %llu samples; false lit %llu (%.4f%%), "
+    fprintf(f, "accuracy of %s against %s: match %.4f%% of %llu covered samples; false lit %llu (%.4f%%), "
            "false shadowed %llu (%.4f%%)\n",
            name, against, 100.0 * om_metrics_match(m), (unsigned long long)m->samples,
            (unsigned long long)m->false_lit, 100.0 * (double)m->false_lit / n,
            (unsigned long long)m->false_shadowed, 100.0 * (double)m->false_shadowed / n);
-    fprintf(f, "near reference edges (%d px): %llu samples; false lit %llu (%.3f%%), false shadowed %llu (%.3f%%)\n",
+    fprintf(f, "near reference edges (%d px): %llu covered samples; false lit %llu (%.3f%%), false shadowed %llu (%.3f%%)\n",
            OM_EDGE_BAND, (unsigned long long)m->edge_samples, (unsigned long long)m->edge_false_lit,
            100.0 * (double)m->edge_false_lit / e, (unsigned long long)m->edge_false_shadowed,
            100.0 * (double)m->edge_false_shadowed / e);
@@ -234,6 +254,23 @@ int cmd_render(int argc, char **argv)
         int rc = same_files(paths, names, 4);
         if (rc) return rc;
     }
+    /* Each file in the format its name says (imgfile.h), before any work. */
+    img_fmt out_fmt, mask_fmt = IMG_NETPBM, diff_fmt = IMG_NETPBM;
+    {
+        int rc = img_fmt_of("render", "--out", out, IMG_ACCEPT_PPM | IMG_ACCEPT_PGM | IMG_ACCEPT_PNG,
+                            ".ppm, .png or, with --format l8, .pgm", &out_fmt);
+        if (!rc && mask) rc = img_fmt_of("render", "--mask", mask, IMG_ACCEPT_PGM | IMG_ACCEPT_PNG, ".pgm or .png", &mask_fmt);
+        if (!rc && diff) rc = img_fmt_of("render", "--diff", diff, IMG_ACCEPT_PPM | IMG_ACCEPT_PNG, ".ppm or .png", &diff_fmt);
+        if (rc) return rc;
+        if (out_fmt == IMG_PGM && fmt != OM_L8)
+            return cli_usage_error("render", "--out '%s' is a grey PGM: add --format l8 for a grey "
+                                   "frame, or name it .ppm or .png", out);
+    }
+    /* The frame's own netpbm goes out as strips arrive; any other format (a PNG, a
+     * grey frame as a PPM) is kept whole, outside --budget, and written after it. */
+    const bool out_whole = out_fmt != IMG_NETPBM && out_fmt != (fmt == OM_L8 ? IMG_PGM : IMG_PPM);
+    const bool mask_whole = mask && mask_fmt == IMG_PNG;
+    const unsigned img_ch = fmt == OM_L8 ? 1 : 3;
     /* With an image on standard output the report goes to standard error. */
     FILE *info = om_out_same(out, "-") || (mask && om_out_same(mask, "-")) ||
                  (diff && om_out_same(diff, "-")) ? stderr : stdout;
@@ -263,11 +300,13 @@ int cmd_render(int argc, char **argv)
     if (w) { cam.width = w; cam.height = h; }
     om_view view;
     int rc = 0;
-    uint8_t *mask_main = NULL, *mask_ref = NULL, *rgb = NULL;
+    uint8_t *mask_main = NULL, *mask_ref = NULL, *rgb = NULL, *img_px = NULL;
     om_ppm_sink sink;
-    om_out diff_out;
+    om_out diff_out, img_out, mask_out;
     memset(&sink, 0, sizeof sink);
     memset(&diff_out, 0, sizeof diff_out);
+    memset(&img_out, 0, sizeof img_out);
+    memset(&mask_out, 0, sizeof mask_out);
     if ((st = om_view_init(&view, &cam, &light, &cs.scene, &d)) != OM_OK) { rc = cli_error(where, &d, st); goto out; }
     const uint32_t W = cam.width, H = cam.height;
     if ((st = om_method_bytes(main_run.m, &main_run.cfg, &cs.scene, W, H, &main_run.min, &main_run.full)) != OM_OK) {
@@ -313,9 +352,16 @@ int cmd_render(int argc, char **argv)
     }
     /* The outputs open (as temporaries) before any work, so an unwritable one fails
      * at once; they replace the old files only once all are complete. */
-    if ((st = om_ppm_open(&sink, out, mask, W, H, fmt == OM_L8, &d)) != OM_OK ||
+    if ((st = om_ppm_open(&sink, out_whole ? NULL : out, mask_whole ? NULL : mask, W, H, fmt == OM_L8, &d)) != OM_OK ||
+        (out_whole && (st = om_out_open(&img_out, out, &d)) != OM_OK) ||
+        (mask_whole && (st = om_out_open(&mask_out, mask, &d)) != OM_OK) ||
         (diff && (st = om_out_open(&diff_out, diff, &d)) != OM_OK)) {
         rc = cli_error(NULL, &d, st);
+        goto out;
+    }
+    if (((against || mask_whole) && !(mask_main = malloc((size_t)W * H))) ||
+        (out_whole && !(img_px = malloc((size_t)W * H * img_ch)))) {
+        rc = cli_error(NULL, &d, cli_oom(&d));
         goto out;
     }
     if ((st = run_init(&main_run, &cs, W, H, &d)) != OM_OK) { rc = cli_error(mname, &d, st); goto out; }
@@ -326,10 +372,11 @@ int cmd_render(int argc, char **argv)
             rc = cli_error(against, &d, st);
             goto out;
         }
-        mask_main = malloc((size_t)W * H);
         mask_ref = malloc((size_t)W * H);
-        if (!mask_main || !mask_ref) { rc = cli_error(NULL, &d, cli_oom(&d)); goto out; }
-        strip_out ro = {NULL, mask_ref};
+        if (!mask_ref) { rc = cli_error(NULL, &d, cli_oom(&d)); goto out; }
+        strip_out ro;
+        memset(&ro, 0, sizeof ro);
+        ro.mask = mask_ref;
         om_frame_stats rfs;
         size_t rfb;
         if ((st = run_frame(&ref_run, &cs, &view, rows, bins, !budget, fmt, &ro, &rfs, &rfb, &d)) != OM_OK) {
@@ -337,7 +384,12 @@ int cmd_render(int argc, char **argv)
             goto out;
         }
     }
-    strip_out so = {&sink, mask_main};
+    strip_out so;
+    memset(&so, 0, sizeof so);
+    so.ppm = &sink;
+    so.mask = mask_main;
+    so.img = img_px;
+    so.img_ch = img_ch;
     om_frame_stats fs;
     size_t frame_bytes;
     uint64_t t0 = om_clock_ns(NULL);
@@ -355,15 +407,20 @@ int cmd_render(int argc, char **argv)
         if (diff) {
             if (!(rgb = malloc((size_t)W * H * 3))) { rc = cli_error(NULL, &d, cli_oom(&d)); goto out; }
             om_diff_image(mask_ref, mask_main, W, H, rgb);
-            if (!om_ppm_put(&diff_out, rgb, W, H)) {
-                rc = cli_error(NULL, &d, om_out_failed(&diff_out, &d));
+            if ((st = img_put(&diff_out, diff_fmt, rgb, 3, W, H, &d)) != OM_OK) {
+                rc = cli_error(NULL, &d, st);
                 goto out;
             }
         }
     }
+    if ((out_whole && (st = img_put(&img_out, out_fmt, img_px, img_ch, W, H, &d)) != OM_OK) ||
+        (mask_whole && (st = img_put(&mask_out, mask_fmt, mask_main, 1, W, H, &d)) != OM_OK)) {
+        rc = cli_error(NULL, &d, st);
+        goto out;
+    }
     {
-        om_out *outs[3] = {&sink.img, &sink.mask, &diff_out};
-        if ((st = om_out_commit(outs, 3, &d)) != OM_OK) { rc = cli_error(NULL, &d, st); goto out; }
+        om_out *outs[5] = {&sink.img, &sink.mask, &img_out, &mask_out, &diff_out};
+        if ((st = om_out_commit(outs, 5, &d)) != OM_OK) { rc = cli_error(NULL, &d, st); goto out; }
     }
     if (!quiet) {
         om_method_stats ms;
@@ -377,6 +434,9 @@ int cmd_render(int argc, char **argv)
                 (double)fs.ns_build / 1e6, (double)fs.ns_resolve / 1e6, (double)fs.ns_shade / 1e6);
         fprintf(info, "memory: scene %zu, frame %zu (peak %zu), method %zu (peak %zu) bytes\n", cs.bytes,
                 frame_bytes, fs.frame_peak, main_run.given, main_run.arena.peak);
+        fprintf(info, "samples: %llu covered (not background), %llu of them exposed (facing the light, "
+                "inside its frustum: what a method decides; the rest are shadowed whatever it says)\n",
+                (unsigned long long)so.covered, (unsigned long long)so.exposed);
         for (uint32_t k = 0; k < ms.ncounters; k++)
             fprintf(info, "%s%s %u", k ? ", " : "stats: ", ms.counter_names[k], ms.counters[k]);
         if (ms.ncounters) fprintf(info, "\n");
@@ -388,7 +448,10 @@ int cmd_render(int argc, char **argv)
     if (against) print_metrics(info, mname, against, &mt);
 out:
     om_ppm_discard(&sink);
+    om_out_discard(&img_out);
+    om_out_discard(&mask_out);
     om_out_discard(&diff_out);
+    free(img_px);
     free(main_run.mem);
     free(ref_run.mem);
     free(mask_main);
@@ -459,12 +522,13 @@ int cmd_info(int argc, char **argv)
 }
 
 static const char compare_help[] =
-    "usage: ombra compare REF.pgm MASK.pgm [--diff D.ppm]\n"
+    "usage: ombra compare REF.pgm MASK.pgm [--diff D.ppm|D.png]\n"
     "\n"
     "Compares two shadow masks of the same frame (255 lit, 0 shadowed, 128 background),\n"
     "the first taken as the reference: match share, false lit and false shadowed, the\n"
     "same near the reference's shadow edges, and optionally a difference image (false\n"
-    "lit red, false shadowed blue).\n";
+    "lit red, false shadowed blue). Masks whose background differs are of different\n"
+    "frames (another scene, camera, time or size): an error, exit status 1.\n";
 
 int cmd_compare(int argc, char **argv)
 {
@@ -483,6 +547,11 @@ int cmd_compare(int argc, char **argv)
     if (!b_path) return cli_usage_error("compare", "needs two masks%s", "");
     if (diff && (om_out_same(diff, a_path) || om_out_same(diff, b_path)))
         return cli_usage_error("compare", "--diff '%s' would replace one of the masks it compares", diff);
+    img_fmt diff_fmt = IMG_NETPBM;
+    if (diff) {
+        int e = img_fmt_of("compare", "--diff", diff, IMG_ACCEPT_PPM | IMG_ACCEPT_PNG, ".ppm or .png", &diff_fmt);
+        if (e) return e;
+    }
     om_diag d;
     memset(&d, 0, sizeof d);
     uint32_t wa, ha, wb, hb;
@@ -499,15 +568,24 @@ int cmd_compare(int argc, char **argv)
     } else {
         om_metrics m;
         om_compare_masks(ma, mb, wa, ha, &m);
+        /* Two methods' masks of one frame share its background (the eye pass decides
+         * it, not the method): where they do not, they are masks of different frames
+         * and the figures would mean nothing. */
+        if (m.mismatched_bg) {
+            fprintf(stderr, "ombra: %s and %s are not masks of one frame: %llu pixels are background "
+                    "(128) in one only, so the scene, camera, --time or --size differ; render both "
+                    "with the same SCENE, --size and --time, changing only --method\n",
+                    a_path, b_path, (unsigned long long)m.mismatched_bg);
+            free(ma);
+            free(mb);
+            return 1;
+        }
         print_metrics(stdout, b_path, a_path, &m);
-        if (m.mismatched_bg)
-            printf("warning: %llu pixels are background in one mask only: not the same frame?\n",
-                   (unsigned long long)m.mismatched_bg);
         if (diff) {
             uint8_t *rgb = malloc((size_t)wa * ha * 3);
             if (rgb) {
                 om_diff_image(ma, mb, wa, ha, rgb);
-                if ((st = om_ppm_write(diff, rgb, wa, ha, &d)) != OM_OK) rc = cli_error(NULL, &d, st);
+                if ((st = img_write(diff, diff_fmt, rgb, 3, wa, ha, &d)) != OM_OK) rc = cli_error(NULL, &d, st);
             }
             free(rgb);
         }

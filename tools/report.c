@@ -231,7 +231,7 @@ static const rcol bench_cols[] = {
     {"build_ms", "map build, ms", R_MS, NULL},
     {"resolve_ms", "lookup, ms", R_MS, NULL},
     {"bytes", "memory, bytes", R_INT, NULL},
-    {"samples", "samples", R_INT, NULL},
+    {"samples", "covered samples", R_INT, NULL},
     {"mismatch_share", "wrong, %", R_SHARE, NULL},
     {"edge_mismatch_share", "wrong near edges, %", R_SHARE, NULL},
 };

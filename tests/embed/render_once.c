@@ -1,7 +1,7 @@
 /* render_once.c — the README's embedding example, compiled with the project's warning
  * flags and run by `make check`: the small scene at 160x120 through strips of 8 rows
  * of RGB565 with the conventional shadow map, in static memory a microcontroller has
- * (about 160 KiB in all). tests/embed/readme.sh fails when the README's copy (the
+ * (about 168 KiB in all). tests/embed/readme.sh fails when the README's copy (the
  * part between the markers) differs from this file's. main() prints the frame's hash
  * and fails if the render does. */
 #include <stdio.h>
@@ -10,7 +10,7 @@
 #include "ombra_measure.h"
 #include <string.h>
 
-static unsigned char scene_mem[48 << 10], frame_mem[64 << 10], method_mem[48 << 10];
+static unsigned char scene_mem[48 << 10], frame_mem[72 << 10], method_mem[48 << 10];
 static uint8_t strip_pixels[160 * 8 * 2];          /* 8 rows of RGB565 */
 static uint64_t frame_hash = OM_HASH_INIT;
 
@@ -53,8 +53,8 @@ int render_once(void)
     memset(&fd, 0, sizeof fd);
     fd.scene = &scene; fd.view = &view; fd.method = m; fd.method_state = state;
     fd.shade = &shade; fd.strip_rows = 8; fd.fb = &fb; fd.on_strip = show;
-    /* om_frame_bytes(&fd, &need): at least need.least; need.with_bins lets each strip
-     * set up only the triangles that reach it */
+    om_frame_need need;   /* with room for the bins each strip sets up only its triangles */
+    if (om_frame_bytes(&fd, &need) != OM_OK || need.with_bins > sizeof frame_mem) return -1;
     om_arena_init(&fa, frame_mem, sizeof frame_mem, "frame");
     return om_render_frame(&fd, &fa, NULL, &d) == OM_OK ? 0 : -1;
 }

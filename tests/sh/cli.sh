@@ -100,6 +100,8 @@ has "$dir/err" "x.ppm" "unwritable output named"
 # Accuracy against the reference, in one run and from two mask files: the same figures.
 expect 0 "render --against ref" -- "$OMBRA" render --size 160x120 --map 512 --against ref --mask "$dir/sm.pgm" --diff "$dir/diff.ppm" --out "$dir/sm.ppm"
 has "$dir/out" "accuracy of sm against ref: match" "--against prints the match share"
+has "$dir/out" "match [0-9.]*% of [0-9]* covered samples" "the accuracy line counts covered samples"
+has "$dir/out" "^samples: [0-9]* covered (not background), [0-9]* of them exposed" "render tells covered from exposed samples"
 against=$(grep '^accuracy' "$dir/out" | sed 's/.*match/match/')
 if [ "$(head -c 2 "$dir/diff.ppm")" = "P6" ]; then ok; else bad "diff image written"; fi
 expect 0 "reference mask" -- "$OMBRA" render --size 160x120 --method ref --mask "$dir/ref.pgm" --out "$dir/ref.ppm"
@@ -111,6 +113,13 @@ expect 1 "compare masks of different sizes" -- "$OMBRA" compare "$dir/ref.pgm" "
 has "$dir/err" "one size" "size mismatch explained"
 expect 1 "compare a non-PGM" -- "$OMBRA" compare "$dir/ref.pgm" "$dir/ok.scene"
 has "$dir/err" "ok.scene" "bad mask file named"
+# masks of different frames (here another scene) are refused, not compared
+expect 0 "mask of another scene" -- "$OMBRA" render "$dir/ok.scene" --size 160x120 --mask "$dir/other.pgm" --out "$dir/other.ppm"
+expect 1 "compare masks of different scenes" -- "$OMBRA" compare "$dir/ref.pgm" "$dir/other.pgm" --diff "$dir/other-diff.ppm"
+has "$dir/err" "not masks of one frame" "different frames explained"
+has "$dir/err" "same SCENE, --size and --time" "different frames: the fix named"
+[ -e "$dir/other-diff.ppm" ] && bad "compare of different frames wrote a diff" || ok
+if [ -s "$dir/out" ]; then bad "compare of different frames printed figures: $(head -c 200 "$dir/out")"; else ok; fi
 
 # A small sweep: one CSV row per point with every column filled, well-formed SVG.
 expect 0 "bench sweep" -- "$OMBRA" bench --scenes "$dir/ok.scene" --runs 1 --methods ref,izb --out "$dir/bench"
@@ -121,6 +130,9 @@ if [ -s "$dir/bench/ok.scene-time.svg" ] && [ -s "$dir/bench/ok.scene-bytes.svg"
 has "$dir/out" "^machine *compute *[0-9.]* *[0-9.]* *[0-9.]*x" "bench scaling table has the machine's compute row"
 has "$dir/out" "^machine *memory *[0-9.]* *[0-9.]* *[0-9.]*x" "bench scaling table has the machine's memory row"
 has "$dir/out" "^ok.scene *izb *[0-9.]* *[0-9.]* *[0-9.]*x" "bench scaling table has a method's row"
+# the footnote on '*' only under a starred row
+if grep -q '[0-9]x\*' "$dir/out"; then has "$dir/out" "^(\* fewer jobs" "a starred row has its footnote"
+elif grep -q "fewer jobs ran" "$dir/out"; then bad "bench prints the '*' footnote with no starred row"; else ok; fi
 if command -v xmllint >/dev/null 2>&1; then
     xmllint --noout "$dir"/bench/*.svg && ok || bad "bench SVG is not well-formed"
 fi
@@ -155,8 +167,8 @@ if [ "$(cat "$dir/code")" -eq 1 ]; then ok; else bad "a render past the file-siz
 has "$dir/err" "good.ppm: cannot write: File too large" "a failed write names the file and the reason"
 cmp -s "$dir/good.ppm" "$dir/keep.ppm" && ok || bad "a failed write damaged the old image"
 if [ -z "$(leftovers)" ]; then ok; else bad "temporaries left behind: $(leftovers)"; fi
-expect 1 "an empty output name" -- "$OMBRA" render --size 16x12 --out ''
-has "$dir/err" "'': cannot create" "an empty output name is refused"
+expect 2 "an empty output name" -- "$OMBRA" render --size 16x12 --out ''
+has "$dir/err" "--out '': no extension" "an empty output name is refused"
 expect 2 "--out and --mask the same file" -- "$OMBRA" render --size 16x12 --out "$dir/good.ppm" --mask "$dir/./good.ppm"
 has "$dir/err" "same file" "the same path twice explained"
 # threads under a budget: counted in it, capped to a sixteenth of it, the same frame
@@ -166,13 +178,17 @@ expect 0 "one thread under a budget" -- "$OMBRA" render --size 160x120 --budget 
 if [ -n "$h1024" ] && [ "$h1024" = "$(grep '^hash' "$dir/out")" ]; then ok; else bad "--threads 1024 under --budget drew another frame"; fi
 expect 0 "info names the threads' share" -- "$OMBRA" info
 has "$dir/out" "counts 16384 bytes" "info reports what a thread counts of a budget"
-# nor may an output be a mesh the scene reads: refused before anything is written
-printf 'v 0 0 0\nv 1 0 0\nv 0 0 1\nf 1 2 3\n' >"$dir/tri.obj"
-printf 'mesh tri.obj\n' >"$dir/mesh.scene"
-expect 2 "--out over a mesh the scene reads" -- "$OMBRA" render "$dir/mesh.scene" --size 16x12 --out "$dir/tri.obj"
+# nor may an output be a mesh the scene reads: refused before anything is written (a
+# mesh under an image's name, since an .obj is no name for an image at all)
+printf 'v 0 0 0\nv 1 0 0\nv 0 0 1\nf 1 2 3\n' >"$dir/tri.png"
+printf 'mesh tri.png\n' >"$dir/mesh.scene"
+expect 2 "--out over a mesh the scene reads" -- "$OMBRA" render "$dir/mesh.scene" --size 16x12 --out "$dir/tri.png"
 has "$dir/err" "a mesh of the scene and --out name the same file" "the mesh named"
-if [ "$(head -c 6 "$dir/tri.obj")" = "v 0 0 " ]; then ok; else bad "the mesh was overwritten"; fi
-expect 2 "--mask over a mesh the scene reads" -- "$OMBRA" render "$dir/mesh.scene" --size 16x12 --out "$dir/m.ppm" --mask "$dir/./tri.obj"
+if [ "$(head -c 6 "$dir/tri.png")" = "v 0 0 " ]; then ok; else bad "the mesh was overwritten"; fi
+expect 2 "--mask over a mesh the scene reads" -- "$OMBRA" render "$dir/mesh.scene" --size 16x12 --out "$dir/m.ppm" --mask "$dir/./tri.png"
+cp "$dir/tri.png" "$dir/tri.obj"
+expect 2 "--out over an .obj" -- "$OMBRA" render --size 16x12 --out "$dir/tri.obj"
+has "$dir/err" "unknown extension '.obj'" "an .obj output refused by its extension"
 # a binary file as the scene is refused at its first bytes, not read whole
 head -c 3000000 /dev/zero >"$dir/zeros.scene"
 expect 1 "a file of zeros as the scene" -- "$OMBRA" render "$dir/zeros.scene" --size 16x12 --out "$dir/z.ppm"
@@ -187,6 +203,7 @@ expect 0 "--out /dev/null --mask /dev/null" -- "$OMBRA" render --size 16x12 --ou
 if [ $? -eq 0 ] && [ "$(wc -c <"$dir/stdout.ppm")" -eq $((13 + 16 * 12 * 3)) ] && [ "$(head -c 2 "$dir/stdout.ppm")" = "P6" ]; then ok; else bad "--out - is not the image alone on standard output"; fi
 has "$dir/err" "hash:" "with --out - the report goes to standard error"
 expect 0 "reference 16x12 image" -- "$OMBRA" render --size 16x12 --out "$dir/r16.ppm"
+cp "$dir/out" "$dir/r16.out"
 cmp -s "$dir/stdout.ppm" "$dir/r16.ppm" && ok || bad "--out - differs from the file"
 if command -v mkfifo >/dev/null 2>&1; then
     rm -f "$dir/fifo"
@@ -199,14 +216,14 @@ if command -v mkfifo >/dev/null 2>&1; then
 fi
 # a symlink stays a link to the file that is replaced, a dangling one is followed,
 # and a replaced file keeps its permissions
-rm -f "$dir/real.ppm" "$dir/link.ppm" "$dir/dangling.ppm"
+rm -f "$dir/real.ppm" "$dir/link.ppm" "$dir/dangling.pgm"
 cp "$dir/keep.ppm" "$dir/real.ppm"
 chmod 640 "$dir/real.ppm"
 ln -s real.ppm "$dir/link.ppm"
-ln -s sub/made.ppm "$dir/dangling.ppm"
+ln -s sub/made.pgm "$dir/dangling.pgm"
 mkdir -p "$dir/sub"
-expect 0 "render through a symlink" -- "$OMBRA" render --size 16x12 --out "$dir/link.ppm" --mask "$dir/dangling.ppm"
-if [ -L "$dir/link.ppm" ] && [ -L "$dir/dangling.ppm" ] && cmp -s "$dir/real.ppm" "$dir/r16.ppm" && [ "$(head -c 2 "$dir/sub/made.ppm")" = "P5" ]; then ok; else bad "symlinks were replaced instead of their files"; fi
+expect 0 "render through a symlink" -- "$OMBRA" render --size 16x12 --out "$dir/link.ppm" --mask "$dir/dangling.pgm"
+if [ -L "$dir/link.ppm" ] && [ -L "$dir/dangling.pgm" ] && cmp -s "$dir/real.ppm" "$dir/r16.ppm" && [ "$(head -c 2 "$dir/sub/made.pgm")" = "P5" ]; then ok; else bad "symlinks were replaced instead of their files"; fi
 if [ "$(ls -l "$dir/real.ppm" | cut -c1-10)" = "-rw-r-----" ]; then ok; else bad "the replaced file lost its permissions: $(ls -l "$dir/real.ppm")"; fi
 # two renders racing to one name: the file is one of them whole, never a mix
 expect 0 "reference 160x120 image" -- "$OMBRA" render --size 160x120 --out "$dir/r160.ppm"
@@ -219,6 +236,34 @@ if [ -z "$(leftovers)" ]; then ok; else bad "temporaries left behind: $(leftover
 # Grey frames are PGM files.
 expect 0 "--format l8 writes a PGM" -- "$OMBRA" render --size 16x12 --format l8 --out "$dir/grey.pgm"
 if [ "$(head -c 2 "$dir/grey.pgm")" = "P5" ] && [ "$(wc -c <"$dir/grey.pgm")" -eq $((13 + 16 * 12)) ]; then ok; else bad "--format l8 did not write a 16x12 PGM"; fi
+
+# Files are what their names say: .png through tools/png.c, the extension decides.
+# png_head FILE: the signature and IHDR's width, height, depth and colour type, in hex
+png_head() { od -An -tx1 -N26 "$1" | tr -d ' \n' | sed 's/^\(.\{16\}\).\{16\}\(.*\)/\1 \2/'; }
+expect 0 "render --out x.png --mask m.png" -- "$OMBRA" render --size 16x12 --out "$dir/x.png" --mask "$dir/xm.png" --against ref --diff "$dir/xd.png"
+if [ "$(png_head "$dir/x.png")" = "89504e470d0a1a0a 000000100000000c0802" ]; then ok; else bad "--out x.png is no 16x12 RGB PNG: $(png_head "$dir/x.png")"; fi
+if [ "$(png_head "$dir/xm.png")" = "89504e470d0a1a0a 000000100000000c0800" ]; then ok; else bad "--mask m.png is no 16x12 grey PNG: $(png_head "$dir/xm.png")"; fi
+if [ "$(png_head "$dir/xd.png")" = "89504e470d0a1a0a 000000100000000c0802" ]; then ok; else bad "--diff d.png is no 16x12 RGB PNG: $(png_head "$dir/xd.png")"; fi
+[ "$(grep '^hash:' "$dir/out")" = "$(grep '^hash:' "$dir/r16.out")" ] && ok || bad "a PNG render drew another frame"
+expect 0 "--format l8 --out x.png" -- "$OMBRA" render --size 16x12 --format l8 --out "$dir/xg.PNG"
+if [ "$(png_head "$dir/xg.PNG")" = "89504e470d0a1a0a 000000100000000c0800" ]; then ok; else bad "a grey frame's PNG is not grey: $(png_head "$dir/xg.PNG")"; fi
+expect 0 "--format l8 --out x.ppm" -- "$OMBRA" render --size 16x12 --format l8 --out "$dir/xg.ppm"
+if [ "$(head -c 2 "$dir/xg.ppm")" = "P6" ] && [ "$(wc -c <"$dir/xg.ppm")" -eq $((13 + 16 * 12 * 3)) ]; then ok; else bad "--format l8 --out x.ppm is no 16x12 PPM"; fi
+for bad_out in "--out x.jpg" "--out x.PGMX" "--mask x.ppm" "--out x" "--mask x.tga"; do
+    flag=${bad_out% *}
+    name=$dir/${bad_out#* }
+    rm -f "$name"
+    expect 2 "render $bad_out is refused" -- "$OMBRA" render --size 16x12 $flag "$name"
+    has "$dir/err" "^ombra render: $flag '$name': " "the refusal names $flag and the file"
+    has "$dir/err" ".png" "the refusal names the extensions accepted"
+    [ -e "$name" ] && bad "render $bad_out wrote the file" || ok
+done
+expect 2 "--out x.pgm of a colour frame" -- "$OMBRA" render --size 16x12 --out "$dir/colour.pgm"
+has "$dir/err" "--format l8" "a colour frame's PGM points at --format l8"
+expect 2 "compare --diff x.gif" -- "$OMBRA" compare "$dir/ref.pgm" "$dir/sm.pgm" --diff "$dir/d.gif"
+has "$dir/err" "compare: --diff '$dir/d.gif': unknown extension '.gif'" "compare --diff's refusal named"
+expect 0 "compare --diff x.png" -- "$OMBRA" compare "$dir/ref.pgm" "$dir/sm.pgm" --diff "$dir/d.png"
+if [ "$(png_head "$dir/d.png")" = "89504e470d0a1a0a 000000a0000000780802" ]; then ok; else bad "compare --diff d.png is no 160x120 PNG"; fi
 
 # Budgets: 0 is refused, 'none' is spelled out.
 expect 2 "--budget 0" -- "$OMBRA" render --size 16x12 --budget 0 --out "$dir/z.ppm"
@@ -306,8 +351,8 @@ expect 0 "the same mesh without a budget" -- "$OMBRA" render "$dir/bigmesh.scene
 rss_ok 2048 "the default scene at --budget 2M" "$OMBRA" render --map 512 --budget 2M --out "$dir/z.ppm" --mask "$dir/z.pgm"
 rss_ok 1024 "izb at --budget 1M" "$OMBRA" render --method izb --budget 1M --out "$dir/z.ppm"
 # a mask is read as far as its header says, not to the end of the file
-{ printf 'P5\n16 12\n255\n'; head -c 192 /dev/zero; head -c 50000000 /dev/zero; } >"$dir/long.pgm"
 "$OMBRA" render --size 16x12 --mask "$dir/m16.pgm" --out "$dir/z.ppm" -q
+{ cat "$dir/m16.pgm"; head -c 50000000 /dev/zero; } >"$dir/long.pgm"
 expect 0 "compare a mask with 50 MB after its pixels" -- "$OMBRA" compare "$dir/m16.pgm" "$dir/long.pgm"
 rss_ok 0 "compare reads a mask's stated size only" "$OMBRA" compare "$dir/m16.pgm" "$dir/long.pgm"
 rm -f "$dir/long.pgm"
