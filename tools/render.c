@@ -20,7 +20,7 @@ static const char render_help[] =
     "  --mask FILE.pgm   shadow mask: 255 lit, 0 shadowed, 128 background\n"
     "  --diff FILE.ppm   with --against: false lit red, false shadowed blue\n"
     "  --size WxH        image size, 1..8192 each (default: the scene's camera)\n"
-    "  --time T          time along the scene's camera and light paths (default 0)\n"
+    "  --time T          time along the scene's camera, light and object paths (default 0)\n"
     "  --format F        framebuffer format: rgb888 (default), rgb565, l8\n"
     "  --strip ROWS      render through strips of ROWS rows (default: whole frame)\n"
     "  --threads N       threads a frame runs on (default: the CPUs online); the\n"
@@ -259,6 +259,7 @@ int cmd_render(int argc, char **argv)
 
     om_camera cam;
     om_light light;
+    if ((st = om_scene_pose_at(&cs.scene, t, &d)) != OM_OK) { cli_scene_free(&cs); return cli_error(where, &d, st); }
     om_scene_at(&cs.scene, t, &cam, &light);
     if (w) { cam.width = w; cam.height = h; }
     om_view view;
@@ -404,6 +405,15 @@ static const char info_help[] =
     "Prints the scene's triangles, vertices, materials and bounds, and the bytes the\n"
     "scene, a frame and each method need at that image size.\n";
 
+
+/* How many objects share mesh m. */
+static uint32_t mesh_users(const om_scene *s, uint32_t m)
+{
+    uint32_t n = 0;
+    for (uint32_t i = 0; i < s->nobjects; i++) n += s->objects[i].mesh == m;
+    return n;
+}
+
 int cmd_info(int argc, char **argv)
 {
     const char *scene_path = NULL;
@@ -438,6 +448,14 @@ int cmd_info(int argc, char **argv)
     printf("scene: %s\n", where);
     printf("triangles %u, vertices %u, materials %u, camera keys %u, light keys %u\n", s->ntris,
            s->nverts, s->nmats, s->ncam_keys, s->nlight_keys);
+    if (s->nobjects) {
+        printf("objects %u sharing %u meshes (%u object keys):\n", s->nobjects, s->nmeshes, s->nobj_keys);
+        for (uint32_t i = 0; i < s->nobjects; i++) {
+            const om_object *o = &s->objects[i];
+            printf("  %-12s mesh %u (%u triangles, %u objects share it), %u keys\n", o->name[0] ? o->name : "(copy)",
+                   o->mesh, s->meshes[o->mesh].ntris, mesh_users(s, o->mesh), o->nkeys);
+        }
+    }
     printf("bounds: (%g, %g, %g) .. (%g, %g, %g)\n", s->lo.x, s->lo.y, s->lo.z, s->hi.x, s->hi.y,
            s->hi.z);
     printf("light: %s\n", s->light.kind == OM_LIGHT_SPOT ? "spot" : "directional");

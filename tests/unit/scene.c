@@ -519,7 +519,7 @@ static void parse_errors(void)
 {
     expect_err("sphre radius 1\n", OM_E_PARSE, 1, 1,
                "line 1, col 1: unknown command 'sphre' (expected camera, light, material, plane, "
-               "box, sphere, cylinder, mesh, triangles, key)");
+               "box, sphere, cylinder, mesh, triangles, key, copy)");
     expect_err("# c\n\ncamera eye 0 5 10 target 0 0 0 fov\n", OM_E_PARSE, 3, 35,
                "line 3, col 35: expected a number after 'fov'");
     expect_err("box size 1 2x 3\n", OM_E_PARSE, 1, 12, "malformed number '2x'");
@@ -551,7 +551,7 @@ static void parse_errors(void)
     expect_err("box\x01\n", OM_E_PARSE, 1, 4, "0x01");
     expect_err("sphere radius 1 segmnts 8\n", OM_E_PARSE, 1, 17,
                "unknown parameter 'segmnts' for 'sphere' (expected radius, segments, rings, scale, "
-               "rotate, translate, albedo, opacity, material)");
+               "rotate, translate, albedo, opacity, material, name)");
     expect_err("sphere radius 1 2\n", OM_E_PARSE, 1, 17, "too many values after 'radius' (it takes 1)");
     expect_err("box 1\n", OM_E_PARSE, 1, 5, "unexpected value '1' for 'box'");
     expect_err("box scale 1 2 translate 0 0 0\n", OM_E_PARSE, 1, 15,
@@ -594,7 +594,7 @@ static void parse_errors(void)
     expect_err("light directional dir 0 -1e-30 0\n", OM_E_RANGE, 1, 23, "too short to give a direction");
     expect_err("key camera 0 eye 0 0 0 target 1e-30 0 0\n", OM_E_RANGE, 1, 31, "gives no direction");
     expect_err("light spot pos 1 2 3\n", OM_E_PARSE, 1, 1, "needs pos X Y Z and target X Y Z");
-    expect_err("key\n", OM_E_PARSE, 1, 4, "expected 'camera' or 'light' after 'key'");
+    expect_err("key\n", OM_E_PARSE, 1, 4, "expected 'camera', 'light' or 'object' after 'key'");
     expect_err("key camera eye 0 0 1 target 0 0 0\n", OM_E_PARSE, 1, 12,
                "expected a number after 'key camera', found 'eye'");
     expect_err("key camera 0 eye 0 0 1\n", OM_E_PARSE, 1, 1, "needs eye X Y Z and target X Y Z");

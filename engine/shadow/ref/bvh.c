@@ -369,3 +369,27 @@ void om__bvh_walk(const om__bvh *b, om_vec3 o, om_vec3 dir, float tmax, float ma
             if (visit(user, b->tris[i])) return;
     }
 }
+
+/* The boxes again from the triangles' vertices as they are now, the nodes and their
+ * triangles kept: after objects moved (om_scene.change) the walk along segments still
+ * meets every triangle it must, since the walk is only a filter. Children sit after
+ * their parent, so one pass from the last node up fits children before parents. */
+void om__bvh_refit(om__bvh *b, const om_scene *s)
+{
+    for (uint32_t i = b->nnodes; i-- > 0;) {
+        om__bvh_node *n = &b->nodes[i];
+        box r;
+        box_empty(&r);
+        if (n->count || !s->ntris) {   /* a leaf, or an empty scene's lone root */
+            for (uint32_t k = 0; k < n->count; k++) {
+                box t = vert_box(s, b->tris[n->first + k]);
+                box_grow(&r, t.lo, t.hi);
+            }
+        } else {
+            for (uint32_t c = 0; c < 2; c++)
+                box_grow(&r, b->nodes[n->first + c].box.w.lo, b->nodes[n->first + c].box.w.hi);
+        }
+        memcpy(n->box.w.lo, r.lo, sizeof r.lo);
+        memcpy(n->box.w.hi, r.hi, sizeof r.hi);
+    }
+}

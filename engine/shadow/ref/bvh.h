@@ -40,6 +40,9 @@ size_t om__bvh_bytes(const om_scene *s, uint32_t leaf);
 size_t om__bvh_scratch_bytes(const om_scene *s);
 om_status om__bvh_build(om__bvh *b, om_arena *a, const om_scene *s, uint32_t leaf, om_diag *d);
 
+/* Refits a BVH built over s (leaves' triangles kept) to s's vertices as they are now. */
+void om__bvh_refit(om__bvh *b, const om_scene *s);
+
 /* A segment o + t * dir, t in [0, tmax], with boxes grown by `margin` on every side.
  * `visit` is called for every triangle in a leaf whose box the segment meets; it
  * returns true to stop the walk. */
