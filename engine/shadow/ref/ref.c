@@ -116,12 +116,12 @@ static uint32_t begin_view(ref_state *r, const om_view *v)
 {
     r->view = *v;
     om__lspace_view(&r->ls, v);
-    /* Moved objects: the smaller modes walk the BVH's 3-D boxes, fitted again to the
-     * vertices where they are now (the others bound the nodes on the light's grid
-     * every frame anyway). The nodes keep their triangles: the answer is the same,
-     * the walk as fast as the objects are near where the build found them. */
+    /* Moved objects: the BVH's objects' subtree is built again where they are (the
+     * static one stays), so the BVH is the one a new state would build; the one pass
+     * plans its parts again over it. */
     if (r->change != r->scene->change) {
-        if (r->mode == LEAST) om__bvh_refit(&r->bvh, r->scene);
+        om__bvh_rebuild_objects(&r->bvh, r->scene);
+        if (r->mode == PACKETS) om__lbvh_plan(&r->lb, &r->bvh);
         r->change = r->scene->change;
     }
     /* Two grid steps at the far end of the light's frustum, in world units: how far
