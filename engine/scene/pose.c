@@ -146,7 +146,9 @@ om_status om_object_find(const om_scene *s, const char *name, uint32_t *object)
     if (!s || !name || !object) return OM_E_INVALID;
     for (uint32_t i = 0; i < s->nobjects; i++) {
         const char *a = s->objects[i].name;
-        if (a && a[0] && !strcmp(a, name)) {
+        size_t k = 0;   /* strcmp, which the engine may not call */
+        while (a && a[k] && a[k] == name[k]) k++;
+        if (a && a[0] && a[k] == '\0' && name[k] == '\0') {
             *object = i;
             return OM_OK;
         }
