@@ -537,6 +537,10 @@ int cmd_info(int argc, char **argv)
     if (s->nobjects) {
         printf("objects %u sharing %u meshes (%u object keys):\n", s->nobjects, s->nmeshes, s->nobj_keys);
         for (uint32_t i = 0; i < s->nobjects; i++) {
+            if (i == 24 && s->nobjects > 25) {   /* a crowd: the first ones say enough */
+                printf("  ... and %u more\n", s->nobjects - i);
+                break;
+            }
             const om_object *o = &s->objects[i];
             printf("  %-12s mesh %u (%u triangles, %u objects share it), %u keys\n", o->name[0] ? o->name : "(copy)",
                    o->mesh, s->meshes[o->mesh].ntris, mesh_users(s, o->mesh), o->nkeys);

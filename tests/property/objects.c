@@ -194,6 +194,16 @@ static void object_model(void)
     CHECK(!memcmp(before, s->verts, vbytes) && s->change == change);
     CHECK_OK(om_scene_pose_at(s, 1.0f, NULL));
     CHECK(s->change == change + 2 && s->objects[3].moved == s->change);
+    /* halfway along the ball's keys: moved by half, scaled by 0.75 about the origin
+     * (its centre at y 2.5 before), turned about y (its centre stays) */
+    CHECK_OK(om_scene_pose_at(s, 0.5f, NULL));
+    const om_object *ball = &s->objects[3];
+    const float cx = 0.5f * (ball->lo.x + ball->hi.x), cy = 0.5f * (ball->lo.y + ball->hi.y);
+    const float cz = 0.5f * (ball->lo.z + ball->hi.z);
+    CHECK_MSG(fabsf(cx - 1.0f) < 1e-3f && fabsf(cy - 1.875f) < 1e-3f && fabsf(cz + 0.5f) < 1e-3f,
+              "ball at t 0.5: centre %g %g %g", cx, cy, cz);
+    /* the scene's bounds follow its objects */
+    CHECK(s->lo.x <= ball->lo.x && s->hi.y >= ball->hi.y);
     free(before);
     h_scene_free(&hs);
 }

@@ -389,6 +389,8 @@ static void bytes_exact(void)
         "box",
         "sphere segments 5 rings 3\nmaterial a\nbox material a albedo 1 1 1\nkey camera 0 eye 0 0 1 target 0 0 0\n",
         "key light 0 pos 1 1 1 target 0 0 0\nkey light 1 pos 1 2 1 target 0 0 0\nplane divisions 3\n",
+        "plane\nbox name b\ncopy b translate 1 0 0 name c\ncopy c albedo 1 0 0\nkey object c 0\n"
+        "key object c 1 scale 2\nsphere segments 5 rings 3 name s\n",
     };
     for (size_t i = 0; i < sizeof texts / sizeof texts[0]; i++) {
         const char *text = texts[i];
@@ -665,6 +667,30 @@ static void parse_errors(void)
 
 /* ---------------------------------------------------------------- paths */
 
+/* Objects: names, copies and keys, and what each bad line says. */
+static void object_lines(void)
+{
+    expect_err("box name a\nbox name a\n", OM_E_PARSE, 2, 10, "object name 'a' is already used (on line 1)");
+    expect_err("box name a\ncopy a name a\n", OM_E_PARSE, 2, 13, "object name 'a' is already used");
+    expect_err("box name 1a\n", OM_E_PARSE, 1, 10, "bad object name '1a'");
+    expect_err("box name\n", OM_E_PARSE, 1, 9, "expected a name after 'name'");
+    expect_err("copy b\n", OM_E_PARSE, 1, 6, "unknown object 'b'");
+    expect_err("copy\n", OM_E_PARSE, 1, 5, "expected an object's name after 'copy'");
+    expect_err("box name a\nkey object b 0\n", OM_E_PARSE, 2, 12, "unknown object 'b'");
+    expect_err("key object a 0\nbox name a\n", OM_E_PARSE, 1, 12, "unknown object 'a'");
+    expect_err("box name a\nkey object a 1\nkey object a 1\n", OM_E_PARSE, 3, 14,
+               "times must increase (the key before, on line 2");
+    expect_err("box name a\nkey object a 0 scale 1\nkey object a 1 scale -1\n", OM_E_RANGE, 3, 22,
+               "the scale passes through zero");
+    expect_err("box name a\nkey object a 0 scale 0\n", OM_E_RANGE, 2, 22, "scale '0' is out of range");
+    expect_err("box name a\nkey object a 0 translate 9999999.5 0 0\n", OM_E_RANGE, 2, 1, "reaches beyond 1e7");
+    expect_err("box name a\ncopy a translate 1e7 0 0\n", OM_E_RANGE, 2, 1, "copy reaches beyond 1e7");
+    expect_err("box name a\nkey object a 0 scale 1 2 3\n", OM_E_PARSE, 2, 24, "too many values after 'scale'");
+    expect_err("box name a\nkey object a\n", OM_E_PARSE, 2, 13, "");
+    expect_err("box name a\nkey object a nan\n", OM_E_PARSE, 2, 14, "");
+
+}
+
 static void scene_at(void)
 {
     parsed p;
@@ -795,6 +821,7 @@ void suite_scene(void)
     RUN(shapes_closed);
     RUN(random_triangles);
     RUN(parse_errors);
+    RUN(object_lines);
     RUN(scene_at);
     RUN(default_scene);
     RUN(small_scene);
