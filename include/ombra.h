@@ -214,6 +214,7 @@ typedef struct om_scene {
     om_solid *solids;      /* 0 and NULL in a hand-made scene: nothing is skipped */
     /* Objects (0 and NULL in a scene without any). */
     uint32_t nobjects, nmeshes, nobj_keys;
+    uint32_t nmesh_verts, nmesh_tris;   /* the sizes of mesh_verts and mesh_idx / 3 */
     om_object *objects;
     om_mesh *meshes;
     om_vec3 *mesh_verts;   /* every mesh's local vertices, each mesh once */
@@ -254,7 +255,8 @@ void om_scene_at(const om_scene *s, float t, om_camera *cam, om_light *light);
 /* Poses object `object` for the next frame: its vertices become m * base * local (m
  * row-major, bottom row 0 0 0 1), its triangles keep facing out under a mirroring m,
  * and the scene's bounds, its solid's box and the change count follow. No memory is
- * carved. OM_E_INVALID for a bad index or bottom row; OM_E_RANGE, with the scene left
+ * carved. OM_E_INVALID for a bad index or bottom row, or an object whose mesh, ranges
+ * or keys do not fit the scene's arrays (a scene built by hand); OM_E_RANGE, with the scene left
  * as it was, for an m that is not finite, singular (the determinant of m * base below
  * 1e-18 in magnitude) or puts a vertex beyond 1e7. Posing an object where it already
  * is changes nothing. */

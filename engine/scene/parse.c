@@ -1224,6 +1224,8 @@ om_status om_scene_parse(const char *text, size_t len, const om_loader *ld, om_a
     s->nobjects = p.nobjects;
     s->nmeshes = p.nmeshes;
     s->nobj_keys = p.nobj_keys;
+    s->nmesh_verts = (uint32_t)p.nmesh_v;
+    s->nmesh_tris = (uint32_t)p.nmesh_t;
     s->objects = (om_object *)arr[A_OBJS];
     s->meshes = (om_mesh *)arr[A_MESHES];
     s->mesh_verts = (om_vec3 *)arr[A_MVERTS];

@@ -45,8 +45,40 @@ static inline void apply(const double m[12], om_vec3 v, double out[3])
     for (int r = 0; r < 3; r++) out[r] = m[4 * r] * x + m[4 * r + 1] * y + m[4 * r + 2] * z + m[4 * r + 3];
 }
 
+/* Whether object oi's mesh, ranges and keys lie inside the scene's arrays: a parsed
+ * scene's always do; a scene built by hand is checked before anything is written. */
+static bool object_fits(const om_scene *s, uint32_t oi)
+{
+    const om_object *o = &s->objects[oi];
+    if (!s->meshes || !s->mesh_verts || !s->mesh_idx || !s->verts || !s->idx || o->mesh >= s->nmeshes)
+        return false;
+    const om_mesh *me = &s->meshes[o->mesh];
+    if ((uint64_t)me->first_vert + me->nverts > s->nmesh_verts ||
+        (uint64_t)me->first_idx + 3ull * me->ntris > 3ull * s->nmesh_tris ||
+        (uint64_t)o->first_vert + me->nverts > s->nverts || (uint64_t)o->first_tri + me->ntris > s->ntris)
+        return false;
+    const uint32_t *li = s->mesh_idx + me->first_idx;
+    for (uint64_t i = 0; i < 3ull * me->ntris; i++)
+        if (li[i] >= me->nverts) return false;
+    /* keys: in the array, each one's next later in it (so a walk ends) */
+    if (o->nkeys) {
+        if (!s->obj_keys || o->first_key >= s->nobj_keys) return false;
+        uint32_t k = o->first_key, n = 1;
+        while (s->obj_keys[k].next != OM_NO_TRI) {
+            const uint32_t nx = s->obj_keys[k].next;
+            if (nx <= k || nx >= s->nobj_keys) return false;
+            k = nx;
+            n++;
+        }
+        if (n != o->nkeys) return false;
+    }
+    return true;
+}
+
 om_status om__object_write(om_scene *s, uint32_t oi, const double m[12], om_diag *d)
 {
+    if (!object_fits(s, oi))
+        return om__fail(d, OM_E_INVALID, "object: its mesh, ranges or keys do not fit the scene's arrays");
     om_object *o = &s->objects[oi];
     for (int i = 0; i < 12; i++)
         if (!finite_d(m[i])) return pose_fail(d, o, "its transform is not finite");
@@ -99,7 +131,7 @@ void om__scene_bounds(om_scene *s)
     }
     for (uint32_t i = 0; i < s->nobjects; i++) {
         const om_object *o = &s->objects[i];
-        if (!s->meshes[o->mesh].nverts) continue;
+        if (o->mesh >= s->nmeshes || !s->meshes[o->mesh].nverts) continue;
         if (!any) {
             s->lo = o->lo;
             s->hi = o->hi;
@@ -144,6 +176,7 @@ om_status om_object_pose(om_scene *s, uint32_t object, const om_mat4 *m, om_diag
 om_status om_object_find(const om_scene *s, const char *name, uint32_t *object)
 {
     if (!s || !name || !object) return OM_E_INVALID;
+    if (!s->objects) return OM_E_NOTFOUND;
     for (uint32_t i = 0; i < s->nobjects; i++) {
         const char *a = s->objects[i].name;
         size_t k = 0;   /* strcmp, which the engine may not call */
@@ -183,8 +216,11 @@ void om__object_key_at(const om_scene *s, const om_object *o, float t, double ou
 om_status om_scene_pose_at(om_scene *s, float t, om_diag *d)
 {
     if (!s) return om__fail(d, OM_E_INVALID, "om_scene_pose_at needs a scene");
+    if (s->nobjects && !s->objects) return om__fail(d, OM_E_INVALID, "om_scene_pose_at: no objects array");
     for (uint32_t i = 0; i < s->nobjects; i++) {
         if (!s->objects[i].nkeys) continue;
+        if (!object_fits(s, i))
+            return om__fail(d, OM_E_INVALID, "object: its mesh, ranges or keys do not fit the scene's arrays");
         double m[12];
         om__object_key_at(s, &s->objects[i], t, m);
         om_status st = pose_m(s, i, m, d);

@@ -204,6 +204,20 @@ static void object_model(void)
               "ball at t 0.5: centre %g %g %g", cx, cy, cz);
     /* the scene's bounds follow its objects */
     CHECK(s->lo.x <= ball->lo.x && s->hi.y >= ball->hi.y);
+    /* a scene whose objects do not fit its arrays (built or edited by hand) is refused */
+    om_mat4 shift = {{1, 0, 0, 0.5f, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}};
+    const uint32_t fv = s->objects[0].first_vert, mesh = s->objects[0].mesh, next = s->obj_keys[0].next;
+    s->objects[0].first_vert = s->nverts - 1;
+    CHECK(om_object_pose(s, 0, &shift, NULL) == OM_E_INVALID);
+    s->objects[0].first_vert = fv;
+    s->objects[0].mesh = s->nmeshes;
+    CHECK(om_object_pose(s, 0, &shift, NULL) == OM_E_INVALID);
+    s->objects[0].mesh = mesh;
+    s->obj_keys[s->objects[3].first_key].next = s->objects[3].first_key;   /* a loop */
+    CHECK(om_scene_pose_at(s, 0.25f, NULL) == OM_E_INVALID);
+    s->obj_keys[s->objects[3].first_key].next = next;
+    CHECK_OK(om_object_pose(s, 0, &shift, NULL));
+    CHECK_OK(om_scene_pose_at(s, 0.25f, NULL));
     free(before);
     h_scene_free(&hs);
 }
