@@ -259,14 +259,17 @@ void om_scene_at(const om_scene *s, float t, om_camera *cam, om_light *light);
  * or keys do not fit the scene's arrays (a scene built by hand); OM_E_RANGE, with the scene left
  * as it was, for an m that is not finite, singular (the determinant of m * base below
  * 1e-18 in magnitude) or puts a vertex beyond 1e7. Posing an object where it already
- * is changes nothing. */
+ * is changes nothing. Make the frame's view (om_view_init) after posing: a directional
+ * light's view follows the scene's bounds, which follow the objects. */
 om_status om_object_pose(om_scene *s, uint32_t object, const om_mat4 *m, om_diag *d);
 /* The index of the object named `name`: OM_E_NOTFOUND when there is none. */
 om_status om_object_find(const om_scene *s, const char *name, uint32_t *object);
 /* Poses every object that has keys (`key object`) at time t along them, interpolated
  * as the camera's are and clamped at the ends; objects without keys keep their pose.
  * om_scene_at stays a query of the camera and light (it takes a const scene): a host
- * that renders at time t calls both. */
+ * that renders at time t calls both. A parsed scene's keys never give a pose that is
+ * refused; a scene built by hand may (OM_E_INVALID or OM_E_RANGE, the objects before
+ * the one refused posed). */
 om_status om_scene_pose_at(om_scene *s, float t, om_diag *d);
 
 /* Counts of an OBJ file: vertices and triangles after fan triangulation. */
