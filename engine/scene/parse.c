@@ -526,29 +526,63 @@ static oinfo *ocache_slot(parser *p, const char *nm, size_t n)
 
 static bool obj_find(parser *p, const char *nm, size_t n, oinfo *out);
 
-/* Reads the lines above the current one for the object named nm: the line that names
- * it (its index, its mesh's) and its keys. The lines are known to be valid. */
-static bool obj_scan(parser *p, const char *nm, size_t n, oinfo *out)
+/* A line above, read for its object without reading its numbers (the lines above are
+ * known to be valid): whether it makes an object, and the names it gives. */
+typedef struct oline {
+    int cmd;
+    bool object;           /* a named shape or mesh line, or a copy */
+    om__tok name, src;     /* its name (len 0: none); a copy's source */
+} oline;
+
+static void oline_read(const char *text, om__line *l, int cmd, oline *o)
+{
+    om__tok t;
+    memset(o, 0, sizeof *o);
+    o->cmd = cmd;
+    if ((cmd == C_MESH || cmd == C_COPY) && om__tok_next(l, &t) == 1) o->src = t;   /* file or source */
+    /* words follow only 'material' and 'name' (their values); everything else is a
+     * parameter's name or a number */
+    while (om__tok_next(l, &t) == 1) {
+        const bool mat = om__tok_is(text, &t, "material"), nm = om__tok_is(text, &t, "name");
+        if (!mat && !nm) continue;
+        om__tok v;
+        if (om__tok_next(l, &v) != 1) break;
+        if (nm) o->name = v;
+    }
+    o->object = cmd == C_COPY || o->name.len > 0;
+}
+
+/* Where the object named nm is named in the lines above the current one (the light
+ * read: no numbers), its index and, unless a copy names it, its mesh's; and its keys.
+ * false: no line names it. */
+typedef struct odef {
+    uint32_t ord, mesh, no;   /* mesh: for a copy, its source's (found by obj_scan) */
+    size_t start;             /* the naming line */
+    uint32_t nkeys, last_line;
+    float last_t, last_scale;
+} odef;
+
+static bool obj_def(parser *p, const char *nm, size_t n, odef *out)
 {
     om__line l;
     om__line_init(&l, p->text, p->l.start, false);
     uint32_t ord = 0, mesh = 0;
     bool found = false;
+    memset(out, 0, sizeof *out);
     while (om__line_next(&l)) {
         om__tok t, a, w;
         if (om__tok_next(&l, &t) != 1) continue;
         const int cmd = cmd_of(p->text, &t);
-        parser q;
-        memset(&q, 0, sizeof q);
-        q.text = p->text;
-        q.len = p->len;
-        q.ld = p->ld;
-        pv pl[P_N_];
         if (cmd == C_KEY) {
             if (!found || om__tok_next(&l, &a) != 1 || !om__tok_is(p->text, &a, "object") ||
                 om__tok_next(&l, &w) != 1 || !tok_eq(p->text, &w, nm, n))
                 continue;
+            parser q;
+            memset(&q, 0, sizeof q);
+            q.text = p->text;
+            q.len = p->len;
             q.l = l;
+            pv pl[P_N_];
             double T;
             uint32_t col;
             if (om__parse_value(&q, "key object", K_NUM, R_COORD, 1, &T, &col) != OM_OK ||
@@ -560,41 +594,92 @@ static bool obj_scan(parser *p, const char *nm, size_t n, oinfo *out)
             out->last_scale = (float)val(pl, P_SCALE1, 0, 1.0);
             continue;
         }
-        if (cmd < C_PLANE || cmd == C_KEY) continue;
-        char file[256];
-        if (cmd == C_MESH || cmd == C_COPY) {
-            if (om__tok_next(&l, &a) != 1 || a.len >= sizeof file) continue;
-            memcpy(file, p->text + a.at, a.len);
-            file[a.len] = '\0';
-        }
-        q.l = l;
-        if (om__parse_params(&q, cmd_names[cmd], sets[cmd].ids, sets[cmd].n, pl) != OM_OK) continue;
-        if (cmd != C_COPY && !pl[P_NAME].has) continue;
-        if (pl[P_NAME].has && tok_eq(p->text, &pl[P_NAME].w, nm, n)) {
-            memset(out, 0, sizeof *out);
-            out->at = pl[P_NAME].w.at;
-            out->len = n;
-            out->used = true;
+        if (cmd < C_PLANE) continue;
+        oline o;
+        oline_read(p->text, &l, cmd, &o);
+        if (!o.object) continue;
+        if (!found && o.name.len && tok_eq(p->text, &o.name, nm, n)) {
             out->ord = ord;
-            out->line = l.no;
-            if (cmd == C_COPY) {
-                oinfo src;
-                if (!obj_find(p, p->text + a.at, a.len, &src)) return false;
-                out->mesh = src.mesh;
-                out->nv = src.nv;
-                out->nt = src.nt;
-                out->closed = src.closed;
-                out->radius = copy_radius(pl, src.radius);
-            } else {
-                out->mesh = mesh;
-                if (measure(&q, cmd, pl, file, out) != OM_OK) return false;
-            }
+            out->mesh = mesh;
+            out->start = l.start;
+            out->no = l.no;
             found = true;
         }
         ord++;
         if (cmd != C_COPY) mesh++;
     }
     return found;
+}
+
+/* What the parser needs of the object named nm (obj_def), and of its mesh: through
+ * the chain of copies it may be a copy of, to the line that made the mesh. A copy's
+ * reach is its largest scale times its source's plus its move's length, so along the
+ * chain reach = A * (the mesh's) + B. Each source is named above its copy: the walk
+ * ends. Only the lines of the chain are parsed whole. */
+static bool obj_scan(parser *p, const char *nm, size_t n, oinfo *out)
+{
+    odef def;
+    if (!obj_def(p, nm, n, &def)) return false;
+    memset(out, 0, sizeof *out);
+    out->len = n;
+    out->used = true;
+    out->ord = def.ord;
+    out->line = def.no;
+    out->nkeys = def.nkeys;
+    out->last_t = def.last_t;
+    out->last_line = def.last_line;
+    out->last_scale = def.last_scale;
+    double A = 1.0, B = 0.0;
+    odef at = def;
+    for (;;) {
+        parser q;
+        memset(&q, 0, sizeof q);
+        q.text = p->text;
+        q.len = p->len;
+        q.ld = p->ld;
+        om__line_init(&q.l, p->text, p->len, false);
+        q.l.next = at.start;
+        q.l.no = at.no - 1;
+        om__tok t, src;
+        if (!om__line_next(&q.l) || om__tok_next(&q.l, &t) != 1) return false;
+        const int cmd = cmd_of(p->text, &t);
+        if (cmd < C_PLANE || cmd == C_KEY) return false;
+        char file[256];
+        if (cmd == C_MESH || cmd == C_COPY) {
+            if (om__tok_next(&q.l, &src) != 1 || src.len >= sizeof file) return false;
+            memcpy(file, p->text + src.at, src.len);
+            file[src.len] = '\0';
+        }
+        pv pl[P_N_];
+        if (om__parse_params(&q, cmd_names[cmd], sets[cmd].ids, sets[cmd].n, pl) != OM_OK) return false;
+        if (at.start == def.start) out->at = pl[P_NAME].w.at;
+        if (cmd != C_COPY) {
+            oinfo m;
+            memset(&m, 0, sizeof m);
+            if (measure(&q, cmd, pl, file, &m) != OM_OK) return false;
+            out->mesh = at.mesh;
+            out->nv = m.nv;
+            out->nt = m.nt;
+            out->closed = m.closed;
+            out->radius = A * m.radius + B;
+            return true;
+        }
+        const double b0 = copy_radius(pl, 0.0);
+        B += A * b0;
+        A *= copy_radius(pl, 1.0) - b0;
+        const oinfo *c = ocache_slot(p, p->text + src.at, src.len);
+        if (c->used && tok_eq(p->text, &src, p->text + c->at, c->len)) {   /* the source known */
+            out->mesh = c->mesh;
+            out->nv = c->nv;
+            out->nt = c->nt;
+            out->closed = c->closed;
+            out->radius = A * c->radius + B;
+            return true;
+        }
+        odef up;   /* the source, named above its copy */
+        if (!obj_def(p, p->text + src.at, src.len, &up) || up.start >= at.start) return false;
+        at = up;
+    }
 }
 
 static bool obj_find(parser *p, const char *nm, size_t n, oinfo *out)
@@ -612,13 +697,16 @@ static bool obj_find(parser *p, const char *nm, size_t n, oinfo *out)
 /* A name given on this line must be new. */
 static om_status name_check(parser *p, const pv *pl)
 {
-    if (!pl[P_NAME].has) return OM_OK;
+    /* the second pass reads the text the first one found unique */
+    if (!pl[P_NAME].has || p->fill) return OM_OK;
     const om__tok *w = &pl[P_NAME].w;
     if (!valid_name(p->text + w->at, w->len))
         return om__parse_fail_tok(p, OM_E_PARSE, w, "bad object name ",
                                   " (a letter or _, then letters, digits, _ . -)");
     oinfo o;
-    if (obj_find(p, p->text + w->at, w->len, &o)) {
+    const uint32_t h = name_hash(p->text + w->at, w->len) % NAME_BITS;
+    /* a name the filter has not seen is new; else the lines above say */
+    if ((p->name_bits[h / 32] >> (h % 32) & 1u) && obj_find(p, p->text + w->at, w->len, &o)) {
         char tmp[4];
         om__str s = om__parse_fail_begin(p, OM_E_PARSE, w->col, tmp, sizeof tmp);
         om__str_s(&s, "object name ");
@@ -668,6 +756,8 @@ static void object_count(parser *p, const pv *pl, oinfo *o)
         o->nkeys = 0;
         *ocache_slot(p, p->text + o->at, o->len) = *o;
         p->name_bytes += o->len + 1;
+        const uint32_t h = name_hash(p->text + o->at, o->len) % NAME_BITS;
+        p->name_bits[h / 32] |= 1u << (h % 32);
     }
     p->nobjects++;
 }

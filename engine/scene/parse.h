@@ -46,7 +46,8 @@ typedef struct oinfo {
     float last_t, last_scale;
 } oinfo;
 
-#define OCACHE 64
+#define OCACHE 16
+#define NAME_BITS 4096     /* a filter of the names so far: a new name mostly skips the scan */
 
 typedef struct parser {
     const char *text;
@@ -76,6 +77,7 @@ typedef struct parser {
     uint32_t nobjects, nmeshes, nobj_keys;   /* objects, meshes and object keys so far */
     uint64_t nmesh_v, nmesh_t, name_bytes;   /* the meshes' vertices, triangles; names */
     oinfo ocache[OCACHE];
+    uint32_t name_bits[NAME_BITS / 32];
 } parser;
 
 /* Starts a message "line L, col C: " on the current line. */

@@ -689,6 +689,30 @@ static void object_lines(void)
     expect_err("box name a\nkey object a\n", OM_E_PARSE, 2, 13, "");
     expect_err("box name a\nkey object a nan\n", OM_E_PARSE, 2, 14, "");
 
+    /* A chain of copies found again by reading the lines above (40 names between push
+     * them out of the parser's cache): the mesh is the first line's, and the reach
+     * grows along the chain (the sphere's 1, then 1 + 1, then 2 x 2 + 0 = 4: a key
+     * moving it by 9999994 fits, by 9999996 does not). */
+    static char text[4096];
+    size_t n = (size_t)snprintf(text, sizeof text, "sphere segments 5 rings 3 name m\ncopy m name c0 translate 1 0 0\n"
+                                                   "copy c0 name c1 scale 2\n");
+    for (int i = 0; i < 40; i++) n += (size_t)snprintf(text + n, sizeof text - n, "box name b%d\n", i);
+    n += (size_t)snprintf(text + n, sizeof text - n, "copy c1 name d\nkey object c1 0 translate 9999994 0 0\n");
+    size_t bytes;
+    CHECK_OK(om_scene_bytes(text, n, NULL, &bytes, NULL));
+    unsigned char *buf = malloc(bytes);
+    om_arena a;
+    om_scene s;
+    om_arena_init(&a, buf, bytes, "scene");
+    CHECK_OK(om_scene_parse(text, n, NULL, &a, &s, NULL));
+    CHECK(s.nobjects == 44 && s.nmeshes == 41 && s.objects[43].mesh == 0 && !strcmp(s.objects[43].name, "d"));
+    CHECK(s.objects[2].nkeys == 1 && s.nmesh_verts == s.meshes[0].nverts + 40 * 8);
+    free(buf);
+    n -= strlen("9999994 0 0\n");
+    n += (size_t)snprintf(text + n, sizeof text - n, "9999996.5 0 0\n");
+    om_diag d;
+    CHECK(om_scene_bytes(text, n, NULL, &bytes, &d) == OM_E_RANGE && d.line == 45);
+
 }
 
 static void scene_at(void)
