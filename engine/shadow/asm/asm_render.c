@@ -358,8 +358,6 @@ static void bounds_part(void *user, uint32_t p, void *scratch)
 }
 #endif
 
-/* This frame's projections (once, from the first observe or build), and the rebuild
- * when the light has moved. */
 /* The base-texel rectangle (u0, v0, u1, v1) that holds the light's image of the box
  * lo..hi, widened as tri_box widens; everything where a corner is behind the light. */
 static void box_rect(const om__asm_state *m, om_vec3 lo, om_vec3 hi, float r[4])
@@ -389,30 +387,36 @@ static bool rect_meets(const float *a, const float *b)
 /* Objects moved since the tiles were drawn (om_scene.change): every tile whose part of
  * the light's image meets a moved object's box, at its old pose or its new one, is
  * drawn again, the base among them; the rest of the tree and its tiles stay. A tile is
- * a function of its place and the scene, so a redrawn tile is what a new one would be. */
+ * a function of its place and the scene, so a redrawn tile is what a new one would be.
+ * The boxes' images are kept apart up to MOVED_RECTS of them (two objects far apart
+ * redraw their own tiles, not those between them), beyond that as one rectangle. */
+#define MOVED_RECTS 16
+
 static void redraw_moved(om__asm_state *m)
 {
     const om_scene *s = m->scene;
     om__asm_tree *t = &m->tree;
-    float mv[4] = {0, 0, 0, 0};
-    bool any = false;
+    float rects[MOVED_RECTS][4], all[4] = {0, 0, 0, 0};
+    uint32_t n = 0, seen = 0;
     for (uint32_t i = 0; i < s->nobjects; i++) {
         const om_object *o = &s->objects[i];
         if (o->moved <= m->change && m->change <= s->change) continue;
-        float a[4], b[4];
-        box_rect(m, o->old_lo, o->old_hi, a);
-        box_rect(m, o->lo, o->hi, b);
         for (int k = 0; k < 2; k++) {
-            const float *r = k ? b : a;
-            if (!any || r[0] < mv[0]) mv[0] = r[0];
-            if (!any || r[1] < mv[1]) mv[1] = r[1];
-            if (!any || r[2] > mv[2]) mv[2] = r[2];
-            if (!any || r[3] > mv[3]) mv[3] = r[3];
-            any = true;
+            float r[4];
+            if (k) box_rect(m, o->lo, o->hi, r);
+            else box_rect(m, o->old_lo, o->old_hi, r);
+            if (n < MOVED_RECTS) memcpy(rects[n++], r, sizeof r);
+            for (int e = 0; e < 4; e++)
+                if (!seen || (e < 2 ? r[e] < all[e] : r[e] > all[e])) all[e] = r[e];
+            seen++;
         }
     }
     m->change = s->change;
-    if (!any) return;
+    if (!seen) return;
+    if (seen > MOVED_RECTS) {   /* too many to keep apart: their union */
+        memcpy(rects[0], all, sizeof all);
+        n = 1;
+    }
     om__asm_render_node(m, OM__ASM_ROOT);
     m->redrawn++;
     for (uint32_t i = 0; i < t->lay.count; i++) {
@@ -423,12 +427,16 @@ static void redraw_moved(om__asm_state *m)
         const float r[4] = {(float)((nd->ox - 1.0) / sc), (float)((nd->oy - 1.0) / sc),
                             (float)((nd->ox + t->lay.tile + 1.0) / sc),
                             (float)((nd->oy + t->lay.tile + 1.0) / sc)};
-        if (!rect_meets(r, mv)) continue;
+        bool meets = false;
+        for (uint32_t k = 0; k < n && !meets; k++) meets = rect_meets(r, rects[k]);
+        if (!meets) continue;
         om__asm_render_node(m, i);
         m->redrawn++;
     }
 }
 
+/* This frame's projections (once, from the first observe or build), and the rebuild
+ * when the light has moved. */
 void om__asm_prepare(om__asm_state *m)
 {
     if (m->prepared) return;
