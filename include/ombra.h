@@ -162,6 +162,41 @@ typedef struct om_light_key { float t; om_vec3 pos, target, dir; } om_light_key;
  * skip the triangles facing away. */
 typedef struct om_solid { uint32_t first, count; om_vec3 lo, hi; } om_solid;
 
+/* Objects: a named shape or mesh line (`name NAME`) or a `copy` of one. Its mesh's
+ * vertices and triangles are stored once, in the mesh's own space (after the defining
+ * line's scale, rotate and translate), however many objects share it; every object
+ * owns a fixed range of the scene's vertices and triangles, which posing rewrites
+ * from its mesh: world = pose * base * local, with base the copy line's own transform
+ * (identity for the line that made the mesh). What the methods read is always the
+ * posed scene, so a scene after any sequence of poses is, bit for bit, the scene
+ * parsed with its objects at that pose. */
+typedef struct om_mesh {
+    uint32_t first_vert, nverts;   /* its local vertices: mesh_verts[first_vert..] */
+    uint32_t first_idx, ntris;     /* its triangles: mesh_idx[first_idx..], 3 per triangle,
+                                      numbered from 0 within the mesh */
+    bool closed;                   /* a box, sphere or cylinder: its objects are solids */
+} om_mesh;
+
+typedef struct om_object_key {
+    float t;
+    float move[3], rot_deg[3], scale;   /* translate, rotate (x, then y, then z), scale */
+    uint32_t next;         /* the object's next key (later t), or OM_NO_TRI */
+} om_object_key;
+
+typedef struct om_object {
+    const char *name;      /* NUL-terminated, in the scene's arena; "" for an unnamed copy */
+    uint32_t mesh;         /* its mesh in om_scene.meshes */
+    uint32_t first_vert, first_tri;   /* its posed vertices and triangles in verts / idx */
+    uint32_t solid;        /* its om_solid, or OM_NO_TRI */
+    uint32_t first_key, nkeys;        /* its keys in om_scene.obj_keys, sorted by t */
+    double base[12];       /* the copy line's transform (rows of a 3x4), applied first */
+    double pose[12];       /* what verts hold now: world = pose * local (base included) */
+    om_vec3 lo, hi;        /* bounds of its posed vertices */
+    om_vec3 old_lo, old_hi;   /* ... before its last move (lo, hi before any) */
+    uint32_t moved;        /* om_scene.change at its last move (0: never moved) */
+    uint32_t last_key;     /* the parser's: its latest key so far */
+} om_object;
+
 /* A scene: indexed triangles with a material per triangle, one camera, one light and
  * optional keyframed paths. All arrays live in the arena the scene was parsed into. */
 typedef struct om_scene {
@@ -177,6 +212,20 @@ typedef struct om_scene {
     om_vec3 lo, hi;        /* bounds of all vertices */
     uint32_t nsolids;      /* closed shapes (box, sphere, cylinder), by first triangle; */
     om_solid *solids;      /* 0 and NULL in a hand-made scene: nothing is skipped */
+    /* Objects (0 and NULL in a scene without any). */
+    uint32_t nobjects, nmeshes, nobj_keys;
+    uint32_t nmesh_verts, nmesh_tris;   /* the sizes of mesh_verts and mesh_idx / 3 */
+    om_object *objects;
+    om_mesh *meshes;
+    om_vec3 *mesh_verts;   /* every mesh's local vertices, each mesh once */
+    uint32_t *mesh_idx;    /* every mesh's triangles, each mesh once */
+    om_object_key *obj_keys;
+    char *names;           /* the objects' names, each NUL-terminated */
+    uint32_t change;       /* counts moves (om_object_pose): a method that keeps state
+                              across frames compares it with the count it last saw, and
+                              the objects whose `moved` is later say what moved */
+    om_vec3 static_lo, static_hi;   /* bounds of the vertices outside every object; */
+    bool has_static;                /* false: there are none */
 } om_scene;
 
 /* The host reads files named in a scene (`mesh FILE.obj`); the engine never does.
@@ -203,6 +252,26 @@ const char *om_scene_small_text(void);
 /* Camera and light at time t along the scene's paths (the scene's own when it has
  * none). Linear interpolation between keys, clamped at the ends. */
 void om_scene_at(const om_scene *s, float t, om_camera *cam, om_light *light);
+/* Poses object `object` for the next frame: its vertices become m * base * local (m
+ * row-major, bottom row 0 0 0 1), its triangles keep facing out under a mirroring m,
+ * and the scene's bounds, its solid's box and the change count follow. No memory is
+ * carved. OM_E_INVALID for a bad index or bottom row, or an object whose mesh, ranges
+ * or keys do not fit the scene's arrays (a scene built by hand); OM_E_RANGE, with the scene left
+ * as it was, for an m that is not finite, singular (the determinant of m * base below
+ * 1e-18 in magnitude) or puts a vertex beyond 1e7. Posing an object where it already
+ * is changes nothing. Make the frame's view (om_view_init) after posing: a directional
+ * light's view follows the scene's bounds, which follow the objects. */
+om_status om_object_pose(om_scene *s, uint32_t object, const om_mat4 *m, om_diag *d);
+/* The index of the object named `name`: OM_E_NOTFOUND when there is none. */
+om_status om_object_find(const om_scene *s, const char *name, uint32_t *object);
+/* Poses every object that has keys (`key object`) at time t along them, interpolated
+ * as the camera's are and clamped at the ends; objects without keys keep their pose.
+ * om_scene_at stays a query of the camera and light (it takes a const scene): a host
+ * that renders at time t calls both. A parsed scene's keys never give a pose that is
+ * refused; a scene built by hand may (OM_E_INVALID or OM_E_RANGE, the objects before
+ * the one refused posed). */
+om_status om_scene_pose_at(om_scene *s, float t, om_diag *d);
+
 /* Counts of an OBJ file: vertices and triangles after fan triangulation. */
 om_status om_obj_count(const char *text, size_t len, uint32_t *nverts, uint32_t *ntris,
                        om_diag *d);
@@ -352,8 +421,8 @@ void om_method_cfg_from(om_method_cfg *c, const om_method *m, const om_method_cf
 
 typedef struct om_method_stats {
     size_t bytes_used;     /* arena bytes held by the method this frame (peak) */
-    uint32_t counters[8];  /* method-specific counts; names in counter_names */
-    const char *counter_names[8];
+    uint32_t counters[10]; /* method-specific counts; names in counter_names */
+    const char *counter_names[10];
     uint32_t ncounters;
 } om_method_stats;
 

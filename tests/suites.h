@@ -28,6 +28,7 @@
     X(suite_far) \
     X(suite_robust) \
     X(suite_threads) \
+    X(suite_objects) \
     /* end of list */
 #endif
 #define X(suite) void suite(void);

@@ -10,7 +10,8 @@
 static const char render_help[] =
     "usage: ombra render [SCENE] [options]\n"
     "\n"
-    "Renders one frame of SCENE (the built-in default scene when omitted).\n"
+    "Renders one frame of SCENE (the built-in default scene when omitted), or with\n"
+    "--frames a sequence of them into numbered files.\n"
     "\n"
     "  --method NAME     shadow method (default sm; 'ombra methods' lists them)\n"
     "  --against NAME    also render NAME (usually ref) on the same visible samples and\n"
@@ -24,7 +25,10 @@ static const char render_help[] =
     "                    background\n"
     "  --diff FILE       with --against, .ppm or .png: false lit red, false shadowed blue\n"
     "  --size WxH        image size, 1..8192 each (default: the scene's camera)\n"
-    "  --time T          time along the scene's camera and light paths (default 0)\n"
+    "  --time T          time along the scene's camera, light and object paths (default 0)\n"
+    "  --frames N        N frames, at times T, T + 1/F, ...: each to files numbered\n"
+    "                    0000, 0001, ... before the extension (ombra-0000.ppm, ...)\n"
+    "  --fps F           frames per unit of time with --frames (default 24)\n"
     "  --format F        framebuffer format: rgb888 (default), rgb565, l8\n"
     "  --strip ROWS      render through strips of ROWS rows (default: whole frame)\n"
     "  --threads N       threads a frame runs on (default: the CPUs online); the\n"
@@ -186,7 +190,7 @@ static int same_files(const char *const *paths, const char *const *names, size_t
     return 0;
 }
 
-int cmd_render(int argc, char **argv)
+static int render_one(int argc, char **argv)
 {
     const char *scene_path = NULL, *out = NULL, *mask = NULL, *mname = "sm";
     const char *against = NULL, *diff = NULL, *threads = NULL;
@@ -296,6 +300,7 @@ int cmd_render(int argc, char **argv)
 
     om_camera cam;
     om_light light;
+    if ((st = om_scene_pose_at(&cs.scene, t, &d)) != OM_OK) { cli_scene_free(&cs); return cli_error(where, &d, st); }
     om_scene_at(&cs.scene, t, &cam, &light);
     if (w) { cam.width = w; cam.height = h; }
     om_view view;
@@ -461,11 +466,102 @@ out:
     return rc;
 }
 
+/* FILE.ext -> FILE-NNNN.ext (the number before the last dot of the last path part). */
+static void numbered(char *dst, size_t cap, const char *name, uint32_t f)
+{
+    const char *slash = strrchr(name, '/'), *dot = strrchr(name, '.');
+    if (!dot || (slash && dot < slash) || dot == (slash ? slash + 1 : name)) dot = name + strlen(name);
+    snprintf(dst, cap, "%.*s-%04u%s", (int)(dot - name), name, f, dot);
+}
+
+/* `--frames N [--fps F]`: N frames at times T + k / F (T from --time, default 0), each
+ * a render of its own into numbered files (--out, --mask, --diff), so a user sees the
+ * objects, the camera and the light move. Without --frames, one frame as always. */
+int cmd_render(int argc, char **argv)
+{
+    uint32_t frames = 0;
+    float fps = 24.0f, t0 = 0.0f;
+    int at_frames = -1;
+    for (int i = 1; i + 1 < argc; i++) {
+        if (!strcmp(argv[i], "--frames")) {
+            if (!cli_parse_u32(argv[i + 1], 1, 100000, &frames))
+                return cli_usage_error("render", "--frames takes a frame count 1..100000, not '%s'", argv[i + 1]);
+            at_frames = i;
+        } else if (!strcmp(argv[i], "--fps")) {
+            if (!cli_parse_float(argv[i + 1], &fps) || !(fps > 0.0f) || fps > 1e6f)
+                return cli_usage_error("render", "--fps takes a frame rate above 0, not '%s'", argv[i + 1]);
+        } else if (!strcmp(argv[i], "--time")) {
+            if (!cli_parse_float(argv[i + 1], &t0))
+                return cli_usage_error("render", "--time takes a number, not '%s'", argv[i + 1]);
+        } else if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
+            break;
+        } else {
+            continue;
+        }
+        i++;
+    }
+    for (int i = 1; i < argc; i++)
+        if (!strcmp(argv[i], "--fps") && at_frames < 0)
+            return cli_usage_error("render", "%s needs --frames", "--fps");
+    if (at_frames < 0) return render_one(argc, argv);
+    const char *out = NULL;
+    bool grey = false;
+    for (int i = 1; i + 1 < argc; i++) {
+        if (!strcmp(argv[i], "--out")) out = argv[i + 1];
+        if (!strcmp(argv[i], "--format") && !strcmp(argv[i + 1], "l8")) grey = true;
+    }
+    for (int i = 1; i + 1 < argc; i++)
+        if ((!strcmp(argv[i], "--out") || !strcmp(argv[i], "--mask") || !strcmp(argv[i], "--diff")) &&
+            !strcmp(argv[i + 1], "-"))
+            return cli_usage_error("render", "--frames writes numbered files: %s cannot be '-'", argv[i]);
+    char **av = malloc((size_t)(argc + 4) * sizeof *av);
+    static char names[4][1024], tbuf[64];
+    if (!av) return 1;
+    int rc = 0;
+    for (uint32_t f = 0; f < frames && !rc; f++) {
+        int n = 0;
+        av[n++] = argv[0];
+        for (int i = 1; i < argc; i++) {
+            const char *a = argv[i];
+            if ((!strcmp(a, "--frames") || !strcmp(a, "--fps") || !strcmp(a, "--time")) && i + 1 < argc) {
+                i++;
+                continue;
+            }
+            av[n++] = argv[i];
+            if (i + 1 < argc && (!strcmp(a, "--out") || !strcmp(a, "--mask") || !strcmp(a, "--diff"))) {
+                char *dst = names[!strcmp(a, "--out") ? 0 : !strcmp(a, "--mask") ? 1 : 2];
+                numbered(dst, sizeof names[0], argv[++i], f);
+                av[n++] = dst;
+            }
+        }
+        if (!out) {
+            numbered(names[3], sizeof names[3], grey ? "ombra.pgm" : "ombra.ppm", f);
+            av[n++] = (char *)"--out";
+            av[n++] = names[3];
+        }
+        snprintf(tbuf, sizeof tbuf, "%.9g", (double)(t0 + (float)f / fps));
+        av[n++] = (char *)"--time";
+        av[n++] = tbuf;
+        rc = render_one(n, av);
+    }
+    free(av);
+    return rc;
+}
+
 static const char info_help[] =
     "usage: ombra info [SCENE] [--size WxH] [--set NAME=VALUE ...]\n"
     "\n"
     "Prints the scene's triangles, vertices, materials and bounds, and the bytes the\n"
     "scene, a frame and each method need at that image size.\n";
+
+
+/* How many objects share mesh m. */
+static uint32_t mesh_users(const om_scene *s, uint32_t m)
+{
+    uint32_t n = 0;
+    for (uint32_t i = 0; i < s->nobjects; i++) n += s->objects[i].mesh == m;
+    return n;
+}
 
 int cmd_info(int argc, char **argv)
 {
@@ -501,6 +597,18 @@ int cmd_info(int argc, char **argv)
     printf("scene: %s\n", where);
     printf("triangles %u, vertices %u, materials %u, camera keys %u, light keys %u\n", s->ntris,
            s->nverts, s->nmats, s->ncam_keys, s->nlight_keys);
+    if (s->nobjects) {
+        printf("objects %u sharing %u meshes (%u object keys):\n", s->nobjects, s->nmeshes, s->nobj_keys);
+        for (uint32_t i = 0; i < s->nobjects; i++) {
+            if (i == 24 && s->nobjects > 25) {   /* a crowd: the first ones say enough */
+                printf("  ... and %u more\n", s->nobjects - i);
+                break;
+            }
+            const om_object *o = &s->objects[i];
+            printf("  %-12s mesh %u (%u triangles, %u objects share it), %u keys\n", o->name[0] ? o->name : "(copy)",
+                   o->mesh, s->meshes[o->mesh].ntris, mesh_users(s, o->mesh), o->nkeys);
+        }
+    }
     printf("bounds: (%g, %g, %g) .. (%g, %g, %g)\n", s->lo.x, s->lo.y, s->lo.z, s->hi.x, s->hi.y,
            s->hi.z);
     printf("light: %s\n", s->light.kind == OM_LIGHT_SPOT ? "spot" : "directional");

@@ -21,7 +21,8 @@ static const pdef pdefs[P_N_] = {
     [P_SEED] = {"seed", 1, K_INT, R_SEED},       [P_AREA] = {"area", 1, K_NUM, R_AREA},
     [P_IN] = {"in", 6, K_NUM, R_COORD},          [P_SCALE] = {"scale", 3, K_SCALE, R_SCALE},
     [P_ROTATE] = {"rotate", 3, K_NUM, R_COORD},  [P_TRANSLATE] = {"translate", 3, K_NUM, R_COORD},
-    [P_MATERIAL] = {"material", 1, K_WORD, 0},
+    [P_MATERIAL] = {"material", 1, K_WORD, 0},   [P_NAME] = {"name", 1, K_WORD, 0},
+    [P_SCALE1] = {"scale", 1, K_NUM, R_SCALE},
 };
 
 /* Every number has a range; `mag` ranges bound the magnitude (scale may be negative:

@@ -13,15 +13,15 @@
 
 enum {
     C_CAMERA, C_LIGHT, C_MATERIAL, C_PLANE, C_BOX, C_SPHERE, C_CYLINDER, C_MESH,
-    C_TRIANGLES, C_KEY, C_N_
+    C_TRIANGLES, C_KEY, C_COPY, C_N_
 };
 static const char *const cmd_names[C_N_] = {
     "camera", "light", "material", "plane", "box", "sphere", "cylinder", "mesh",
-    "triangles", "key",
+    "triangles", "key", "copy",
 };
 
 /* The parameters each command takes. */
-#define COMMON_PARAMS P_SCALE, P_ROTATE, P_TRANSLATE, P_ALBEDO, P_OPACITY, P_MATERIAL
+#define COMMON_PARAMS P_SCALE, P_ROTATE, P_TRANSLATE, P_ALBEDO, P_OPACITY, P_MATERIAL, P_NAME
 static const uint8_t cam_params[] = {P_EYE, P_TARGET, P_UP, P_FOV, P_SIZE, P_NEAR, P_FAR};
 static const uint8_t spot_params[] = {P_POS, P_TARGET, P_FOV, P_NEAR, P_FAR};
 static const uint8_t dir_params[] = {P_DIR};
@@ -34,6 +34,8 @@ static const uint8_t mesh_params[] = {COMMON_PARAMS};
 static const uint8_t tris_params[] = {P_COUNT, P_SEED, P_AREA, P_IN, COMMON_PARAMS};
 static const uint8_t keycam_params[] = {P_EYE, P_TARGET};
 static const uint8_t keylight_params[] = {P_POS, P_TARGET, P_DIR};
+static const uint8_t keyobj_params[] = {P_TRANSLATE, P_ROTATE, P_SCALE1};
+static const uint8_t copy_params[] = {COMMON_PARAMS};
 #define NP(a) (sizeof(a) / sizeof((a)[0]))
 
 /* ---------------------------------------------------------------- camera and light */
@@ -232,6 +234,16 @@ static om_status do_material(parser *p)
 }
 
 /* ---------------------------------------------------------------- objects */
+
+static const struct { const uint8_t *ids; size_t n; } sets[C_N_] = {
+    [C_PLANE] = {plane_params, NP(plane_params)},
+    [C_BOX] = {box_params, NP(box_params)},
+    [C_SPHERE] = {sphere_params, NP(sphere_params)},
+    [C_CYLINDER] = {cyl_params, NP(cyl_params)},
+    [C_MESH] = {mesh_params, NP(mesh_params)},
+    [C_TRIANGLES] = {tris_params, NP(tris_params)},
+    [C_COPY] = {copy_params, NP(copy_params)},
+};
 
 /* Transform and material of an object from its COMMON parameters. Materials are laid
  * out as [default, named in order of definition, inline in order of appearance]. */
@@ -449,16 +461,397 @@ static void add_solid(parser *p, uint64_t first, uint64_t nt)
     }
 }
 
+/* ---------------------------------------------------------------- named objects */
+
+static int cmd_of(const char *text, const om__tok *t)
+{
+    for (int i = 0; i < C_N_; i++)
+        if (om__tok_is(text, t, cmd_names[i])) return i;
+    return -1;
+}
+
+static bool tok_eq(const char *text, const om__tok *t, const char *nm, size_t n)
+{
+    return t->len == n && memcmp(text + t->at, nm, n) == 0;
+}
+
+static void common_xform(const pv *pl, om__xform *xf)
+{
+    double one[3] = {1.0, 1.0, 1.0}, zero[3] = {0.0, 0.0, 0.0};
+    om__xform_make(xf, pl[P_SCALE].has ? pl[P_SCALE].v : one,
+                   pl[P_ROTATE].has ? pl[P_ROTATE].v : zero,
+                   pl[P_TRANSLATE].has ? pl[P_TRANSLATE].v : zero);
+}
+
+/* How far a copy's vertices can reach: its transform moves a point of the mesh at
+ * distance r at most by the largest scale times r plus the translation. */
+static double copy_radius(const pv *pl, double r)
+{
+    double sm = 1.0, t = 0.0;
+    if (pl[P_SCALE].has)
+        sm = fmax(fabs(pl[P_SCALE].v[0]), fmax(fabs(pl[P_SCALE].v[1]), fabs(pl[P_SCALE].v[2])));
+    if (pl[P_TRANSLATE].has)
+        for (int i = 0; i < 3; i++) t += pl[P_TRANSLATE].v[i] * pl[P_TRANSLATE].v[i];
+    return sm * r + sqrt(t);
+}
+
+/* A named shape or mesh line's mesh: counts and reach, from a counting sink. */
+static om_status measure(parser *p, int cmd, const pv *pl, const char *file, oinfo *o)
+{
+    om__xform xf;
+    common_xform(pl, &xf);
+    om__sink k;
+    om__sink_init(&k, false);
+    om__sink_begin(&k, &xf, 0);
+    if (cmd == C_MESH) {
+        const char *data = NULL;
+        size_t dlen = 0;
+        om_status st = p->ld && p->ld->load ? p->ld->load(p->ld->user, file, &data, &dlen) : OM_E_NOTFOUND;
+        if (st != OM_OK) return st;
+        if ((st = om__obj_run(data, dlen, file, p->l.no, &k, NULL)) != OM_OK) return st;
+    } else {
+        shape_gen(&k, cmd, pl);
+    }
+    o->nv = k.nv;
+    o->nt = k.nt;
+    o->radius = sqrt(k.r2);
+    o->closed = cmd == C_BOX || cmd == C_SPHERE || cmd == C_CYLINDER;
+    return OM_OK;
+}
+
+static oinfo *ocache_slot(parser *p, const char *nm, size_t n)
+{
+    return &p->ocache[name_hash(nm, n) % OCACHE];
+}
+
+static bool obj_find(parser *p, const char *nm, size_t n, oinfo *out);
+
+/* A line above, read for its object without reading its numbers (the lines above are
+ * known to be valid): whether it makes an object, and the names it gives. */
+typedef struct oline {
+    int cmd;
+    bool object;           /* a named shape or mesh line, or a copy */
+    om__tok name, src;     /* its name (len 0: none); a copy's source */
+} oline;
+
+static void oline_read(const char *text, om__line *l, int cmd, oline *o)
+{
+    om__tok t;
+    memset(o, 0, sizeof *o);
+    o->cmd = cmd;
+    if ((cmd == C_MESH || cmd == C_COPY) && om__tok_next(l, &t) == 1) o->src = t;   /* file or source */
+    /* words follow only 'material' and 'name' (their values); everything else is a
+     * parameter's name or a number */
+    while (om__tok_next(l, &t) == 1) {
+        const bool mat = om__tok_is(text, &t, "material"), nm = om__tok_is(text, &t, "name");
+        if (!mat && !nm) continue;
+        om__tok v;
+        if (om__tok_next(l, &v) != 1) break;
+        if (nm) o->name = v;
+    }
+    o->object = cmd == C_COPY || o->name.len > 0;
+}
+
+/* Where the object named nm is named in the lines above the current one (the light
+ * read: no numbers), its index and, unless a copy names it, its mesh's; and its keys.
+ * false: no line names it. */
+typedef struct odef {
+    uint32_t ord, mesh, no;   /* mesh: for a copy, its source's (found by obj_scan) */
+    size_t start;             /* the naming line */
+    uint32_t nkeys, last_line;
+    float last_t, last_scale;
+} odef;
+
+static bool obj_def(parser *p, const char *nm, size_t n, odef *out)
+{
+    om__line l;
+    om__line_init(&l, p->text, p->l.start, false);
+    uint32_t ord = 0, mesh = 0;
+    bool found = false;
+    memset(out, 0, sizeof *out);
+    while (om__line_next(&l)) {
+        om__tok t, a, w;
+        if (om__tok_next(&l, &t) != 1) continue;
+        const int cmd = cmd_of(p->text, &t);
+        if (cmd == C_KEY) {
+            if (!found || om__tok_next(&l, &a) != 1 || !om__tok_is(p->text, &a, "object") ||
+                om__tok_next(&l, &w) != 1 || !tok_eq(p->text, &w, nm, n))
+                continue;
+            parser q;
+            memset(&q, 0, sizeof q);
+            q.text = p->text;
+            q.len = p->len;
+            q.l = l;
+            pv pl[P_N_];
+            double T;
+            uint32_t col;
+            if (om__parse_value(&q, "key object", K_NUM, R_COORD, 1, &T, &col) != OM_OK ||
+                om__parse_params(&q, "key object", keyobj_params, NP(keyobj_params), pl) != OM_OK)
+                continue;
+            out->nkeys++;
+            out->last_t = (float)T;
+            out->last_line = l.no;
+            out->last_scale = (float)val(pl, P_SCALE1, 0, 1.0);
+            continue;
+        }
+        if (cmd < C_PLANE) continue;
+        oline o;
+        oline_read(p->text, &l, cmd, &o);
+        if (!o.object) continue;
+        if (!found && o.name.len && tok_eq(p->text, &o.name, nm, n)) {
+            out->ord = ord;
+            out->mesh = mesh;
+            out->start = l.start;
+            out->no = l.no;
+            found = true;
+        }
+        ord++;
+        if (cmd != C_COPY) mesh++;
+    }
+    return found;
+}
+
+/* What the parser needs of the object named nm (obj_def), and of its mesh: through
+ * the chain of copies it may be a copy of, to the line that made the mesh. A copy's
+ * reach is its largest scale times its source's plus its move's length, so along the
+ * chain reach = A * (the mesh's) + B. Each source is named above its copy: the walk
+ * ends. Only the lines of the chain are parsed whole. */
+static bool obj_scan(parser *p, const char *nm, size_t n, oinfo *out)
+{
+    odef def;
+    if (!obj_def(p, nm, n, &def)) return false;
+    memset(out, 0, sizeof *out);
+    out->len = n;
+    out->used = true;
+    out->ord = def.ord;
+    out->line = def.no;
+    out->nkeys = def.nkeys;
+    out->last_t = def.last_t;
+    out->last_line = def.last_line;
+    out->last_scale = def.last_scale;
+    double A = 1.0, B = 0.0;
+    odef at = def;
+    for (;;) {
+        parser q;
+        memset(&q, 0, sizeof q);
+        q.text = p->text;
+        q.len = p->len;
+        q.ld = p->ld;
+        om__line_init(&q.l, p->text, p->len, false);
+        q.l.next = at.start;
+        q.l.no = at.no - 1;
+        om__tok t, src;
+        if (!om__line_next(&q.l) || om__tok_next(&q.l, &t) != 1) return false;
+        const int cmd = cmd_of(p->text, &t);
+        if (cmd < C_PLANE || cmd == C_KEY) return false;
+        char file[256];
+        if (cmd == C_MESH || cmd == C_COPY) {
+            if (om__tok_next(&q.l, &src) != 1 || src.len >= sizeof file) return false;
+            memcpy(file, p->text + src.at, src.len);
+            file[src.len] = '\0';
+        }
+        pv pl[P_N_];
+        if (om__parse_params(&q, cmd_names[cmd], sets[cmd].ids, sets[cmd].n, pl) != OM_OK) return false;
+        if (at.start == def.start) out->at = pl[P_NAME].w.at;
+        if (cmd != C_COPY) {
+            oinfo m;
+            memset(&m, 0, sizeof m);
+            if (measure(&q, cmd, pl, file, &m) != OM_OK) return false;
+            out->mesh = at.mesh;
+            out->nv = m.nv;
+            out->nt = m.nt;
+            out->closed = m.closed;
+            out->radius = A * m.radius + B;
+            return true;
+        }
+        const double b0 = copy_radius(pl, 0.0);
+        B += A * b0;
+        A *= copy_radius(pl, 1.0) - b0;
+        const oinfo *c = ocache_slot(p, p->text + src.at, src.len);
+        if (c->used && tok_eq(p->text, &src, p->text + c->at, c->len)) {   /* the source known */
+            out->mesh = c->mesh;
+            out->nv = c->nv;
+            out->nt = c->nt;
+            out->closed = c->closed;
+            out->radius = A * c->radius + B;
+            return true;
+        }
+        odef up;   /* the source, named above its copy */
+        if (!obj_def(p, p->text + src.at, src.len, &up) || up.start >= at.start) return false;
+        at = up;
+    }
+}
+
+static bool obj_find(parser *p, const char *nm, size_t n, oinfo *out)
+{
+    oinfo *c = ocache_slot(p, nm, n);
+    if (c->used && c->len == n && memcmp(p->text + c->at, nm, n) == 0) {
+        *out = *c;
+        return true;
+    }
+    if (!obj_scan(p, nm, n, out)) return false;
+    *c = *out;
+    return true;
+}
+
+/* A name given on this line must be new. */
+static om_status name_check(parser *p, const pv *pl)
+{
+    /* the second pass reads the text the first one found unique */
+    if (!pl[P_NAME].has || p->fill) return OM_OK;
+    const om__tok *w = &pl[P_NAME].w;
+    if (!valid_name(p->text + w->at, w->len))
+        return om__parse_fail_tok(p, OM_E_PARSE, w, "bad object name ",
+                                  " (a letter or _, then letters, digits, _ . -)");
+    oinfo o;
+    const uint32_t h = name_hash(p->text + w->at, w->len) % NAME_BITS;
+    /* a name the filter has not seen is new; else the lines above say */
+    if ((p->name_bits[h / 32] >> (h % 32) & 1u) && obj_find(p, p->text + w->at, w->len, &o)) {
+        char tmp[4];
+        om__str s = om__parse_fail_begin(p, OM_E_PARSE, w->col, tmp, sizeof tmp);
+        om__str_s(&s, "object name ");
+        om__str_tok(&s, p->text + w->at, w->len);
+        om__str_s(&s, " is already used (on line ");
+        om__str_u(&s, o.line);
+        om__str_s(&s, ")");
+        return OM_E_PARSE;
+    }
+    return OM_OK;
+}
+
+/* Second pass: the object's record and its name; its geometry lies at
+ * [first_v, first_v + nv) and [first_t, first_t + nt). */
+static om_object *object_add(parser *p, const pv *pl, uint32_t mesh, uint64_t first_v, uint64_t first_t,
+                             bool closed)
+{
+    om_scene *s = p->s;
+    om_object *o = &s->objects[p->nobjects];
+    memset(o, 0, sizeof *o);
+    o->mesh = mesh;
+    o->first_vert = (uint32_t)first_v;
+    o->first_tri = (uint32_t)first_t;
+    o->solid = closed ? p->nsolids : OM_NO_TRI;
+    o->first_key = OM_NO_TRI;
+    o->last_key = OM_NO_TRI;
+    o->base[0] = o->base[5] = o->base[10] = 1.0;
+    o->name = "";
+    if (pl[P_NAME].has) {
+        char *nm = s->names + p->name_bytes;
+        memcpy(nm, p->text + pl[P_NAME].w.at, pl[P_NAME].w.len);
+        nm[pl[P_NAME].w.len] = '\0';
+        o->name = nm;
+    }
+    return o;
+}
+
+/* Remembers a new object in the cache and counts it. */
+static void object_count(parser *p, const pv *pl, oinfo *o)
+{
+    if (pl[P_NAME].has) {
+        o->at = pl[P_NAME].w.at;
+        o->len = pl[P_NAME].w.len;
+        o->used = true;
+        o->ord = p->nobjects;
+        o->line = p->l.no;
+        o->nkeys = 0;
+        *ocache_slot(p, p->text + o->at, o->len) = *o;
+        p->name_bytes += o->len + 1;
+        const uint32_t h = name_hash(p->text + o->at, o->len) % NAME_BITS;
+        p->name_bits[h / 32] |= 1u << (h % 32);
+    }
+    p->nobjects++;
+}
+
+/* A named shape or mesh line, after its geometry went to the scene as a static
+ * line's would ([first_v, ..) and [first_t, ..)): it becomes its mesh too, and its
+ * object is posed through om__object_write like every later move. */
+static om_status named_done(parser *p, int cmd, const pv *pl, const char *file, uint64_t first_v,
+                            uint64_t first_t)
+{
+    oinfo o;
+    om_status st;
+    memset(&o, 0, sizeof o);
+    o.mesh = p->nmeshes;
+    if ((st = measure(p, cmd, pl, file, &o)) != OM_OK) return st;
+    if (p->fill) {
+        om_scene *s = p->s;
+        if (p->out.overflow || first_v + o.nv > s->nverts || first_t + o.nt > s->ntris)
+            return OM_E_INVALID;
+        om_mesh *me = &s->meshes[p->nmeshes];
+        me->first_vert = (uint32_t)p->nmesh_v;
+        me->nverts = (uint32_t)o.nv;
+        me->first_idx = (uint32_t)(3 * p->nmesh_t);
+        me->ntris = (uint32_t)o.nt;
+        me->closed = o.closed;
+        memcpy(s->mesh_verts + p->nmesh_v, s->verts + first_v, (size_t)o.nv * sizeof(om_vec3));
+        for (uint64_t i = 0; i < 3 * o.nt; i++)
+            s->mesh_idx[3 * p->nmesh_t + i] = s->idx[3 * first_t + i] - (uint32_t)first_v;
+        om_object *ob = object_add(p, pl, p->nmeshes, first_v, first_t, o.closed);
+        /* the solid (if closed) was recorded by the shape's own path, just before */
+        if (o.closed) ob->solid = p->nsolids - 1;
+        double id[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
+        if ((st = om__object_write(s, p->nobjects, id, p->d)) != OM_OK) return st;
+        ob->old_lo = ob->lo;
+        ob->old_hi = ob->hi;
+    }
+    p->nmesh_v += o.nv;
+    p->nmesh_t += o.nt;
+    p->nmeshes++;
+    object_count(p, pl, &o);
+    return OM_OK;
+}
+
+/* copy SRC [name NAME] COMMON: an object sharing SRC's mesh, under its own transform. */
+static om_status do_copy(parser *p)
+{
+    pv pl[P_N_];
+    om_status st;
+    om__tok src;
+    int r = om__tok_next(&p->l, &src);
+    if (r < 0) return om__parse_bad_byte(p, &src);
+    if (r == 0)
+        return om__parse_fail(p, OM_E_PARSE, om__line_end_col(&p->l), "expected an object's name after 'copy'",
+                              NULL, 0, NULL);
+    if ((st = om__parse_params(p, "copy", copy_params, NP(copy_params), pl)) != OM_OK) return st;
+    oinfo si;
+    if (!obj_find(p, p->text + src.at, src.len, &si))
+        return om__parse_fail_tok(p, OM_E_PARSE, &src, "unknown object ",
+                                  " (name it with 'name' on a shape or mesh line above)");
+    if ((st = name_check(p, pl)) != OM_OK) return st;
+    om__xform xf;
+    uint16_t mat = 0;
+    if ((st = object_common(p, pl, &xf, &mat)) != OM_OK) return st;
+    oinfo o = si;
+    o.radius = copy_radius(pl, si.radius);
+    if (!(o.radius <= OM__COORD_MAX * (1.0 - 1e-9))) return out_of_range(p, "copy");
+    if ((st = check_totals(p, si.nv, si.nt)) != OM_OK) return st;
+    if (p->fill) {
+        om_scene *s = p->s;
+        if (p->nv + si.nv > s->nverts || p->nt + si.nt > s->ntris || si.mesh >= p->nmeshes)
+            return OM_E_INVALID;
+        om_object *ob = object_add(p, pl, si.mesh, p->nv, p->nt, si.closed);
+        memcpy(ob->base, xf.m, sizeof ob->base);
+        for (uint64_t t = 0; t < si.nt; t++) s->tri_mat[p->nt + t] = mat;
+        if (si.closed) {
+            om_solid *so = &s->solids[p->nsolids];
+            so->first = (uint32_t)p->nt;
+            so->count = (uint32_t)si.nt;
+        }
+        if ((st = om__object_write(s, p->nobjects, ob->base, p->d)) != OM_OK) return st;
+        ob->old_lo = ob->lo;
+        ob->old_hi = ob->hi;
+        p->out.nv += si.nv;
+        p->out.nt += si.nt;
+    }
+    p->nv += si.nv;
+    p->nt += si.nt;
+    p->nsolids += si.closed;
+    object_count(p, pl, &o);
+    return OM_OK;
+}
+
 static om_status do_object(parser *p, int cmd)
 {
-    static const struct { const uint8_t *ids; size_t n; } sets[C_N_] = {
-        [C_PLANE] = {plane_params, NP(plane_params)},
-        [C_BOX] = {box_params, NP(box_params)},
-        [C_SPHERE] = {sphere_params, NP(sphere_params)},
-        [C_CYLINDER] = {cyl_params, NP(cyl_params)},
-        [C_MESH] = {mesh_params, NP(mesh_params)},
-        [C_TRIANGLES] = {tris_params, NP(tris_params)},
-    };
     pv pl[P_N_];
     om_status st;
     om__tok file;
@@ -482,10 +875,15 @@ static om_status do_object(parser *p, int cmd)
                 return om__parse_fail(p, OM_E_RANGE, pl[P_IN].vcol[i + 3],
                             "'in' needs X0 <= X1, Y0 <= Y1 and Z0 <= Z1", NULL, 0, NULL);
     }
+    if ((st = name_check(p, pl)) != OM_OK) return st;
     om__xform xf;
     uint16_t mat = 0;
     if ((st = object_common(p, pl, &xf, &mat)) != OM_OK) return st;
-    if (cmd == C_MESH) return do_mesh(p, &file, name, &xf, mat);
+    const uint64_t first_v = p->nv, first_t = p->nt;
+    if (cmd == C_MESH) {
+        if ((st = do_mesh(p, &file, name, &xf, mat)) != OM_OK) return st;
+        return pl[P_NAME].has ? named_done(p, cmd, pl, name, first_v, first_t) : OM_OK;
+    }
 
     uint64_t nv, nt;
     shape_counts(cmd, pl, &nv, &nt);
@@ -511,7 +909,7 @@ static om_status do_object(parser *p, int cmd)
     p->nv += nv;
     p->nt += nt;
     p->nsolids += closed;
-    return OM_OK;
+    return pl[P_NAME].has ? named_done(p, cmd, pl, NULL, first_v, first_t) : OM_OK;
 }
 
 /* ---------------------------------------------------------------- keys */
@@ -546,6 +944,65 @@ static om_status key_meets(parser *p, const char *what, uint32_t col, float last
     return key_fail(p, OM_E_RANGE, col, what, ": between the key on line ", line, " (t = ", last, how);
 }
 
+/* key object NAME T [translate X Y Z] [rotate AX AY AZ] [scale S]: applied after the
+ * object's own transform. A key's scale and translation bound how far its vertices
+ * reach at any rotation (|translate| + |scale| * radius), and between two keys of one
+ * sign the scale never passes through zero, so no pose along the path is refused. */
+static om_status do_key_object(parser *p)
+{
+    pv pl[P_N_];
+    om_status st;
+    om__tok w;
+    const char *what = "key object";
+    int r = om__tok_next(&p->l, &w);
+    if (r < 0) return om__parse_bad_byte(p, &w);
+    if (r == 0)
+        return om__parse_fail(p, OM_E_PARSE, om__line_end_col(&p->l), "expected an object's name after 'key object'",
+                              NULL, 0, NULL);
+    double T;
+    uint32_t tcol;
+    if ((st = om__parse_value(p, what, K_NUM, R_COORD, 1, &T, &tcol)) != OM_OK) return st;
+    if ((st = om__parse_params(p, what, keyobj_params, NP(keyobj_params), pl)) != OM_OK) return st;
+    oinfo o;
+    if (!obj_find(p, p->text + w.at, w.len, &o))
+        return om__parse_fail_tok(p, OM_E_PARSE, &w, "unknown object ",
+                                  " (name it with 'name' on a shape, mesh or copy line above)");
+    om_object_key k;
+    memset(&k, 0, sizeof k);
+    k.t = (float)T;
+    k.scale = (float)val(pl, P_SCALE1, 0, 1.0);
+    k.next = OM_NO_TRI;
+    double reach = 0.0;
+    for (int i = 0; i < 3; i++) {
+        k.move[i] = (float)val(pl, P_TRANSLATE, i, 0.0);
+        k.rot_deg[i] = (float)val(pl, P_ROTATE, i, 0.0);
+        reach += (double)k.move[i] * k.move[i];
+    }
+    if (o.nkeys && !(k.t > o.last_t)) return key_order(p, what, tcol, o.last_t, o.last_line);
+    if (o.nkeys && (k.scale < 0.0f) != (o.last_scale < 0.0f))
+        return key_meets(p, what, pl[P_SCALE1].has ? pl[P_SCALE1].vcol[0] : p->cmd.col, o.last_t, o.last_line,
+                         ") and this one the scale passes through zero");
+    if (!(sqrt(reach) + fabs((double)k.scale) * o.radius <= OM__COORD_MAX * (1.0 - 1e-9)))
+        return out_of_range(p, "key object");
+    if (p->fill) {
+        om_scene *s = p->s;
+        if (p->nobj_keys >= s->nobj_keys || o.ord >= s->nobjects) return OM_E_INVALID;
+        om_object *ob = &s->objects[o.ord];
+        s->obj_keys[p->nobj_keys] = k;
+        if (ob->nkeys) s->obj_keys[ob->last_key].next = p->nobj_keys;
+        else ob->first_key = p->nobj_keys;
+        ob->last_key = p->nobj_keys;
+        ob->nkeys++;
+    }
+    o.nkeys++;
+    o.last_t = k.t;
+    o.last_line = p->l.no;
+    o.last_scale = k.scale;
+    *ocache_slot(p, p->text + o.at, o.len) = o;
+    p->nobj_keys++;
+    return OM_OK;
+}
+
 static om_status do_key(parser *p)
 {
     pv pl[P_N_];
@@ -554,11 +1011,12 @@ static om_status do_key(parser *p)
     int r = om__tok_next(&p->l, &t);
     if (r < 0) return om__parse_bad_byte(p, &t);
     bool cam = r > 0 && om__tok_is(p->text, &t, "camera");
+    if (r > 0 && om__tok_is(p->text, &t, "object")) return do_key_object(p);
     if (!cam && !(r > 0 && om__tok_is(p->text, &t, "light"))) {
         if (r == 0)
             return om__parse_fail(p, OM_E_PARSE, om__line_end_col(&p->l),
-                        "expected 'camera' or 'light' after 'key'", NULL, 0, NULL);
-        return om__parse_fail_tok(p, OM_E_PARSE, &t, "expected 'camera' or 'light' after 'key', found ", NULL);
+                        "expected 'camera', 'light' or 'object' after 'key'", NULL, 0, NULL);
+        return om__parse_fail_tok(p, OM_E_PARSE, &t, "expected 'camera', 'light' or 'object' after 'key', found ", NULL);
     }
     const char *what = cam ? "key camera" : "key light";
     double T;
@@ -661,6 +1119,7 @@ static om_status run(parser *p)
         case C_LIGHT: st = do_light(p); break;
         case C_MATERIAL: st = do_material(p); break;
         case C_KEY: st = do_key(p); break;
+        case C_COPY: st = do_copy(p); break;
         case -1: {
             char tmp[4];
             om__str s = om__parse_fail_begin(p, OM_E_PARSE, t.col, tmp, sizeof tmp);
@@ -691,6 +1150,28 @@ static om_status run(parser *p)
 
 /* ================================================================ public entry points */
 
+/* The bounds of a scene with objects: of the vertices outside every object (objects
+ * lie in increasing order of their first vertex), then with each object's. */
+static void scene_bounds_objects(om_scene *s)
+{
+    uint32_t v = 0;
+    s->has_static = false;
+    for (uint32_t i = 0; i <= s->nobjects; i++) {
+        const uint32_t end = i < s->nobjects ? s->objects[i].first_vert : s->nverts;
+        for (; v < end; v++) {
+            om_vec3 x = s->verts[v];
+            if (!s->has_static) {
+                s->static_lo = s->static_hi = x;
+                s->has_static = true;
+            }
+            s->static_lo = om__v3(fminf(s->static_lo.x, x.x), fminf(s->static_lo.y, x.y), fminf(s->static_lo.z, x.z));
+            s->static_hi = om__v3(fmaxf(s->static_hi.x, x.x), fmaxf(s->static_hi.y, x.y), fmaxf(s->static_hi.z, x.z));
+        }
+        if (i < s->nobjects) v += s->meshes[s->objects[i].mesh].nverts;
+    }
+    om__scene_bounds(s);
+}
+
 typedef struct al_vec3 { char c; om_vec3 x; } al_vec3;
 typedef struct al_u32 { char c; uint32_t x; } al_u32;
 typedef struct al_u16 { char c; uint16_t x; } al_u16;
@@ -698,8 +1179,14 @@ typedef struct al_mat { char c; om_material x; } al_mat;
 typedef struct al_ck { char c; om_camera_key x; } al_ck;
 typedef struct al_lk { char c; om_light_key x; } al_lk;
 typedef struct al_so { char c; om_solid x; } al_so;
+typedef struct al_ob { char c; om_object x; } al_ob;
+typedef struct al_me { char c; om_mesh x; } al_me;
+typedef struct al_ok { char c; om_object_key x; } al_ok;
 
-enum { A_VERTS, A_IDX, A_TRIMAT, A_MATS, A_CKEYS, A_LKEYS, A_SOLIDS, A_N_ };
+enum {
+    A_VERTS, A_IDX, A_TRIMAT, A_MATS, A_CKEYS, A_LKEYS, A_SOLIDS, A_OBJS, A_MESHES, A_MVERTS,
+    A_MIDX, A_OKEYS, A_NAMES, A_N_
+};
 
 /* Each array's size and alignment, from the first pass's counts. */
 static void layout(const parser *p, uint64_t size[A_N_], size_t align[A_N_])
@@ -712,6 +1199,12 @@ static void layout(const parser *p, uint64_t size[A_N_], size_t align[A_N_])
     size[A_CKEYS] = (uint64_t)p->ncam * sizeof(om_camera_key);   align[A_CKEYS] = offsetof(al_ck, x);
     size[A_LKEYS] = (uint64_t)p->nlight * sizeof(om_light_key);  align[A_LKEYS] = offsetof(al_lk, x);
     size[A_SOLIDS] = (uint64_t)p->nsolids * sizeof(om_solid);    align[A_SOLIDS] = offsetof(al_so, x);
+    size[A_OBJS] = (uint64_t)p->nobjects * sizeof(om_object);    align[A_OBJS] = offsetof(al_ob, x);
+    size[A_MESHES] = (uint64_t)p->nmeshes * sizeof(om_mesh);     align[A_MESHES] = offsetof(al_me, x);
+    size[A_MVERTS] = p->nmesh_v * sizeof(om_vec3);               align[A_MVERTS] = offsetof(al_vec3, x);
+    size[A_MIDX] = p->nmesh_t * 3 * sizeof(uint32_t);            align[A_MIDX] = offsetof(al_u32, x);
+    size[A_OKEYS] = (uint64_t)p->nobj_keys * sizeof(om_object_key); align[A_OKEYS] = offsetof(al_ok, x);
+    size[A_NAMES] = p->name_bytes;                               align[A_NAMES] = 1;
 }
 
 /* Bytes of one array: om_arena_need's worst case, or nothing for an empty array. */
@@ -818,11 +1311,23 @@ om_status om_scene_parse(const char *text, size_t len, const om_loader *ld, om_a
     s->light_keys = (om_light_key *)arr[A_LKEYS];
     s->nsolids = p.nsolids;
     s->solids = (om_solid *)arr[A_SOLIDS];
+    s->nobjects = p.nobjects;
+    s->nmeshes = p.nmeshes;
+    s->nobj_keys = p.nobj_keys;
+    s->nmesh_verts = (uint32_t)p.nmesh_v;
+    s->nmesh_tris = (uint32_t)p.nmesh_t;
+    s->objects = (om_object *)arr[A_OBJS];
+    s->meshes = (om_mesh *)arr[A_MESHES];
+    s->mesh_verts = (om_vec3 *)arr[A_MVERTS];
+    s->mesh_idx = (uint32_t *)arr[A_MIDX];
+    s->obj_keys = (om_object_key *)arr[A_OKEYS];
+    s->names = (char *)arr[A_NAMES];
     s->mats[0].r = s->mats[0].g = s->mats[0].b = 0.8f;
     s->mats[0].opacity = 1.0f;
 
     /* The second pass reuses the parser: one on the stack is enough for small targets. */
     uint32_t named = p.nnamed, inline_ = p.ninline, solids = p.nsolids;
+    const uint64_t nmesh_v = p.nmesh_v, name_bytes = p.name_bytes;
     parser_init(&p, text, len, ld, d);
     p.fill = true;
     p.nnamed_total = named;
@@ -838,7 +1343,8 @@ om_status om_scene_parse(const char *text, size_t len, const om_loader *ld, om_a
     if (st == OM_OK && (p.out.overflow || p.out.nv != s->nverts || p.out.nt != s->ntris ||
                         p.nv != s->nverts || p.nt != s->ntris || p.nnamed != named ||
                         p.ninline != inline_ || p.ncam != s->ncam_keys || p.nlight != s->nlight_keys ||
-                        p.nsolids != solids))
+                        p.nsolids != solids || p.nobjects != s->nobjects || p.nmeshes != s->nmeshes ||
+                        p.nobj_keys != s->nobj_keys || p.nmesh_v != nmesh_v || p.name_bytes != name_bytes))
         st = om__fail(d, OM_E_INVALID, "a mesh file changed between the counting and filling passes");
     if (st != OM_OK) {
         om_arena_rewind(a, mark);
@@ -847,7 +1353,9 @@ om_status om_scene_parse(const char *text, size_t len, const om_loader *ld, om_a
     }
     s->camera = p.cam;
     s->light = p.light;
-    if (s->nverts) {
+    if (s->nobjects) {
+        scene_bounds_objects(s);
+    } else if (s->nverts) {
         s->lo = s->hi = s->verts[0];
         for (uint32_t i = 1; i < s->nverts; i++) {
             om_vec3 v = s->verts[i];

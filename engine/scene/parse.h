@@ -10,7 +10,7 @@
 enum {
     P_EYE, P_TARGET, P_UP, P_FOV, P_SIZE, P_NEAR, P_FAR, P_POS, P_DIR, P_ALBEDO, P_OPACITY,
     P_SIZE2, P_DIVISIONS, P_SIZE3, P_RADIUS, P_SEGMENTS, P_RINGS, P_HEIGHT, P_COUNT, P_SEED,
-    P_AREA, P_IN, P_SCALE, P_ROTATE, P_TRANSLATE, P_MATERIAL, P_N_
+    P_AREA, P_IN, P_SCALE, P_ROTATE, P_TRANSLATE, P_MATERIAL, P_NAME, P_SCALE1, P_N_
 };
 enum { K_NUM, K_INT, K_SCALE, K_WORD };   /* what a parameter's values are */
 enum {
@@ -31,6 +31,23 @@ typedef struct pv {
 #define MCACHE 64          /* material names remembered; a miss rescans earlier lines */
 
 typedef struct mslot { size_t at, len; uint32_t ord; bool used; } mslot;
+
+/* What the parser knows of an object by name: found again by reading the lines above
+ * (obj_scan), remembered in a small cache (no table to allocate). */
+typedef struct oinfo {
+    size_t at, len;        /* the name in the text */
+    bool used;
+    uint32_t ord, mesh;    /* the object's and its mesh's index */
+    uint64_t nv, nt;       /* its mesh's vertices and triangles */
+    bool closed;
+    double radius;         /* how far from the origin its vertices reach at rest (base on) */
+    uint32_t line;         /* where it is named */
+    uint32_t nkeys, last_line;   /* its keys so far, and the latest's line, t and scale */
+    float last_t, last_scale;
+} oinfo;
+
+#define OCACHE 16
+#define NAME_BITS 4096     /* a filter of the names so far: a new name mostly skips the scan */
 
 typedef struct parser {
     const char *text;
@@ -57,6 +74,10 @@ typedef struct parser {
     om_scene *s;           /* second pass */
     om__sink out;          /* second pass: the whole scene's sink */
     mslot cache[MCACHE];
+    uint32_t nobjects, nmeshes, nobj_keys;   /* objects, meshes and object keys so far */
+    uint64_t nmesh_v, nmesh_t, name_bytes;   /* the meshes' vertices, triangles; names */
+    oinfo ocache[OCACHE];
+    uint32_t name_bits[NAME_BITS / 32];
 } parser;
 
 /* Starts a message "line L, col C: " on the current line. */

@@ -84,6 +84,21 @@ void om__sincos_deg(double deg, double *s, double *c);
 
 #define OM__COORD_MAX 1e7  /* largest |coordinate| after transformation */
 
+/* ---- objects (pose.c) */
+
+/* out = a * b, both 3x4 rows of affine transforms (out may be either). */
+void om__xform_mul(const double a[12], const double b[12], double out[12]);
+/* Writes object oi's vertices (m * its mesh's local ones), triangles (corners swapped
+ * where m mirrors), bounds and solid box, and keeps m as its pose: the one place that
+ * turns a mesh into scene geometry, at parse time and for every move. Refuses (scene
+ * unchanged) a transform that is not finite, singular or carries a vertex beyond
+ * 1e7. Neither the change count nor the scene's bounds: the callers' part. */
+om_status om__object_write(om_scene *s, uint32_t oi, const double m[12], om_diag *d);
+/* s->lo, s->hi from the static bounds and every object's. */
+void om__scene_bounds(om_scene *s);
+/* The transform of o's key path at time t, base included. */
+void om__object_key_at(const om_scene *s, const om_object *o, float t, double out[12]);
+
 typedef struct om__sink {
     om__xform xf;
     bool write;            /* false: count and check only */
@@ -99,6 +114,7 @@ typedef struct om__sink {
     bool overflow;         /* write mode: more than the capacity was offered */
     uint32_t where;        /* caller's note for the first out-of-range vertex (OBJ line) */
     uint32_t note;         /* the caller keeps its current note here */
+    double r2;             /* the largest squared distance of a vertex from the origin */
 } om__sink;
 
 void om__sink_init(om__sink *k, bool write);

@@ -73,6 +73,7 @@ void om__sink_vert(om__sink *k, double x, double y, double z)
     /* Written so that NaN fails the test too. */
     bool inside = fabs(X) <= OM__COORD_MAX && fabs(Y) <= OM__COORD_MAX &&
                   fabs(Z) <= OM__COORD_MAX;
+    if (inside && X * X + Y * Y + Z * Z > k->r2) k->r2 = X * X + Y * Y + Z * Z;
     if (k->check_range && !inside && !k->out_of_range) {
         k->out_of_range = true;
         k->where = k->note;

@@ -88,6 +88,7 @@ bool bench_pin(int cpu);
     X(bench_threads) \
     X(bench_calls) \
     X(bench_serial) \
+    X(bench_objects) \
     /* end of list */
 #define X(name) void name(void);
 OM_BENCHES

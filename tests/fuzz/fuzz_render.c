@@ -67,7 +67,12 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             memset(&fd, 0, sizeof fd);
             fd.scene = &s; fd.view = &v; fd.method = m; fd.method_state = state; fd.shade = &shade;
             fd.strip_rows = rows; fd.fb = &fb;
-            for (int frame = 0; frame < 2; frame++) om_render_frame(&fd, &fa, NULL, &d);
+            /* the second frame with the objects moved along their keys: what a kept
+             * state redoes where things move (ref's objects' BVH, asm's tiles) */
+            for (int frame = 0; frame < 2; frame++) {
+                (void)om_scene_pose_at(&s, (float)(ctl >> 6) + 0.5f * (float)frame, NULL);
+                om_render_frame(&fd, &fa, NULL, &d);
+            }
         }
         if (!guarded(mb, give) || !guarded(fb_mem, fbytes)) abort();
         free(mb);

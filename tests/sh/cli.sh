@@ -426,5 +426,28 @@ has "$dir/err" "threads takes a thread count" "--threads 0 is a usage error"
 expect 0 "render --threads 2" -- "$OMBRA" render --size 64x48 --threads 2 --out "$dir/z.ppm"
 has "$dir/out" ", 2 thread(s)$" "render says how many threads the frame ran on"
 
+# Things move: info lists objects and their shared meshes; --frames writes numbered
+# files, frame k the same bits as --time T + k / F; a bad object line names its place.
+cat >"$dir/move.scene" <<'EOF'
+camera eye 0 6 9 target 0 0.5 0
+plane size 12 12
+box size 1 2 1 translate 0 1 0 name crate
+copy crate translate 2 0 1
+key object crate 0
+key object crate 1 translate -2 0 0 rotate 0 90 0
+EOF
+expect 0 "info of objects" -- "$OMBRA" info "$dir/move.scene"
+has "$dir/out" "objects 2 sharing 1 meshes (2 object keys)" "info counts objects and meshes"
+has "$dir/out" "crate .*2 objects share it" "info says who shares a mesh"
+expect 0 "render --frames" -- "$OMBRA" render "$dir/move.scene" --size 64x48 --frames 3 --fps 2 -q --out "$dir/f.ppm" --mask "$dir/f.pgm"
+[ -s "$dir/f-0000.ppm" ] && [ -s "$dir/f-0002.ppm" ] && [ -s "$dir/f-0002.pgm" ] && ok || bad "--frames did not write numbered files"
+expect 0 "render --time 1" -- "$OMBRA" render "$dir/move.scene" --size 64x48 --time 1 -q --out "$dir/t1.ppm"
+cmp -s "$dir/f-0002.ppm" "$dir/t1.ppm" && ok || bad "frame 2 at 2 fps is not --time 1"
+cmp -s "$dir/f-0000.ppm" "$dir/t1.ppm" && bad "the object did not move" || ok
+expect 2 "--fps without --frames" -- "$OMBRA" render --fps 3
+printf 'box name a\ncopy b\n' >"$dir/bad-copy.scene"
+expect 1 "copy of an unknown object" -- "$OMBRA" info "$dir/bad-copy.scene"
+has "$dir/err" "line 2, col 6: unknown object 'b'" "an unknown object is named with its place"
+
 echo "cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]

@@ -389,6 +389,7 @@ static void bytes_exact(void)
         "box",
         "sphere segments 5 rings 3\nmaterial a\nbox material a albedo 1 1 1\nkey camera 0 eye 0 0 1 target 0 0 0\n",
         "key light 0 pos 1 1 1 target 0 0 0\nkey light 1 pos 1 2 1 target 0 0 0\nplane divisions 3\n",
+        "box name b\ncopy b name c\ncopy c albedo 1 0 0\nkey object c 1 scale 2\nsphere rings 3 name s\n",
     };
     for (size_t i = 0; i < sizeof texts / sizeof texts[0]; i++) {
         const char *text = texts[i];
@@ -519,7 +520,7 @@ static void parse_errors(void)
 {
     expect_err("sphre radius 1\n", OM_E_PARSE, 1, 1,
                "line 1, col 1: unknown command 'sphre' (expected camera, light, material, plane, "
-               "box, sphere, cylinder, mesh, triangles, key)");
+               "box, sphere, cylinder, mesh, triangles, key, copy)");
     expect_err("# c\n\ncamera eye 0 5 10 target 0 0 0 fov\n", OM_E_PARSE, 3, 35,
                "line 3, col 35: expected a number after 'fov'");
     expect_err("box size 1 2x 3\n", OM_E_PARSE, 1, 12, "malformed number '2x'");
@@ -551,7 +552,7 @@ static void parse_errors(void)
     expect_err("box\x01\n", OM_E_PARSE, 1, 4, "0x01");
     expect_err("sphere radius 1 segmnts 8\n", OM_E_PARSE, 1, 17,
                "unknown parameter 'segmnts' for 'sphere' (expected radius, segments, rings, scale, "
-               "rotate, translate, albedo, opacity, material)");
+               "rotate, translate, albedo, opacity, material, name)");
     expect_err("sphere radius 1 2\n", OM_E_PARSE, 1, 17, "too many values after 'radius' (it takes 1)");
     expect_err("box 1\n", OM_E_PARSE, 1, 5, "unexpected value '1' for 'box'");
     expect_err("box scale 1 2 translate 0 0 0\n", OM_E_PARSE, 1, 15,
@@ -594,7 +595,7 @@ static void parse_errors(void)
     expect_err("light directional dir 0 -1e-30 0\n", OM_E_RANGE, 1, 23, "too short to give a direction");
     expect_err("key camera 0 eye 0 0 0 target 1e-30 0 0\n", OM_E_RANGE, 1, 31, "gives no direction");
     expect_err("light spot pos 1 2 3\n", OM_E_PARSE, 1, 1, "needs pos X Y Z and target X Y Z");
-    expect_err("key\n", OM_E_PARSE, 1, 4, "expected 'camera' or 'light' after 'key'");
+    expect_err("key\n", OM_E_PARSE, 1, 4, "expected 'camera', 'light' or 'object' after 'key'");
     expect_err("key camera eye 0 0 1 target 0 0 0\n", OM_E_PARSE, 1, 12,
                "expected a number after 'key camera', found 'eye'");
     expect_err("key camera 0 eye 0 0 1\n", OM_E_PARSE, 1, 1, "needs eye X Y Z and target X Y Z");
@@ -664,6 +665,54 @@ static void parse_errors(void)
 }
 
 /* ---------------------------------------------------------------- paths */
+
+/* Objects: names, copies and keys, and what each bad line says. */
+static void object_lines(void)
+{
+    expect_err("box name a\nbox name a\n", OM_E_PARSE, 2, 10, "object name 'a' is already used (on line 1)");
+    expect_err("box name a\ncopy a name a\n", OM_E_PARSE, 2, 13, "object name 'a' is already used");
+    expect_err("box name 1a\n", OM_E_PARSE, 1, 10, "bad object name '1a'");
+    expect_err("box name\n", OM_E_PARSE, 1, 9, "expected a name after 'name'");
+    expect_err("copy b\n", OM_E_PARSE, 1, 6, "unknown object 'b'");
+    expect_err("copy\n", OM_E_PARSE, 1, 5, "expected an object's name after 'copy'");
+    expect_err("box name a\nkey object b 0\n", OM_E_PARSE, 2, 12, "unknown object 'b'");
+    expect_err("key object a 0\nbox name a\n", OM_E_PARSE, 1, 12, "unknown object 'a'");
+    expect_err("box name a\nkey object a 1\nkey object a 1\n", OM_E_PARSE, 3, 14,
+               "times must increase (the key before, on line 2");
+    expect_err("box name a\nkey object a 0 scale 1\nkey object a 1 scale -1\n", OM_E_RANGE, 3, 22,
+               "the scale passes through zero");
+    expect_err("box name a\nkey object a 0 scale 0\n", OM_E_RANGE, 2, 22, "scale '0' is out of range");
+    expect_err("box name a\nkey object a 0 translate 9999999.5 0 0\n", OM_E_RANGE, 2, 1, "reaches beyond 1e7");
+    expect_err("box name a\ncopy a translate 1e7 0 0\n", OM_E_RANGE, 2, 1, "copy reaches beyond 1e7");
+    expect_err("box name a\nkey object a 0 scale 1 2 3\n", OM_E_PARSE, 2, 24, "too many values after 'scale'");
+    expect_err("box name a\nkey object a\n", OM_E_PARSE, 2, 13, "");
+    expect_err("box name a\nkey object a nan\n", OM_E_PARSE, 2, 14, "");
+
+    /* A chain of copies found again by reading the lines above (40 names between push
+     * them out of the parser's cache): the mesh is the first line's, and the reach
+     * grows along the chain (the sphere's 1, then 1 + 1, then 2 x 2 + 0 = 4: a key
+     * moving it by 9999994 fits, by 9999996 does not). */
+    static char text[4096];
+    size_t n = (size_t)snprintf(text, sizeof text, "sphere segments 5 rings 3 name m\ncopy m name c0 translate 1 0 0\n"
+                                                   "copy c0 name c1 scale 2\n");
+    for (int i = 0; i < 40; i++) n += (size_t)snprintf(text + n, sizeof text - n, "box name b%d\n", i);
+    n += (size_t)snprintf(text + n, sizeof text - n, "copy c1 name d\nkey object c1 0 translate 9999994 0 0\n");
+    size_t bytes;
+    CHECK_OK(om_scene_bytes(text, n, NULL, &bytes, NULL));
+    unsigned char *buf = malloc(bytes);
+    om_arena a;
+    om_scene s;
+    om_arena_init(&a, buf, bytes, "scene");
+    CHECK_OK(om_scene_parse(text, n, NULL, &a, &s, NULL));
+    CHECK(s.nobjects == 44 && s.nmeshes == 41 && s.objects[43].mesh == 0 && !strcmp(s.objects[43].name, "d"));
+    CHECK(s.objects[2].nkeys == 1 && s.nmesh_verts == s.meshes[0].nverts + 40 * 8);
+    free(buf);
+    n -= strlen("9999994 0 0\n");
+    n += (size_t)snprintf(text + n, sizeof text - n, "9999996.5 0 0\n");
+    om_diag d;
+    CHECK(om_scene_bytes(text, n, NULL, &bytes, &d) == OM_E_RANGE && d.line == 45);
+
+}
 
 static void scene_at(void)
 {
@@ -795,6 +844,7 @@ void suite_scene(void)
     RUN(shapes_closed);
     RUN(random_triangles);
     RUN(parse_errors);
+    RUN(object_lines);
     RUN(scene_at);
     RUN(default_scene);
     RUN(small_scene);

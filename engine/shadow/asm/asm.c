@@ -193,6 +193,7 @@ static om_status asm_begin(void *state, const om_view *v, om_diag *d)
     m->view = *v;
     om__asm_pctx_begin(&m->pc, &m->tree.lay, &m->cfg, &m->view);
     m->samples = m->shadowed = m->analysed = m->straddling = m->candidates = m->rebuilds = 0;
+    m->redrawn = 0;
     m->prepared = false;
     m->cache = OM__ASM_NONE;
     om__asm_frame(&m->tree);
@@ -750,7 +751,9 @@ static void asm_stats(const void *state, om_method_stats *out)
     out->counter_names[5] = "refinable cells";
     out->counter_names[6] = "samples";
     out->counter_names[7] = "samples shadowed";
-    out->ncounters = 8;
+    out->counters[8] = m->redrawn;
+    out->counter_names[8] = "tiles redrawn: objects moved";
+    out->ncounters = 9;
 }
 
 #define SET(field, name, kind, lo, hi, def, doc) OM__SETTING(om__asm_cfg, field, name, kind, lo, hi, def, doc)

@@ -286,6 +286,8 @@ typedef struct om__asm_state {
     uint32_t cache;        /* the last leaf found by resolve, or OM__ASM_NONE */
     om__asm_tile cache_tile;
     uint32_t samples, shadowed, analysed, straddling, candidates, rebuilds;
+    uint32_t change;       /* the scene's change count the tiles hold */
+    uint32_t redrawn;      /* this frame: tiles drawn again where objects moved */
 #if OM_WITH_JOBS
     /* The host's threads for this frame (om__lend, asm_jobs.c), NULL without; the
      * slots' scratch, slot[j] for j < nslot (one a job: render and analysis scratch). */

@@ -358,6 +358,83 @@ static void bounds_part(void *user, uint32_t p, void *scratch)
 }
 #endif
 
+/* The base-texel rectangle (u0, v0, u1, v1) that holds the light's image of the box
+ * lo..hi, widened as tri_box widens; everything where a corner is behind the light. */
+static void box_rect(const om__asm_state *m, om_vec3 lo, om_vec3 hi, float r[4])
+{
+    om__asm_dvec q[8];
+    for (int c = 0; c < 8; c++) {
+        om_vec3 p = om__v3(c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z);
+        q[c] = dapply(&m->view.light_vp, om__sub(p, m->view.origin));
+    }
+    const double R = (double)m->tree.lay.tile;
+    float b[4];
+    for (int c = 0; c < 8; c += 2) {   /* corners c and c + 1, with corner 0 in each */
+        const om__asm_dvec t[3] = {q[0], q[c], q[c + 1]};
+        tri_box(t, R, b);
+        if (c == 0 || b[0] < r[0]) r[0] = b[0];
+        if (c == 0 || b[1] < r[1]) r[1] = b[1];
+        if (c == 0 || b[2] > r[2]) r[2] = b[2];
+        if (c == 0 || b[3] > r[3]) r[3] = b[3];
+    }
+}
+
+static bool rect_meets(const float *a, const float *b)
+{
+    return !(a[2] < b[0] || b[2] < a[0] || a[3] < b[1] || b[3] < a[1]);
+}
+
+/* Objects moved since the tiles were drawn (om_scene.change): every tile whose part of
+ * the light's image meets a moved object's box, at its old pose or its new one, is
+ * drawn again, the base among them; the rest of the tree and its tiles stay. A tile is
+ * a function of its place and the scene, so a redrawn tile is what a new one would be.
+ * The boxes' images are kept apart up to MOVED_RECTS of them (two objects far apart
+ * redraw their own tiles, not those between them), beyond that as one rectangle. */
+#define MOVED_RECTS 16
+
+static void redraw_moved(om__asm_state *m)
+{
+    const om_scene *s = m->scene;
+    om__asm_tree *t = &m->tree;
+    float rects[MOVED_RECTS][4], all[4] = {0, 0, 0, 0};
+    uint32_t n = 0, seen = 0;
+    for (uint32_t i = 0; i < s->nobjects; i++) {
+        const om_object *o = &s->objects[i];
+        if (o->moved <= m->change && m->change <= s->change) continue;
+        for (int k = 0; k < 2; k++) {
+            float r[4];
+            if (k) box_rect(m, o->lo, o->hi, r);
+            else box_rect(m, o->old_lo, o->old_hi, r);
+            if (n < MOVED_RECTS) memcpy(rects[n++], r, sizeof r);
+            for (int e = 0; e < 4; e++)
+                if (!seen || (e < 2 ? r[e] < all[e] : r[e] > all[e])) all[e] = r[e];
+            seen++;
+        }
+    }
+    m->change = s->change;
+    if (!seen) return;
+    if (seen > MOVED_RECTS) {   /* too many to keep apart: their union */
+        memcpy(rects[0], all, sizeof all);
+        n = 1;
+    }
+    om__asm_render_node(m, OM__ASM_ROOT);
+    m->redrawn++;
+    for (uint32_t i = 0; i < t->lay.count; i++) {
+        const om__asm_node *nd = om__asm_node_at(t, i);
+        if (!nd->alive) continue;
+        /* its texels on its level's grid, in base texels, a texel wider on each side */
+        const double sc = t->lay.scale[nd->level];
+        const float r[4] = {(float)((nd->ox - 1.0) / sc), (float)((nd->oy - 1.0) / sc),
+                            (float)((nd->ox + t->lay.tile + 1.0) / sc),
+                            (float)((nd->oy + t->lay.tile + 1.0) / sc)};
+        bool meets = false;
+        for (uint32_t k = 0; k < n && !meets; k++) meets = rect_meets(r, rects[k]);
+        if (!meets) continue;
+        om__asm_render_node(m, i);
+        m->redrawn++;
+    }
+}
+
 /* This frame's projections (once, from the first observe or build), and the rebuild
  * when the light has moved. */
 void om__asm_prepare(om__asm_state *m)
@@ -390,5 +467,8 @@ void om__asm_prepare(om__asm_state *m)
         m->built_org = m->view.origin;
         m->built = true;
         m->rebuilds++;
+        m->change = m->scene->change;
+    } else if (m->change != m->scene->change) {
+        redraw_moved(m);
     }
 }

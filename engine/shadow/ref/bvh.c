@@ -42,15 +42,20 @@ static size_t node_bound(size_t n, uint32_t leaf)
     return 2 * (leaves ? leaves : 1);
 }
 
+/* A scene with objects splits its root into the static triangles and the objects'
+ * (om__bvh_build): two subtrees, each within its own bound, and the root and its two
+ * children on top. */
+static bool two_level(const om_scene *s) { return s->nobjects && s->ntris; }
+
 size_t om__bvh_nodes_max(const om_scene *s, uint32_t leaf)
 {
-    return node_bound(s->ntris ? s->ntris : 1, leaf);
+    return node_bound(s->ntris ? s->ntris : 1, leaf) + (two_level(s) ? 4 : 0);
 }
 
 size_t om__bvh_bytes(const om_scene *s, uint32_t leaf)
 {
     size_t n = s->ntris ? s->ntris : 1;
-    return om_arena_need(node_bound(n, leaf) * sizeof(om__bvh_node), 16) +
+    return om_arena_need(om__bvh_nodes_max(s, leaf) * sizeof(om__bvh_node), 16) +
            om_arena_need(n * sizeof(uint32_t), 4);
 }
 
@@ -212,33 +217,14 @@ typedef struct job {
     bool known;
 } job;
 
-om_status om__bvh_build(om__bvh *b, om_arena *a, const om_scene *s, uint32_t leaf, om_diag *d)
+/* Builds the subtree of the job `top` (its node allocated, its triangles' range in
+ * tris), appending its nodes from b->nnodes on. */
+static void build_from(om__bvh *b, const boxes *bxs, job top, uint32_t leaf, size_t cap)
 {
-    void *pn, *pt, *pb;
-    om_status st;
-    size_t n = s->ntris ? s->ntris : 1;
+    const boxes bx = *bxs;
     const uint32_t least = leaf / 2 ? leaf / 2 : 1;
-    size_t cap = node_bound(n, leaf);
-    memset(b, 0, sizeof *b);
-    if ((st = om_arena_alloc(a, cap * sizeof(om__bvh_node), 16, &pn, d)) ||
-        (st = om_arena_alloc(a, n * sizeof(uint32_t), 4, &pt, d)))
-        return st;
-    b->nodes = (om__bvh_node *)pn;
-    b->tris = (uint32_t *)pt;
-    size_t mark = om_arena_mark(a);
-    boxes bx = {s, NULL, b->tris};
-    if (om_arena_left(a) >= om__bvh_scratch_bytes(s)) {
-        if ((st = om_arena_alloc(a, n * sizeof(box), 4, &pb, d))) return st;
-        box *tb = (box *)pb;
-        for (uint32_t t = 0; t < s->ntris; t++) tb[t] = vert_box(s, t);
-        bx.tb = tb;
-    }
-    for (uint32_t t = 0; t < s->ntris; t++) b->tris[t] = t;
-    b->nnodes = 1;
     job stack[STACK];
-    memset(&stack[0], 0, sizeof stack[0]);
-    stack[0].count = s->ntris;
-    stack[0].depth = 1;
+    stack[0] = top;
     int sp = 1;
     while (sp > 0) {
         job j = stack[--sp];
@@ -327,8 +313,105 @@ om_status om__bvh_build(om__bvh *b, om_arena *a, const om_scene *s, uint32_t lea
             }
         }
     }
+}
+
+/* Two-level: the objects' triangles, in the order of the objects and their ranges, at
+ * tris[obj_first..]: the same order whenever they are built, so a rebuild after moves
+ * is the build of the scene posed there. */
+static void object_tris(om__bvh *b, const om_scene *s)
+{
+    uint32_t k = b->obj_first;
+    for (uint32_t i = 0; i < s->nobjects; i++) {
+        const om_object *o = &s->objects[i];
+        for (uint32_t t = 0; t < s->meshes[o->mesh].ntris; t++) b->tris[k++] = o->first_tri + t;
+    }
+}
+
+/* The objects' subtree under node 2, from its first node on, and the root's box. */
+static void build_objects(om__bvh *b, const boxes *bx, uint32_t leaf, size_t cap)
+{
+    job top;
+    memset(&top, 0, sizeof top);
+    top.node = 2;
+    top.first = b->obj_first;
+    top.count = b->obj_count;
+    top.depth = 2;
+    b->nnodes = b->obj_nodes;
+    build_from(b, bx, top, leaf, cap);
+    box r;
+    box_empty(&r);
+    for (int c = 1; c < 3; c++) box_grow(&r, b->nodes[c].box.w.lo, b->nodes[c].box.w.hi);
+    memcpy(b->nodes[0].box.w.lo, r.lo, sizeof r.lo);
+    memcpy(b->nodes[0].box.w.hi, r.hi, sizeof r.hi);
+}
+
+om_status om__bvh_build(om__bvh *b, om_arena *a, const om_scene *s, uint32_t leaf, om_diag *d)
+{
+    void *pn, *pt, *pb;
+    om_status st;
+    size_t n = s->ntris ? s->ntris : 1;
+    size_t cap = om__bvh_nodes_max(s, leaf);
+    memset(b, 0, sizeof *b);
+    if ((st = om_arena_alloc(a, cap * sizeof(om__bvh_node), 16, &pn, d)) ||
+        (st = om_arena_alloc(a, n * sizeof(uint32_t), 4, &pt, d)))
+        return st;
+    b->nodes = (om__bvh_node *)pn;
+    b->tris = (uint32_t *)pt;
+    size_t mark = om_arena_mark(a);
+    boxes bx = {s, NULL, b->tris};
+    const bool two = two_level(s);
+    if (two) {
+        /* static triangles first, in order, then the objects' (object_tris) */
+        uint32_t k = 0, t = 0;
+        for (uint32_t i = 0; i <= s->nobjects; i++) {
+            const uint32_t end = i < s->nobjects ? s->objects[i].first_tri : s->ntris;
+            for (; t < end; t++) b->tris[k++] = t;
+            if (i < s->nobjects) t += s->meshes[s->objects[i].mesh].ntris;
+        }
+        b->obj_first = k;
+        b->obj_count = s->ntris - k;
+        object_tris(b, s);
+    } else {
+        for (uint32_t t = 0; t < s->ntris; t++) b->tris[t] = t;
+    }
+    if (om_arena_left(a) >= om__bvh_scratch_bytes(s)) {
+        if ((st = om_arena_alloc(a, n * sizeof(box), 4, &pb, d))) return st;
+        box *tb = (box *)pb;
+        /* tb[i] is the box of tris[i] (boxes) */
+        for (uint32_t i = 0; i < s->ntris; i++) tb[i] = vert_box(s, b->tris[i]);
+        bx.tb = tb;
+    }
+    job top;
+    memset(&top, 0, sizeof top);
+    top.depth = 1;
+    if (!two) {
+        top.count = s->ntris;
+        b->nnodes = 1;
+        build_from(b, &bx, top, leaf, cap);
+    } else {
+        b->nodes[0].first = 1;
+        b->nodes[0].count = 0;
+        b->nnodes = 3;
+        top.node = 1;
+        top.count = b->obj_first;
+        top.depth = 2;
+        build_from(b, &bx, top, leaf, cap);
+        b->obj_nodes = b->nnodes;
+        b->obj_leaf = leaf;
+        b->obj_cap = (uint32_t)cap;
+        build_objects(b, &bx, leaf, cap);
+        if (b->depth < 1) b->depth = 1;
+    }
     om_arena_rewind(a, mark);
     return OM_OK;
+}
+
+void om__bvh_rebuild_objects(om__bvh *b, const om_scene *s)
+{
+    if (!b->obj_nodes) return;
+    const boxes bx = {s, NULL, b->tris};   /* boxes from the vertices: the same numbers */
+    object_tris(b, s);
+    build_objects(b, &bx, b->obj_leaf, b->obj_cap);
 }
 
 static bool hits(const om__bvh_node *n, const float o[3], const float inv[3], float tmax, float m)
@@ -369,3 +452,4 @@ void om__bvh_walk(const om__bvh *b, om_vec3 o, om_vec3 dir, float tmax, float ma
             if (visit(user, b->tris[i])) return;
     }
 }
+

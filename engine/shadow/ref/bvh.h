@@ -27,10 +27,16 @@ typedef struct om__bvh_node {
     uint32_t first, count;
 } om__bvh_node;
 
+/* A scene with objects gets two levels: the root's children are the static triangles'
+ * subtree (node 1, built once) and the objects' (node 2, its nodes from obj_nodes on,
+ * over tris[obj_first, obj_first + obj_count)), which om__bvh_rebuild_objects builds
+ * again after moves, for a cost that grows with the objects' triangles only. */
 typedef struct om__bvh {
     om__bvh_node *nodes;
     uint32_t *tris;        /* triangle indices, leaves refer to ranges of it */
     uint32_t nnodes, depth;
+    uint32_t obj_first, obj_count, obj_nodes;   /* two levels (obj_nodes 0: one) */
+    uint32_t obj_leaf, obj_cap;
 } om__bvh;
 
 /* The most nodes a BVH over s with leaves of `leaf` can have. */
@@ -39,6 +45,10 @@ size_t om__bvh_nodes_max(const om_scene *s, uint32_t leaf);
 size_t om__bvh_bytes(const om_scene *s, uint32_t leaf);
 size_t om__bvh_scratch_bytes(const om_scene *s);
 om_status om__bvh_build(om__bvh *b, om_arena *a, const om_scene *s, uint32_t leaf, om_diag *d);
+
+/* Builds the objects' subtree again where they are now: the BVH om__bvh_build would
+ * build for s posed so (nothing where s has no objects). */
+void om__bvh_rebuild_objects(om__bvh *b, const om_scene *s);
 
 /* A segment o + t * dir, t in [0, tmax], with boxes grown by `margin` on every side.
  * `visit` is called for every triangle in a leaf whose box the segment meets; it
