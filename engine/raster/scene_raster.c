@@ -484,8 +484,13 @@ static void walk_batches(const om_scene *s, const om_mat4 *vp, om_vec3 o, om_ras
 /* One triangle of the walk with vertex bins (om__scene_raster_hiz), its rows reaching
  * the target's; `box`: its box is yet to be tested for a pixel centre of the target;
  * `cbox`: the centres its box holds when the caller has them (block_list), or NULL. */
-OM_INLINE void bin_tri(const om_scene *s, const om_mat4 *vp, om_vec3 o, om_raster *r, uint32_t *hiz, om__cull *cl,
-                       bool cull, const om__vsnap *vs, om__guard g, bool box, uint32_t t, const int32_t *cbox)
+#if VERT_LANES
+#define BIN_INLINE OM_INLINE   /* the block walk's loop takes it without a call */
+#else
+#define BIN_INLINE static inline   /* the compiler's choice: a Cortex-M counts less */
+#endif
+BIN_INLINE void bin_tri(const om_scene *s, const om_mat4 *vp, om_vec3 o, om_raster *r, uint32_t *hiz, om__cull *cl,
+                        bool cull, const om__vsnap *vs, om__guard g, bool box, uint32_t t, const int32_t *cbox)
 {
     const om_target *tg = r->target;
     const uint32_t *ix = s->idx + (size_t)t * 3;
