@@ -98,6 +98,23 @@ static void chart(FILE *f, const rcsv *c)
     svg_write_inline(f, &ch, s, ns);
 }
 
+/* One CSV of the cross directory: its paragraph, its chart where asked and its table;
+ * where the file is not there (path non-NULL), what writes it; nothing for a NULL path. */
+static void section(FILE *f, const char *path, const char *intro, const rcol *cols, size_t ncols, bool with_chart,
+                    const char *what)
+{
+    rcsv c;
+    if (!path) return;
+    if (!rcsv_load(&c, path)) {
+        missing(f, path, what);
+        return;
+    }
+    if (intro) fputs(intro, f);
+    if (with_chart) chart(f, &c);
+    report_table(f, &c, cols, ncols, NULL, NULL);
+    rcsv_free(&c);
+}
+
 void report_machines(FILE *f, const char *cross)
 {
     fprintf(f, "<h2 id=\"machines\">Small machines</h2>\n<p class=\"read\">The same methods built "
@@ -106,54 +123,30 @@ void report_machines(FILE *f, const char *cross)
                "keep the frame's small), and the firmware's size.</p>\n");
     char *m4 = cli_path(cross, "m4.csv"), *m7 = cli_path(cross, "m7.csv"), *size = cli_path(cross, "m4-size.csv");
     char *per = cli_path(cross, "m4-methods.csv");
-    rcsv c;
-    if (per && rcsv_load(&c, per)) {
-        fprintf(f, "<p>Per method at 160x120: its own files' code (the shared parts are in the "
-                   "last table), the least method arena it works in, its whole footprint on the "
-                   "small scene with the arena the firmware gives it (at most 256 KiB: scene, frame "
-                   "and method arenas, the other static data and the stack; the run fails beyond), "
-                   "and its instructions a frame:</p>\n");
-        report_table(f, &c, method_cols, sizeof method_cols / sizeof method_cols[0], NULL, NULL);
-        rcsv_free(&c);
-    } else if (per) {
-        missing(f, per, "each method's code, least arena, footprint and instructions a frame");
-    }
-    if (m4 && rcsv_load(&c, m4)) {
-        chart(f, &c);
-        report_table(f, &c, m4_cols, sizeof m4_cols / sizeof m4_cols[0], NULL, NULL);
-        rcsv_free(&c);
-    } else if (m4) {
-        missing(f, m4, "instructions a frame and arena bytes per method on the Cortex-M4 build");
-    }
-    if (m7 && rcsv_load(&c, m7)) {
-        fprintf(f, "<p>The same firmware for a Cortex-M7 (QEMU's mps2-an500, a double FPU: "
+    section(f, per, "<p>Per method at 160x120: its own files' code (the shared parts are in the "
+                    "last table), the least method arena it works in, its whole footprint on the "
+                    "small scene with the arena the firmware gives it (at most 256 KiB: scene, frame "
+                    "and method arenas, the other static data and the stack; the run fails beyond), "
+                    "and its instructions a frame:</p>\n",
+            method_cols, sizeof method_cols / sizeof method_cols[0], false,
+            "each method's code, least arena, footprint and instructions a frame");
+    section(f, m4, NULL, m4_cols, sizeof m4_cols / sizeof m4_cols[0], true,
+            "instructions a frame and arena bytes per method on the Cortex-M4 build");
+    section(f, m7, "<p>The same firmware for a Cortex-M7 (QEMU's mps2-an500, a double FPU: "
                    "what a Teensy 4 or an STM32H7 runs), <code>none</code>, <code>sm</code> and "
-                   "<code>hybrid</code> on the small scene:</p>\n");
-        report_table(f, &c, m4_cols, sizeof m4_cols / sizeof m4_cols[0], NULL, NULL);
-        rcsv_free(&c);
-    } else if (m7) {
-        missing(f, m7, "instructions a frame on the Cortex-M7 build");
-    }
-    if (size && rcsv_load(&c, size)) {
-        fprintf(f, "<p>The firmware's size (every method and both scenes linked in; the "
-                   "<code>.bss</code> holds the arenas):</p>\n");
-        report_table(f, &c, size_cols, sizeof size_cols / sizeof size_cols[0], NULL, NULL);
-        rcsv_free(&c);
-    } else if (size) {
-        missing(f, size, "the code size of each Cortex-M4 build");
-    }
+                   "<code>hybrid</code> on the small scene:</p>\n",
+            m4_cols, sizeof m4_cols / sizeof m4_cols[0], false, "instructions a frame on the Cortex-M7 build");
+    section(f, size, "<p>The firmware's size (every method and both scenes linked in; the "
+                     "<code>.bss</code> holds the arenas):</p>\n",
+            size_cols, sizeof size_cols / sizeof size_cols[0], false, "the code size of each Cortex-M4 build");
     char *code = cli_path(cross, "code-size.csv");
-    if (code && rcsv_load(&c, code)) {
-        fprintf(f, "<p>Code per method and part of the engine (each part's files compiled "
-                   "alone for Cortex-M4 at <code>-Os</code>), and the README's embedding example "
-                   "as Cortex-M4 firmware with every method and with <code>sm</code> alone "
-                   "(<code>OM_WITH_*=0</code> for the others), as <code>make cross-test</code> "
-                   "prints them:</p>\n");
-        report_table(f, &c, code_cols, sizeof code_cols / sizeof code_cols[0], NULL, NULL);
-        rcsv_free(&c);
-    } else if (code) {
-        missing(f, code, "the code size of each method and part of the engine");
-    }
+    section(f, code, "<p>Code per method and part of the engine (each part's files compiled "
+                     "alone for Cortex-M4 at <code>-Os</code>), and the README's embedding example "
+                     "as Cortex-M4 firmware with every method and with <code>sm</code> alone "
+                     "(<code>OM_WITH_*=0</code> for the others), as <code>make cross-test</code> "
+                     "prints them:</p>\n",
+            code_cols, sizeof code_cols / sizeof code_cols[0], false,
+            "the code size of each method and part of the engine");
     free(m4);
     free(m7);
     free(per);
