@@ -12,38 +12,39 @@ m4=out/cross/m4.csv m7=out/cross/m7.csv
 for f in "$m4" "$m7"; do
     [ -f "$f" ] || { echo "count-table.sh: no $f: run CROSS_ONLY=m4-count make cross-test first" >&2; exit 1; }
 done
+# table CSV MHZ CPI FPS_DIGITS HEADER CELLS: a row per method in the CSV's order; each
+# cell of CELLS is WHAT:SCENE@WxH, WHAT m (millions of instructions), e (of which the
+# eye pass) or f (frames a second at MHZ and CPI).
+table() {
+    awk -F, -v mhz="$2" -v cpi="$3" -v fd="$4" -v head="$5" -v cells="$6" '
+        NR == 1 { next }
+        { key = $1 "@" $3 "x" $4; ins[$2, key] = $6; eye[$2, key] = $7; if (!($2 in seen)) { seen[$2] = 1; order[++n] = $2 } }
+        END {
+            nc = split(cells, c, " ")
+            print head
+            line = "| ---"
+            for (j = 1; j <= nc; j++) line = line " | ---:"
+            print line " |"
+            for (i = 1; i <= n; i++) {
+                k = order[i]
+                line = "| `" k "`"
+                for (j = 1; j <= nc; j++) {
+                    what = substr(c[j], 1, 1); at = substr(c[j], 3)
+                    v = what == "f" ? sprintf("%." fd "f", mhz * 1e6 / (cpi * ins[k, at])) \
+                                    : sprintf("%.1f", (what == "e" ? eye[k, at] : ins[k, at]) / 1e6)
+                    line = line " | " v
+                }
+                print line " |"
+            }
+        }' "$1"
+}
 echo "Cortex-M4F at 168 MHz and 1.25 cycles an instruction (M: millions of instructions a frame):"
 echo
-awk -F, -v mhz=168 -v cpi=1.25 '
-    function m(n) { return sprintf("%.1f", n / 1e6) }
-    function fps(n) { return sprintf("%.1f", mhz * 1e6 / (cpi * n)) }
-    NR == 1 { next }
-    { key = $1 "@" $3 "x" $4; ins[$2, key] = $6; eye[$2, key] = $7; if (!($2 in seen)) { seen[$2] = 1; order[++n] = $2 } }
-    END {
-        print "| method | small 160x120, M | of which eye | fps | small 320x240, M | of which eye | fps | default 160x120, M |"
-        print "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"
-        for (i = 1; i <= n; i++) {
-            k = order[i]
-            printf "| `%s` | %s | %s | %s | %s | %s | %s | %s |\n", k,
-                m(ins[k, "small@160x120"]), m(eye[k, "small@160x120"]), fps(ins[k, "small@160x120"]),
-                m(ins[k, "small@320x240"]), m(eye[k, "small@320x240"]), fps(ins[k, "small@320x240"]),
-                m(ins[k, "default@160x120"])
-        }
-    }' "$m4"
+table "$m4" 168 1.25 1 \
+    "| method | small 160x120, M | of which eye | fps | small 320x240, M | of which eye | fps | default 160x120, M |" \
+    "m:small@160x120 e:small@160x120 f:small@160x120 m:small@320x240 e:small@320x240 f:small@320x240 m:default@160x120"
 echo
 echo "Cortex-M7 at 600 MHz and 1.0 cycles an instruction, small scene:"
 echo
-awk -F, -v mhz=600 -v cpi=1.0 '
-    function m(n) { return sprintf("%.1f", n / 1e6) }
-    function fps(n) { return sprintf("%.0f", mhz * 1e6 / (cpi * n)) }
-    NR == 1 { next }
-    { key = $3 "x" $4; ins[$2, key] = $6; if (!($2 in seen)) { seen[$2] = 1; order[++n] = $2 } }
-    END {
-        print "| method | 160x120, M | fps | 320x240, M | fps |"
-        print "| --- | ---: | ---: | ---: | ---: |"
-        for (i = 1; i <= n; i++) {
-            k = order[i]
-            printf "| `%s` | %s | %s | %s | %s |\n", k, m(ins[k, "160x120"]), fps(ins[k, "160x120"]),
-                m(ins[k, "320x240"]), fps(ins[k, "320x240"])
-        }
-    }' "$m7"
+table "$m7" 600 1.0 0 "| method | 160x120, M | fps | 320x240, M | fps |" \
+    "m:small@160x120 f:small@160x120 m:small@320x240 f:small@320x240"
