@@ -113,7 +113,6 @@ static bool locate(const om__smlook *L, const om_sample *smp, tap *out)
             texel = (float)((double)texel / dens);
     }
     const float tanang = om__smlook_tan(smp->nl);   /* nl: kept by the exposure marks */
-    const float bias = L->bias_world + L->bias_slope * texel * tanang;   /* warped maps' */
     om_vec4 q;
     if (L->warp_x && L->normal_offset == 0.0f) {
         q = q0;   /* the point did not move: its projection and warp are done */
@@ -163,7 +162,9 @@ static bool locate(const om__smlook *L, const om_sample *smp, tap *out)
         const float z = om__smlook_depth(&v->light_proj, spot, q, iw);
         float r = 0.0f;
         if (spot) {
-            const float w = om__mat_apply(&v->light_vp, om__v3(smp->p[0], smp->p[1], smp->p[2])).w;
+            const float w = L->normal_offset == 0.0f
+                                ? q.w   /* the point did not move */
+                                : om__mat_apply(&v->light_vp, om__v3(smp->p[0], smp->p[1], smp->p[2])).w;
             r = 1.0f / (w > L->half_near ? w : L->half_near);
         }
         out->zlit = om__smlook_threshold(om__smlook_biased(L->bias_c1, L->bias_c2, spot, z, r, tanang));
@@ -180,6 +181,7 @@ static bool locate(const om__smlook *L, const om_sample *smp, tap *out)
     } else {
         dz = OM_DEPTH_ONE_F * om__fabsf(v->light_proj.m[10]);
     }
+    const float bias = L->bias_world + L->bias_slope * texel * tanang;
     out->zlit = om__smlook_threshold(z - bias * dz);
     return true;
 }
