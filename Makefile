@@ -42,7 +42,7 @@ all: $(O)/ombra
 # V=1 shows the full compiler lines.
 Q = $(if $(V),,@)
 
-$(O)/%.o: %.c $(wildcard include/*.h engine/*.h engine/*/*.h engine/*/*/*.h platform/*.h tools/*.h tests/*.h)
+$(O)/%.o: %.c $(wildcard include/*.h engine/*.h engine/*/*.h engine/*/*/*.h platform/*.h tools/*.h tests/*.h tests/*/*.h)
 	@mkdir -p $(dir $@)
 	@$(if $(V),,echo "  CC $(O)/$<")
 	$(Q)$(CC) $(CFLAGS_ALL) -c $< -o $@

@@ -25,6 +25,7 @@
     X(suite_hybrid) \
     X(suite_methods) \
     X(suite_oracle) \
+    X(suite_oracle_far) \
     X(suite_far) \
     X(suite_robust) \
     X(suite_threads) \
