@@ -145,8 +145,8 @@ static void write_town(town *t)
         "# feet and a tower's hundreds of metres away are both on screen.\n"
         "\n"
         "camera eye -2.5 1.7 470 target -0.5 1.5 370 fov 60 size 1024 768 near 0.2 far 1000\n"
-        "# low in the east-north-east: shadows 3 times as long as what casts them fall\n"
-        "# across the main street, towards the camera\n"
+        "# 25 degrees up, behind the camera: shadows twice as long as what casts them fall\n"
+        "# down the main street, the west side's across it\n"
         "light directional dir 0.25 -0.42 -0.87\n"
         "\n"
         "material ground albedo 0.62 0.60 0.56\n"
@@ -214,7 +214,7 @@ static void write_town(town *t)
         "# a walk down the main street at 1.5 m/s (t in seconds)\n"
         "key camera 0 eye -2.5 1.7 470 target -0.5 1.5 370\n"
         "key camera 20 eye -2.5 1.7 440 target -0.5 1.5 340\n"
-        "# the sun climbs a little and swings south\n"
+        "# the sun sinks a little and swings west\n"
         "key light 0 dir 0.25 -0.42 -0.87\n"
         "key light 20 dir 0.38 -0.36 -0.85\n");
 }
