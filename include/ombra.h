@@ -249,6 +249,13 @@ om_status om_scene_parse(const char *text, size_t len, const om_loader *ld,
 const char *om_scene_default_text(void);
 /* Its small twin for microcontrollers: the same composition in under 2,000 triangles. */
 const char *om_scene_small_text(void);
+/* The built-in town: a few hundred houses, towers, walls, lamps and trees over a ground
+ * a kilometre across, a camera at eye height looking down its main street, a low
+ * directional sun, and keys that walk the camera and move the sun. Too long for a
+ * C99 string literal, it is written into buf: at most cap bytes, the NUL included (cut
+ * short when cap is too small; buf may be NULL when cap is 0). Returns the text's
+ * length without the NUL, so om_scene_town_text(NULL, 0) + 1 bytes hold it. */
+size_t om_scene_town_text(char *buf, size_t cap);
 /* Camera and light at time t along the scene's paths (the scene's own when it has
  * none). Linear interpolation between keys, clamped at the ends. */
 void om_scene_at(const om_scene *s, float t, om_camera *cam, om_light *light);

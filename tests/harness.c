@@ -14,6 +14,15 @@ const char h_cloud_bar[] = "camera eye 0 6 14 target 0 1 0 fov 50 near 0.1 far 1
                            "box size 0.3 0.05 14 rotate 0 45 0 translate 0 3.8 0\n"
                            "triangles count 2000 seed 7 area 20 in -5 0.5 -5 5 3 5\n";
 
+char *h_town_text(void)
+{
+    const size_t len = om_scene_town_text(NULL, 0);
+    char *text = malloc(len + 1);
+    CHECK_MSG(text != NULL, "the town's %zu bytes", len + 1);
+    if (text) om_scene_town_text(text, len + 1);
+    return text;
+}
+
 bool h_scene_parse_ld(h_scene *hs, const char *text, const om_loader *ld)
 {
     om_diag d;

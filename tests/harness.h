@@ -18,6 +18,9 @@ bool h_scene_parse(h_scene *hs, const char *text);
  * the hybrid's map leaves 39K samples uncertain, in a tile of 32768 that it cuts into
  * four regions (hybrid_tile.c), every one reached by the bar, and a tile of the rest. */
 extern const char h_cloud_bar[];
+/* The built-in town's text (om_scene_town_text) in a heap block the caller frees;
+ * NULL (the current test failed) when out of memory. */
+char *h_town_text(void);
 /* The same with a loader for the scene's `mesh` files (NULL: none). */
 bool h_scene_parse_ld(h_scene *hs, const char *text, const om_loader *ld);
 void h_scene_free(h_scene *hs);

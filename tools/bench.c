@@ -27,9 +27,10 @@ static const char bench_help[] =
     "Sweeps every method's settings (see 'ombra methods') on a set of scenes and writes\n"
     "a CSV table and SVG charts of accuracy against speed and memory.\n"
     "\n"
-    "  --scenes LIST     comma-separated: default, random-1K, random-10K, random-100K,\n"
-    "                    random-1M, or scene files (default: default,random-10K); NAME@WxH\n"
-    "                    measures that scene at its own size\n"
+    "  --scenes LIST     comma-separated: default, town, random-1K, random-10K,\n"
+    "                    random-100K, random-1M, or scene files (default:\n"
+    "                    default,random-10K,town@512x384); NAME@WxH measures that scene\n"
+    "                    at its own size\n"
     "  --methods LIST    comma-separated method names (default: every swept method)\n"
     "  --size WxH        image size (default: each scene's own camera size)\n"
     "  --runs N          frames per point; times are their median (default 3)\n"
@@ -72,23 +73,39 @@ bool cli_scene_size(char *entry, uint32_t *w, uint32_t *h)
 bool cli_builtin_scene(const char *name)
 {
     char text[512];
-    return !strcmp(name, "default") || random_scene(name, text, sizeof text) != NULL;
+    return !strcmp(name, "default") || !strcmp(name, "town") ||
+           random_scene(name, text, sizeof text) != NULL;
+}
+
+/* A built-in scene's text (no meshes) into cs's arena, sized by its bytes query. */
+static om_status load_text(const char *text, size_t len, cli_scene *cs, om_diag *d)
+{
+    om_status st = om_scene_bytes(text, len, NULL, &cs->bytes, d);
+    if (st) return st;
+    cs->mem = malloc(cs->bytes ? cs->bytes : 1);
+    if (!cs->mem) return cli_oom(d);
+    om_arena_init(&cs->arena, cs->mem, cs->bytes, "scene");
+    return om_scene_parse(text, len, NULL, &cs->arena, &cs->scene, d);
 }
 
 om_status cli_load_named(const char *name, cli_scene *cs, om_diag *d)
 {
     char text[512];
     if (!strcmp(name, "default")) return cli_scene_load(cs, NULL, 0, d);
+    if (!strcmp(name, "town")) {
+        memset(cs, 0, sizeof *cs);
+        const size_t len = om_scene_town_text(NULL, 0);
+        char *town = malloc(len + 1);
+        if (!town) return cli_oom(d);
+        om_scene_town_text(town, len + 1);
+        om_status st = load_text(town, len, cs, d);
+        free(town);
+        return st;
+    }
     const char *r = random_scene(name, text, sizeof text);
     if (!r) return cli_scene_load(cs, name, 0, d);
     memset(cs, 0, sizeof *cs);
-    size_t len = strlen(r);
-    om_status st = om_scene_bytes(r, len, NULL, &cs->bytes, d);
-    if (st) return st;
-    cs->mem = malloc(cs->bytes ? cs->bytes : 1);
-    if (!cs->mem) return cli_oom(d);
-    om_arena_init(&cs->arena, cs->mem, cs->bytes, "scene");
-    return om_scene_parse(r, len, NULL, &cs->arena, &cs->scene, d);
+    return load_text(r, strlen(r), cs, d);
 }
 
 static int cmp_d(const void *a, const void *b)
@@ -387,8 +404,8 @@ static int check_names(const char *cmd, char **names, size_t n, const char *meth
     for (size_t i = 0; i < n; i++) {
         if (!names[i][0]) return cli_usage_error(cmd, "--scenes has an empty name%s", "");
         if (!cli_builtin_scene(names[i]) && (stat(names[i], &sb) != 0 || S_ISDIR(sb.st_mode)))
-            return cli_usage_error(cmd, "unknown scene '%s': not default, random-1K, random-10K, "
-                                   "random-100K, random-1M or a scene file", names[i]);
+            return cli_usage_error(cmd, "unknown scene '%s': not default, town, random-1K, "
+                                   "random-10K, random-100K, random-1M or a scene file", names[i]);
         for (size_t j = 0; j < i; j++)
             if (!strcmp(cli_base_name(names[i]), cli_base_name(names[j])))
                 return cli_usage_error(cmd, "two scenes named '%s' would write the same charts",
@@ -682,7 +699,7 @@ static int scaling(const char *cmd, char **names, size_t nn, const uint32_t *sw,
 
 int cmd_bench(int argc, char **argv)
 {
-    const char *scenes = "default,random-10K", *methods = NULL, *dir = "out/bench";
+    const char *scenes = "default,random-10K,town@512x384", *methods = NULL, *dir = "out/bench";
     uint32_t w = 0, h = 0, runs = 3;
     bool tri_sweep = false, scale = true;
     const char *threads = NULL;

@@ -105,7 +105,7 @@ typedef struct cli_point {
     int ok;
 } cli_point;
 
-/* Loads "default", "random-1K" ... "random-1M", or a scene file. */
+/* Loads "default", "town", "random-1K" ... "random-1M", or a scene file. */
 om_status cli_load_named(const char *name, cli_scene *cs, om_diag *d);
 /* Inits `m` with its one-pass bytes (timed: p->init) and renders `runs` frames of
  * view `v`; median times into p, the last frame's mask (and shaded RGB888 pixels, if
@@ -136,7 +136,7 @@ om_status cli_grab_mask(void *user, const om_strip *st, const om_framebuffer *fb
 /* Cuts a trailing "@WxH" (the size to measure that scene at) off a --scenes entry
  * into w, h (0 when there is none); false when what follows the @ is not a size. */
 bool cli_scene_size(char *entry, uint32_t *w, uint32_t *h);
-/* Whether NAME is a built-in scene ("default", "random-1K" ...). */
+/* Whether NAME is a built-in scene ("default", "town", "random-1K" ...). */
 bool cli_builtin_scene(const char *name);
 /* The view a sweep measures: the scene at time 0, at --size w x h when given (w > 0),
  * else at its camera's own size (v->cam.width, height). */

@@ -18,7 +18,8 @@ static const char usage[] =
     "                   against time and memory\n"
     "  report           the sweep as one HTML page: charts, table, crops\n"
     "  methods          list the shadow methods\n"
-    "  scene            print the built-in default scene (a start for your own)\n"
+    "  scene            print a built-in scene: the default one (a start for your\n"
+    "                   own), its small twin or the town\n"
     "\n"
     "'ombra <command> --help' describes a command's options; 'ombra --version' prints\n"
     "the version.\n";
@@ -29,10 +30,13 @@ static const char methods_help[] =
     "Lists the shadow methods and every setting ('--set NAME=VALUE') with its default.\n";
 
 static const char scene_help[] =
-    "usage: ombra scene [--small]\n"
+    "usage: ombra scene [--small | --town]\n"
     "\n"
     "Prints the built-in default scene in the scene format: a start for your own.\n"
-    "  --small   its twin for microcontrollers: the same objects in 1,600 triangles\n";
+    "  --small   its twin for microcontrollers: the same objects in 1,600 triangles\n"
+    "  --town    the town: 514 houses, towers, walls, lamps and trees (10,100\n"
+    "            triangles) over a ground a kilometre across, seen from its main\n"
+    "            street under a low sun, with a walk down the street\n";
 
 /* A setting's default as it would be written: the shortest decimal that reads back
  * as the same float (0.01, not 0.00999999978). */
@@ -99,9 +103,22 @@ static int no_options(int argc, char **argv, const char *help, int (*run)(void))
 static int print_scene(int argc, char **argv)
 {
     if (argc > 2 && (!strcmp(argv[2], "--help") || !strcmp(argv[2], "-h"))) { fputs(scene_help, stdout); return 0; }
-    if (argc > 3 || (argc == 3 && strcmp(argv[2], "--small")))
-        return cli_usage_error("scene", "takes only --small; unexpected '%s'", argv[strcmp(argv[2], "--small") ? 2 : 3]);
-    fputs(argc == 3 ? om_scene_small_text() : om_scene_default_text(), stdout);
+    const bool small = argc > 2 && !strcmp(argv[2], "--small"), town = argc > 2 && !strcmp(argv[2], "--town");
+    if (argc > 3 || (argc == 3 && !small && !town))
+        return cli_usage_error("scene", "takes only --small or --town; unexpected '%s'", argv[argc > 3 && (small || town) ? 3 : 2]);
+    if (!town) {
+        fputs(small ? om_scene_small_text() : om_scene_default_text(), stdout);
+        return 0;
+    }
+    const size_t len = om_scene_town_text(NULL, 0);
+    char *text = malloc(len + 1);
+    if (!text) {
+        om_diag d;
+        return cli_error(NULL, &d, cli_oom(&d));
+    }
+    om_scene_town_text(text, len + 1);
+    fputs(text, stdout);
+    free(text);
     return 0;
 }
 

@@ -133,6 +133,9 @@ void om__gen_plane(om__sink *k, double sx, double sz, uint32_t div);
 void om__gen_box(om__sink *k, double sx, double sy, double sz);
 void om__gen_sphere(om__sink *k, double r, uint32_t seg, uint32_t rings);
 void om__gen_cylinder(om__sink *k, double r, double h, uint32_t seg);
+/* splitmix64: tiny, well mixed, and the same sequence everywhere (the random cloud's
+ * triangles, the built-in town's houses). */
+uint64_t om__mix_next(uint64_t *state);
 /* n roughly equilateral triangles of area `area / n` each, randomly oriented, with
  * their vertices inside box = {x0, y0, z0, x1, y1, z1} (where the box is large enough). */
 void om__gen_triangles(om__sink *k, uint32_t n, uint32_t seed, double area,

@@ -220,8 +220,7 @@ void om__gen_cylinder(om__sink *k, double r, double h, uint32_t seg)
     }
 }
 
-/* splitmix64: tiny, well mixed, and the same sequence everywhere. */
-static uint64_t mix_next(uint64_t *state)
+uint64_t om__mix_next(uint64_t *state)
 {
     uint64_t z = (*state += 0x9E3779B97F4A7C15ull);
     z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
@@ -232,7 +231,7 @@ static uint64_t mix_next(uint64_t *state)
 /* Uniform in [0, 1): the top 53 bits times 2^-53, both exact. */
 static double uniform(uint64_t *state)
 {
-    return (double)(mix_next(state) >> 11) * (1.0 / 9007199254740992.0);
+    return (double)(om__mix_next(state) >> 11) * (1.0 / 9007199254740992.0);
 }
 
 void om__gen_triangles(om__sink *k, uint32_t n, uint32_t seed, double area,

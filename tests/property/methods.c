@@ -1,5 +1,6 @@
 /* property/methods.c — what every method holds: the reference's samples and exposure,
- * frames under odd lights, and a kept state's frames those of a fresh one. */
+ * frames under odd lights, a kept state's frames those of a fresh one, and the
+ * built-in town rendered by every method. */
 #include "../test.h"
 #include "../harness.h"
 
@@ -117,9 +118,48 @@ static void kept_state_as_fresh(void)
                     "key light 4 pos -5 10 3 target 0 0 0\n", 1.0f);
 }
 
+/* The town: every method renders a small view of its street, at both ends of the walk
+ * (the sun moved between them), whole and through strips, on the reference's samples;
+ * the exact methods agree with ref, and every other one but `none` is wrong on under
+ * a fifth of the samples `none` (no shadows at all) is wrong on. */
+static void town_every_method(void)
+{
+    char *text = h_town_text();
+    h_scene hs;
+    const bool ok = text && h_scene_parse(&hs, text);
+    free(text);
+    if (!ok) return;
+    for (int k = 0; k < 2; k++) {
+        const float t = k ? 20.0f : 0.0f;
+        uint64_t none_wrong = 0;
+        CHECK_OK(h_render(&hs.s, "ref", NULL, W, H, t, 0, mask, NULL, NULL));
+        CHECK_OK(h_render(&hs.s, "none", NULL, W, H, t, 0, mask2, NULL, NULL));
+        om_metrics m;
+        om_compare_masks(mask, mask2, W, H, &m);
+        none_wrong = m.false_lit + m.false_shadowed;
+        CHECK_MSG(none_wrong > W * H / 20, "t %g: only %llu samples in shadow", (double)t, (unsigned long long)none_wrong);
+        for (size_t i = 0; i < om_method_count(); i++) {
+            const om_method *me = om_method_at(i);
+            const om_method_cfg c = h_cfg(om_method_name(me), "map=1024");
+            CHECK_OK(h_render(&hs.s, om_method_name(me), &c, W, H, t, k ? 16 : 0, mask2, NULL, NULL));
+            om_compare_masks(mask, mask2, W, H, &m);
+            CHECK_EQ_U(m.mismatched_bg, 0);
+            const uint64_t wrong = m.false_lit + m.false_shadowed;
+            if (om_method_flags(me) & OM_METHOD_EXACT)
+                CHECK_MSG(wrong == 0, "%s at t %g: %llu samples differ from ref", om_method_name(me), (double)t,
+                          (unsigned long long)wrong);
+            else if (strcmp(om_method_name(me), "none"))
+                CHECK_MSG(wrong * 5 < none_wrong, "%s at t %g: %llu samples wrong, none %llu", om_method_name(me),
+                          (double)t, (unsigned long long)wrong, (unsigned long long)none_wrong);
+        }
+    }
+    h_scene_free(&hs);
+}
+
 void suite_methods(void)
 {
     RUN(methods_agree_on_samples);
     RUN(odd_lights);
     RUN(kept_state_as_fresh);
+    RUN(town_every_method);
 }

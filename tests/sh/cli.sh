@@ -59,6 +59,26 @@ expect 0 "small scene whole" -- "$OMBRA" render "$dir/small.scene" --size 160x12
 hash_s=$(grep '^hash:' "$dir/out")
 expect 0 "small scene strips" -- "$OMBRA" render "$dir/small.scene" --size 160x120 --strip 8 --out "$dir/s1.ppm"
 if [ "$(grep '^hash:' "$dir/out")" = "$hash_s" ]; then ok; else bad "strips (with row bins) changed the small scene"; fi
+# The town: printed, read back with the triangles and bounds its help states, rendered
+# (sm against ref, whole and in strips: one frame); tests/stability/town-walk.scene holds
+# the same objects, light and materials; bench knows it by name.
+expect 0 "scene --town" -- "$OMBRA" scene --town
+cp "$dir/out" "$dir/town.scene"
+expect 0 "scene --help" -- "$OMBRA" scene --help
+has "$dir/out" "--town .*(10,100$" "scene help states the town's triangles"
+expect 0 "town info" -- "$OMBRA" info "$dir/town.scene"
+has "$dir/out" "^triangles 10100, " "the town has the triangles it states"
+has "$dir/out" "^bounds: (-500, 0, -500) .. (500, 85.6, 500)$" "the town's bounds"
+expect 0 "town render" -- "$OMBRA" render "$dir/town.scene" --size 160x120 --against ref --out "$dir/t0.ppm"
+has "$dir/out" "^accuracy of sm against ref: match" "the town renders against ref"
+hash_t=$(grep '^hash:' "$dir/out")
+expect 0 "town strips" -- "$OMBRA" render "$dir/town.scene" --size 160x120 --strip 8 --out "$dir/t1.ppm"
+if [ "$(grep '^hash:' "$dir/out")" = "$hash_t" ]; then ok; else bad "strips changed the town"; fi
+objects() { grep -v '^#\|^camera \|^key \|^$' "$1"; }
+walk=$(dirname "$0")/../stability/town-walk.scene
+if [ "$(objects "$walk")" = "$(objects "$dir/town.scene")" ]; then ok; else bad "$walk is not the town's objects"; fi
+expect 0 "bench on the town" -- "$OMBRA" bench --scenes town@64x48 --methods sm --runs 1 --no-scaling --out "$dir/bench-town"
+has "$dir/out" "^town *sm " "bench measures the town"
 # Every value a setting takes renders: an importance map asked below 8 texels is 8.
 expect 0 "rtw.importance 3" -- "$OMBRA" render --size 64x48 --method rtw --set rtw.importance=3 --out "$dir/i3.ppm"
 hash_i=$(grep '^hash:' "$dir/out")

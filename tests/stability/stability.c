@@ -2,7 +2,8 @@
  * cases in tests/stability/ (each where some method is known to fail: close-ups of a
  * far light's shadows, grazing light, a memory cap far below the view's needs with a
  * fast camera, the irregular z-buffer's hot spot with a small pool, curved edges
- * without tessellation, shadow fusion and thin geometry). Per method and case: mean and
+ * without tessellation, shadow fusion and thin geometry, the splits of cascaded maps
+ * along a walk through the town). Per method and case: mean and
  * worst mismatch share against the reference, the same near shadow edges, flicker, the
  * median frame time and the arena's peak bytes, to stdout and a CSV the report shows
  * (with each frame's mismatch share and the frame that flickers most, for its strips).

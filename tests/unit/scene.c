@@ -1,6 +1,6 @@
 /* unit/scene.c — the scene text format, procedural shapes and paths: values and
  * defaults as parsed, exact byte queries, closed outward-wound shapes, errors with the
- * right status, line and column, om_scene_at and the default scene. OBJ meshes are in
+ * right status, line and column, om_scene_at and the built-in scenes. OBJ meshes are in
  * unit/obj.c, random mutations in unit/scene_fuzz.c, shared helpers in scene_util.c. */
 #include "../test.h"
 #include "../../engine/testing.h"
@@ -832,6 +832,81 @@ static void small_scene(void)
     done(&small);
 }
 
+/* The town: the same text through any buffer (sized by the query; cut short, a prefix
+ * with nothing written past the buffer), the figures its first line states, a low
+ * sun, and a plan the camera can walk: nothing in the carriageway or at the eye. */
+static bool in_box(om_vec3 p, om_vec3 lo, om_vec3 hi, float margin)
+{
+    return p.x > lo.x - margin && p.x < hi.x + margin && p.y > lo.y - margin && p.y < hi.y + margin &&
+           p.z > lo.z - margin && p.z < hi.z + margin;
+}
+
+static void town_scene(void)
+{
+    const size_t len = om_scene_town_text(NULL, 0);
+    char *text = malloc(len + 1), *cut = malloc(len + 1);
+    if (!text || !cut) { free(text); free(cut); CHECK(0); return; }
+    CHECK(om_scene_town_text(text, len + 1) == len && strlen(text) == len);
+    CHECK_MSG(len > 4095, "%zu bytes: one C99 literal would hold it", len);
+    CHECK(om_scene_town_text(NULL, 7) == len);
+    const size_t caps[] = {1, 2, 77, 4096, len};
+    for (size_t i = 0; i < sizeof caps / sizeof caps[0]; i++) {
+        memset(cut, 0x5A, len + 1);
+        CHECK(om_scene_town_text(cut, caps[i]) == len);
+        CHECK_MSG(cut[caps[i] - 1] == '\0' && !memcmp(cut, text, caps[i] - 1) && cut[caps[i]] == 0x5A,
+                  "cut short at %zu bytes", caps[i]);
+    }
+    free(cut);
+
+    parsed p;
+    CHECK_MSG(parse(text, &p) == OM_OK, "%s", p.d.msg);
+    unsigned objects = 0, thousands = 0, units = 0;
+    CHECK(sscanf(text, "# ombra town: %u boxes and cylinders, %u,%u triangles", &objects, &thousands, &units) == 3);
+    free(text);
+    if (p.st != OM_OK) return;
+    CHECK_EQ_U(p.s.ntris, 10100);
+    CHECK_EQ_U(p.s.ntris, thousands * 1000 + units);
+    CHECK_EQ_U(p.s.nsolids, objects);   /* every box and cylinder; the ground is open */
+    CHECK(p.s.camera.width == 1024 && p.s.camera.height == 768);
+    CHECK(veq(p.s.lo, -500, 0, -500) && p.s.hi.x == 500.0f && p.s.hi.z == 500.0f && p.s.hi.y < 100.0f);
+    for (uint32_t i = 0; i < p.s.nverts; i++) CHECK(p.s.verts[i].y >= 0.0f);
+    /* a low sun all along its path: 15 to 30 degrees above the horizon */
+    CHECK(p.s.light.kind == OM_LIGHT_DIRECTIONAL && p.s.ncam_keys == 2 && p.s.nlight_keys == 2);
+    for (uint32_t k = 0; k < p.s.nlight_keys; k++) {
+        const om_vec3 d = p.s.light_keys[k].dir;
+        const float up = -d.y / sqrtf(om__dot(d, d));
+        CHECK_MSG(up > 0.2588f && up < 0.5f, "sun key %u: sin of its elevation %g", k, (double)up);
+    }
+    /* varied sizes: towers, thin lamps, low walls */
+    uint32_t towers = 0, thin = 0, low = 0;
+    for (uint32_t i = 0; i < p.s.nsolids; i++) {
+        const om_vec3 lo = p.s.solids[i].lo, hi = p.s.solids[i].hi;
+        towers += hi.y - lo.y > 40.0f;
+        thin += hi.x - lo.x < 0.5f && hi.z - lo.z < 0.5f;
+        low += hi.y - lo.y < 3.0f;
+        /* the carriageway is clear from end to end */
+        CHECK_MSG(lo.x >= 4.0f || hi.x <= -4.0f, "solid %u reaches the carriageway", i);
+    }
+    CHECK_MSG(towers >= 3 && thin >= 50 && low >= 10, "%u towers, %u lamps, %u low walls", towers, thin, low);
+    /* the walk: the eye at 1.7 m, inside no solid, its near plane clear of them */
+    for (int k = 0; k <= 10; k++) {
+        om_camera c;
+        om_scene_at(&p.s, 2.0f * (float)k, &c, NULL);
+        CHECK(feq(c.eye.y, 1.7f, 1e-6f));
+        for (uint32_t i = 0; i < p.s.nsolids; i++)
+            CHECK_MSG(!in_box(c.eye, p.s.solids[i].lo, p.s.solids[i].hi, 2 * c.znear), "t %d: the eye in solid %u", 2 * k, i);
+    }
+    size_t bytes;
+    text = malloc(len + 1);
+    if (text) {
+        om_scene_town_text(text, len + 1);
+        CHECK_OK(om_scene_bytes(text, len, NULL, &bytes, NULL));
+        CHECK_EQ_U(bytes, p.bytes);
+    }
+    free(text);
+    done(&p);
+}
+
 void suite_scene(void)
 {
     RUN(numbers);
@@ -848,4 +923,5 @@ void suite_scene(void)
     RUN(scene_at);
     RUN(default_scene);
     RUN(small_scene);
+    RUN(town_scene);
 }
