@@ -160,60 +160,117 @@ static om_status csm_build(void *state, om_diag *d)
 }
 
 /* One tap without a normal offset (the defaults): the sample's projection through
- * the light's matrix, which picked its cascade, gives its texel there too (the
+ * the light's matrix, which picks its cascade, gives its texel there too (the
  * window's affine map of it: the same texel as the cascade's matrix gives, up to
  * rounding) and its depth (the windows leave depth alone), so each sample is
- * projected once; the bias and the test are smlookup.h's, with the cascade's texel. */
-static void lookup_plain(const om__csm *m, om_strip *st, uint32_t c8[8])
-{
-    const uint32_t n = m->n, size = m->size;
-    const om_mat4 vp = m->view.light_vp, proj = m->view.light_proj;
-    const bool spot = m->view.light.kind == OM_LIGHT_SPOT;
-    const float half = 0.5f * (float)size, half_near = m->look[0].half_near, inv_half_near = 1.0f / half_near;
+ * projected once; the bias and the test are smlookup.h's, with the cascade's texel.
+ * What a strip's samples share, copied once a strip (the terms' byte stores may
+ * alias anything the state's pointers reach). */
+typedef struct plain {
+    om_mat4 vp, proj;
+    bool spot;
+    uint32_t n, size;
+    float half, half_near, inv_half_near;
     om__csm_win win[OM__CSM_MAX];
     float c1[OM__CSM_MAX], c2[OM__CSM_MAX];
     const uint32_t *depth[OM__CSM_MAX];
-    for (uint32_t k = 0; k < n; k++) {
-        win[k] = m->win[k];
-        c1[k] = m->look[k].bias_c1;
-        c2[k] = m->look[k].bias_c2;
-        depth[k] = m->depth[k];
+} plain;
+
+/* A sample's biased depth and the texel it reads (false: behind the light, lit);
+ * counts it held by its cascade or by none. */
+static inline bool plain_locate(const plain *P, const om_sample *smp, float *zb, const uint32_t **tap,
+                                uint32_t c8[8])
+{
+    const om_vec4 q = om__mat_apply(&P->vp, om__v3(smp->p[0], smp->p[1], smp->p[2]));
+    if (!(q.w > 0.0f)) return false;
+    const float iw = 1.0f / q.w, x = q.x * iw, y = q.y * iw;
+    if (!(x == x && y == y)) return false;
+    const uint32_t n = P->n;
+    uint32_t k = n, last = n;
+    for (uint32_t j = 0; j < n; j++) {
+        const om__csm_win *w = &P->win[j];
+        if (!w->live) continue;
+        last = j;
+        if (om__fabsf(x - w->cx) <= w->limx && om__fabsf(y - w->cy) <= w->limy) {
+            k = j;
+            break;
+        }
+    }
+    const bool held = k < n;   /* else the last live one, as om__csm_pick */
+    if (!held) k = last;
+    if (k == n) return false;
+    c8[held ? 2 + k : 6]++;
+    const om__csm_win *w = &P->win[k];
+    const float uf = ((x - w->cx) * w->ix + 1.0f) * P->half;
+    const float wf = (1.0f - (y - w->cy) * w->iy) * P->half;
+    *tap = P->depth[k] + om__smlook_texel(wf, P->size) * P->size + om__smlook_texel(uf, P->size);
+    const float z = om__smlook_depth(&P->proj, P->spot, q, iw);
+    const float r = P->spot ? (q.w > P->half_near ? iw : P->inv_half_near) : 0.0f;
+    *zb = om__smlook_biased(P->c1[k], P->c2[k], P->spot, z, r, om__smlook_tan(smp->nl));
+    return true;
+}
+
+static void lookup_plain(const om__csm *m, om_strip *st, uint32_t c8[8])
+{
+    plain P;
+    P.vp = m->view.light_vp;
+    P.proj = m->view.light_proj;
+    P.spot = m->view.light.kind == OM_LIGHT_SPOT;
+    P.n = m->n;
+    P.size = m->size;
+    P.half = 0.5f * (float)m->size;
+    P.half_near = m->look[0].half_near;
+    P.inv_half_near = 1.0f / P.half_near;
+    for (uint32_t k = 0; k < m->n; k++) {
+        P.win[k] = m->win[k];
+        P.c1[k] = m->look[k].bias_c1;
+        P.c2[k] = m->look[k].bias_c2;
+        P.depth[k] = m->depth[k];
     }
     const size_t count = (size_t)st->rows * st->width;
+#if OM_SMLOOK_DIRECT
+    /* a microcontroller's loads take a cycle or two: each sample tested at once */
     for (size_t i = 0; i < count; i++) {
         om_term *t = &st->terms[i];
         t->r = t->g = t->b = 255;
         if (!(t->flags & OM_TERM_EXPOSED)) continue;
         c8[0]++;
-        const om_sample *smp = &st->samples[i];
-        const om_vec4 q = om__mat_apply(&vp, om__v3(smp->p[0], smp->p[1], smp->p[2]));
-        if (!(q.w > 0.0f)) continue;   /* behind the light: lit, as sm's lookup leaves it */
-        const float iw = 1.0f / q.w, x = q.x * iw, y = q.y * iw;
-        if (!(x == x && y == y)) continue;
-        uint32_t k = n, last = n;
-        for (uint32_t j = 0; j < n; j++) {
-            if (!win[j].live) continue;
-            last = j;
-            if (om__fabsf(x - win[j].cx) <= win[j].limx && om__fabsf(y - win[j].cy) <= win[j].limy) {
-                k = j;
-                break;
-            }
-        }
-        const bool held = k < n;   /* else the last live one, as om__csm_pick */
-        if (!held) k = last;
-        if (k == n) continue;
-        c8[held ? 2 + k : 6]++;
-        const float uf = ((x - win[k].cx) * win[k].ix + 1.0f) * half;
-        const float wf = (1.0f - (y - win[k].cy) * win[k].iy) * half;
-        const uint32_t at = om__smlook_texel(wf, size) * size + om__smlook_texel(uf, size);
-        const float z = om__smlook_depth(&proj, spot, q, iw);
-        const float r = spot ? (q.w > half_near ? iw : inv_half_near) : 0.0f;
-        const float zb = om__smlook_biased(c1[k], c2[k], spot, z, r, om__smlook_tan(smp->nl));
-        if (!om__smlook_lit(zb, depth[k][at])) {
+        float zb;
+        const uint32_t *tap;
+        if (plain_locate(&P, &st->samples[i], &zb, &tap, c8) && !om__smlook_lit(zb, *tap)) {
             t->r = t->g = t->b = 0;
             c8[1]++;
         }
     }
+#else
+    /* Blocks, as smlookup.c's: a run of samples located first, each map load asked
+     * for at once, then tested, so that the loads overlap. */
+    enum { BLOCK = 32 };
+    float zb[BLOCK];
+    const uint32_t *tap[BLOCK];
+    uint32_t idx[BLOCK];
+    for (size_t i = 0; i < count;) {
+        int got = 0;
+        for (; i < count && got < BLOCK; i++) {
+            om_term *t = &st->terms[i];
+            t->r = t->g = t->b = 255;
+            if (!(t->flags & OM_TERM_EXPOSED)) continue;
+            c8[0]++;
+            if (plain_locate(&P, &st->samples[i], &zb[got], &tap[got], c8)) {
+#if defined(__GNUC__) || defined(__clang__)
+                __builtin_prefetch(tap[got]);
+#endif
+                idx[got++] = (uint32_t)i;
+            }
+        }
+        for (int j = 0; j < got; j++)
+            if (!om__smlook_lit(zb[j], *tap[j])) {
+                om_term *t = &st->terms[idx[j]];
+                t->r = t->g = t->b = 0;
+                c8[1]++;
+            }
+    }
+#endif
 }
 
 /* The terms of a strip: each exposed sample tested in the cascade it picks. counts:
