@@ -374,7 +374,7 @@ static const om_setting settings[] = {
     OM__SETTING(om__csm_cfg, map_size, "csm.map", OM_SETTING_U32, 1, OM_MAX_DIM, 1024,
                 "side of each cascade's map in texels"),
     OM__SETTING(om__csm_cfg, lambda, "csm.lambda", OM_SETTING_F32, 0, 1, 0.9,
-                "split scheme: 1 logarithmic, 0 uniform, between a blend (practical split)"),
+                "practical split: 1 logarithmic, 0 uniform, between a blend (csm.fit 1: logarithmic)"),
     OM__SETTING(om__csm_cfg, fit, "csm.fit", OM_SETTING_U32, 0, 1, 0,
                 "1: splits and windows fitted to the visible samples' depths and extent"),
     OM__SET_BIAS(om__csm_cfg), OM__SET_SLOPE(om__csm_cfg), OM__SET_OFFSET(om__csm_cfg), OM__SET_PCF(om__csm_cfg),

@@ -1,19 +1,20 @@
 /* csm_split.c — where csm's cascades lie: the view depth the splits share out, the
  * practical split scheme (Zhang et al. 2006), the fitted mode's observation of the
- * visible samples (Lauritzen et al. 2011), each cascade's window of the light's image
- * and the cascade a sample reads.
+ * visible samples (Lauritzen et al. 2011) and each cascade's window of the light's
+ * image; csm.h's om__csm_pick says which cascade a sample reads.
  *
- * Every window is a box of the light's normalized device coordinates (its texels
- * may be longer on one axis; the bias takes the longer); its margin of texels keeps the PCF taps and the normal offset of every sample it holds
- * on the map. The practical mode's window holds the projection of its slice of the
- * view frustum (the slice's eight corners: the projection is linear for a directional
- * light, and a spot light's window is the whole image where a corner lies behind the
- * light); the fitted mode's, the projections of the samples its bins of view depth
- * hold. Both are clipped to the light's image: no exposed sample lies outside it, and
- * a directional light's image is fitted to the visible samples already (frame.c). The
- * fitted mode's splits fall on bin edges, so the box of a cascade's bins holds every
- * exposed sample whose depth falls in its slice, and the pick (the same arithmetic)
- * finds it in that window or an earlier one. */
+ * Every window is a box of the light's normalized device coordinates (its texels may
+ * be longer on one axis; the bias takes the longer); its margin of texels keeps the
+ * PCF taps and the normal offset of every sample it holds on the map. The practical
+ * mode's window holds the projection of its slice of the view frustum (the slice's
+ * eight corners: the projection is linear for a directional light, and a spot
+ * light's window is the whole image where a corner lies behind the light); the
+ * fitted mode's, the projections of the samples its bins of view depth hold, split
+ * logarithmically. Both are clipped to the light's image: no exposed sample lies
+ * outside it, and a directional light's image is fitted to the visible samples
+ * already (frame.c). The fitted mode's splits fall on bin edges, so the box of a
+ * cascade's bins holds every exposed sample whose depth falls in its slice, and the
+ * pick (the same arithmetic) finds it in that window or an earlier one. */
 #include "csm.h"
 
 void om__csm_range(om__csm *m)
@@ -181,8 +182,11 @@ void om__csm_windows(om__csm *m)
                 m->split[k] = m->znear;
             }
         } else {
+            /* logarithmic over the samples' range, as Lauritzen et al.: the blend with
+             * the uniform split makes up for a near plane far in front of the
+             * geometry, which the samples' range has not */
             float ideal[OM__CSM_MAX + 1];
-            om__csm_practical(m->edge[a], m->edge[z + 1], c->lambda, n, ideal);
+            om__csm_practical(m->edge[a], m->edge[z + 1], 1.0f, n, ideal);
             at[0] = a;
             for (uint32_t k = 1; k < n; k++) {   /* the nearest edge at or above the ideal split */
                 uint32_t e = at[k - 1];
