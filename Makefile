@@ -109,7 +109,7 @@ $(O)/embed-render-sized: tests/embed/render_sized.c $(O)/libombra.a include/ombr
 # OM_WITH_*) compiled with every other method off and linked ahead of the library;
 # tests/sh/methods.sh checks that no other method's code came along and that the frame
 # is the full library's.
-ONLY_SM = -DOM_WITH_NONE=0 -DOM_WITH_REF=0 -DOM_WITH_ASM=0 -DOM_WITH_RTW=0 -DOM_WITH_SPSM=0 \
+ONLY_SM = -DOM_WITH_NONE=0 -DOM_WITH_REF=0 -DOM_WITH_CSM=0 -DOM_WITH_ASM=0 -DOM_WITH_RTW=0 -DOM_WITH_SPSM=0 \
           -DOM_WITH_IZB=0 -DOM_WITH_HYBRID=0
 $(O)/embed-only-sm: tests/embed/render_once.c engine/shadow/registry.c $(O)/libombra.a \
                     include/ombra.h $(wildcard engine/*/*.h engine/*/*/*.h)

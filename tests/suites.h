@@ -18,6 +18,7 @@
     X(suite_shadow_common) \
     X(suite_ref) \
     X(suite_sm) \
+    X(suite_csm) \
     X(suite_asm) \
     X(suite_rtw) \
     X(suite_spsm) \

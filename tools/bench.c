@@ -229,6 +229,7 @@ om_status cli_measure_strips(const om_method *m, const om_method_cfg *cfg, const
 static const struct { const char *method, *sweep; } sweeps[] = {
     {"none", ""},
     {"sm", "map=256,512,1024,2048,4096,8192"},
+    {"csm", "csm.map=256,512,1024,2048 csm.fit=0,1"},
     {"izb", "izb.pool=0,65536,16384"},
     {"asm", "asm.cap=1048576,4194304,8388608,16777216"},
     {"rtw", "map=512,1024,2048 rtw.exact=1,0"},

@@ -6,7 +6,7 @@
 #ifndef OM_CONFIG_H
 #define OM_CONFIG_H
 
-/* OM_WITH_NONE, _REF, _SM, _ASM, _RTW, _SPSM, _IZB, _HYBRID (1): whether the method is
+/* OM_WITH_NONE, _REF, _SM, _CSM, _ASM, _RTW, _SPSM, _IZB, _HYBRID (1): whether the method is
  * built in. registry.c is the only file that reads them: a method left out is not in
  * its list, so a program linked against the library carries none of its code (a
  * firmware may compile registry.c alone with some of them 0, ahead of the library). */
@@ -18,6 +18,9 @@
 #endif
 #ifndef OM_WITH_SM
 #define OM_WITH_SM 1
+#endif
+#ifndef OM_WITH_CSM
+#define OM_WITH_CSM 1
 #endif
 #ifndef OM_WITH_ASM
 #define OM_WITH_ASM 1

@@ -162,7 +162,7 @@ static void stage_build(om__frame *c, uint32_t b)
 {
     b = c->j.slots[b].run;
     const uint32_t y0 = b * c->j.map_band, rows = c->j.map_size - y0;
-    c->j.bands->build_rows(c->fd->method_state, c->j.map_bins.rows ? &c->j.map_bins : NULL, y0,
+    c->j.bands->build_rows(c->fd->method_state, c->j.map_k, c->j.map_bins.rows ? &c->j.map_bins : NULL, y0,
                            rows < c->j.map_band ? rows : c->j.map_band, c->j.slots[b].counts);
 }
 
@@ -346,22 +346,24 @@ void om__jobs_make_bins(om__frame *c, const om_mat4 *vp, uint32_t w, uint32_t h,
     run_stage(c, stage_bin_rows, BANDS_PER_JOB * c->jobs);
 }
 
-/* The light depth pass by bands of the map (om__bands.build_rows): with bins,
- * BANDS_PER_JOB bands a job, each setting up only its own triangles; without, one band
- * a job, since each band then walks every triangle. The bands' counts are added up
- * after the map, as the resolve's after a strip. */
+/* The light depth pass by bands of each map (om__bands.build_rows), one map after
+ * another: with bins, BANDS_PER_JOB bands a job, each setting up only its own
+ * triangles; without, one band a job, since each band then walks every triangle. The
+ * bands' counts are added up after each map, as the resolve's after a strip. */
 static void build_map(om__frame *c)
 {
     const om_mat4 *vp;
-    c->j.map_size = c->j.bands->map_of(c->fd->method_state, &vp);
-    if (c->j.map_bins.rows) om__jobs_make_bins(c, vp, c->j.map_size, c->j.map_size, &c->j.map_bins);
-    uint32_t n = c->j.map_bins.rows ? BANDS_PER_JOB * c->jobs : c->jobs;
-    c->j.map_band = ((c->j.map_size + n - 1) / n + 15) / 16 * 16;
-    const uint32_t nb = (c->j.map_size + c->j.map_band - 1) / c->j.map_band;
-    clear_counts(c->j.slots, nb);
-    order_bands(c, c->j.map_bins.rows, c->j.map_band, nb);
-    run_stage(c, stage_build, nb);
-    merge_counts(c->j.slots, nb, c->j.bands->merge, c->fd->method_state);
+    for (c->j.map_k = 0; (c->j.map_size = c->j.bands->map_of(c->fd->method_state, c->j.map_k, &vp)) != 0;
+         c->j.map_k++) {
+        if (c->j.map_bins.rows) om__jobs_make_bins(c, vp, c->j.map_size, c->j.map_size, &c->j.map_bins);
+        uint32_t n = c->j.map_bins.rows ? BANDS_PER_JOB * c->jobs : c->jobs;
+        c->j.map_band = ((c->j.map_size + n - 1) / n + 15) / 16 * 16;
+        const uint32_t nb = (c->j.map_size + c->j.map_band - 1) / c->j.map_band;
+        clear_counts(c->j.slots, nb);
+        order_bands(c, c->j.map_bins.rows, c->j.map_band, nb);
+        run_stage(c, stage_build, nb);
+        merge_counts(c->j.slots, nb, c->j.bands->merge, c->fd->method_state);
+    }
 }
 
 /* The method's pass over the current strip (om__pass): plan, the jobs on their slots,

@@ -35,7 +35,7 @@ typedef struct om__frame_jobs {
     uint32_t rows_now;         /* a band stage's rows a band */
     bool eye, mark;            /* the eye stage: run the eye pass, mark exposure */
     om__bins map_bins;         /* the light map's (rows NULL: none) */
-    uint32_t map_size, map_band;   /* the map build: the map's side, rows per band */
+    uint32_t map_k, map_size, map_band;   /* the map build: which map, its side, rows per band */
     const om__bins *mk;        /* the bins being made, through mk_vp */
     const om_mat4 *mk_vp;
     uint32_t mk_w, mk_h;

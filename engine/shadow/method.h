@@ -25,14 +25,15 @@ typedef struct om__bands {
     void (*merge)(void *state, const uint32_t counts[8]);
     size_t scratch;
     /* May be NULL. The light depth pass by bands of the map's rows, in place of build:
-     * map_of, on the calling thread, does what the rows share and gives this frame's
-     * map side and light matrix (after observe); build_rows rasterizes rows
-     * [y0, y0 + rows) of the map, with bins made for that matrix and side
-     * (om__bins_make) or NULL, and adds to `counts`, which the frame adds up over the
-     * bands and hands to merge once after the map. The same map and counts whatever
-     * the bands. */
-    uint32_t (*map_of)(void *state, const om_mat4 **vp);
-    void (*build_rows)(const void *state, const om__bins *bins, uint32_t y0, uint32_t rows,
+     * map_of(state, k), on the calling thread, does what the rows of map k share and
+     * gives its side and light matrix (after observe), 0 where the method has no map
+     * k (the frame asks for k = 0, 1, ... until then: one map for most methods, one a
+     * cascade for csm); build_rows rasterizes rows [y0, y0 + rows) of map k, with bins
+     * made for that matrix and side (om__bins_make) or NULL, and adds to `counts`,
+     * which the frame adds up over the bands and hands to merge once after each map.
+     * The same maps and counts whatever the bands. */
+    uint32_t (*map_of)(void *state, uint32_t k, const om_mat4 **vp);
+    void (*build_rows)(const void *state, uint32_t k, const om__bins *bins, uint32_t y0, uint32_t rows,
                        uint32_t counts[8]);
     /* May be NULL. Runs on the calling thread after merge, over the whole strip: what
      * the bands left to the method (asm's use stamps on the leaves its bands read). */

@@ -10,6 +10,7 @@
     X(none, OM_WITH_NONE)    \
     X(ref, OM_WITH_REF)      \
     X(sm, OM_WITH_SM)        \
+    X(csm, OM_WITH_CSM)      \
     X(asm, OM_WITH_ASM)      \
     X(rtw, OM_WITH_RTW)      \
     X(spsm, OM_WITH_SPSM)    \

@@ -155,13 +155,15 @@ static void method_cfg(om_method_cfg *c, const om_method *m, const size_cfg *sz,
         /* small enough for small machines, the same everywhere (the hashes must agree):
          * each method's whole footprint on the small scene at 160x120 within 256 KiB
          * (the counting firmware checks it), which takes spsm's 24-byte texels a map of
-         * 64 and asm a cap of 96 KiB */
+         * 64, asm a cap of 96 KiB and csm four cascades of 48 (sm's 96 x 96 texels) */
         om_method_cfg_set(c, "map", strcmp(om_method_name(m), "spsm") ? 96 : 64, NULL);
         om_method_cfg_set(c, "hybrid.map", 64, NULL);
+        om_method_cfg_set(c, "csm.map", 48, NULL);
         om_method_cfg_set(c, "asm.cap", 96u << 10, NULL);
         om_method_cfg_set(c, "rtw.importance", 64, NULL);
     } else {
         om_method_cfg_set(c, "map", 1024, NULL);
+        om_method_cfg_set(c, "csm.map", 512, NULL);   /* sm's 1024 x 1024 texels */
     }
     if (aa) {
         om_method_cfg_set(c, "pcf", 3, NULL);

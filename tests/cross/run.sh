@@ -377,7 +377,7 @@ if command -v arm-none-eabi-gcc >/dev/null 2>&1; then
         >"$out/example_main.c"
     for methods in all sm; do
         only=""
-        [ "$methods" = sm ] && only="-DOM_WITH_NONE=0 -DOM_WITH_REF=0 -DOM_WITH_ASM=0 -DOM_WITH_RTW=0 -DOM_WITH_SPSM=0 -DOM_WITH_IZB=0 -DOM_WITH_HYBRID=0"
+        [ "$methods" = sm ] && only="-DOM_WITH_NONE=0 -DOM_WITH_REF=0 -DOM_WITH_CSM=0 -DOM_WITH_ASM=0 -DOM_WITH_RTW=0 -DOM_WITH_SPSM=0 -DOM_WITH_IZB=0 -DOM_WITH_HYBRID=0"
         # shellcheck disable=SC2086
         if arm-none-eabi-gcc $BFLAGS -O2 $M4 $only -Dmain=host_main $ENGINE tests/embed/render_once.c \
                "$out/example_main.c" platform/cortex-m/startup.c platform/cortex-m/semihost.c \

@@ -83,6 +83,7 @@ static void stress_method(ctx *c, const om_method *m)
     om_method_cfg cfg;   /* small maps and structures, where m takes them */
     om_method_cfg_default(&cfg, m);
     om_method_cfg_set(&cfg, "map", 256, NULL);
+    om_method_cfg_set(&cfg, "csm.map", 128, NULL);   /* four: the texels of one 256 map */
     om_method_cfg_set(&cfg, "asm.cap", 2u << 20, NULL);
     om_method_cfg_set(&cfg, "rtw.importance", 64, NULL);
     size_t mn, full;

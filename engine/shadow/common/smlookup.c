@@ -24,11 +24,11 @@ void om__smlook_begin(om__smlook *L, const om_view *v)
     if (v->light.kind == OM_LIGHT_SPOT) {
         const float k = L->dz_num / L->dz_den * OM_DEPTH_ONE_F;
         L->bias_c1 = L->bias_world * k;
-        L->bias_c2 = L->bias_slope * (L->span_per_dist / fsize) * k;
+        L->bias_c2 = L->bias_slope * (L->span_per_dist * L->window / fsize) * k;
     } else {
         const float k = OM_DEPTH_ONE_F * om__fabsf(v->light_proj.m[10]);
         L->bias_c1 = L->bias_world * k;
-        L->bias_c2 = L->bias_slope * (2.0f / om__fabsf(v->light_proj.m[0]) / fsize) * k;
+        L->bias_c2 = L->bias_slope * (2.0f / om__fabsf(v->light_proj.m[0]) * L->window / fsize) * k;
     }
 }
 
@@ -38,7 +38,7 @@ static float texel_world(const om__smlook *L, float dist)
     const om_view *v = L->view;
     float span = v->light.kind == OM_LIGHT_SPOT ? dist * L->span_per_dist
                                                 : 2.0f / om__fabsf(v->light_proj.m[0]);
-    return span / (float)L->size;
+    return span * L->window / (float)L->size;
 }
 
 /* Warps (u, v) in place; *density: warped texels per unwarped texel there, the
@@ -75,15 +75,6 @@ static inline int32_t texel_floor_d(double f, uint32_t size)
  * warped map also where it lies before the warp (normalized coordinates), from which
  * unwarped PCF taps are placed. */
 typedef struct tap { uint64_t zlit; uint32_t at; int32_t cx, cy; double u, v; } tap;
-
-
-/* om__smlook_clamp(texel_floor(f, size), size) in one step: below 0 (or NaN) the
- * first texel, from `size` on the last, between them the truncation, which is the
- * floor there. */
-static inline uint32_t texel_clamped(float f, uint32_t size)
-{
-    return f >= 0.0f ? (f < (float)size ? (uint32_t)f : size - 1) : 0u;
-}
 
 
 /* All of the test's arithmetic; false when the sample is behind the light. */
@@ -149,7 +140,7 @@ static bool locate(const om__smlook *L, const om_sample *smp, tap *out)
         out->u = out->v = 0.0;   /* no warp: taps are the map's texels */
         const float uf = (q.x * iw + 1.0f) * (0.5f * (float)L->size);
         const float wf = (1.0f - q.y * iw) * (0.5f * (float)L->size);
-        out->at = texel_clamped(wf, L->size) * L->size + texel_clamped(uf, L->size);
+        out->at = om__smlook_texel(wf, L->size) * L->size + om__smlook_texel(uf, L->size);
         if (L->pcf > 1) {
             out->cx = texel_floor(uf, L->size);
             out->cy = texel_floor(wf, L->size);
@@ -254,7 +245,7 @@ OM_INLINE bool plain_locate(const plain *P, const bool spot, const om_sample *sm
     const float iw = 1.0f / q.w;
     const float uf = (q.x * iw + 1.0f) * P->half;
     const float wf = (1.0f - q.y * iw) * P->half;
-    *at = texel_clamped(wf, P->size) * P->size + texel_clamped(uf, P->size);
+    *at = om__smlook_texel(wf, P->size) * P->size + om__smlook_texel(uf, P->size);
     const float z = om__smlook_depth(&P->proj, spot, q, iw);
     const float r = spot ? (q.w > P->half_near ? iw : P->inv_half_near) : 0.0f;
     *zb = om__smlook_biased(P->c1, P->c2, spot, z, r, tanang);
@@ -377,4 +368,10 @@ void om__smlook_strip(const om__smlook *Lin, om_strip *st, uint32_t *samples, ui
     }
     *samples += nsamples;
     *shadowed += nshadowed;
+}
+
+uint8_t om__smlook_sample(const om__smlook *L, const om_sample *smp)
+{
+    tap t;
+    return locate(L, smp, &t) ? test(L, &t) : 255;
 }

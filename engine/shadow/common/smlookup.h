@@ -39,6 +39,10 @@ typedef struct om__smlook {
     const om_view *view;
     const uint32_t *depth;     /* size * size, row 0 at the top (v = 0) */
     uint32_t size;
+    /* The share of the light's image, across, that the map covers: 1 for a map of the
+     * whole image (sm, rtw), less for a window of it (csm's cascades, whose light_vp
+     * is cropped to it); a texel's world size shrinks with it. */
+    float window;
     float bias_const;          /* fraction of the light's depth range (far - near) */
     float bias_slope, normal_offset;   /* texels */
     uint32_t pcf;              /* k for k x k, 1 = a single tap */
@@ -67,6 +71,9 @@ void om__smlook_begin(om__smlook *L, const om_view *v);
  * or lies behind the light. Counts the exposed samples and the shadowed ones (term
  * below 255) into *samples, *shadowed. */
 void om__smlook_strip(const om__smlook *L, om_strip *st, uint32_t *samples, uint32_t *shadowed);
+/* The term of one exposed sample, as om__smlook_strip gives it: for a method that
+ * picks one of several maps per sample (csm). */
+uint8_t om__smlook_sample(const om__smlook *L, const om_sample *smp);
 
 /* The tangent of the angle between a sample's normal and the light, from their
  * cosine (the sample's nl), at most 10. */
@@ -100,6 +107,14 @@ static inline float om__smlook_depth(const om_mat4 *proj, bool spot, om_vec4 q, 
 static inline uint32_t om__smlook_clamp(int32_t x, uint32_t size)
 {
     return x < 0 ? 0u : (uint32_t)x >= size ? size - 1 : (uint32_t)x;
+}
+
+/* The texel of a coordinate f (in texels) on a map of `size`, clamped: below 0 (or
+ * NaN) the first texel, from `size` on the last, between them the truncation, which
+ * is the floor there. */
+static inline uint32_t om__smlook_texel(float f, uint32_t size)
+{
+    return f >= 0.0f ? (f < (float)size ? (uint32_t)f : size - 1) : 0u;
 }
 
 /* The least stored depth a biased sample depth z is not behind: z <= D for a stored

@@ -164,6 +164,7 @@ static om_status rtw_init(void **state, om_arena *a, const om_method_cfg *mc, co
     if (m->limit > 0.0 && m->limit < 1.0 / (double)m->size) m->limit = 1.0 / (double)m->size;
     m->look.depth = m->depth;
     m->look.size = m->size;
+    m->look.window = 1.0f;   /* the whole light image */
     m->look.bias_const = c->bias_const;
     m->look.bias_slope = c->bias_slope;
     m->look.normal_offset = c->normal_offset;
@@ -492,9 +493,10 @@ static uint32_t render_tess(const om__rtw *m, om_raster *r)
 
 /* Rows [y0, y0 + rows) of the map (om__bands.build_rows); counts[2] += triangles
  * drawn, counted so that the bands add up to the whole map's count. */
-static void rtw_build_rows(const void *state, const om__bins *bins, uint32_t y0, uint32_t rows,
+static void rtw_build_rows(const void *state, uint32_t k, const om__bins *bins, uint32_t y0, uint32_t rows,
                            uint32_t counts[8])
 {
+    (void)k;   /* one map */
     const om__rtw *m = (const om__rtw *)state;
     /* Warped vertices (rtw.exact 0): the cap on splitting counts the pieces of the
      * whole map in triangle order, so a band would split every triangle to fill its
@@ -526,9 +528,10 @@ static void map_grids(om__rtw *m)
 
 /* What the map's rows share, on the calling thread: the analysis's tables and the
  * grids. */
-static uint32_t rtw_map_of(void *state, const om_mat4 **vp)
+static uint32_t rtw_map_of(void *state, uint32_t k, const om_mat4 **vp)
 {
     om__rtw *m = (om__rtw *)state;
+    if (k > 0) return 0;   /* one map */
     om__rtw_importance_finish(m);
     om__rtw_build_tables(m);
     map_grids(m);
@@ -541,7 +544,7 @@ void om__rtw_render_map(om__rtw *m)
 {
     map_grids(m);
     uint32_t counts[8] = {0};
-    rtw_build_rows(m, NULL, 0, m->size, counts);
+    rtw_build_rows(m, 0, NULL, 0, m->size, counts);
     m->tris_drawn = counts[2];
 }
 

@@ -87,6 +87,7 @@ static om_status sm_init(void **state, om_arena *a, const om_method_cfg *mc, con
         m->verts = (om__vsnap *)p;
     m->look.depth = m->depth;
     m->look.size = m->size;
+    m->look.window = 1.0f;   /* the whole light image */
     m->look.bias_const = c->bias_const;
     m->look.bias_slope = c->bias_slope;
     m->look.normal_offset = c->normal_offset;
@@ -114,7 +115,7 @@ static om_status sm_observe(void *state, const om_strip *st, om_diag *d)
     return OM_OK;
 }
 
-static void sm_build_rows(const void *state, const om__bins *bins, uint32_t y0, uint32_t rows,
+static void sm_build_rows(const void *state, uint32_t k, const om__bins *bins, uint32_t y0, uint32_t rows,
                           uint32_t counts[8]);
 
 static om_status sm_build(void *state, om_diag *d)
@@ -124,7 +125,7 @@ static om_status sm_build(void *state, om_diag *d)
     const om__bins b = {NULL, m->verts, false};
     if (m->verts) om__bins_make(m->scene, &m->view.light_vp, m->view.origin, m->size, m->size, &b);
     uint32_t counts[8] = {0};
-    sm_build_rows(state, m->verts ? &b : NULL, 0, m->size, counts);
+    sm_build_rows(state, 0, m->verts ? &b : NULL, 0, m->size, counts);
     return OM_OK;
 }
 
@@ -151,16 +152,18 @@ static void sm_merge(void *state, const uint32_t counts[8])
 }
 
 /* The depth pass by rows of the map: each band a target of its own rows. */
-static uint32_t sm_map_of(void *state, const om_mat4 **vp)
+static uint32_t sm_map_of(void *state, uint32_t k, const om_mat4 **vp)
 {
     const sm_state *m = (const sm_state *)state;
+    if (k > 0) return 0;   /* one map */
     *vp = &m->view.light_vp;
     return m->size;
 }
 
-static void sm_build_rows(const void *state, const om__bins *bins, uint32_t y0, uint32_t rows,
+static void sm_build_rows(const void *state, uint32_t k, const om__bins *bins, uint32_t y0, uint32_t rows,
                           uint32_t counts[8])
 {
+    (void)k;        /* one map */
     (void)counts;   /* the map counts nothing */
     const sm_state *m = (const sm_state *)state;
     om_target tg = {m->size, m->size, y0, rows, m->depth + (size_t)y0 * m->size, NULL};

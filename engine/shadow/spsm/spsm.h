@@ -148,7 +148,8 @@ static inline bool om__spsm_clip_f(float ax, float ay, float dx, float dy, float
  * of the map's rows (om__bands: map_of on the calling thread, then build_rows for
  * each band), or all at once. */
 om_status om__spsm_build(void *state, om_diag *d);
-uint32_t om__spsm_map_of(void *state, const om_mat4 **vp);
-void om__spsm_build_rows(const void *state, const om__bins *bins, uint32_t y0, uint32_t rows, uint32_t counts[8]);
+uint32_t om__spsm_map_of(void *state, uint32_t k, const om_mat4 **vp);
+void om__spsm_build_rows(const void *state, uint32_t k, const om__bins *bins, uint32_t y0, uint32_t rows,
+                         uint32_t counts[8]);
 
 #endif

@@ -309,9 +309,10 @@ static void span(void *user, int32_t y, int32_t x0, int32_t x1, const om__rtri *
 
 /* What the map's rows share, on the calling thread (om__bands.map_of): the texels the
  * lookup will read, and with spsm.fine the fine map's points (those cleared). */
-uint32_t om__spsm_map_of(void *state, const om_mat4 **vp)
+uint32_t om__spsm_map_of(void *state, uint32_t k, const om_mat4 **vp)
 {
     om__spsm_state *m = (om__spsm_state *)state;
+    if (k > 0) return 0;   /* one map */
     om__spsm_observe_fold(m);    /* the bands' marks, where they observed */
     m->win.t4_at = (size_t)-1;   /* no texel index: the map is about to change */
     m->win.bd_have = false;
@@ -324,8 +325,10 @@ uint32_t om__spsm_map_of(void *state, const om_mat4 **vp)
 
 /* Rows [y0, y0 + rows) of the map (om__bands.build_rows): every buffer of a texel (or a
  * fine point) in them is written by this band alone. */
-void om__spsm_build_rows(const void *state, const om__bins *bins, uint32_t y0, uint32_t rows, uint32_t counts[8])
+void om__spsm_build_rows(const void *state, uint32_t k, const om__bins *bins, uint32_t y0, uint32_t rows,
+                         uint32_t counts[8])
 {
+    (void)k;        /* one map */
     (void)counts;   /* the needs were counted before the bands */
     const om__spsm_state *m = (const om__spsm_state *)state;
     const size_t S = m->size;
@@ -396,6 +399,6 @@ om_status om__spsm_build(void *state, om_diag *d)
     om__spsm_state *m = (om__spsm_state *)state;
     const om_mat4 *vp;
     uint32_t counts[8] = {0};
-    om__spsm_build_rows(m, NULL, 0, om__spsm_map_of(m, &vp), counts);
+    om__spsm_build_rows(m, 0, NULL, 0, om__spsm_map_of(m, 0, &vp), counts);
     return OM_OK;
 }
