@@ -125,9 +125,9 @@ static void filter(const uint8_t *px, unsigned ch, uint32_t w, uint32_t h, uint8
     size_t stride = (size_t)w * ch;
     for (uint32_t y = 0; y < h; y++) {
         uint8_t *o = raw + y * (stride + 1);
-        const uint8_t *p = px + y * stride;
+        const uint8_t *p = px + y * stride, *up = y ? p - stride : NULL;
         o[0] = y ? 2 : 0;
-        for (size_t i = 0; i < stride; i++) o[1 + i] = (uint8_t)(y ? p[i] - p[i - stride] : p[i]);
+        for (size_t i = 0; i < stride; i++) o[1 + i] = (uint8_t)(up ? p[i] - up[i] : p[i]);
     }
 }
 
