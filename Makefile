@@ -60,11 +60,27 @@ $(O)/run-tests: $(TEST_OBJ) $(PLATFORM_OBJ) $(O)/libombra.a
 $(O)/bench: $(BENCH_SRC) $(PLATFORM_OBJ) $(O)/libombra.a $(wildcard tests/bench/*.h)
 	$(Q)$(CC) $(CFLAGS_ALL) -o $@ $(filter %.c %.o %.a,$^) $(LDLIBS) $(PTHREAD)
 
+# The report's scenes (a scene joins the page with one more entry here; NAME@WxH
+# measures it at that size). Where arm-none-eabi-gcc and qemu-system-arm are installed,
+# `run` counts the Cortex-M4 figures (CROSS_ONLY=m4-count make cross-test, about two
+# minutes) for the page's small-machines section and chips; without them the page shows
+# the tables that command last wrote into the firmware's README, with that file's commit.
+REPORT_SCENES = default,random-10K@320x240,random-100K@320x240,tests/stability/closeup.scene@160x120
+FW_DOC = platform/cortex-m/README.md
+
 run: $(O)/ombra
 	@mkdir -p out
 	$(O)/ombra render --out out/default.ppm --mask out/default-mask.pgm
 	$(MAKE) --no-print-directory stability
-	$(O)/ombra report --scenes default,random-10K@320x240,random-100K@320x240,tests/stability/closeup.scene@160x120 --size 640x480 --runs 3 --tri-sweep --equal-memory --out out/report
+	@if command -v arm-none-eabi-gcc >/dev/null 2>&1 && command -v qemu-system-arm >/dev/null 2>&1; then \
+	  echo "run: counting the Cortex-M4 figures: CROSS_ONLY=m4-count make cross-test (log: out/cross-count.log)"; \
+	  CROSS_ONLY=m4-count sh tests/cross/run.sh >out/cross-count.log 2>&1 || \
+	    echo "run: the Cortex-M count failed (out/cross-count.log); the page shows what out/cross or $(FW_DOC) has"; \
+	else \
+	  echo "run: no arm-none-eabi-gcc or qemu-system-arm: the page shows the tables of $(FW_DOC)"; \
+	fi
+	$(O)/ombra report --scenes $(REPORT_SCENES) --size 640x480 --runs 3 --tri-sweep --equal-memory --out out/report \
+	  --cross-doc $(FW_DOC) --cross-doc-rev "$$(git log -1 --format='%h, %cs' -- $(FW_DOC) 2>/dev/null)"
 
 # One suite, four builds: the same tests must pass under gcc and clang at -O0 and -O2.
 # gcc -O0 also takes the paths made for microcontrollers (OM_FAST_FLOAT, core.h;

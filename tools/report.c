@@ -16,7 +16,8 @@
 
 static const char report_help[] =
     "usage: ombra report [--scenes LIST] [--size WxH] [--runs N] [--threads N] [--out DIR]\n"
-    "                    [--tri-sweep] [--equal-memory] [--cross DIR]\n"
+    "                    [--tri-sweep] [--equal-memory] [--cross DIR] [--cross-doc FILE]\n"
+    "                    [--cross-doc-rev TEXT]\n"
     "\n"
     "Runs 'ombra bench' with the same options, then writes DIR/index.html: per scene the\n"
     "charts, the table and crops where the methods disagree most (default: the default\n"
@@ -24,21 +25,24 @@ static const char report_help[] =
     "(say, a big scene smaller than the rest); DIR/stability.csv, when there, adds the\n"
     "stability section. --equal-memory adds each method's best setting within memory\n"
     "budgets of 64 KiB to 16 MiB. The small-machines section reads what 'make cross-test'\n"
-    "wrote into the --cross directory (default out/cross). --threads N: the threads\n"
-    "each frame runs on (default: the CPUs online), which the page states.\n";
+    "wrote into the --cross directory (default out/cross); without it, the tables that\n"
+    "command last wrote into --cross-doc (default platform/cortex-m/README.md), labelled\n"
+    "--cross-doc-rev (the commit that wrote them: make run passes git's). The page opens\n"
+    "with a summary: per budget and accuracy the fastest setting measured, and the chips.\n"
+    "--threads N: the threads each frame runs on (default: the CPUs online), which the\n"
+    "page states.\n";
 
 #define CROP_MAX 64
 #define ZOOM 3
 
-/* mask -> grey RGB: lit light, shadowed dark, background black; crops are crop x crop
- * (CROP_MAX, or less for a smaller image) */
+/* mask -> grey RGB as the mask file has it: lit 255, shadowed 0, background (no
+ * surface) 128; crops are crop x crop (CROP_MAX, or less for a smaller image) */
 void report_mask_rgb(const uint8_t *mask, uint32_t W, uint32_t x0, uint32_t y0, uint32_t crop,
                      uint8_t *rgb)
 {
     for (uint32_t y = 0; y < crop; y++)
         for (uint32_t x = 0; x < crop; x++) {
-            uint8_t m = mask[(size_t)(y0 + y) * W + x0 + x];
-            uint8_t v = m == OM_MASK_LIT ? 235 : m == OM_MASK_SHADOW ? 60 : 0;
+            uint8_t v = mask[(size_t)(y0 + y) * W + x0 + x];
             uint8_t *o = rgb + 3 * ((size_t)y * crop + x);
             o[0] = o[1] = o[2] = v;
         }
@@ -140,7 +144,9 @@ static int scene_crops(FILE *f, const char *name, uint32_t w, uint32_t h)
                "frame marks the %ux%u pixels at (%u, %u) where the methods, each at its defaults, "
                "disagree most with the reference. Below, that window %u times larger: the frame, "
                "the reference's shadow mask, and per method its mask and its difference (red: lit "
-               "where the reference is shadowed; blue: the other way round).</p>\n",
+               "where the reference is shadowed; blue: the other way round). Masks as the mask file "
+               "has them: lit white, shadowed black, and mid grey where no surface is (the "
+               "background, 128 in the file, which no method decides).</p>\n",
             W, H, crop, crop, bx, by, ZOOM);
     uint8_t rgb[CROP_MAX * CROP_MAX * 3];
     report_crop_rgb(frame, W, bx, by, crop, rgb);   /* before the outline is drawn over the frame */
@@ -148,23 +154,23 @@ static int scene_crops(FILE *f, const char *name, uint32_t w, uint32_t h)
     report_outline(dm, W, H, bx, by, crop);
     fprintf(f, "<div class=\"frame\">");
     report_img(f, dm, W, H, 1, "reference frame, the crops' window outlined");
-    fprintf(f, "</div>\n<div class=\"strip\">\n<figure>");
+    fprintf(f, "</div>\n<div class=\"strip\">\n<div class=\"pair\"><figure>");
     report_img(f, rgb, crop, crop, ZOOM, "frame crop");
     fprintf(f, "<figcaption>frame</figcaption></figure>\n<figure>");
     report_mask_rgb(ref, W, bx, by, crop, rgb);
     report_img(f, rgb, crop, crop, ZOOM, "reference mask");
-    fprintf(f, "<figcaption>ref</figcaption></figure>\n");
+    fprintf(f, "<figcaption>ref</figcaption></figure></div>\n");
     for (size_t k = 0; k < nm; k++) {
         om_metrics mt;
         om_compare_masks(ref, masks[k], W, H, &mt);
-        fprintf(f, "<figure>");
+        fprintf(f, "<div class=\"pair\"><figure>");
         report_mask_rgb(masks[k], W, bx, by, crop, rgb);
         report_img(f, rgb, crop, crop, ZOOM, om_method_name(ms[k]));
         fprintf(f, "<figcaption>%s mask</figcaption></figure>\n<figure>", om_method_name(ms[k]));
         om_diff_image(ref, masks[k], W, H, dm);
         report_crop_rgb(dm, W, bx, by, crop, rgb);
         report_img(f, rgb, crop, crop, ZOOM, "difference");
-        fprintf(f, "<figcaption>%s: %.3f%% wrong</figcaption></figure>\n", om_method_name(ms[k]),
+        fprintf(f, "<figcaption>%s: %.3f%% wrong</figcaption></figure></div>\n", om_method_name(ms[k]),
                 100.0 * (1.0 - om_metrics_match(&mt)));
         free(masks[k]);
     }
@@ -269,7 +275,9 @@ static int scene_part(FILE *f, const char *dir, const char *name, uint32_t w, ui
     scene_about(f, name);
     static const char *const charts[3] = {"time", "bytes", "first"};
     static const char *const read[3] = {
-        "Down is more accurate, left is faster. Each point is one setting of a method; the grey "
+        "Down is more accurate, left is faster. Each point is one setting of a method, each method "
+        "a colour and a marker; points at 0 wrong sit on a row of their own under the axis' decades, "
+        "each method in a lane, so the exact methods stay apart. The grey "
         "staircase is the Pareto front over all methods: every point above or right of it is beaten "
         "on both counts by a point on it. A bar spans the fastest to the slowest of the %s frames: "
         "points whose bars overlap are not reliably different in speed.",
@@ -282,10 +290,15 @@ static int scene_part(FILE *f, const char *dir, const char *name, uint32_t w, ui
     for (int c = 0; c < 3; c++) {
         char file[300];
         snprintf(file, sizeof file, "%s-%s.svg", base, charts[c]);
+        char id[300];
+        report_chart_id(id, sizeof id, name, charts[c]);
         fprintf(f, "<p class=\"read\">");
         fprintf(f, read[c], c == 1 ? "" : runs);
-        fprintf(f, "</p>\n");
+        fprintf(f, "</p>\n<div class=\"chart-box\" id=\"");
+        svg_escape(f, id);
+        fprintf(f, "\">");
         inline_file(f, dir, file, inline_svg);
+        fprintf(f, "</div>\n");
     }
     fprintf(f, "<h3>The numbers</h3>\n<p>Per point (%s frames each): the median frame and their spread, "
                "the method's init, the map's build and the lookup per sample (a frame's other "
@@ -305,7 +318,7 @@ static void step(int i, int n, const char *what, const char *name)
 int cmd_report(int argc, char **argv)
 {
     const char *scenes = "default", *dir = "out/report", *size = NULL, *runs = "3", *cross = "out/cross";
-    const char *threads = NULL;
+    const char *threads = NULL, *doc = "platform/cortex-m/README.md", *doc_rev = NULL;
     bool tri = false, memory = false;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -318,6 +331,8 @@ int cmd_report(int argc, char **argv)
         else if (!strcmp(a, "--size")) size = v;
         else if (!strcmp(a, "--runs")) runs = v;
         else if (!strcmp(a, "--cross")) cross = v;
+        else if (!strcmp(a, "--cross-doc")) doc = v;
+        else if (!strcmp(a, "--cross-doc-rev")) doc_rev = v;
         else if (!strcmp(a, "--threads")) threads = v;
         else return cli_usage_error("report", "unknown option '%s'", a);
         i++;
@@ -336,6 +351,12 @@ int cmd_report(int argc, char **argv)
     if (tri) bargv[bargc++] = "--tri-sweep";
     int rc = cmd_bench(bargc, bargv);   /* its usage errors name 'report' (argv[0]) */
     if (rc) return rc;
+    if (memory) {
+        step(2, nsteps, "accuracy at equal memory", NULL);
+        /* two frames a point: its time is a median of two, the section's cost half the sweep's */
+        if ((rc = report_memory_measure(dir, atoi(runs) < 2 ? atoi(runs) : 2))) return rc;
+    }
+    const rcross x = {cross, doc, doc_rev};
     om_diag d;
     memset(&d, 0, sizeof d);
     om_out page;
@@ -345,6 +366,10 @@ int cmd_report(int argc, char **argv)
     om_status st = path && list && csv ? om_out_open(&page, path, &d) : cli_oom(&d);
     if (st != OM_OK) { free(path); free(list); free(csv); return cli_error(NULL, &d, st); }
     if (!rcsv_load(&bench, csv)) memset(&bench, 0, sizeof bench);
+    rcsv mem;
+    char *mpath = memory ? cli_path(dir, "memory.csv") : NULL;
+    bool have_mem = mpath && rcsv_load(&mem, mpath);
+    free(mpath);
     FILE *f = page.f;
     fprintf(f, "<!DOCTYPE html>\n<html xmlns=\"http://www.w3.org/1999/xhtml\" lang=\"en\">\n<head>\n"
                "<meta charset=\"utf-8\"/>\n<title>ombra report</title>\n<style>\n"
@@ -360,8 +385,17 @@ int cmd_report(int argc, char **argv)
                "img { image-rendering: pixelated; border: 1px solid #888; max-width: 100%%; height: auto; }\n"
                ".strip { display: flex; flex-wrap: wrap; gap: 8px; margin-top: 8px; }\n"
                "figure { margin: 0; font-size: 12px; text-align: center; }\n"
-               "</style>\n</head>\n<body>\n<h1>ombra: hard shadows, accuracy against speed</h1>\n"
-               "<p>Every method renders the same visible samples; accuracy is the share of samples "
+               ".pair { display: flex; gap: 4px; }\n"
+               ".cards { display: flex; flex-wrap: wrap; gap: 12px; align-items: flex-start; }\n"
+               "table.summary td { text-align: left; vertical-align: top; }\n"
+               "table.summary small { color: #555; }\n"
+               "caption { font-weight: bold; text-align: left; padding: 2px 0; }\n"
+               "#summary { border: 1px solid #bbb; padding: 0 12px 12px; background: #fcfcf7; }\n"
+               "#summary h2 { margin-top: 0.5em; }\n"
+               ".anim img { border-color: #444; }\n"
+               "</style>\n</head>\n<body>\n<h1>ombra: hard shadows, accuracy against speed</h1>\n");
+    report_summary(f, bench.rows ? &bench : NULL, have_mem ? &mem : NULL, &x);
+    fprintf(f, "<p>Every method renders the same visible samples; accuracy is the share of samples "
                "whose binary shadow state differs from the exact reference (<code>ref</code>). "
                "Times are medians of %s frames, each on %u thread%s (<code>--threads</code>; "
                "the <code>threads</code> column of <code>bench.csv</code> says how many jobs "
@@ -382,7 +416,7 @@ int cmd_report(int argc, char **argv)
     }
     fprintf(f, ".</p>\n");
     memcpy(list, scenes, strlen(scenes) + 1);
-    int k = 2;
+    int k = 2 + memory;
     for (char *name = strtok(list, ","); name && !rc; name = strtok(NULL, ","), k++) {
         uint32_t sw, sh;
         cli_scene_size(name, &sw, &sh);   /* bench has checked it */
@@ -397,12 +431,8 @@ int cmd_report(int argc, char **argv)
                    "the triangles that reach them.</p>\n");
         inline_file(f, dir, "triangles.svg", inline_svg);
     }
-    if (memory && !rc) {
-        step(nsteps - 2, nsteps, "accuracy at equal memory", NULL);
-        /* two frames a point: its time is a median of two, the section's cost half the sweep's */
-        rc = report_memory(f, atoi(runs) < 2 ? atoi(runs) : 2);
-    }
-    if (!rc) report_machines(f, cross);
+    if (have_mem && !rc) report_memory(f, &mem);
+    if (!rc) report_machines(f, &x);
     char *stab = cli_path(dir, "stability.csv");
     rcsv sc;
     if (!rc) step(nsteps - 1, nsteps, "stability strips and crops, from ", stab);
@@ -423,6 +453,7 @@ int cmd_report(int argc, char **argv)
     else if ((st = om_out_commit(outs, 1, &d)) != OM_OK) rc = cli_error(NULL, &d, st);
     if (!rc) printf("wrote %s\n", path);
     rcsv_free(&bench);
+    if (have_mem) rcsv_free(&mem);
     free(csv);
     free(path);
     free(list);

@@ -55,14 +55,46 @@ void report_outline(uint8_t *rgb, uint32_t W, uint32_t H, uint32_t x0, uint32_t 
  * tests/stability/CASE.scene when it is there). */
 void report_stability(FILE *f, const rcsv *sc);
 
-/* The equal-memory section (report_memory.c): per budget of 64 KiB to 16 MiB, each
- * method's best setting that fits, its mismatch share and time (medians of `runs`
- * frames), as a chart and a table. Returns 0, or the exit status of a failure. */
-int report_memory(FILE *f, int runs);
+/* The equal-memory section (report_memory.c), in two steps, so the summary at the top
+ * of the page can use what it measured: report_memory_measure renders, per scene and
+ * budget (all the arenas together), the settings of each method that use the most of
+ * it and writes DIR/memory.csv (one row a setting measured, its mismatch share and
+ * time, the method's best marked; a row "does not fit" with the least it needs);
+ * report_memory draws a chart and a table per scene from it. Returns 0, or the exit
+ * status of a failure. The scenes and budgets of memory.csv, in their order: */
+int report_memory_measure(const char *dir, int runs);
+void report_memory(FILE *f, const rcsv *mem);
+size_t report_memory_scenes(const rcsv *c, const char **names, size_t max);
+size_t report_memory_budgets(const rcsv *c, const char *scene, double *budgets, size_t max);
 
-/* The small-machines section (report_machines.c), from CROSS/m4.csv and
- * CROSS/m4-size.csv as make cross-test writes them; a line naming that command for
- * each file that is not there. */
-void report_machines(FILE *f, const char *cross);
+/* What the page says about Cortex-M4 firmware, per method: its code, its whole
+ * footprint on the small scene at 160x120 and its instructions a frame there, and the
+ * frames a second they make at CHIP_MHZ and CHIP_CPI (assumed: QEMU counts
+ * instructions, not cycles). From CROSS/m4-methods.csv where `make cross-test` wrote
+ * it, else from the tables it last wrote into the firmware's README (`doc`). */
+#define CHIP_MHZ 168
+#define CHIP_CPI 1.25
+typedef struct rchip { char method[32]; double text, whole, instructions, fps; } rchip;
+typedef struct rcross {
+    const char *dir;        /* where make cross-test writes its CSVs (out/cross) */
+    const char *doc;        /* the firmware README (platform/cortex-m/README.md) */
+    const char *doc_rev;    /* the commit that last changed it, as the caller found it */
+} rcross;
+/* Fills up to max chips; *from says which: "csv" or "doc" (NULL: neither is there). */
+size_t report_chips(const rcross *x, rchip *out, size_t max, const char **from);
+
+/* The small-machines section (report_machines.c), from the CSVs of x->dir as make
+ * cross-test writes them, or, without them, the firmware README's tables labelled with
+ * its commit, and how to refresh them. */
+void report_machines(FILE *f, const rcross *x);
+
+/* The decision summary at the top of the page (report_summary.c): from this run's
+ * memory.csv and bench.csv, per scene and budget the fastest setting that meets each
+ * accuracy (exact, 0.1%, 1% wrong), and the chips' table; every cell links to the
+ * chart or table it comes from. */
+void report_summary(FILE *f, const rcsv *bench, const rcsv *mem, const rcross *x);
+
+/* The anchor of a scene's chart: "chart-NAME-KIND" (KIND: time, bytes, first). */
+void report_chart_id(char *buf, size_t n, const char *scene, const char *kind);
 
 #endif

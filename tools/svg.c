@@ -1,8 +1,12 @@
 /* svg.c — see svg.h. Layout: 800 x 460, the plot inset for the axes on the left and
  * below and the legend on the right. Point labels are placed greedily, nearest spot
- * first, never over another label or a point: a dense cluster gets leader lines
- * rather than a pile of text. */
+ * first, never over another label: a dense cluster gets leader lines rather than a
+ * pile of text, and a label with no free spot left is not drawn but listed under the
+ * plot. A series' colour and marker follow the method's place in the registry (so a
+ * method looks the same on every chart); points at 0 on a log axis sit in a lane per
+ * series, so exact methods at the same time stay apart. */
 #include "svg.h"
+#include "ombra.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -16,9 +20,38 @@
 #define BOTTOM 58
 #define LABEL_FONT 10
 #define MAX_BOXES 1024
+#define NSTYLE 10
+#define LANE 9.0   /* px between the zero row's lanes */
 
-static const char *const colors[] = {"#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd",
-                                     "#8c564b", "#e377c2", "#17becf"};
+static const char *const colors[NSTYLE] = {"#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd",
+                                           "#8c564b", "#e377c2", "#17becf", "#7f7f7f", "#bcbd22"};
+
+/* A series' style: the method's index in the registry, else its place on the chart. */
+static size_t style_of(const svg_series *s, size_t k)
+{
+    const om_method *m = om_method_find(s[k].name);
+    for (size_t i = 0; m && i < om_method_count(); i++)
+        if (om_method_at(i) == m) return i % NSTYLE;
+    return k % NSTYLE;
+}
+
+/* A marker: five shapes, filled, then the same hollow. */
+static void marker(FILE *f, size_t style, double X, double Y, const char *cls)
+{
+    const char *col = colors[style];
+    const double r = 4.6;
+    fprintf(f, "<path class=\"%s\" fill=\"%s\" stroke=\"%s\" stroke-width=\"%s\" d=\"", cls,
+            style < 5 ? col : "white", col, style < 5 ? "0.6" : "1.8");
+    switch (style % 5) {
+    case 0: fprintf(f, "M%.1f %.1fa%.1f %.1f 0 1 0 %.1f 0a%.1f %.1f 0 1 0 %.1f 0Z", X - r * 0.85, Y, r * 0.85,
+                    r * 0.85, 2 * r * 0.85, r * 0.85, r * 0.85, -2 * r * 0.85); break;
+    case 1: fprintf(f, "M%.1f %.1fh%.1fv%.1fh%.1fZ", X - r * 0.75, Y - r * 0.75, 1.5 * r, 1.5 * r, -1.5 * r); break;
+    case 2: fprintf(f, "M%.1f %.1fL%.1f %.1fL%.1f %.1fZ", X, Y - r, X + r, Y + r * 0.75, X - r, Y + r * 0.75); break;
+    case 3: fprintf(f, "M%.1f %.1fL%.1f %.1fL%.1f %.1fL%.1f %.1fZ", X, Y - r * 1.1, X + r, Y, X, Y + r * 1.1, X - r, Y); break;
+    default: fprintf(f, "M%.1f %.1fL%.1f %.1fL%.1f %.1fZ", X, Y + r, X + r, Y - r * 0.75, X - r, Y - r * 0.75); break;
+    }
+    fprintf(f, "\">");
+}
 
 void svg_escape(FILE *f, const char *t)
 {
@@ -98,6 +131,7 @@ static void fit(axis *a, const svg_series *s, size_t ns, bool is_x)
     for (size_t k = 0; k < ns; k++)
         for (size_t i = 0; i < s[k].n; i++) {
             double v = is_x ? s[k].x[i] : s[k].y[i];
+            if (isnan(v)) continue;   /* a missing point: no y, its x still on the axis */
             if (a->log && !(v > 0)) { a->zero = true; continue; }
             if (v < lo) lo = v;
             if (v > hi) hi = v;
@@ -204,7 +238,7 @@ static void ticks(FILE *f, const axis *a, bool is_x)
 
 /* What a label must keep clear of: other labels and points, and (softly: given up
  * before a label is) the spread whiskers. */
-typedef struct box { double x0, y0, x1, y1; bool soft; } box;
+typedef struct box { double x0, y0, x1, y1; bool soft, text; } box;
 
 static bool overlaps(const box *a, const box *b)
 {
@@ -213,13 +247,15 @@ static bool overlaps(const box *a, const box *b)
 
 /* Places one label near (x, y): the first of the candidate spots, nearest first, that
  * stays inside the plot and clear of every box so far (then clear of all but the
- * whiskers; at last, the nearest spot inside the plot, so no point goes unlabelled);
- * writes it, with a leader line when it sits away from its point. */
-static void place_label(FILE *f, const char *text, double x, double y, const char *col, box *boxes,
+ * whiskers; then of the other labels only, so a point may be covered but no text);
+ * writes it, with a leader line when it sits away from its point. Returns false, and
+ * writes nothing, when no spot is clear of the other labels. */
+static bool place_label(FILE *f, const char *text, double x, double y, const char *col, box *boxes,
                         size_t *nb)
 {
-    enum { NDIR = 16, NRING = 10 };
-    const double w = 0.58 * LABEL_FONT * (double)strlen(text), h = LABEL_FONT + 1;
+    enum { NDIR = 16, NRING = 24 };
+    /* wide enough for the widest sans-serif the page may fall back on */
+    const double w = 0.62 * LABEL_FONT * (double)strlen(text) + 2, h = LABEL_FONT + 2;
     for (int pass = 0; pass < 3; pass++)
         for (int ring = 1; ring <= NRING; ring++)
             for (int d = 0; d < NDIR; d++) {
@@ -234,11 +270,12 @@ static void place_label(FILE *f, const char *text, double x, double y, const cha
                 b.x1 = b.x0 + w;
                 b.y1 = b.y0 + h;
                 b.soft = false;
+                b.text = true;
                 if (b.x0 < LEFT + 2 || b.x1 > WIDTH - RIGHT - 2 || b.y0 < TOP + 2 || b.y1 > HEIGHT - BOTTOM - 2)
                     continue;
                 bool clear = true;
-                for (size_t i = 0; i < *nb && clear && pass < 2; i++)
-                    clear = (pass == 1 && boxes[i].soft) || !overlaps(&b, &boxes[i]);
+                for (size_t i = 0; i < *nb && clear; i++)
+                    clear = (pass >= 1 && boxes[i].soft) || (pass == 2 && !boxes[i].text) || !overlaps(&b, &boxes[i]);
                 if (!clear) continue;
                 if (ring > 1) {
                     double lx = b.x0 > x ? b.x0 : b.x1 < x ? b.x1 : (b.x0 + b.x1) / 2;
@@ -246,13 +283,15 @@ static void place_label(FILE *f, const char *text, double x, double y, const cha
                     fprintf(f, "<line class=\"leader\" x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" "
                                "stroke=\"%s\" stroke-width=\"0.6\" opacity=\"0.7\"/>\n", x, y, lx, ly, col);
                 }
+                /* the baseline a little above the box's bottom: descenders stay inside */
                 fprintf(f, "<text class=\"label\" x=\"%.1f\" y=\"%.1f\" font-size=\"%d\" fill=\"%s\">",
-                        b.x0, b.y1 - 2, LABEL_FONT, col);
+                        b.x0 + 1, b.y1 - 3, LABEL_FONT, col);
                 svg_escape(f, text);
                 fprintf(f, "</text>\n");
                 if (*nb < MAX_BOXES) boxes[(*nb)++] = b;
-                return;
+                return true;
             }
+    return false;
 }
 
 typedef struct pt { double x, y; } pt;
@@ -296,13 +335,15 @@ static void front(FILE *f, const axis *ax, const axis *ay, const svg_series *s, 
     }
 }
 
-static void legend(FILE *f, const svg_chart *c, const svg_series *s, size_t ns)
+/* The legend: each series' marker and name, the front, the whiskers, the marks of
+ * points that are missing, and the labels that found no room (as "series: label").
+ * Returns where it ends. */
+static double legend(FILE *f, const svg_chart *c, const svg_series *s, size_t ns, bool missing)
 {
     double ly = TOP + 14;
     for (size_t k = 0; k < ns; k++, ly += 18) {
-        const char *col = colors[k % (sizeof colors / sizeof colors[0])];
-        fprintf(f, "<circle cx=\"%d\" cy=\"%.1f\" r=\"5\" fill=\"%s\"/>\n", WIDTH - RIGHT + 16, ly - 4, col);
-        fprintf(f, "<text x=\"%d\" y=\"%.1f\" font-size=\"12\">", WIDTH - RIGHT + 26, ly);
+        marker(f, style_of(s, k), WIDTH - RIGHT + 16, ly - 4, "key");
+        fprintf(f, "</path>\n<text x=\"%d\" y=\"%.1f\" font-size=\"12\">", WIDTH - RIGHT + 26, ly);
         svg_escape(f, s[k].name);
         fprintf(f, "</text>\n");
     }
@@ -310,7 +351,7 @@ static void legend(FILE *f, const svg_chart *c, const svg_series *s, size_t ns)
     if (c->pareto) {
         fprintf(f, "<line x1=\"%d\" y1=\"%.1f\" x2=\"%d\" y2=\"%.1f\" stroke=\"#333\" stroke-width=\"2\" "
                    "stroke-opacity=\"0.45\"/>\n", WIDTH - RIGHT + 6, ly - 4, WIDTH - RIGHT + 24, ly - 4);
-        fprintf(f, "<circle cx=\"%d\" cy=\"%.1f\" r=\"5\" fill=\"none\" stroke=\"#333\" stroke-width=\"1.5\" "
+        fprintf(f, "<circle cx=\"%d\" cy=\"%.1f\" r=\"7\" fill=\"none\" stroke=\"#333\" stroke-width=\"1.5\" "
                    "stroke-opacity=\"0.6\"/>\n", WIDTH - RIGHT + 15, ly - 4);
         fprintf(f, "<text class=\"front-name\" x=\"%d\" y=\"%.1f\" font-size=\"11\">Pareto front (all methods)</text>\n",
                 WIDTH - RIGHT + 26, ly);
@@ -322,7 +363,24 @@ static void legend(FILE *f, const svg_chart *c, const svg_series *s, size_t ns)
         fprintf(f, "<line x1=\"%d\" y1=\"%.1f\" x2=\"%d\" y2=\"%.1f\" stroke=\"#555\"/>\n", WIDTH - RIGHT + 8,
                 ly - 4, WIDTH - RIGHT + 22, ly - 4);
         fprintf(f, "<text x=\"%d\" y=\"%.1f\" font-size=\"11\">min-max of the runs</text>\n", WIDTH - RIGHT + 26, ly);
+        ly += 18;
     }
+    if (missing) {
+        fprintf(f, "<text x=\"%d\" y=\"%.1f\" font-size=\"13\" fill=\"#555\">&#215;</text>\n", WIDTH - RIGHT + 11, ly);
+        fprintf(f, "<text x=\"%d\" y=\"%.1f\" font-size=\"11\">no setting fits (line broken)</text>\n",
+                WIDTH - RIGHT + 26, ly);
+        ly += 18;
+    }
+    return ly;
+}
+
+/* Where point i of series k is drawn: on a log axis a point at 0 sits on the zero row,
+ * in its series' lane. */
+static double pos_y(const axis *ay, const svg_series *s, size_t k, size_t i, const double *lane)
+{
+    const double y0 = HEIGHT - BOTTOM, y1 = TOP;
+    double Y = px(ay, s[k].y[i], y0, y1);
+    return ay->log && !(s[k].y[i] > 0) ? Y + lane[k] : Y;
 }
 
 bool svg_write(FILE *f, const svg_chart *c, const svg_series *s, size_t ns)
@@ -336,7 +394,7 @@ bool svg_write_inline(FILE *f, const svg_chart *c, const svg_series *s, size_t n
     axis ax = {0, 1, 0, 0, c->logx, false, c->xunit}, ay = {0, 1, 0, 0, c->logy, false, c->yunit};
     fit(&ax, s, ns, true);
     fit(&ay, s, ns, false);
-    const double x0 = LEFT, x1 = WIDTH - RIGHT, y0 = HEIGHT - BOTTOM, y1 = TOP;
+    const double x0 = LEFT, x1 = WIDTH - RIGHT, y1 = TOP;
     fprintf(f, "<svg xmlns=\"http://www.w3.org/2000/svg\" class=\"chart\" width=\"%d\" height=\"%d\" "
                "viewBox=\"0 0 %d %d\" font-family=\"sans-serif\">\n", WIDTH, HEIGHT, WIDTH, HEIGHT);
     fprintf(f, "<rect width=\"%d\" height=\"%d\" fill=\"white\"/>\n", WIDTH, HEIGHT);
@@ -355,52 +413,102 @@ bool svg_write_inline(FILE *f, const svg_chart *c, const svg_series *s, size_t n
     svg_escape(f, c->ylabel);
     fprintf(f, "%s</text>\n", c->logy ? " (log scale)" : "");
     if (c->pareto) front(f, &ax, &ay, s, ns);
-    /* the points first (so labels keep clear of all of them), lines and whiskers under */
+    /* the zero row's lanes: one per series with a point at 0, centred on the row */
+    static double lane[64];
+    size_t nl = 0, nz = 0;
+    for (size_t k = 0; k < ns && k < 64; k++)
+        for (size_t i = 0; i < s[k].n; i++)
+            if (ay.log && !(s[k].y[i] > 0) && !isnan(s[k].y[i])) { nz++; break; }
+    const double step = nz > 1 && LANE * (double)(nz - 1) > 30 ? 30 / (double)(nz - 1) : LANE;
+    for (size_t k = 0; k < ns && k < 64; k++) {
+        bool z = false;
+        for (size_t i = 0; i < s[k].n; i++) z |= ay.log && !(s[k].y[i] > 0) && !isnan(s[k].y[i]);
+        lane[k] = z ? ((double)nl++ - (double)(nz - 1) / 2) * step : 0;
+    }
+    if (ns > 64) ns = 64;
+    /* the points first (so labels keep clear of all of them), lines and whiskers under;
+     * a line is broken at a missing point, marked by a cross along the top */
     static box boxes[MAX_BOXES];
-    size_t nb = 0;
+    size_t nb = 0, nmiss = 0;
     for (size_t k = 0; k < ns; k++) {
-        const char *col = colors[k % (sizeof colors / sizeof colors[0])];
+        const char *col = colors[style_of(s, k)];
         if (c->lines && s[k].n > 1) {
-            fprintf(f, "<polyline fill=\"none\" stroke=\"%s\" stroke-width=\"1.5\" points=\"", col);
-            for (size_t i = 0; i < s[k].n; i++)
-                fprintf(f, "%.1f,%.1f ", px(&ax, s[k].x[i], x0, x1), px(&ay, s[k].y[i], y0, y1));
-            fprintf(f, "\"/>\n");
+            bool open = false;
+            for (size_t i = 0; i < s[k].n; i++) {
+                if (isnan(s[k].y[i])) {
+                    if (open) fprintf(f, "\"/>\n");
+                    open = false;
+                    continue;
+                }
+                if (!open) fprintf(f, "<polyline class=\"line\" fill=\"none\" stroke=\"%s\" stroke-width=\"1.5\" points=\"", col);
+                open = true;
+                fprintf(f, "%.1f,%.1f ", px(&ax, s[k].x[i], x0, x1), pos_y(&ay, s, k, i, lane));
+            }
+            if (open) fprintf(f, "\"/>\n");
         }
+        bool missing = false;
         for (size_t i = 0; i < s[k].n; i++) {
-            double X = px(&ax, s[k].x[i], x0, x1), Y = px(&ay, s[k].y[i], y0, y1);
+            double X = px(&ax, s[k].x[i], x0, x1);
+            if (isnan(s[k].y[i])) {
+                double Y = y1 + 9 + 14.0 * (double)nmiss;
+                char bx[48];
+                svg_format(bx, sizeof bx, s[k].x[i], c->xunit);
+                fprintf(f, "<text class=\"missing\" x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\" font-size=\"12\" "
+                           "fill=\"%s\">&#215;<title>", X, Y + 4, col);
+                svg_escape(f, s[k].name);
+                fprintf(f, ": no setting fits at %s</title></text>\n", bx);
+                if (nb < MAX_BOXES) boxes[nb++] = (box){X - 4.5, Y - 4.5, X + 4.5, Y + 4.5, false, false};
+                missing = true;
+                continue;
+            }
+            double Y = pos_y(&ay, s, k, i, lane);
             if (s[k].xlo && s[k].xhi) {
                 double a = px(&ax, s[k].xlo[i], x0, x1), b = px(&ax, s[k].xhi[i], x0, x1);
                 fprintf(f, "<path class=\"spread\" stroke=\"%s\" stroke-width=\"1.2\" fill=\"none\" "
                            "d=\"M%.1f %.1fH%.1fM%.1f %.1fV%.1fM%.1f %.1fV%.1f\"/>\n",
                         col, a, Y, b, a, Y - 3, Y + 3, b, Y - 3, Y + 3);
-                if (nb < MAX_BOXES) boxes[nb++] = (box){a - 1, Y - 3.5, b + 1, Y + 3.5, true};
+                if (nb < MAX_BOXES) boxes[nb++] = (box){a - 1, Y - 3.5, b + 1, Y + 3.5, true, false};
             }
-            if (nb < MAX_BOXES) boxes[nb++] = (box){X - 4.5, Y - 4.5, X + 4.5, Y + 4.5, false};
+            if (nb < MAX_BOXES) boxes[nb++] = (box){X - 4.5, Y - 4.5, X + 4.5, Y + 4.5, false, false};
         }
+        nmiss += missing;
     }
     for (size_t k = 0; k < ns; k++) {
-        const char *col = colors[k % (sizeof colors / sizeof colors[0])];
         for (size_t i = 0; i < s[k].n; i++) {
-            fprintf(f, "<circle class=\"point\" cx=\"%.1f\" cy=\"%.1f\" r=\"4\" fill=\"%s\">",
-                    px(&ax, s[k].x[i], x0, x1), px(&ay, s[k].y[i], y0, y1), col);
+            if (isnan(s[k].y[i])) continue;
+            marker(f, style_of(s, k), px(&ax, s[k].x[i], x0, x1), pos_y(&ay, s, k, i, lane), "point");
             char bx[48], by[48];
             svg_format(bx, sizeof bx, s[k].x[i], c->xunit);
             svg_format(by, sizeof by, s[k].y[i], c->yunit);
             fprintf(f, "<title>");
             svg_escape(f, s[k].name);
             if (s[k].labels && s[k].labels[i]) { fputc(' ', f); svg_escape(f, s[k].labels[i]); }
-            fprintf(f, ": %s, %s</title></circle>\n", bx, by);
+            fprintf(f, ": %s, %s</title></path>\n", bx, by);
         }
     }
-    /* labels after every point is known, series by series */
+    /* labels after every point is known, series by series; those with no room left
+     * are listed under the legend */
+    static char unplaced[MAX_BOXES][64];
+    size_t nu = 0;
     for (size_t k = 0; k < ns; k++) {
-        const char *col = colors[k % (sizeof colors / sizeof colors[0])];
+        const char *col = colors[style_of(s, k)];
         for (size_t i = 0; s[k].labels && i < s[k].n; i++)
-            if (s[k].labels[i] && s[k].labels[i][0])
-                place_label(f, s[k].labels[i], px(&ax, s[k].x[i], x0, x1), px(&ay, s[k].y[i], y0, y1), col,
-                            boxes, &nb);
+            if (s[k].labels[i] && s[k].labels[i][0] && !isnan(s[k].y[i]) &&
+                !place_label(f, s[k].labels[i], px(&ax, s[k].x[i], x0, x1), pos_y(&ay, s, k, i, lane), col,
+                             boxes, &nb) && nu < MAX_BOXES)
+                snprintf(unplaced[nu++], sizeof unplaced[0], "%s %s", s[k].name, s[k].labels[i]);
     }
-    legend(f, c, s, ns);
+    double ly = legend(f, c, s, ns, nmiss > 0);
+    if (nu) {
+        fprintf(f, "<text class=\"label-note\" x=\"%d\" y=\"%.1f\" font-size=\"10\">no room to label:</text>\n",
+                WIDTH - RIGHT + 8, ly);
+        for (size_t i = 0; i < nu && ly + 13 < HEIGHT - 4; i++) {
+            ly += 13;
+            fprintf(f, "<text class=\"label-note\" x=\"%d\" y=\"%.1f\" font-size=\"10\">", WIDTH - RIGHT + 8, ly);
+            svg_escape(f, unplaced[i]);
+            fprintf(f, "</text>\n");
+        }
+    }
     fprintf(f, "</svg>\n");
     return !ferror(f);
 }
