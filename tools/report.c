@@ -198,6 +198,14 @@ static void scene_about(FILE *f, const char *name)
         fprintf(f, "<p>The built-in default scene: a few solids on a plane under a spot light.</p>\n");
         return;
     }
+    if (!strcmp(name, "town")) {
+        fprintf(f, "<p>The built-in town (<code>ombra scene --town</code>): houses, towers, walls, "
+                   "lamps and trees along streets over a ground a kilometre across, seen from eye "
+                   "height down the main street under a low sun: the case cascaded shadow maps are "
+                   "made for, and the comparison of the Rectilinear Texture Warping paper's "
+                   "section 6.4.</p>\n");
+        return;
+    }
     if (!strncmp(name, "random-", 7)) {
         fprintf(f, "<p><code>%s</code>: random triangles of one constant total area in a box above a "
                    "plane (the Alias-Free Shadow Maps paper's Table 1): the more there are, the "

@@ -36,6 +36,7 @@ static const struct mscene { const char *scene; uint32_t w, h; size_t budgets[NB
 typedef struct knobs { const char *method, *a, *av, *b, *bv; } knobs;
 static const knobs cands[] = {
     {"sm", "map", "16 32 64 128 256 512 1024 2048 4096", NULL, NULL},
+    {"csm", "csm.map", "8 16 32 64 128 256 512 1024 2048", NULL, NULL},
     {"asm", "asm.root", "64 128 256 512 1024", "asm.cap", "16384 65536 262144 1048576 4194304 16777216"},
     {"rtw", "map", "32 64 128 256 512 1024 2048", NULL, NULL},
     {"spsm", "map", "16 32 64 128 256 512 1024 2048", NULL, NULL},
