@@ -36,12 +36,18 @@ static const char moving_scene[] =
 
 /* Frame f's pose: the keys at t = f / 20, and the first crate turned and moved by the
  * host (mirrored on odd frames, so its triangles' winding turns too; every third frame
- * 3 units away, so the tiles of its old pose are not those of its new one). */
+ * 3 units away, so the tiles of its old pose are not those of its new one; on even
+ * frames posed first somewhere no frame sees, so that what a kept state must undo is
+ * the pose two moves back, not the last one's). */
 static void pose_frame(om_scene *s, uint32_t f)
 {
     CHECK_OK(om_scene_pose_at(s, 0.05f * (float)f, NULL));
     uint32_t crate;
     CHECK_OK(om_object_find(s, "crate", &crate));
+    if (f % 2 == 0) {
+        const om_mat4 away = {{1, 0, 0, 4.5f, 0, 1, 0, 0, 0, 0, 1, -2.5f, 0, 0, 0, 1}};
+        CHECK_OK(om_object_pose(s, crate, &away, NULL));
+    }
     const float a = 0.13f * (float)f, c = cosf(a), sn = sinf(a), mx = (f & 1) ? -1.0f : 1.0f;
     const float jump = f % 3 ? 0.0f : -3.0f;   /* every third frame far from the last */
     om_mat4 m = {{mx * c, 0, sn, 0.2f * (float)f + jump, 0, 1, 0, 0, -mx * sn, 0, c, -0.1f * (float)f, 0, 0, 0, 1}};
