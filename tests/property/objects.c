@@ -11,6 +11,7 @@
 #include "../harness.h"
 #include "../jobs_util.h"
 #include "../../platform/platform.h"
+#include "../../engine/shadow/asm/asm.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -56,14 +57,16 @@ static void pose_frame(om_scene *s, uint32_t f)
 
 static om_vec3 mk3(float x, float y, float z) { om_vec3 v = {x, y, z}; return v; }
 
-/* asm's reference: every object's old box made the whole world, so every tile is
- * drawn again in this frame. */
-static void everything_moved(om_scene *s)
+/* asm's reference: every object moved, and the box asm's tiles hold it in (its
+ * state's `drawn`) made the whole world, so every tile is drawn again, whole, in this
+ * frame. */
+static void everything_moved(om_scene *s, void *asm_state)
 {
+    om__asm_state *m = (om__asm_state *)asm_state;
     for (uint32_t i = 0; i < s->nobjects; i++) {
-        s->objects[i].old_lo = mk3(-1e7f, -1e7f, -1e7f);
-        s->objects[i].old_hi = mk3(1e7f, 1e7f, 1e7f);
         s->objects[i].moved = ++s->change;
+        m->drawn[2 * i] = mk3(-1e7f, -1e7f, -1e7f);
+        m->drawn[2 * i + 1] = mk3(1e7f, 1e7f, 1e7f);
     }
 }
 
@@ -140,7 +143,7 @@ static void moved_is_baked(void)
                             ha = runner_frame(&ra, &a.s, rows, pools[k], threads[k]);
                             if (is_asm) {   /* the same frames, every tile redrawn */
                                 pose_frame(&b.s, f);
-                                everything_moved(&b.s);
+                                everything_moved(&b.s, rb.state);
                                 hb = runner_frame(&rb, &b.s, rows, pools[k], threads[k]);
                                 CHECK_MSG(ha == hb, "asm: frame %u of %u, %u threads, strips %u, least %d: "
                                           "its redrawn tiles are not new ones", f, frames[fi], threads[k], rows, least);

@@ -292,9 +292,12 @@ static uint32_t gather_cells(const om__asm_state *m, const om__asm_rs *rs, float
 /* Renders texels [ox, ox + tile) x [oy, oy + tile) of level `level`'s grid into a
  * tile's depth and ids, from the triangles whose light bounds meet the region. The light's clip space is composed with the window that maps the
  * region's tile to [-1, 1] (x' = s x + k w), so the engine's rasterizer, clipping and
- * fill rule apply unchanged at any depth of the tree. */
+ * fill rule apply unchanged at any depth of the tree. Only the tile's texels
+ * [wx0, wx1) x [wy0, wy1) are written, from the triangles that meet them: a texel
+ * depends on nothing but the triangles whose bounds hold its centre, so a part drawn
+ * again is what the whole tile drawn again holds there. */
 static void render(const om__asm_state *m, const om__asm_rs *rs, uint32_t level, uint32_t ox, uint32_t oy,
-                   uint32_t *depth, uint16_t *id16, uint32_t *id32)
+                   const uint32_t win[4], uint32_t *depth, uint16_t *id16, uint32_t *id32)
 {
     const om__asm_layout *l = &m->tree.lay;
     const om_scene *s = m->scene;
@@ -304,8 +307,8 @@ static void render(const om__asm_state *m, const om__asm_rs *rs, uint32_t level,
     const double ky = 1.0 - s_ + 2.0 * (double)oy / (double)T;
     /* the region in base texels, one texel of margin against rounding */
     const double ic = m->inv_scale[level];
-    const float u0 = (float)(((double)ox - 1.0) * ic), u1 = (float)(((double)ox + T + 1.0) * ic);
-    const float v0 = (float)(((double)oy - 1.0) * ic), v1 = (float)(((double)oy + T + 1.0) * ic);
+    const float u0 = (float)(((double)ox + win[0] - 1.0) * ic), u1 = (float)(((double)ox + win[2] + 1.0) * ic);
+    const float v0 = (float)(((double)oy + win[1] - 1.0) * ic), v1 = (float)(((double)oy + win[3] + 1.0) * ic);
     om_target tg = {T, T, 0, T, rs->sdepth, rs->sid};
     om__target_clear(&tg);
     om_raster r = {&tg, OM_RASTER_DEPTH_ID, NULL, NULL, NULL, NULL, 0, false, NULL, NULL, NULL, NULL, 0, 0, NULL, 0};
@@ -356,12 +359,15 @@ static void render(const om__asm_state *m, const om__asm_rs *rs, uint32_t level,
             render_tri(&r, q, s_, kx, ky, t);
         }
     }
-    const size_t t2 = (size_t)T * T;
-    memcpy(depth, rs->sdepth, t2 * sizeof *depth);
-    if (id16)
-        for (size_t i = 0; i < t2; i++) id16[i] = rs->sid[i] == OM_NO_TRI ? (uint16_t)0xFFFFu : (uint16_t)rs->sid[i];
-    else
-        memcpy(id32, rs->sid, t2 * sizeof *id32);
+    for (uint32_t y = win[1]; y < win[3]; y++) {
+        const size_t i0 = (size_t)y * T + win[0], n = win[2] - win[0];
+        memcpy(depth + i0, rs->sdepth + i0, n * sizeof *depth);
+        if (id16)
+            for (size_t i = i0; i < i0 + n; i++)
+                id16[i] = rs->sid[i] == OM_NO_TRI ? (uint16_t)0xFFFFu : (uint16_t)rs->sid[i];
+        else
+            memcpy(id32 + i0, rs->sid + i0, n * sizeof *id32);
+    }
 }
 
 /* A node's tile depends on nothing but its place and the frame's light and bounds, so
@@ -370,7 +376,32 @@ void om__asm_render_with(om__asm_state *m, uint32_t index, const om__asm_rs *rs)
 {
     om__asm_tile tl;
     om__asm_tile_of(&m->tree, index, &tl);
-    render(m, rs, tl.node->level, tl.node->ox, tl.node->oy, tl.depth, tl.id16, tl.id32);
+    const uint32_t all[4] = {0, 0, tl.size, tl.size};
+    render(m, rs, tl.node->level, tl.node->ox, tl.node->oy, all, tl.depth, tl.id16, tl.id32);
+}
+
+/* The texels of node `index`'s tile that the base-texel rectangles touch (a texel
+ * wider on each side), drawn again. */
+static void render_part(om__asm_state *m, uint32_t index, const float (*rects)[4], uint32_t n)
+{
+    const om__asm_rs rs = {m->sdepth, m->sid, m->cull, m->gbits};
+    om__asm_tile tl;
+    om__asm_tile_of(&m->tree, index, &tl);
+    const double sc = m->tree.lay.scale[tl.node->level], T = (double)tl.size;
+    const double o[2] = {(double)tl.node->ox, (double)tl.node->oy};
+    double w[4] = {T, T, 0, 0};
+    for (uint32_t k = 0; k < n; k++)
+        for (int e = 0; e < 2; e++) {
+            double lo = floor((double)rects[k][e] * sc - o[e]) - 1.0, hi = ceil((double)rects[k][e + 2] * sc - o[e]) + 1.0;
+            lo = !(lo > 0.0) ? 0.0 : lo > T ? T : lo;
+            hi = !(hi > 0.0) ? 0.0 : hi > T ? T : hi;
+            if (hi <= lo) continue;
+            if (lo < w[e]) w[e] = lo;
+            if (hi > w[e + 2]) w[e + 2] = hi;
+        }
+    if (!(w[0] < w[2] && w[1] < w[3])) return;
+    const uint32_t win[4] = {(uint32_t)w[0], (uint32_t)w[1], (uint32_t)w[2], (uint32_t)w[3]};
+    render(m, &rs, tl.node->level, tl.node->ox, tl.node->oy, win, tl.depth, tl.id16, tl.id32);
 }
 
 void om__asm_render_node(om__asm_state *m, uint32_t index)
@@ -487,7 +518,7 @@ static void redraw_moved(om__asm_state *m)
         memcpy(rects[0], all, sizeof all);
         n = 1;
     }
-    om__asm_render_node(m, OM__ASM_ROOT);
+    render_part(m, OM__ASM_ROOT, (const float (*)[4])rects, n);
     m->redrawn++;
     for (uint32_t i = 0; i < t->lay.count; i++) {
         const om__asm_node *nd = om__asm_node_at(t, i);
@@ -497,10 +528,12 @@ static void redraw_moved(om__asm_state *m)
         const float r[4] = {(float)((nd->ox - 1.0) / sc), (float)((nd->oy - 1.0) / sc),
                             (float)((nd->ox + t->lay.tile + 1.0) / sc),
                             (float)((nd->oy + t->lay.tile + 1.0) / sc)};
-        bool meets = false;
-        for (uint32_t k = 0; k < n && !meets; k++) meets = rect_meets(r, rects[k]);
-        if (!meets) continue;
-        om__asm_render_node(m, i);
+        float hit[MOVED_RECTS][4];
+        uint32_t nh = 0;
+        for (uint32_t k = 0; k < n; k++)
+            if (rect_meets(r, rects[k])) memcpy(hit[nh++], rects[k], sizeof hit[0]);
+        if (!nh) continue;
+        render_part(m, i, (const float (*)[4])hit, nh);
         m->redrawn++;
     }
 }
