@@ -26,17 +26,17 @@ ENGINE=$(find engine -name '*.c' | sort | tr '\n' ' ')
 WARN="-std=c99 -Wall -Wextra -Wpedantic -Werror -Iinclude -I$out"
 # What the Makefile passes gcc (clang has no such flag): see its DETERM.
 GX=-fexcess-precision=standard
-# Which cases a build renders (driver.c's OM_CROSS_ONLY: bit 4 * size + case; sizes
-# 160x120, 320x240, 640x480; cases default, default-aa, cloud, stab). x86 renders them
+# Which cases a build renders (driver.c's OM_CROSS_ONLY: bit 5 * size + case; sizes
+# 160x120, 320x240, 640x480; cases default, default-aa, cloud, stab, moving). x86 renders them
 # all; the CPUs under qemu-user the 640x480 ones, where last-bit differences show; the
 # boards, about 100x slower under qemu-system-arm (those without a double FPU, M0, M3
-# and M4, 3-6x slower again), all four at 160x120 and the default scene at 320x240,
+# and M4, 3-6x slower again), all five at 160x120 and the default scene at 320x240,
 # through strips; the M0, the slowest (soft float, Thumb-1), the 160x120 ones, its
 # arithmetic checked at 320x240 by the M3's (soft float too). Builds run in parallel
 # (below), which keeps the whole run within 20 minutes on two cores.
-ALL=0xfff
-BIG=0xf00
-BOARD=0x1f
+ALL=0x7fff
+BIG=0x7c00
+BOARD=0x3f
 
 # The boards' CPUs. The M0 firmware runs on the M3 board (QEMU has no M0 board) with
 # the traps of driver.c on, so that it faults where an M0 would.
@@ -65,8 +65,8 @@ armhf-gcc-O2|same|arm-linux-gnueabihf-gcc|-O2 $GX|qemu-arm -L /usr/arm-linux-gnu
 ppc32-gcc-O2|same|powerpc-linux-gnu-gcc|-O2 $GX|qemu-ppc -L /usr/powerpc-linux-gnu|$BIG
 s390x-gcc-O2|same|s390x-linux-gnu-gcc|-O2 -fexcess-precision=fast|qemu-s390x -L /usr/s390x-linux-gnu|$BIG
 s390x-clang-O0|same|clang|-O0 --target=s390x-linux-gnu|qemu-s390x -L /usr/s390x-linux-gnu|$BIG
-cortex-m0-gcc-O2|board|arm-none-eabi-gcc|-O2 $M0|mps2-an385|0xf
-cortex-m0-clang-O2|board|clang|-O2 $M0|mps2-an385|0xf
+cortex-m0-gcc-O2|board|arm-none-eabi-gcc|-O2 $M0|mps2-an385|0x1f
+cortex-m0-clang-O2|board|clang|-O2 $M0|mps2-an385|0x1f
 cortex-m3-gcc-O2|board|arm-none-eabi-gcc|-O2 $M3|mps2-an385|$BOARD
 cortex-m3-clang-O2|board|clang|-O2 $M3|mps2-an385|$BOARD
 cortex-m4-gcc-O2|board|arm-none-eabi-gcc|-O2 $M4|mps2-an386|$BOARD
@@ -95,9 +95,12 @@ case_names() {
     z=0
     for size in 160x120 320x240 640x480; do
         c=0
-        for cs in default default-aa cloud stab; do
-            if [ $(((m >> (4 * z + c)) & 1)) -eq 1 ]; then
-                if [ "$cs" = stab ]; then echo "stab-t0@$size"; echo "stab-t1@$size"; else echo "$cs@$size"; fi
+        for cs in default default-aa cloud stab moving; do
+            if [ $(((m >> (5 * z + c)) & 1)) -eq 1 ]; then
+                case $cs in
+                    stab|moving) echo "$cs-t0@$size"; echo "$cs-t1@$size" ;;
+                    *) echo "$cs@$size" ;;
+                esac
             fi
             c=$((c + 1))
         done
@@ -300,10 +303,11 @@ IFS='
 '
 
 # Instructions per frame on the Cortex-M4 (driver.c's OM_CROSS_COUNT): every method on
-# the small scene at 160x120 and 320x240 and the default scene at 160x120, strips of 8
-# rows, counted under qemu-system-arm -icount shift=0, with each method's least arena
-# and whole footprint (the driver fails when a footprint on the small scene at 160x120
-# passes 256 KiB). Written to out/cross/m4.csv (the report reads it) with the
+# the small scene at 160x120 and 320x240, its animated variant (the ball rolling: a
+# frame after a move, the pose apart) and the default scene at 160x120, strips of 8
+# rows, counted under qemu-system-arm -icount shift=0, with each method's least arena,
+# whole footprint and first frame (the driver fails when a footprint on the small scene
+# or its animated variant at 160x120 passes 256 KiB). Written to out/cross/m4.csv (the report reads it) with the
 # firmware's sizes in out/cross/m4-size.csv; a table here. Then the Cortex-M7
 # (mps2-an500, double FPU) on the small scene for none, sm and hybrid, in
 # out/cross/m7.csv: what an M7-class chip runs.
@@ -321,18 +325,19 @@ count_cpu() {   # count_cpu NAME FLAGS BOARD [METHODS]
     ok=true
     timeout 900 qemu-system-arm -M "$board" -icount shift=0 -nographic -monitor none -serial none \
         -semihosting-config enable=on,target=native -kernel "$out/$cpu-count" >"$out/$cpu-count.txt" 2>&1 || ok=false
-    { echo "scene,method,width,height,strip_rows,instructions,eye,observe,build,resolve,shade,method_bytes,frame_bytes,scene_bytes,min_bytes,static_bytes,stack_bytes,whole_bytes"
-      awk '$1 == "count" {printf "%s,%s,%s,%s,8", $2, $5, $3, $4; for (i = 6; i <= 18; i++) printf ",%s", $i; print ""}' \
+    { echo "scene,method,width,height,strip_rows,instructions,eye,observe,build,resolve,shade,method_bytes,frame_bytes,scene_bytes,min_bytes,static_bytes,stack_bytes,whole_bytes,first_frame,pose"
+      awk '$1 == "count" {printf "%s,%s,%s,%s,8", $2, $5, $3, $4; for (i = 6; i <= 20; i++) printf ",%s", $i; print ""}' \
           "$out/$cpu-count.txt"; } >"$csv.tmp" && mv "$csv.tmp" "$csv"
     echo "cross: $cpu ($board) instructions per frame, strips of 8 rows ($csv); fps at a clock and CPI in"
     echo "    platform/cortex-m/README.md; bytes: the method's least arena, and the whole footprint (scene,"
     echo "    frame and method arenas' peaks, other .data/.bss, the stack's deepest point), at most 256 KiB"
-    echo "    on the small scene at 160x120:"
+    echo "    on the small scene and its animated variant (moving) at 160x120; the method's first frame"
+    echo "    after its init, and on moving the objects' pose and the view before the frame counted:"
     awk -F, 'function k(n,  s) { s = sprintf("%.0f", n); while (s ~ /[0-9][0-9][0-9][0-9]/) sub(/[0-9][0-9][0-9]($|,)/, ",&", s); return s }
         NR > 1 {
         g = $1 "@" $3 "x" $4
-        if (g != last) { printf "    %-16s %-7s %14s %12s %12s %12s %10s %10s\n", "scene", "method", "instructions", "eye", "shadow", "shade", "least", "whole"; last = g }
-        printf "    %-16s %-7s %14s %12s %12s %12s %10s %10s\n", g, $2, k($6), k($7), k($8 + $9 + $10), k($11), k($15), k($18) }' "$csv"
+        if (g != last) { printf "    %-16s %-7s %14s %12s %12s %12s %10s %10s %14s %10s\n", "scene", "method", "instructions", "eye", "shadow", "shade", "least", "whole", "first frame", "pose"; last = g }
+        printf "    %-16s %-7s %14s %12s %12s %12s %10s %10s %14s %10s\n", g, $2, k($6), k($7), k($8 + $9 + $10), k($11), k($15), k($18), k($19), k($20) }' "$csv"
     $ok || {
         echo "cross: FAIL the $cpu counting firmware: $(grep -v '^count' "$out/$cpu-count.txt" | tail -c 600)"
         return 1

@@ -602,9 +602,10 @@ static void float_bounds_hold(void)
 }
 
 /* The float path (asm.float 1: each sample placed in float, with bounds, the exact
- * double path deciding where they do not) gives the exact path's frames, counters and
- * tree: on close-ups refined to 65,536 texels a side (where float alone could not place
- * samples), with strips, a moving camera, a directional light and a small cap. */
+ * double path deciding where they do not; in the lean mode also each triangle's bounds
+ * for a tile) gives the exact path's frames, counters and tree: on close-ups refined
+ * to 65,536 texels a side (where float alone could not place samples), with strips, a
+ * moving camera, a directional light and a small cap; the lean mode's too. */
 static void float_path_is_exact(void)
 {
     /* the default scene without its camera path, seen from close (bench_asm's views) */
@@ -624,7 +625,7 @@ static void float_path_is_exact(void)
                                        "camera eye 0.8 1.4 2.6 target -1.2 0.0 0.4\n",
                                        "camera eye 0 2.5 12 target 0 0.8 0\n"};
     enum { BW = 160, BH = 120 };
-    static om_term terms[2][BW * BH];
+    static om_term terms[3][BW * BH];
     for (int k = 0; k < 4; k++) {
         h_scene hs;
         if (k < 3) {
@@ -638,30 +639,33 @@ static void float_path_is_exact(void)
                                          "key camera 1 eye 3 3 5 target 0 0 0\n")) {
             return;
         }
-        arun r[2];
+        arun r[3];   /* exact; float; float in the lean mode */
         bool ok = true;
-        for (int j = 0; j < 2; j++) {
+        for (int j = 0; j < 3; j++) {
             om_method_cfg c;
             om_method_cfg_default(&c, om_method_find("asm"));
             CHECK_OK(om_method_cfg_set(&c, "asm.cap", k == 2 ? 200000 : 8u << 20, NULL));
             CHECK_OK(om_method_cfg_set(&c, "asm.work", 4096, NULL));
-            CHECK_OK(om_method_cfg_set(&c, "asm.float", j, NULL));
-            ok = arun_init(&r[j], &hs.s, &c, BW, BH, false) && ok;
+            CHECK_OK(om_method_cfg_set(&c, "asm.float", j > 0, NULL));
+            ok = arun_init(&r[j], &hs.s, &c, BW, BH, j == 2) && ok;
         }
         uint32_t finest = 0;
         for (int f = 0; ok && f < 6; f++) {
-            om_method_stats ms[2];
-            for (int j = 0; j < 2; j++)
+            om_method_stats ms[3];
+            for (int j = 0; j < 3; j++)
                 CHECK_OK(arun_frame(&r[j], k == 3 ? 0.2f * (float)f : 0.0f, 0.0f, f % 2 ? 7 : 0, NULL,
                                     terms[j], &ms[j]));
-            CHECK_MSG(memcmp(terms[0], terms[1], sizeof terms[0]) == 0, "view %d frame %d: terms differ", k, f);
-            for (uint32_t i = 0; i < ms[0].ncounters; i++)
-                CHECK_MSG(ms[0].counters[i] == ms[1].counters[i], "view %d frame %d: %s %u, float %u", k, f,
-                          ms[0].counter_names[i], ms[0].counters[i], ms[1].counters[i]);
+            for (int j = 1; j < 3; j++) {
+                CHECK_MSG(memcmp(terms[0], terms[j], sizeof terms[0]) == 0, "view %d frame %d: terms differ (%s)", k, f,
+                          j == 2 ? "lean" : "float");
+                for (uint32_t i = 0; i < ms[0].ncounters; i++)
+                    CHECK_MSG(ms[0].counters[i] == ms[j].counters[i], "view %d frame %d: %s %u, %s %u", k, f,
+                              ms[0].counter_names[i], ms[0].counters[i], j == 2 ? "lean" : "float", ms[j].counters[i]);
+            }
             finest = counter(&ms[1], "effective resolution");
         }
         if (k < 2) CHECK_MSG(finest >= 65536, "view %d refined to %u only", k, finest);
-        for (int j = 0; j < 2; j++) arun_free(&r[j]);
+        for (int j = 0; j < 3; j++) arun_free(&r[j]);
         h_scene_free(&hs);
     }
 }

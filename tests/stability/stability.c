@@ -3,7 +3,9 @@
  * far light's shadows, grazing light, a memory cap far below the view's needs with a
  * fast camera, the irregular z-buffer's hot spot with a small pool, curved edges
  * without tessellation, shadow fusion and thin geometry, the splits of cascaded maps
- * along a walk through the town). Per method and case: mean and
+ * along a walk through the town) and where objects move (one passing under a lattice,
+ * a spinning fan, a door opening into light: the states kept across frames must
+ * follow them). Per method and case: mean and
  * worst mismatch share against the reference, the same near shadow edges, flicker, the
  * median frame time and the arena's peak bytes, to stdout and a CSV the report shows
  * (with each frame's mismatch share and the frame that flickers most, for its strips).
@@ -64,17 +66,22 @@ static void settings(const char *text, const om_method *m, om_method_cfg *c)
     }
 }
 
+/* The last key's time, of the camera, the light or any object */
 static float end_time(const om_scene *s)
 {
     float t = 0;
     if (s->ncam_keys) t = s->cam_keys[s->ncam_keys - 1].t;
     if (s->nlight_keys && s->light_keys[s->nlight_keys - 1].t > t) t = s->light_keys[s->nlight_keys - 1].t;
+    for (uint32_t k = 0; k < s->nobj_keys; k++)
+        if (s->obj_keys[k].t > t) t = s->obj_keys[k].t;
     return t;
 }
 
-/* Renders `frames` frames of method m with one state (progressive methods refine);
- * masks out; returns 0 when every frame rendered within the arena. */
-static int path(const om_scene *s, const om_method *m, const om_method_cfg *cfg, int frames,
+/* Renders `frames` frames of method m with one state (progressive methods refine),
+ * the objects posed at each frame's time (at time 0 before the state is made, so
+ * every run starts from the same scene); masks out; returns 0 when every frame
+ * rendered within the arena. */
+static int path(om_scene *s, const om_method *m, const om_method_cfg *cfg, int frames,
                 uint8_t *masks, double *ms, size_t *peak)
 {
     size_t mn, full;
@@ -87,13 +94,15 @@ static int path(const om_scene *s, const om_method *m, const om_method_cfg *cfg,
     om_arena_init(&ma, mem, full, "method");
     om_arena_init(&fa, fmem, bench_frame_bytes(NULL, NULL, W, H, 1), "frame");
     void *state;
-    int bad = om_method_init(m, &state, &ma, cfg, s, W, H, &d) != OM_OK;
+    int bad = om_scene_pose_at(s, 0, &d) != OM_OK || om_method_init(m, &state, &ma, cfg, s, W, H, &d) != OM_OK;
     float tend = end_time(s);
     for (int f = 0; f < frames && !bad; f++) {
         om_camera cam;
         om_light light;
         om_view v;
-        om_scene_at(s, frames > 1 ? tend * (float)f / (float)(frames - 1) : 0, &cam, &light);
+        float t = frames > 1 ? tend * (float)f / (float)(frames - 1) : 0;
+        if (om_scene_pose_at(s, t, &d) != OM_OK) { bad = 1; break; }
+        om_scene_at(s, t, &cam, &light);
         cam.width = W;
         cam.height = H;
         if (om_view_init(&v, &cam, &light, s, &d) != OM_OK) { bad = 1; break; }

@@ -90,9 +90,16 @@ static uint64_t cand_count(const om__asm_layout *l)
     return n ? n : 1;
 }
 
+/* Each object's box as the tiles hold it (om__asm_state.drawn); none without objects. */
+static size_t drawn_bytes(const om_scene *s)
+{
+    return s->nobjects ? om_arena_need(om__size_mul(s->nobjects, 2 * sizeof(om_vec3)), 8) : 0;
+}
+
 static size_t asm_need(const om_scene *s, const om__asm_layout *l, bool lean)
 {
-    return om__size_add(om__size_add(om_arena_need(sizeof(om__asm_state), 16), l->arena_bytes),
+    return om__size_add(om__size_add(om__size_add(om_arena_need(sizeof(om__asm_state), 16), l->arena_bytes),
+                                     drawn_bytes(s)),
                         om__size_add(scratch_bytes(l, cand_count(l)), lean ? 0 : scene_bytes(s)));
 }
 
@@ -146,7 +153,13 @@ static om_status asm_init(void **state, om_arena *a, const om_method_cfg *mc, co
     m->centre[0] = m->centre[1] = NULL;
     m->cull = NULL;
     m->gready = false;
+    m->drawn = NULL;
     if ((st = om__asm_tree_init(&m->tree, a, &l, d))) return st;
+    if (s->nobjects) {
+        if ((st = om_arena_alloc(a, (size_t)s->nobjects * 2 * sizeof(om_vec3), 8, &p, d))) return st;
+        m->drawn = (om_vec3 *)p;
+        memset(m->drawn, 0, (size_t)s->nobjects * 2 * sizeof(om_vec3));   /* set at the first build */
+    }
     const size_t t2 = (size_t)l.tile * l.tile;
     uint64_t nc = cand_count(&l);
     if (!lean) {

@@ -287,6 +287,9 @@ typedef struct om__asm_state {
     om__asm_tile cache_tile;
     uint32_t samples, shadowed, analysed, straddling, candidates, rebuilds;
     uint32_t change;       /* the scene's change count the tiles hold */
+    om_vec3 *drawn;        /* per object, lo and hi of its box as the tiles hold it: a
+                              host may move it several times between two frames, and
+                              the scene keeps only the box before its last move */
     uint32_t redrawn;      /* this frame: tiles drawn again where objects moved */
 #if OM_WITH_JOBS
     /* The host's threads for this frame (om__lend, asm_jobs.c), NULL without; the

@@ -76,6 +76,55 @@ static inline bool box_holds_centre(const float *b, double sc)
            holds_integer((double)b[1] * sc - 0.5 - e, (double)b[3] * sc - 0.5 + e);
 }
 
+/* Float-first bounds (asm.float, lean mode, where double is software and tri_box's
+ * double projection of every triangle for every tile is most of a tile's cost): a
+ * box in base texels that holds the one tri_box makes from the same vertices. Each
+ * vertex's light clip x, y, w in float, with a bound on their distance to dapply's
+ * values (a dot product of four terms rounds within 4 * 2^-24 of the sum of their
+ * magnitudes, dapply's within 4 * 2^-53: 1e-6 of it holds both with room), then x / w
+ * and y / w over those intervals, then tri_box's widening and more. false where float
+ * cannot bound the box (a vertex near or behind the light's plane, values out of
+ * range): the exact path decides. A box that holds tri_box's skips a triangle only
+ * where tri_box's would: it misses the region, or holds no texel centre. */
+static bool tri_box_float(const om_mat4 *mt, const om_vec3 p[3], float R, float b[4])
+{
+    const float *a = mt->m;
+    float lo_u = 0, lo_v = 0, hi_u = 0, hi_v = 0;
+    for (int i = 0; i < 3; i++) {
+        float e[3], c[3];
+        for (int r = 0; r < 3; r++) {
+            const int k = r == 2 ? 12 : 4 * r;   /* rows x, y and w */
+            const float t0 = a[k] * p[i].x, t1 = a[k + 1] * p[i].y, t2 = a[k + 2] * p[i].z;
+            c[r] = t0 + t1 + t2 + a[k + 3];
+            e[r] = (om__fabsf(t0) + om__fabsf(t1) + om__fabsf(t2) + om__fabsf(a[k + 3])) * 1e-6f + 1e-30f;
+        }
+        const float wl = c[2] - e[2], wh = c[2] + e[2];
+        /* tri_box's own test of the plane, with the bounds against it */
+        if (!(wl > 1e-6f * (om__fabsf(c[0]) + e[0] + om__fabsf(c[1]) + e[1]) + 1e-30f) || !(wh < 1e30f)) return false;
+        float q[2][2];
+        for (int r = 0; r < 2; r++) {
+            const float xl = c[r] - e[r], xh = c[r] + e[r];
+            float ql = xl / wl < xl / wh ? xl / wl : xl / wh, qh = xh / wl > xh / wh ? xh / wl : xh / wh;
+            q[r][0] = ql - (om__fabsf(ql) * 1e-6f + 1e-30f);
+            q[r][1] = qh + (om__fabsf(qh) * 1e-6f + 1e-30f);
+        }
+        /* u = (x / w + 1) R / 2, v = (1 - y / w) R / 2 */
+        const float u0 = (q[0][0] + 1.0f) * 0.5f * R, u1 = (q[0][1] + 1.0f) * 0.5f * R;
+        const float v0 = (1.0f - q[1][1]) * 0.5f * R, v1 = (1.0f - q[1][0]) * 0.5f * R;
+        if (i == 0 || u0 < lo_u) lo_u = u0;
+        if (i == 0 || v0 < lo_v) lo_v = v0;
+        if (i == 0 || u1 > hi_u) hi_u = u1;
+        if (i == 0 || v1 > hi_v) hi_v = v1;
+    }
+    if (!(lo_u > -1e29f && hi_u < 1e29f && lo_v > -1e29f && hi_v < 1e29f)) return false;
+    /* tri_box widens by 1/256 + 1e-6 |u| and rounds to float; this, by far more */
+    b[0] = lo_u - (1.0f / 128 + om__fabsf(lo_u) * 1e-5f);
+    b[1] = lo_v - (1.0f / 128 + om__fabsf(lo_v) * 1e-5f);
+    b[2] = hi_u + (1.0f / 128 + om__fabsf(hi_u) * 1e-5f);
+    b[3] = hi_v + (1.0f / 128 + om__fabsf(hi_v) * 1e-5f);
+    return true;
+}
+
 /* One triangle into the tile: its clip coordinates composed with the tile's window. */
 static void render_tri(om_raster *r, const om__asm_dvec q[3], double s_, double kx, double ky,
                        uint32_t t)
@@ -243,9 +292,12 @@ static uint32_t gather_cells(const om__asm_state *m, const om__asm_rs *rs, float
 /* Renders texels [ox, ox + tile) x [oy, oy + tile) of level `level`'s grid into a
  * tile's depth and ids, from the triangles whose light bounds meet the region. The light's clip space is composed with the window that maps the
  * region's tile to [-1, 1] (x' = s x + k w), so the engine's rasterizer, clipping and
- * fill rule apply unchanged at any depth of the tree. */
+ * fill rule apply unchanged at any depth of the tree. Only the tile's texels
+ * [wx0, wx1) x [wy0, wy1) are written, from the triangles that meet them: a texel
+ * depends on nothing but the triangles whose bounds hold its centre, so a part drawn
+ * again is what the whole tile drawn again holds there. */
 static void render(const om__asm_state *m, const om__asm_rs *rs, uint32_t level, uint32_t ox, uint32_t oy,
-                   uint32_t *depth, uint16_t *id16, uint32_t *id32)
+                   const uint32_t win[4], uint32_t *depth, uint16_t *id16, uint32_t *id32)
 {
     const om__asm_layout *l = &m->tree.lay;
     const om_scene *s = m->scene;
@@ -255,8 +307,8 @@ static void render(const om__asm_state *m, const om__asm_rs *rs, uint32_t level,
     const double ky = 1.0 - s_ + 2.0 * (double)oy / (double)T;
     /* the region in base texels, one texel of margin against rounding */
     const double ic = m->inv_scale[level];
-    const float u0 = (float)(((double)ox - 1.0) * ic), u1 = (float)(((double)ox + T + 1.0) * ic);
-    const float v0 = (float)(((double)oy - 1.0) * ic), v1 = (float)(((double)oy + T + 1.0) * ic);
+    const float u0 = (float)(((double)ox + win[0] - 1.0) * ic), u1 = (float)(((double)ox + win[2] + 1.0) * ic);
+    const float v0 = (float)(((double)oy + win[1] - 1.0) * ic), v1 = (float)(((double)oy + win[3] + 1.0) * ic);
     om_target tg = {T, T, 0, T, rs->sdepth, rs->sid};
     om__target_clear(&tg);
     om_raster r = {&tg, OM_RASTER_DEPTH_ID, NULL, NULL, NULL, NULL, 0, false, NULL, NULL, NULL, NULL, 0, 0, NULL, 0};
@@ -267,11 +319,17 @@ static void render(const om__asm_state *m, const om__asm_rs *rs, uint32_t level,
     if (m->lean) {
         /* The same triangles in the same order as the fast path below, so the same tile:
          * projections and bounds are made per tile instead of kept per frame. */
+        const bool first = m->cfg.asm_float != 0;
         for (uint32_t t = 0; t < s->ntris; t++) {
             const uint32_t *ix = s->idx + (size_t)t * 3;
             om__asm_dvec q[3];
             float b[4];
-            for (int i = 0; i < 3; i++) q[i] = dapply(&m->view.light_vp, om__sub(s->verts[ix[i]], m->view.origin));
+            om_vec3 p[3];
+            for (int i = 0; i < 3; i++) p[i] = om__sub(s->verts[ix[i]], m->view.origin);
+            if (first && tri_box_float(&m->view.light_vp, p, (float)T, b) &&
+                (!box_meets(b, u0, v0, u1, v1) || !box_holds_centre(b, l->scale[level])))
+                continue;   /* the box that holds tri_box's misses: so would tri_box's */
+            for (int i = 0; i < 3; i++) q[i] = dapply(&m->view.light_vp, p[i]);
             tri_box(q, T, b);
             if (!box_meets(b, u0, v0, u1, v1) || !box_holds_centre(b, l->scale[level])) continue;
             r.cull_back = om__cull_next(&cl, t);
@@ -301,12 +359,15 @@ static void render(const om__asm_state *m, const om__asm_rs *rs, uint32_t level,
             render_tri(&r, q, s_, kx, ky, t);
         }
     }
-    const size_t t2 = (size_t)T * T;
-    memcpy(depth, rs->sdepth, t2 * sizeof *depth);
-    if (id16)
-        for (size_t i = 0; i < t2; i++) id16[i] = rs->sid[i] == OM_NO_TRI ? (uint16_t)0xFFFFu : (uint16_t)rs->sid[i];
-    else
-        memcpy(id32, rs->sid, t2 * sizeof *id32);
+    for (uint32_t y = win[1]; y < win[3]; y++) {
+        const size_t i0 = (size_t)y * T + win[0], n = win[2] - win[0];
+        memcpy(depth + i0, rs->sdepth + i0, n * sizeof *depth);
+        if (id16)
+            for (size_t i = i0; i < i0 + n; i++)
+                id16[i] = rs->sid[i] == OM_NO_TRI ? (uint16_t)0xFFFFu : (uint16_t)rs->sid[i];
+        else
+            memcpy(id32 + i0, rs->sid + i0, n * sizeof *id32);
+    }
 }
 
 /* A node's tile depends on nothing but its place and the frame's light and bounds, so
@@ -315,7 +376,32 @@ void om__asm_render_with(om__asm_state *m, uint32_t index, const om__asm_rs *rs)
 {
     om__asm_tile tl;
     om__asm_tile_of(&m->tree, index, &tl);
-    render(m, rs, tl.node->level, tl.node->ox, tl.node->oy, tl.depth, tl.id16, tl.id32);
+    const uint32_t all[4] = {0, 0, tl.size, tl.size};
+    render(m, rs, tl.node->level, tl.node->ox, tl.node->oy, all, tl.depth, tl.id16, tl.id32);
+}
+
+/* The texels of node `index`'s tile that the base-texel rectangles touch (a texel
+ * wider on each side), drawn again. */
+static void render_part(om__asm_state *m, uint32_t index, const float (*rects)[4], uint32_t n)
+{
+    const om__asm_rs rs = {m->sdepth, m->sid, m->cull, m->gbits};
+    om__asm_tile tl;
+    om__asm_tile_of(&m->tree, index, &tl);
+    const double sc = m->tree.lay.scale[tl.node->level], T = (double)tl.size;
+    const double o[2] = {(double)tl.node->ox, (double)tl.node->oy};
+    double w[4] = {T, T, 0, 0};
+    for (uint32_t k = 0; k < n; k++)
+        for (int e = 0; e < 2; e++) {
+            double lo = floor((double)rects[k][e] * sc - o[e]) - 1.0, hi = ceil((double)rects[k][e + 2] * sc - o[e]) + 1.0;
+            lo = !(lo > 0.0) ? 0.0 : lo > T ? T : lo;
+            hi = !(hi > 0.0) ? 0.0 : hi > T ? T : hi;
+            if (hi <= lo) continue;
+            if (lo < w[e]) w[e] = lo;
+            if (hi > w[e + 2]) w[e + 2] = hi;
+        }
+    if (!(w[0] < w[2] && w[1] < w[3])) return;
+    const uint32_t win[4] = {(uint32_t)w[0], (uint32_t)w[1], (uint32_t)w[2], (uint32_t)w[3]};
+    render(m, &rs, tl.node->level, tl.node->ox, tl.node->oy, win, tl.depth, tl.id16, tl.id32);
 }
 
 void om__asm_render_node(om__asm_state *m, uint32_t index)
@@ -384,9 +470,23 @@ static bool rect_meets(const float *a, const float *b)
     return !(a[2] < b[0] || b[2] < a[0] || a[3] < b[1] || b[3] < a[1]);
 }
 
+/* Each object's box as the tiles now hold it (after a build or a redraw). */
+static void note_drawn(om__asm_state *m, bool all)
+{
+    const om_scene *s = m->scene;
+    if (!m->drawn) return;
+    for (uint32_t i = 0; i < s->nobjects; i++) {
+        const om_object *o = &s->objects[i];
+        if (!all && o->moved <= m->change && m->change <= s->change) continue;
+        m->drawn[2 * i] = o->lo;
+        m->drawn[2 * i + 1] = o->hi;
+    }
+}
+
 /* Objects moved since the tiles were drawn (om_scene.change): every tile whose part of
- * the light's image meets a moved object's box, at its old pose or its new one, is
- * drawn again, the base among them; the rest of the tree and its tiles stay. A tile is
+ * the light's image meets a moved object's box, where the tiles hold it (m->drawn:
+ * however many times it moved since) or where it is now, is drawn again, the base
+ * among them; the rest of the tree and its tiles stay. A tile is
  * a function of its place and the scene, so a redrawn tile is what a new one would be.
  * The boxes' images are kept apart up to MOVED_RECTS of them (two objects far apart
  * redraw their own tiles, not those between them), beyond that as one rectangle. */
@@ -404,20 +504,21 @@ static void redraw_moved(om__asm_state *m)
         for (int k = 0; k < 2; k++) {
             float r[4];
             if (k) box_rect(m, o->lo, o->hi, r);
-            else box_rect(m, o->old_lo, o->old_hi, r);
+            else box_rect(m, m->drawn[2 * i], m->drawn[2 * i + 1], r);
             if (n < MOVED_RECTS) memcpy(rects[n++], r, sizeof r);
             for (int e = 0; e < 4; e++)
                 if (!seen || (e < 2 ? r[e] < all[e] : r[e] > all[e])) all[e] = r[e];
             seen++;
         }
     }
+    note_drawn(m, false);
     m->change = s->change;
     if (!seen) return;
     if (seen > MOVED_RECTS) {   /* too many to keep apart: their union */
         memcpy(rects[0], all, sizeof all);
         n = 1;
     }
-    om__asm_render_node(m, OM__ASM_ROOT);
+    render_part(m, OM__ASM_ROOT, (const float (*)[4])rects, n);
     m->redrawn++;
     for (uint32_t i = 0; i < t->lay.count; i++) {
         const om__asm_node *nd = om__asm_node_at(t, i);
@@ -427,10 +528,12 @@ static void redraw_moved(om__asm_state *m)
         const float r[4] = {(float)((nd->ox - 1.0) / sc), (float)((nd->oy - 1.0) / sc),
                             (float)((nd->ox + t->lay.tile + 1.0) / sc),
                             (float)((nd->oy + t->lay.tile + 1.0) / sc)};
-        bool meets = false;
-        for (uint32_t k = 0; k < n && !meets; k++) meets = rect_meets(r, rects[k]);
-        if (!meets) continue;
-        om__asm_render_node(m, i);
+        float hit[MOVED_RECTS][4];
+        uint32_t nh = 0;
+        for (uint32_t k = 0; k < n; k++)
+            if (rect_meets(r, rects[k])) memcpy(hit[nh++], rects[k], sizeof hit[0]);
+        if (!nh) continue;
+        render_part(m, i, (const float (*)[4])hit, nh);
         m->redrawn++;
     }
 }
@@ -467,6 +570,7 @@ void om__asm_prepare(om__asm_state *m)
         m->built_org = m->view.origin;
         m->built = true;
         m->rebuilds++;
+        note_drawn(m, true);
         m->change = m->scene->change;
     } else if (m->change != m->scene->change) {
         redraw_moved(m);
