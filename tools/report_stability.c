@@ -92,7 +92,7 @@ static void cell(FILE *f, const char *method, const double *v, int n, int flick,
  * as under make stability); the masks of frames last - 1 and last come out, the last
  * frame's pixels when rgb is given, and every frame's mask, one after the other, when
  * all is. */
-static om_status path(const om_scene *s, const om_method *m, const om_method_cfg *cfg, int frames,
+static om_status path(om_scene *s, const om_method *m, const om_method_cfg *cfg, int frames,
                       int last, uint8_t *prev, uint8_t *cur, uint8_t *rgb, uint8_t *all, om_diag *d)
 {
     size_t mn, full, fbytes = cli_frame_rows(NULL, SW, SH, false);
@@ -104,15 +104,22 @@ static om_status path(const om_scene *s, const om_method *m, const om_method_cfg
     om_arena_init(&ma, mem, full, "method");
     om_arena_init(&fa, fmem, fbytes, "frame");
     void *state;
-    st = om_method_init(m, &state, &ma, cfg, s, SW, SH, d);
+    /* as make stability: the objects posed at time 0 for the state, then at each
+     * frame's time; the path runs to the last key of the camera, light or an object */
+    st = om_scene_pose_at(s, 0, d);
+    if (st == OM_OK) st = om_method_init(m, &state, &ma, cfg, s, SW, SH, d);
     float tend = 0;
     if (s->ncam_keys) tend = s->cam_keys[s->ncam_keys - 1].t;
     if (s->nlight_keys && s->light_keys[s->nlight_keys - 1].t > tend) tend = s->light_keys[s->nlight_keys - 1].t;
+    for (uint32_t k = 0; k < s->nobj_keys; k++)
+        if (s->obj_keys[k].t > tend) tend = s->obj_keys[k].t;
     for (int fr = 0; fr <= last && st == OM_OK; fr++) {
         om_camera cam;
         om_light light;
         om_view v;
-        om_scene_at(s, frames > 1 ? tend * (float)fr / (float)(frames - 1) : 0, &cam, &light);
+        const float t = frames > 1 ? tend * (float)fr / (float)(frames - 1) : 0;
+        if ((st = om_scene_pose_at(s, t, d)) != OM_OK) break;
+        om_scene_at(s, t, &cam, &light);
         cam.width = SW;
         cam.height = SH;
         if ((st = om_view_init(&v, &cam, &light, s, d)) != OM_OK) break;
