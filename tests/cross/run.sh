@@ -354,6 +354,7 @@ if [ -z "${CROSS_ONLY:-}" ] || echo "m4-count" | grep -Eq -- "$CROSS_ONLY"; then
     if command -v arm-none-eabi-gcc >/dev/null 2>&1 && command -v qemu-system-arm >/dev/null 2>&1; then
         t0=$(date +%s)
         if count_m4; then
+            counted=1
             note m4-count "instructions per frame counted ($(($(date +%s) - t0)) s)"
         else
             fail=$((fail + 1))
@@ -430,6 +431,16 @@ if command -v arm-none-eabi-gcc >/dev/null 2>&1; then
             END { print "method,text,min_bytes,whole_bytes,instructions_small,instructions_default"
                   for (i = 1; i <= n; i++) { m = order[i]; print m "," text[m] "," mn[m] "," whole[m] "," small[m] "," big[m] } }' \
             out/cross/code-size.csv out/cross/m4.csv >out/cross/m4-methods.csv
+    fi
+fi
+
+# The firmware README's figures are what count-table.sh prints from this count.
+if [ -n "${counted:-}" ]; then
+    if sh tests/cross/count-table.sh --check platform/cortex-m/README.md; then
+        note readme "platform/cortex-m/README.md's tables are this count's"
+    else
+        fail=$((fail + 1))
+        note readme "FAIL: platform/cortex-m/README.md's tables are not this count's"
     fi
 fi
 
