@@ -436,12 +436,14 @@ fi
 
 # The firmware README's figures are what count-table.sh prints from this count.
 if [ -n "${counted:-}" ]; then
-    if sh tests/cross/count-table.sh --check platform/cortex-m/README.md; then
-        note readme "platform/cortex-m/README.md's tables are this count's"
-    else
-        fail=$((fail + 1))
-        note readme "FAIL: platform/cortex-m/README.md's tables are not this count's"
-    fi
+    rc=0
+    sh tests/cross/count-table.sh --check platform/cortex-m/README.md || rc=$?
+    case $rc in
+        0) note readme "platform/cortex-m/README.md's tables are this count's" ;;
+        2) note readme "not compared: the README was counted with another toolchain" ;;
+        *) fail=$((fail + 1))
+           note readme "FAIL: platform/cortex-m/README.md's tables are not this count's" ;;
+    esac
 fi
 
 echo "cross: summary ($(($(date +%s) - t_start)) s in all):"
