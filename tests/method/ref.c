@@ -441,6 +441,30 @@ static void moves_rebuild_what_moved(void)
     h_scene_free(&hs);
 }
 
+/* A scene whose every triangle is an object's (the static side of the root empty: it
+ * once read as an inner node whose children were the root, and the walk never ended)
+ * gives the terms of the same scene with its floor static, a BVH of another shape. */
+static void objects_alone(void)
+{
+    static const char *const scenes[2] = {
+        "camera eye 0 3 6 target 0 0 0\nlight spot pos 2 8 2 target 0 0 0\n"
+        "box size 4 0.2 4 name floor\nsphere radius 0.5 translate 0 1 0 name s\ncopy s translate 1 0 0\n",
+        "camera eye 0 3 6 target 0 0 0\nlight spot pos 2 8 2 target 0 0 0\n"
+        "box size 4 0.2 4\nsphere radius 0.5 translate 0 1 0 name s\ncopy s translate 1 0 0\n",
+    };
+    static om_term t[2][W * H];
+    for (int k = 0; k < 2; k++) {
+        h_scene hs;
+        if (!h_scene_parse(&hs, scenes[k])) return;
+        CHECK_OK(h_render(&hs.s, "ref", NULL, W, H, 0, 0, mask, t[k], NULL));
+        h_scene_free(&hs);
+    }
+    uint32_t shadowed = 0;
+    for (int i = 0; i < W * H; i++) shadowed += t[0][i].r == 0;
+    CHECK_MSG(shadowed > 100, "%u samples shadowed", shadowed);
+    CHECK(!memcmp(t[0], t[1], sizeof t[0]));
+}
+
 void suite_ref(void)
 {
     RUN(square_under_sun);
@@ -449,4 +473,5 @@ void suite_ref(void)
     RUN(lbvh_fit_in_parts);
     RUN(ref_small_equals_fast);
     RUN(moves_rebuild_what_moved);
+    RUN(objects_alone);
 }
