@@ -1,6 +1,8 @@
 /* bvh.c — build (binned SAH, 16 bins along the widest centroid axis, a median split
- * when the bins cannot separate) and the segment walk. The build is iterative with an
- * explicit stack so its depth never depends on the C stack. */
+ * when the bins cannot separate), the two levels of a scene with objects (a subtree
+ * per object in its own region, a top level over them; bvh.h) and the segment walk.
+ * The builds are iterative with explicit stacks so their depth never depends on the C
+ * stack. */
 #include "bvh.h"
 
 #include <float.h>
@@ -43,20 +45,35 @@ static size_t node_bound(size_t n, uint32_t leaf)
 }
 
 /* A scene with objects splits its root into the static triangles and the objects'
- * (om__bvh_build): two subtrees, each within its own bound, and the root and its two
- * children on top. */
+ * (om__bvh_build): the root, its two children, the static subtree within its bound,
+ * every object's region within its own (node_bound of its triangles) and the top level
+ * over the objects (a node per object and one fewer above them). */
 static bool two_level(const om_scene *s) { return s->nobjects && s->ntris; }
+
+static uint32_t obj_tris(const om_scene *s, uint32_t i)
+{
+    return s->meshes[s->objects[i].mesh].ntris;
+}
 
 size_t om__bvh_nodes_max(const om_scene *s, uint32_t leaf)
 {
-    return node_bound(s->ntris ? s->ntris : 1, leaf) + (two_level(s) ? 4 : 0);
+    if (!two_level(s)) return node_bound(s->ntris ? s->ntris : 1, leaf);
+    size_t n = s->ntris, regions = 0;
+    for (uint32_t i = 0; i < s->nobjects; i++) {
+        n -= obj_tris(s, i);
+        if (obj_tris(s, i)) regions += node_bound(obj_tris(s, i), leaf);
+    }
+    return 3 + node_bound(n ? n : 1, leaf) + 2 * (size_t)s->nobjects + regions;
 }
 
 size_t om__bvh_bytes(const om_scene *s, uint32_t leaf)
 {
     size_t n = s->ntris ? s->ntris : 1;
     return om_arena_need(om__bvh_nodes_max(s, leaf) * sizeof(om__bvh_node), 16) +
-           om_arena_need(n * sizeof(uint32_t), 4);
+           om_arena_need(n * sizeof(uint32_t), 4) +
+           (two_level(s) ? om_arena_need((3 * (size_t)s->nobjects + 2) * sizeof(uint32_t), 4) +
+                               om_arena_need(6 * (size_t)s->nobjects * sizeof(float), 4)
+                         : 0);
 }
 
 size_t om__bvh_scratch_bytes(const om_scene *s)
@@ -315,29 +332,134 @@ static void build_from(om__bvh *b, const boxes *bxs, job top, uint32_t leaf, siz
     }
 }
 
-/* Two-level: the objects' triangles, in the order of the objects and their ranges, at
- * tris[obj_first..]: the same order whenever they are built, so a rebuild after moves
- * is the build of the scene posed there. */
-static void object_tris(om__bvh *b, const om_scene *s)
+/* The subtree of object i in its region (its root at the region's start), and the
+ * region's spare nodes made leaves of one of its triangles: nothing refers to them,
+ * and every pass over all nodes finds them well formed. */
+static void build_object(om__bvh *b, const boxes *bx, uint32_t i)
 {
-    uint32_t k = b->obj_first;
-    for (uint32_t i = 0; i < s->nobjects; i++) {
-        const om_object *o = &s->objects[i];
-        for (uint32_t t = 0; t < s->meshes[o->mesh].ntris; t++) b->tris[k++] = o->first_tri + t;
+    const uint32_t lo = b->obj_node[i], hi = b->obj_node[i + 1];
+    if (lo == hi) return;   /* no triangles: no region */
+    job top;
+    memset(&top, 0, sizeof top);
+    top.node = lo;
+    top.first = b->obj_tri[i];
+    top.count = b->obj_tri[i + 1] - b->obj_tri[i];
+    top.depth = 3;
+    /* its triangles in their order again (a build leaves them partitioned), so that
+     * the build is a new one's (at om__bvh_build, the order they are already in) */
+    for (uint32_t t = 0; t < top.count; t++) b->tris[top.first + t] = bx->s->objects[i].first_tri + t;
+    const uint32_t all = b->nnodes;
+    b->nnodes = lo + 1;
+    build_from(b, bx, top, b->obj_leaf, hi);
+    memcpy(b->obj_box + 6 * (size_t)i, b->nodes[lo].box.w.lo, 3 * sizeof(float));
+    memcpy(b->obj_box + 6 * (size_t)i + 3, b->nodes[lo].box.w.hi, 3 * sizeof(float));
+    for (uint32_t k = b->nnodes; k < hi; k++) {
+        memset(&b->nodes[k], 0, sizeof b->nodes[k]);
+        b->nodes[k].first = top.first;
+        b->nodes[k].count = 1;
+    }
+    b->nnodes = all;
+}
+
+/* A box's centre along axis as an unsigned key in the floats' order (centre_key). */
+static uint32_t obj_key(const om__bvh *b, uint32_t i, int axis)
+{
+    const float *o = b->obj_box + 6 * (size_t)i;
+    float c = (o[axis] + o[3 + axis]) * 0.5f, u0;
+    uint32_t u;
+    u0 = c;
+    memcpy(&u, &u0, sizeof u);
+    if (u == 0x80000000u) u = 0;
+    return u & 0x80000000u ? ~u : u | 0x80000000u;
+}
+
+/* The k-th smallest key of perm[first, first + n) to first + k (select_median's
+ * quickselect, on the objects' keys). */
+static void select_obj(const om__bvh *b, uint32_t *perm, uint32_t n, uint32_t k, int axis)
+{
+    uint32_t lo = 0, hi = n - 1;
+    while (lo < hi) {
+        const uint32_t pivot = obj_key(b, perm[lo + (hi - lo) / 2], axis);
+        uint32_t i = lo, j = hi;
+        while (i <= j) {
+            while (i < hi && obj_key(b, perm[i], axis) < pivot) i++;
+            while (j > lo && obj_key(b, perm[j], axis) > pivot) j--;
+            if (i <= j) {
+                const uint32_t t = perm[i]; perm[i] = perm[j]; perm[j] = t;
+                i++;
+                if (j == 0) break;
+                j--;
+            }
+        }
+        if (k <= j) hi = j;
+        else if (k >= i) lo = i;
+        else return;
     }
 }
 
-/* The objects' subtree under node 2, from its first node on, and the root's box. */
-static void build_objects(om__bvh *b, const boxes *bx, uint32_t leaf, size_t cap)
+/* The top level: node 2 over the objects with triangles, split at the median of their
+ * boxes' centres along the widest axis of those centres down to one object a node,
+ * which becomes a copy of its root; then the root's box. The objects in their order
+ * first, so the same boxes give the same tree. Its depth is below 33 (a median split
+ * of at most 2^32 objects), so a walk's stack holds it above any object's subtree. */
+static void build_top(om__bvh *b, const om_scene *s)
 {
-    job top;
-    memset(&top, 0, sizeof top);
-    top.node = 2;
-    top.first = b->obj_first;
-    top.count = b->obj_count;
-    top.depth = 2;
-    b->nnodes = b->obj_nodes;
-    build_from(b, bx, top, leaf, cap);
+    uint32_t n = 0;
+    for (uint32_t i = 0; i < s->nobjects; i++)
+        if (b->obj_node[i] != b->obj_node[i + 1]) b->perm[n++] = i;
+    b->top_end = b->top_first;
+    if (n == 0) {   /* objects without triangles: node 2 a spare (the root below) */
+        memset(&b->nodes[2], 0, sizeof b->nodes[2]);
+        b->nodes[2].count = 1;
+    }
+    typedef struct tjob { uint32_t node, first, count; } tjob;
+    tjob stack[STACK];
+    int sp = 0;
+    if (n) stack[sp++] = (tjob){2, 0, n};
+    while (sp > 0) {
+        const tjob j = stack[--sp];
+        om__bvh_node *nd = &b->nodes[j.node];
+        if (j.count == 1) {
+            *nd = b->nodes[b->obj_node[b->perm[j.first]]];
+            continue;
+        }
+        box bb, cb;
+        box_empty(&bb);
+        box_empty(&cb);
+        for (uint32_t k = j.first; k < j.first + j.count; k++) {
+            const float *o = b->obj_box + 6 * (size_t)b->perm[k];
+            box t;
+            memcpy(t.lo, o, sizeof t.lo);
+            memcpy(t.hi, o + 3, sizeof t.hi);
+            box_grow(&bb, t.lo, t.hi);
+            grow_centre(&cb, &t);
+        }
+        memcpy(nd->box.w.lo, bb.lo, sizeof bb.lo);
+        memcpy(nd->box.w.hi, bb.hi, sizeof bb.hi);
+        int axis = 0;
+        for (int k = 1; k < 3; k++)
+            if (cb.hi[k] - cb.lo[k] > cb.hi[axis] - cb.lo[axis]) axis = k;
+        const uint32_t half = j.count / 2;
+        select_obj(b, b->perm + j.first, j.count, half, axis);
+        nd->first = b->top_end;
+        nd->count = 0;
+        b->top_end += 2;
+        stack[sp++] = (tjob){nd->first, j.first, half};
+        stack[sp++] = (tjob){nd->first + 1, j.first + half, j.count - half};
+    }
+    for (uint32_t k = b->top_end; k < b->top_first + 2 * s->nobjects; k++) {
+        /* spare: as a region's (build_object) */
+        memset(&b->nodes[k], 0, sizeof b->nodes[k]);
+        b->nodes[k].count = 1;
+    }
+    /* The root over both sides; where one side has no triangles, a copy of the other
+     * (the empty side's node a spare, which nothing then refers to). */
+    if (!n || !b->obj_first) {
+        b->nodes[0] = b->nodes[n ? 2 : 1];
+        return;
+    }
+    b->nodes[0].first = 1;
+    b->nodes[0].count = 0;
     box r;
     box_empty(&r);
     for (int c = 1; c < 3; c++) box_grow(&r, b->nodes[c].box.w.lo, b->nodes[c].box.w.hi);
@@ -357,20 +479,33 @@ om_status om__bvh_build(om__bvh *b, om_arena *a, const om_scene *s, uint32_t lea
         return st;
     b->nodes = (om__bvh_node *)pn;
     b->tris = (uint32_t *)pt;
-    size_t mark = om_arena_mark(a);
-    boxes bx = {s, NULL, b->tris};
     const bool two = two_level(s);
     if (two) {
-        /* static triangles first, in order, then the objects' (object_tris) */
+        if ((st = om_arena_alloc(a, (3 * (size_t)s->nobjects + 2) * sizeof(uint32_t), 4, &pb, d)))
+            return st;
+        b->obj_node = (uint32_t *)pb;
+        b->obj_tri = b->obj_node + s->nobjects + 1;
+        b->perm = b->obj_tri + s->nobjects + 1;
+        if ((st = om_arena_alloc(a, 6 * (size_t)s->nobjects * sizeof(float), 4, &pb, d))) return st;
+        b->obj_box = (float *)pb;
+    }
+    size_t mark = om_arena_mark(a);
+    boxes bx = {s, NULL, b->tris};
+    if (two) {
+        /* static triangles first, in order, then each object's in the objects' order */
         uint32_t k = 0, t = 0;
         for (uint32_t i = 0; i <= s->nobjects; i++) {
             const uint32_t end = i < s->nobjects ? s->objects[i].first_tri : s->ntris;
             for (; t < end; t++) b->tris[k++] = t;
-            if (i < s->nobjects) t += s->meshes[s->objects[i].mesh].ntris;
+            if (i < s->nobjects) t += obj_tris(s, i);
         }
         b->obj_first = k;
         b->obj_count = s->ntris - k;
-        object_tris(b, s);
+        for (uint32_t i = 0; i < s->nobjects; i++) {
+            b->obj_tri[i] = k;
+            for (uint32_t j = 0; j < obj_tris(s, i); j++) b->tris[k++] = s->objects[i].first_tri + j;
+        }
+        b->obj_tri[s->nobjects] = k;
     } else {
         for (uint32_t t = 0; t < s->ntris; t++) b->tris[t] = t;
     }
@@ -389,17 +524,34 @@ om_status om__bvh_build(om__bvh *b, om_arena *a, const om_scene *s, uint32_t lea
         b->nnodes = 1;
         build_from(b, &bx, top, leaf, cap);
     } else {
-        b->nodes[0].first = 1;
-        b->nodes[0].count = 0;
+        /* the static subtree from node 3 on, within its bound; then the top level's
+         * place and the objects' regions (om__bvh_nodes_max) */
         b->nnodes = 3;
         top.node = 1;
         top.count = b->obj_first;
         top.depth = 2;
-        build_from(b, &bx, top, leaf, cap);
-        b->obj_nodes = b->nnodes;
+        const size_t static_cap = 3 + node_bound(b->obj_first ? b->obj_first : 1, leaf);
+        if (b->obj_first) build_from(b, &bx, top, leaf, static_cap);
+        else {   /* no static triangles: a spare (build_top) */
+            memset(&b->nodes[1], 0, sizeof b->nodes[1]);
+            b->nodes[1].count = 1;
+        }
+        for (uint32_t k = b->nnodes; k < static_cap; k++) {
+            memset(&b->nodes[k], 0, sizeof b->nodes[k]);   /* spare, as build_object's */
+            b->nodes[k].count = 1;
+        }
+        b->top_first = (uint32_t)static_cap;
+        uint32_t at = b->top_first + 2 * s->nobjects;
+        for (uint32_t i = 0; i < s->nobjects; i++) {
+            b->obj_node[i] = at;
+            if (obj_tris(s, i)) at += (uint32_t)node_bound(obj_tris(s, i), leaf);
+        }
+        b->obj_node[s->nobjects] = at;
+        b->nnodes = at;
         b->obj_leaf = leaf;
-        b->obj_cap = (uint32_t)cap;
-        build_objects(b, &bx, leaf, cap);
+        for (uint32_t i = 0; i < s->nobjects; i++) build_object(b, &bx, i);
+        build_top(b, s);
+        b->seen = s->change;
         if (b->depth < 1) b->depth = 1;
     }
     om_arena_rewind(a, mark);
@@ -408,10 +560,19 @@ om_status om__bvh_build(om__bvh *b, om_arena *a, const om_scene *s, uint32_t lea
 
 void om__bvh_rebuild_objects(om__bvh *b, const om_scene *s)
 {
-    if (!b->obj_nodes) return;
+    b->rebuilt = 0;
+    if (!b->obj_node || b->seen == s->change) return;
     const boxes bx = {s, NULL, b->tris};   /* boxes from the vertices: the same numbers */
-    object_tris(b, s);
-    build_objects(b, &bx, b->obj_leaf, b->obj_cap);
+    for (uint32_t i = 0; i < s->nobjects; i++) {
+        /* moved after the count last seen, up to now (in unsigned differences, which
+         * a wrapped count keeps) */
+        const uint32_t m = s->objects[i].moved;
+        if (m - b->seen - 1u >= s->change - b->seen) continue;
+        build_object(b, &bx, i);
+        b->rebuilt++;
+    }
+    build_top(b, s);
+    b->seen = s->change;
 }
 
 static bool hits(const om__bvh_node *n, const float o[3], const float inv[3], float tmax, float m)

@@ -28,17 +28,29 @@ typedef struct om__bvh_node {
 } om__bvh_node;
 
 /* A scene with objects gets two levels: the root's children are the static triangles'
- * subtree (node 1, built once) and the objects' (node 2, its nodes from obj_nodes on,
- * over tris[obj_first, obj_first + obj_count)), which om__bvh_rebuild_objects builds
- * again after moves, for a cost that grows with the objects' triangles only. */
+ * subtree (node 1, built once) and the objects' top level (node 2). Every object with
+ * triangles has a subtree of its own in a fixed region of the nodes (obj_node[i] to
+ * obj_node[i + 1]: its root at the region's start, its nodes after it, the rest of the
+ * region spare leaves that nothing refers to) over its fixed range of the triangle list
+ * (the objects' triangles in their order from obj_first on), built again only when it
+ * moved; the top level (node 2 and the nodes from top_first to top_end, a median split
+ * over the objects' boxes, each leaf a copy of an object's root) is built again after
+ * any move. So a frame after moves builds what moved, plus a node or two per object,
+ * and the BVH is the one a new state would build on the scene posed there. */
 typedef struct om__bvh {
     om__bvh_node *nodes;
     uint32_t *tris;        /* triangle indices, leaves refer to ranges of it */
     uint32_t nnodes, depth;
-    uint32_t obj_first, obj_count, obj_nodes;   /* two levels (obj_nodes 0: one) */
-    uint32_t obj_leaf, obj_cap;
+    uint32_t obj_first, obj_count;   /* two levels (obj_node NULL: one) */
+    uint32_t top_first, top_end;
+    uint32_t *obj_node;    /* nobjects + 1 region starts */
+    uint32_t *obj_tri;     /* nobjects + 1: each object's range in tris */
+    uint32_t *perm;        /* nobjects: the top level's build order */
+    float *obj_box;        /* nobjects x (lo, hi): each object's box at its build (the
+                              middle mode writes grid boxes into the nodes) */
+    uint32_t obj_leaf, rebuilt;   /* rebuilt: object subtrees built by the last call */
+    uint32_t seen;         /* the scene's change count the objects were built at */
 } om__bvh;
-
 /* The most nodes a BVH over s with leaves of `leaf` can have. */
 size_t om__bvh_nodes_max(const om_scene *s, uint32_t leaf);
 /* Bytes the BVH keeps, and the scratch its build needs on top (released after). */
@@ -46,8 +58,10 @@ size_t om__bvh_bytes(const om_scene *s, uint32_t leaf);
 size_t om__bvh_scratch_bytes(const om_scene *s);
 om_status om__bvh_build(om__bvh *b, om_arena *a, const om_scene *s, uint32_t leaf, om_diag *d);
 
-/* Builds the objects' subtree again where they are now: the BVH om__bvh_build would
- * build for s posed so (nothing where s has no objects). */
+/* Builds again the subtrees of the objects that moved since the BVH last saw the
+ * scene (om_object.moved), and the top level over all of them when any did: the BVH
+ * om__bvh_build would build for s posed so (nothing where s has no objects). Sets
+ * b->rebuilt to how many object subtrees it built. */
 void om__bvh_rebuild_objects(om__bvh *b, const om_scene *s);
 
 /* A segment o + t * dir, t in [0, tmax], with boxes grown by `margin` on every side.

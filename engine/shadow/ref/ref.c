@@ -26,7 +26,7 @@ typedef struct ref_state {
     int mode;              /* LEAST, CACHE or PACKETS */
     const om__lend *lend;  /* the frame's threads for the fit (om__pass.lend), or NULL */
     uint32_t samples, candidates, blocked;
-    uint32_t change;       /* the scene's change count the 3-D boxes were fitted at */
+    uint32_t rebuilt;      /* object subtrees built again this frame */
 } ref_state;
 
 /* Three sizes, the same bits; only the speed differs:
@@ -103,8 +103,8 @@ static om_status ref_init(void **state, om_arena *a, const om_method_cfg *c, con
     r->mat_od = (om__odepth *)p;
     for (uint32_t i = 0; i < s->nmats; i++) r->mat_od[i] = om__material_odepth(&s->mats[i]);
     if ((st = om__bvh_build(&r->bvh, a, s, fast ? LEAF_FAST : LEAF_SMALL, d))) return st;
-    if (mode == PACKETS) om__lbvh_plan(&r->lb, &r->bvh);
-    r->change = s->change;
+    if (mode == PACKETS) om__lbvh_plan(&r->lb, &r->bvh, s->nobjects);
+    r->rebuilt = 0;
     *state = r;
     return OM_OK;
 }
@@ -116,14 +116,12 @@ static uint32_t begin_view(ref_state *r, const om_view *v)
 {
     r->view = *v;
     om__lspace_view(&r->ls, v);
-    /* Moved objects: the BVH's objects' subtree is built again where they are (the
-     * static one stays), so the BVH is the one a new state would build; the one pass
-     * plans its parts again over it. */
-    if (r->change != r->scene->change) {
-        om__bvh_rebuild_objects(&r->bvh, r->scene);
-        if (r->mode == PACKETS) om__lbvh_plan(&r->lb, &r->bvh);
-        r->change = r->scene->change;
-    }
+    /* Moved objects: their subtrees and the top level over the objects are built
+     * again where they are (the static subtree and the still objects' stay), so the BVH
+     * is the one a new state would build; the one pass's parts stay (bvh.h: each
+     * object's nodes keep their region). */
+    om__bvh_rebuild_objects(&r->bvh, r->scene);
+    r->rebuilt = r->bvh.rebuilt;
     /* Two grid steps at the far end of the light's frustum, in world units: how far
      * snapping can move a triangle's edge or a sample across the light's image. */
     om_vec3 ext = om__sub(r->scene->hi, r->scene->lo);
@@ -512,7 +510,9 @@ static void ref_stats(const void *state, om_method_stats *out)
     out->counter_names[2] = "samples blocked";
     out->counters[3] = r->bvh.nnodes;
     out->counter_names[3] = "bvh nodes";
-    out->ncounters = 4;
+    out->counters[4] = r->rebuilt;
+    out->counter_names[4] = "objects rebuilt";
+    out->ncounters = 5;
 }
 
 const om_method om__method_ref = {

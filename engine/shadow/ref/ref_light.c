@@ -57,11 +57,36 @@ static bool part_of(const om__bvh *b, uint32_t at, uint32_t sz, uint32_t last, o
     return p->hi - p->lo == sz - 1;   /* in the build's order, the descendants are these */
 }
 
-void om__lbvh_plan(om__lbvh *lb, const om__bvh *b)
+/* The objects' parts: the objects with triangles in runs of about equal triangle
+ * counts, each a part of no node of its own (OM__LBVH_NONE) over their regions' nodes
+ * and triangles (bvh.h: both contiguous in the objects' order); at most `most`, and
+ * none smaller than a part is worth. The top level above them is fitted by
+ * om__lbvh_fit_top. */
+static void plan_objects(om__lbvh *lb, const om__bvh *b, uint32_t nobjects, uint32_t most)
+{
+    uint32_t want = 1 + b->obj_count / (2 * PART_LEAST);
+    if (want > most) want = most;
+    uint32_t i = 0;
+    for (uint32_t k = 0; k < want && i < nobjects; k++) {
+        const uint32_t upto = (uint32_t)((uint64_t)b->obj_count * (k + 1) / want), at = i;
+        while (i < nobjects && (k + 1 == want || b->obj_tri[i + 1] - b->obj_first <= upto)) i++;
+        if (i == at) i++;   /* one object more than the share: a part of it alone */
+        if (b->obj_tri[i] == b->obj_tri[at]) continue;   /* none with triangles */
+        om__lbvh_part *p = &lb->parts[lb->nparts++];
+        p->node = OM__LBVH_NONE;
+        p->lo = b->obj_node[at];
+        p->hi = b->obj_node[i];
+        p->tlo = b->obj_tri[at];
+        p->thi = b->obj_tri[i];
+    }
+}
+
+void om__lbvh_plan(om__lbvh *lb, const om__bvh *b, uint32_t nobjects)
 {
     uint32_t size[OM__LBVH_PARTS];
     om__lnode *sc = lb->nodes;
     lb->nparts = lb->ntop = 0;
+    lb->top_first = lb->top_end = 0;
     if (!b->nnodes || (!b->nodes[0].count && !b->nodes[0].first))
         return;   /* an empty scene's lone root: om__lbvh_fit_top's */
     /* The nodes as scratch until the first fit: how many nodes each has under it
@@ -75,14 +100,44 @@ void om__lbvh_plan(om__lbvh *lb, const om__bvh *b)
         sc[i].count += c0->count + c1->count;
         sc[i].first = c0->first > c1->first ? c0->first : c1->first;
     }
-    if (!part_of(b, 0, sc[0].count, sc[0].first, &lb->parts[0])) return;
-    size[0] = sc[0].count;
-    lb->nparts = 1;
+    /* Two levels (bvh.h): the objects' parts, the static subtree's split as one
+     * level's root, and above them node 2, 1 where not a part, and the root. */
+    uint32_t start = 0, most = OM__LBVH_PARTS, k0 = 0;
+    if (b->obj_node) {
+        const uint32_t share = (uint32_t)((uint64_t)OM__LBVH_PARTS * b->obj_count /
+                                          (b->obj_count + b->obj_first));
+        plan_objects(lb, b, nobjects, share < 1 ? 1 : share > OM__LBVH_PARTS - 4 ? OM__LBVH_PARTS - 4 : share);
+        lb->top_first = b->top_first;
+        lb->top_end = b->top_end;
+        lb->top[lb->ntop++] = 0;
+        lb->top[lb->ntop++] = 2;
+        if (!b->obj_first) {
+            lb->top[lb->ntop++] = 1;   /* a spare (bvh.c's build_top) */
+            return;
+        }
+        start = 1;
+        k0 = lb->nparts;
+        most = OM__LBVH_PARTS - 2 - lb->nparts;   /* the top's 0 and 2 and a split's each */
+    }
+    if (!part_of(b, start, sc[start].count, sc[start].first, &lb->parts[k0])) {
+        /* not in the build's order: the static nodes as one part */
+        if (start) {
+            om__lbvh_part *p = &lb->parts[lb->nparts++];
+            p->node = 1;
+            p->lo = 3;
+            p->hi = b->top_first;
+            p->tlo = 0;
+            p->thi = b->obj_first;
+        }
+        return;
+    }
+    size[k0] = sc[start].count;
+    lb->nparts = k0 + 1;
     /* The largest part splits into its children while there is room: the node above
      * them joins the top. */
-    while (lb->nparts < OM__LBVH_PARTS) {
-        uint32_t k = 0;
-        for (uint32_t i = 1; i < lb->nparts; i++)
+    while (lb->nparts - k0 < most) {
+        uint32_t k = k0;
+        for (uint32_t i = k0 + 1; i < lb->nparts; i++)
             if (size[i] > size[k]) k = i;
         const uint32_t at = lb->parts[k].node, c = b->nodes[at].first;
         om__lbvh_part p[2];
@@ -182,7 +237,7 @@ void om__lbvh_fit_part(om__lbvh *lb, const om__bvh *b, const om__lspace *ls, uin
     const om__lbvh_part *p = &lb->parts[k];
     for (uint32_t t = p->tlo; t < p->thi; t++) tri_box(&lb->tris[t], ls, b->tris[t]);
     fit_nodes(lb, b, p->lo, p->hi);
-    fit_nodes(lb, b, p->node, p->node + 1);
+    if (p->node != OM__LBVH_NONE) fit_nodes(lb, b, p->node, p->node + 1);
 }
 
 void om__lbvh_fit_top(om__lbvh *lb, const om__bvh *b, const om__lspace *ls)
@@ -192,6 +247,7 @@ void om__lbvh_fit_top(om__lbvh *lb, const om__bvh *b, const om__lspace *ls)
         lb->nodes[0].first = lb->nodes[0].count = 0;
         return;
     }
+    fit_nodes(lb, b, lb->top_first, lb->top_end);   /* two levels: above the objects' parts */
     for (uint32_t i = lb->ntop; i-- > 0;) fit_nodes(lb, b, lb->top[i], lb->top[i] + 1);
 }
 

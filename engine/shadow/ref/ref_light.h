@@ -40,6 +40,7 @@ typedef struct om__lnode {
  * code whoever fits it, so the boxes are the same bits for any number of jobs. A
  * part's triangles are [tlo, thi) of the BVH's list (its leaves' ranges). */
 #define OM__LBVH_PARTS 64
+#define OM__LBVH_NONE UINT32_MAX   /* a part of objects' regions: no node of its own */
 typedef struct om__lbvh_part { uint32_t node, lo, hi, tlo, thi; } om__lbvh_part;
 
 typedef struct om__lbvh {
@@ -48,14 +49,17 @@ typedef struct om__lbvh {
     om__lbvh_part *parts;    /* OM__LBVH_PARTS of them */
     uint32_t *top;           /* as many */
     uint32_t nparts, ntop;
+    uint32_t top_first, top_end;   /* two levels: the top's nodes, fitted before `top` */
 } om__lbvh;
 
 /* Bytes for a BVH over s with leaves of `leaf`; the arrays from the arena. */
 size_t om__lbvh_bytes(const om_scene *s, uint32_t leaf);
 om_status om__lbvh_init(om__lbvh *lb, om_arena *a, const om_scene *s, uint32_t leaf,
                         om_diag *d);
-/* The parts of the fit for b (once, after b is built). */
-void om__lbvh_plan(om__lbvh *lb, const om__bvh *b);
+/* The parts of the fit for b (once, after b is built: a rebuild of objects keeps
+ * their regions and the top level's place). A two-level b's objects are parts of
+ * their own, by runs of objects (its nobjects). */
+void om__lbvh_plan(om__lbvh *lb, const om__bvh *b, uint32_t nobjects);
 /* Bounds every triangle and node of b for this frame from ls's projected vertices (ls
  * must have them, begun for the frame): every part (om__lbvh_fit_part, k in [0,
  * nparts), in any order or at once), then the top (om__lbvh_fit_top). */
