@@ -39,9 +39,10 @@ typedef struct arun {
     uint32_t W, H;
 } arun;
 
-/* A state in the bytes a single fast pass needs, or with `lean` in the minimum. */
+/* A state in the bytes a single fast pass needs, or with `lean` in the minimum (2: and
+ * room for the lean mode's bounds of chunks of 8 triangles, 2 bytes a triangle). */
 static bool arun_init(arun *r, const om_scene *s, const om_method_cfg *c, uint32_t W, uint32_t H,
-                      bool lean)
+                      int lean)
 {
     size_t mn, full;
     om_diag d;
@@ -53,7 +54,9 @@ static bool arun_init(arun *r, const om_scene *s, const om_method_cfg *c, uint32
     if (!r->m) { CHECK_MSG(0, "asm is not registered"); return false; }
     CHECK_OK(om_method_bytes(r->m, c, s, W, H, &mn, &full));
     CHECK(mn <= full);
-    if (lean) full = mn;
+    const size_t most = full;
+    if (lean) full = mn + (lean == 2 ? 2 * (size_t)s->ntris + 64 : 0);
+    CHECK(full <= most);
     r->bytes = full;
     r->mem = malloc(full);
     r->fmem = malloc(h_frame_least(W, H));
@@ -603,9 +606,11 @@ static void float_bounds_hold(void)
 
 /* The float path (asm.float 1: each sample placed in float, with bounds, the exact
  * double path deciding where they do not; in the lean mode also each triangle's bounds
- * for a tile) gives the exact path's frames, counters and tree: on close-ups refined
- * to 65,536 texels a side (where float alone could not place samples), with strips, a
- * moving camera, a directional light and a small cap; the lean mode's too. */
+ * for a tile, and with room left its chunks' bounds) gives the exact path's frames,
+ * counters and tree: on close-ups refined to 65,536 texels a side (where float alone
+ * could not place samples), with strips, a moving camera, a directional light and a
+ * small cap; the lean mode's too. It fails with a chunk's bounds half a texel too
+ * narrow, or the float test of texel centres a quarter texel too narrow. */
 static void float_path_is_exact(void)
 {
     /* the default scene without its camera path, seen from close (bench_asm's views) */
@@ -625,7 +630,7 @@ static void float_path_is_exact(void)
                                        "camera eye 0.8 1.4 2.6 target -1.2 0.0 0.4\n",
                                        "camera eye 0 2.5 12 target 0 0.8 0\n"};
     enum { BW = 160, BH = 120 };
-    static om_term terms[3][BW * BH];
+    static om_term terms[4][BW * BH];
     for (int k = 0; k < 4; k++) {
         h_scene hs;
         if (k < 3) {
@@ -639,33 +644,37 @@ static void float_path_is_exact(void)
                                          "key camera 1 eye 3 3 5 target 0 0 0\n")) {
             return;
         }
-        arun r[3];   /* exact; float; float in the lean mode */
+        arun r[4];   /* exact; float; float in the lean mode, in the minimum and with chunks */
         bool ok = true;
-        for (int j = 0; j < 3; j++) {
+        for (int j = 0; j < 4; j++) {
             om_method_cfg c;
             om_method_cfg_default(&c, om_method_find("asm"));
             CHECK_OK(om_method_cfg_set(&c, "asm.cap", k == 2 ? 200000 : 8u << 20, NULL));
             CHECK_OK(om_method_cfg_set(&c, "asm.work", 4096, NULL));
             CHECK_OK(om_method_cfg_set(&c, "asm.float", j > 0, NULL));
-            ok = arun_init(&r[j], &hs.s, &c, BW, BH, j == 2) && ok;
+            ok = arun_init(&r[j], &hs.s, &c, BW, BH, j < 2 ? 0 : j - 1) && ok;
         }
         uint32_t finest = 0;
         for (int f = 0; ok && f < 6; f++) {
-            om_method_stats ms[3];
-            for (int j = 0; j < 3; j++)
+            om_method_stats ms[4];
+            for (int j = 0; j < 4; j++)
                 CHECK_OK(arun_frame(&r[j], k == 3 ? 0.2f * (float)f : 0.0f, 0.0f, f % 2 ? 7 : 0, NULL,
                                     terms[j], &ms[j]));
-            for (int j = 1; j < 3; j++) {
+            static const char *const mode[4] = {"exact", "float", "lean", "lean with chunks"};
+            for (int j = 1; j < 4; j++) {
                 CHECK_MSG(memcmp(terms[0], terms[j], sizeof terms[0]) == 0, "view %d frame %d: terms differ (%s)", k, f,
-                          j == 2 ? "lean" : "float");
+                          mode[j]);
                 for (uint32_t i = 0; i < ms[0].ncounters; i++)
                     CHECK_MSG(ms[0].counters[i] == ms[j].counters[i], "view %d frame %d: %s %u, %s %u", k, f,
-                              ms[0].counter_names[i], ms[0].counters[i], j == 2 ? "lean" : "float", ms[j].counters[i]);
+                              ms[0].counter_names[i], ms[0].counters[i], mode[j], ms[j].counters[i]);
             }
+            /* the chunks' bounds are there: 16 bytes a chunk of 8 (r[2] has the minimum) */
+            CHECK_MSG(ms[3].bytes_used >= r[2].bytes + hs.s.ntris * 2, "view %d: %zu bytes used, minimum %zu", k,
+                      ms[3].bytes_used, r[2].bytes);
             finest = counter(&ms[1], "effective resolution");
         }
         if (k < 2) CHECK_MSG(finest >= 65536, "view %d refined to %u only", k, finest);
-        for (int j = 0; j < 3; j++) arun_free(&r[j]);
+        for (int j = 0; j < 4; j++) arun_free(&r[j]);
         h_scene_free(&hs);
     }
 }

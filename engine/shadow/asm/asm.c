@@ -194,6 +194,19 @@ static om_status asm_init(void **state, om_arena *a, const om_method_cfg *mc, co
     m->cand = (om__asm_cand *)p;
     m->ncand_max = nc > UINT32_MAX ? UINT32_MAX : (uint32_t)nc;
     for (uint32_t i = 0; i <= OM__ASM_MAX_LEVEL; i++) m->inv_scale[i] = (double)l.tile / om__asm_grid(&l, i);
+    m->chunk = NULL;
+    m->chunk_tris = 0;
+    m->chunk_ready = false;
+    if (lean && c->asm_float && s->ntris > 8) {
+        /* what the arena has left: the finest runs it holds, if any */
+        for (uint32_t ct = 8; ct <= 256 && !m->chunk; ct *= 2) {
+            const size_t nb = ((size_t)s->ntris + ct - 1) / ct * 4 * sizeof(float);
+            if (om_arena_need(nb, 8) > om_arena_left(a)) continue;
+            if ((st = om_arena_alloc(a, nb, 8, &p, d))) return st;
+            m->chunk = (float *)p;
+            m->chunk_tris = ct;
+        }
+    }
     m->cache = OM__ASM_NONE;
     *state = m;
     return OM_OK;
@@ -208,6 +221,7 @@ static om_status asm_begin(void *state, const om_view *v, om_diag *d)
     m->samples = m->shadowed = m->analysed = m->straddling = m->candidates = m->rebuilds = 0;
     m->redrawn = 0;
     m->prepared = false;
+    m->chunk_ready = false;
     m->cache = OM__ASM_NONE;
     om__asm_frame(&m->tree);
     return OM_OK;
@@ -749,6 +763,8 @@ static void asm_stats(const void *state, om_method_stats *out)
     const om__asm_tree *t = &m->tree;
     memset(out, 0, sizeof *out);
     out->bytes_used = asm_need(m->scene, &t->lay, m->lean);
+    if (m->chunk)
+        out->bytes_used += om_arena_need(((size_t)m->scene->ntris + m->chunk_tris - 1) / m->chunk_tris * 4 * sizeof(float), 8);
     uint64_t inuse = om__asm_bytes_in_use(t);
     double eff = om__asm_grid(&t->lay, om__asm_depth(t));
     const uint32_t v[8] = {t->pool.in_use, t->created, t->evicted,

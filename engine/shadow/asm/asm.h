@@ -278,6 +278,13 @@ typedef struct om__asm_state {
     uint32_t *glist, gcap;
     uint32_t *gbits;       /* (ntris + 31) / 32 words */
     bool gready;           /* this frame's lists were made */
+    /* Lean mode with asm.float, where the arena has room: per run of chunk_tris
+     * triangles (in index order), the union of their float bounds (tri_box_cached), or
+     * everything where one has none, made once a frame before its first tile
+     * (chunk_ready), so that a tile skips a run whose union misses it. NULL without. */
+    float *chunk;
+    uint32_t chunk_tris;
+    bool chunk_ready;
     uint32_t *sdepth, *sid;   /* one tile of scratch for the rasterizer */
     om__asm_cand *cand;
     uint32_t ncand_max;
@@ -312,6 +319,9 @@ typedef struct om__asm_rs {
 void om__asm_prepare(om__asm_state *m);
 void om__asm_render_node(om__asm_state *m, uint32_t index);
 void om__asm_render_with(om__asm_state *m, uint32_t index, const om__asm_rs *rs);
+/* This frame's chunk bounds (om__asm_state.chunk), if not made yet: before the frame's
+ * first tile, on the calling thread. */
+void om__asm_chunks(om__asm_state *m);
 
 /* What a band's analysis adds to the tree, in a job's scratch, put on the tree after
  * the bands on the calling thread (asm_jobs.c): sums, maxima and marks, the same in any

@@ -158,6 +158,7 @@ static void render_fn(void *user, uint32_t k, void *scratch)
 bool om__asm_render_list(om__asm_state *m, const uint32_t *list, uint32_t n)
 {
     if (!m->lend) return false;
+    om__asm_chunks(m);   /* before the jobs, which read them */
     render_job j = {m, list, {0}};
     slot_layout_m(m, &j.sl);
     m->lend->run(m->lend, render_fn, &j, n);

@@ -3,7 +3,8 @@
  * engine's rasterizer from the triangles whose bounds meet it. Once a frame, prepare
  * projects the scene and bounds each triangle in base texels, and lays a grid of cells
  * over them so that a tile gathers its triangles from its cells; lean mode keeps none
- * of it and tests every triangle. asm.c decides which tiles exist. */
+ * of it and tests every triangle, or every chunk of triangles where it has room for
+ * their bounds. asm.c decides which tiles exist. */
 #include "../method.h"
 #include "asm.h"
 
@@ -76,6 +77,27 @@ static inline bool box_holds_centre(const float *b, double sc)
            holds_integer((double)b[1] * sc - 0.5 - e, (double)b[3] * sc - 0.5 + e);
 }
 
+/* box_holds_centre in float, for the float-first bounds below and their chunks' unions:
+ * true wherever box_holds_centre is, its intervals wider than that test's by more than
+ * the float rounding of b * sc - 0.5 (a relative 2^-22 at most, sc's own rounding to
+ * float included) and the same 1/32 texel; false where no texel centre lies in them.
+ * So a box it says holds none holds none. */
+static inline bool fholds_integer(float lo, float hi)
+{
+    const float e = 1.0f / 32 + 1.0f / 1024 + (om__fabsf(lo) + om__fabsf(hi)) * 0x1p-19f;
+    lo -= e;
+    hi += e;
+    if (!(hi - lo < 1.0f) || !(lo > -0x1p22f && lo < 0x1p22f)) return true;
+    float c = (float)(int32_t)lo;   /* towards zero: lo's ceiling, or one below it */
+    if (c < lo) c += 1.0f;
+    return c <= hi;
+}
+
+static inline bool fbox_holds_centre(const float *b, float sc)
+{
+    return fholds_integer(b[0] * sc - 0.5f, b[2] * sc - 0.5f) && fholds_integer(b[1] * sc - 0.5f, b[3] * sc - 0.5f);
+}
+
 /* Float-first bounds (asm.float, lean mode, where double is software and tri_box's
  * double projection of every triangle for every tile is most of a tile's cost): a
  * box in base texels that holds the one tri_box makes from the same vertices. Each
@@ -85,36 +107,46 @@ static inline bool box_holds_centre(const float *b, double sc)
  * and y / w over those intervals, then tri_box's widening and more. false where float
  * cannot bound the box (a vertex near or behind the light's plane, values out of
  * range): the exact path decides. A box that holds tri_box's skips a triangle only
- * where tri_box's would: it misses the region, or holds no texel centre. */
-static bool tri_box_float(const om_mat4 *mt, const om_vec3 p[3], float R, float b[4])
+ * where tri_box's would: it misses the region, or holds no texel centre. Made of
+ * each vertex's part (vert_box_float: bounds u0, u1, v0, v1 of its u and v, false
+ * where float cannot bound them) and the triangle's box of them (box_of_verts). */
+static bool vert_box_float(const om_mat4 *mt, om_vec3 p, float R, float o[4])
 {
     const float *a = mt->m;
+    float e[3], c[3];
+    for (int r = 0; r < 3; r++) {
+        const int k = r == 2 ? 12 : 4 * r;   /* rows x, y and w */
+        const float t0 = a[k] * p.x, t1 = a[k + 1] * p.y, t2 = a[k + 2] * p.z;
+        c[r] = t0 + t1 + t2 + a[k + 3];
+        e[r] = (om__fabsf(t0) + om__fabsf(t1) + om__fabsf(t2) + om__fabsf(a[k + 3])) * 1e-6f + 1e-30f;
+    }
+    const float wl = c[2] - e[2], wh = c[2] + e[2];
+    /* tri_box's own test of the plane, with the bounds against it */
+    if (!(wl > 1e-6f * (om__fabsf(c[0]) + e[0] + om__fabsf(c[1]) + e[1]) + 1e-30f) || !(wh < 1e30f)) return false;
+    float q[2][2];
+    for (int r = 0; r < 2; r++) {
+        const float xl = c[r] - e[r], xh = c[r] + e[r];
+        float ql = xl / wl < xl / wh ? xl / wl : xl / wh, qh = xh / wl > xh / wh ? xh / wl : xh / wh;
+        q[r][0] = ql - (om__fabsf(ql) * 1e-6f + 1e-30f);
+        q[r][1] = qh + (om__fabsf(qh) * 1e-6f + 1e-30f);
+    }
+    /* u = (x / w + 1) R / 2, v = (1 - y / w) R / 2 */
+    o[0] = (q[0][0] + 1.0f) * 0.5f * R;
+    o[1] = (q[0][1] + 1.0f) * 0.5f * R;
+    o[2] = (1.0f - q[1][1]) * 0.5f * R;
+    o[3] = (1.0f - q[1][0]) * 0.5f * R;
+    return true;
+}
+
+/* The triangle's box from its vertices' parts (each vert_box_float's, all true). */
+static bool box_of_verts(const float *const o[3], float b[4])
+{
     float lo_u = 0, lo_v = 0, hi_u = 0, hi_v = 0;
     for (int i = 0; i < 3; i++) {
-        float e[3], c[3];
-        for (int r = 0; r < 3; r++) {
-            const int k = r == 2 ? 12 : 4 * r;   /* rows x, y and w */
-            const float t0 = a[k] * p[i].x, t1 = a[k + 1] * p[i].y, t2 = a[k + 2] * p[i].z;
-            c[r] = t0 + t1 + t2 + a[k + 3];
-            e[r] = (om__fabsf(t0) + om__fabsf(t1) + om__fabsf(t2) + om__fabsf(a[k + 3])) * 1e-6f + 1e-30f;
-        }
-        const float wl = c[2] - e[2], wh = c[2] + e[2];
-        /* tri_box's own test of the plane, with the bounds against it */
-        if (!(wl > 1e-6f * (om__fabsf(c[0]) + e[0] + om__fabsf(c[1]) + e[1]) + 1e-30f) || !(wh < 1e30f)) return false;
-        float q[2][2];
-        for (int r = 0; r < 2; r++) {
-            const float xl = c[r] - e[r], xh = c[r] + e[r];
-            float ql = xl / wl < xl / wh ? xl / wl : xl / wh, qh = xh / wl > xh / wh ? xh / wl : xh / wh;
-            q[r][0] = ql - (om__fabsf(ql) * 1e-6f + 1e-30f);
-            q[r][1] = qh + (om__fabsf(qh) * 1e-6f + 1e-30f);
-        }
-        /* u = (x / w + 1) R / 2, v = (1 - y / w) R / 2 */
-        const float u0 = (q[0][0] + 1.0f) * 0.5f * R, u1 = (q[0][1] + 1.0f) * 0.5f * R;
-        const float v0 = (1.0f - q[1][1]) * 0.5f * R, v1 = (1.0f - q[1][0]) * 0.5f * R;
-        if (i == 0 || u0 < lo_u) lo_u = u0;
-        if (i == 0 || v0 < lo_v) lo_v = v0;
-        if (i == 0 || u1 > hi_u) hi_u = u1;
-        if (i == 0 || v1 > hi_v) hi_v = v1;
+        if (i == 0 || o[i][0] < lo_u) lo_u = o[i][0];
+        if (i == 0 || o[i][2] < lo_v) lo_v = o[i][2];
+        if (i == 0 || o[i][1] > hi_u) hi_u = o[i][1];
+        if (i == 0 || o[i][3] > hi_v) hi_v = o[i][3];
     }
     if (!(lo_u > -1e29f && hi_u < 1e29f && lo_v > -1e29f && hi_v < 1e29f)) return false;
     /* tri_box widens by 1/256 + 1e-6 |u| and rounds to float; this, by far more */
@@ -125,18 +157,59 @@ static bool tri_box_float(const om_mat4 *mt, const om_vec3 p[3], float R, float 
     return true;
 }
 
+
+/* A vertex's light clip coordinates composed with the tile's window. */
+static om_vec4 in_window(om__asm_dvec q, double s_, double kx, double ky)
+{
+    om_vec4 c;
+    c.x = (float)(q.x * s_ + q.w * kx);
+    c.y = (float)(q.y * s_ + q.w * ky);
+    c.z = (float)q.z;
+    c.w = (float)q.w;
+    return c;
+}
+
 /* One triangle into the tile: its clip coordinates composed with the tile's window. */
 static void render_tri(om_raster *r, const om__asm_dvec q[3], double s_, double kx, double ky,
                        uint32_t t)
 {
     om_vec4 c[3];
-    for (int i = 0; i < 3; i++) {
-        c[i].x = (float)(q[i].x * s_ + q[i].w * kx);
-        c[i].y = (float)(q[i].y * s_ + q[i].w * ky);
-        c[i].z = (float)q[i].z;
-        c[i].w = (float)q[i].w;
-    }
+    for (int i = 0; i < 3; i++) c[i] = in_window(q[i], s_, kx, ky);
     om__raster_tri(r, c, t);
+}
+
+/* Lean mode: a tile's vertices in its window (in_window), by vertex index modulo
+ * VCACHE, so that a mesh's triangles drawn one after another project each vertex they
+ * share once (on the stack: its values are what in_window gives, whatever it holds). */
+#define VCACHE 128
+typedef struct vslot {
+    uint32_t v;            /* the vertex, or UINT32_MAX: none */
+    om_vec4 c;
+} vslot;
+
+/* And its part of the float-first bounds (vert_box_float), the same way. */
+typedef struct fslot {
+    uint32_t v;            /* the vertex, or UINT32_MAX: none */
+    bool ok;               /* vert_box_float's verdict */
+    float o[4];
+} fslot;
+
+/* The float-first box of the triangle with vertex indices ix (box_of_verts of its
+ * vertices' parts), the parts through the cache fc (VCACHE slots). */
+static bool tri_box_cached(const om__asm_state *m, fslot *fc, const uint32_t *ix, float R, float b[4])
+{
+    float ov[3][4];   /* copies: two of the vertices may share a slot */
+    for (int i = 0; i < 3; i++) {
+        fslot *e = &fc[ix[i] % VCACHE];
+        if (e->v != ix[i]) {
+            e->v = ix[i];
+            e->ok = vert_box_float(&m->view.light_vp, om__sub(m->scene->verts[ix[i]], m->view.origin), R, e->o);
+        }
+        if (!e->ok) return false;
+        memcpy(ov[i], e->o, sizeof ov[i]);
+    }
+    const float *const o[3] = {ov[0], ov[1], ov[2]};
+    return box_of_verts(o, b);
 }
 
 /* The triangles whose bounds meet the region and hold a texel centre, in index order,
@@ -320,20 +393,48 @@ static void render(const om__asm_state *m, const om__asm_rs *rs, uint32_t level,
         /* The same triangles in the same order as the fast path below, so the same tile:
          * projections and bounds are made per tile instead of kept per frame. */
         const bool first = m->cfg.asm_float != 0;
+        vslot vc[VCACHE];
+        fslot fc[VCACHE];
+        for (int i = 0; i < VCACHE; i++) vc[i].v = fc[i].v = UINT32_MAX;
+        const uint32_t ct = m->chunk_ready ? m->chunk_tris : s->ntris;
+        const float fsc = (float)l->scale[level];
         for (uint32_t t = 0; t < s->ntris; t++) {
+            /* a chunk whose union of float boxes misses the region or holds no texel
+             * centre: so do its triangles' boxes (the union holds each, and a box
+             * fails both tests wherever a box that holds it does) */
+            if (ct < s->ntris && t % ct == 0) {
+                const float *cb = &m->chunk[(size_t)(t / ct) * 4];
+                if (!box_meets(cb, u0, v0, u1, v1) || !fbox_holds_centre(cb, fsc)) {
+                    t += ct - 1;
+                    continue;
+                }
+            }
             const uint32_t *ix = s->idx + (size_t)t * 3;
             om__asm_dvec q[3];
             float b[4];
-            om_vec3 p[3];
-            for (int i = 0; i < 3; i++) p[i] = om__sub(s->verts[ix[i]], m->view.origin);
-            if (first && tri_box_float(&m->view.light_vp, p, (float)T, b) &&
-                (!box_meets(b, u0, v0, u1, v1) || !box_holds_centre(b, l->scale[level])))
+            const bool bounded = first && tri_box_cached(m, fc, ix, (float)T, b);
+            if (bounded && (!box_meets(b, u0, v0, u1, v1) || !fbox_holds_centre(b, fsc)))
                 continue;   /* the box that holds tri_box's misses: so would tri_box's */
-            for (int i = 0; i < 3; i++) q[i] = dapply(&m->view.light_vp, p[i]);
-            tri_box(q, T, b);
-            if (!box_meets(b, u0, v0, u1, v1) || !box_holds_centre(b, l->scale[level])) continue;
+            /* Where the float box meets, the triangle is drawn without tri_box's verdict:
+             * one that tri_box's box would skip writes no texel centre of the window (the
+             * box holds its snapped image), so drawing it leaves the tile as it was. */
+            if (!bounded) {
+                for (int i = 0; i < 3; i++) q[i] = dapply(&m->view.light_vp, om__sub(s->verts[ix[i]], m->view.origin));
+                tri_box(q, T, b);
+                if (!box_meets(b, u0, v0, u1, v1) || !box_holds_centre(b, l->scale[level])) continue;
+            }
+            om_vec4 c[3];
+            for (int i = 0; i < 3; i++) {
+                vslot *e = &vc[ix[i] % VCACHE];
+                if (e->v != ix[i]) {
+                    e->v = ix[i];
+                    e->c = in_window(bounded ? dapply(&m->view.light_vp, om__sub(s->verts[ix[i]], m->view.origin)) : q[i],
+                                     s_, kx, ky);
+                }
+                c[i] = e->c;
+            }
             r.cull_back = om__cull_next(&cl, t);
-            render_tri(&r, q, s_, kx, ky, t);
+            om__raster_tri(&r, c, t);
         }
     } else {
         const double sc = l->scale[level];
@@ -386,6 +487,7 @@ static void render_part(om__asm_state *m, uint32_t index, const float (*rects)[4
 {
     const om__asm_rs rs = {m->sdepth, m->sid, m->cull, m->gbits};
     om__asm_tile tl;
+    om__asm_chunks(m);
     om__asm_tile_of(&m->tree, index, &tl);
     const double sc = m->tree.lay.scale[tl.node->level], T = (double)tl.size;
     const double o[2] = {(double)tl.node->ox, (double)tl.node->oy};
@@ -404,8 +506,34 @@ static void render_part(om__asm_state *m, uint32_t index, const float (*rects)[4
     render(m, &rs, tl.node->level, tl.node->ox, tl.node->oy, win, tl.depth, tl.id16, tl.id32);
 }
 
+void om__asm_chunks(om__asm_state *m)
+{
+    if (!m->chunk || m->chunk_ready) return;
+    const om_scene *s = m->scene;
+    const uint32_t ct = m->chunk_tris;
+    const float R = (float)m->tree.lay.tile;
+    fslot fc[VCACHE];
+    for (int i = 0; i < VCACHE; i++) fc[i].v = UINT32_MAX;
+    for (uint32_t c = 0; c * ct < s->ntris; c++) {
+        float *u = &m->chunk[(size_t)c * 4];
+        const uint32_t t1 = (c + 1) * ct < s->ntris ? (c + 1) * ct : s->ntris;
+        for (uint32_t t = c * ct; t < t1; t++) {
+            float b[4];
+            if (!tri_box_cached(m, fc, s->idx + (size_t)t * 3, R, b)) {   /* unbounded: every tile */
+                u[0] = u[1] = -FLT_MAX;
+                u[2] = u[3] = FLT_MAX;
+                break;
+            }
+            for (int e = 0; e < 4; e++)
+                if (t == c * ct || (e < 2 ? b[e] < u[e] : b[e] > u[e])) u[e] = b[e];
+        }
+    }
+    m->chunk_ready = true;
+}
+
 void om__asm_render_node(om__asm_state *m, uint32_t index)
 {
+    om__asm_chunks(m);
     const om__asm_rs rs = {m->sdepth, m->sid, m->cull, m->gbits};
     om__asm_render_with(m, index, &rs);
 }
