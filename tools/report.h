@@ -61,10 +61,11 @@ void report_stability(FILE *f, const rcsv *sc);
  * it and writes DIR/memory.csv (one row a setting measured, its mismatch share and
  * time, the method's best marked; a row "does not fit" with the least it needs);
  * report_memory draws a chart and a table per scene from it. Returns 0, or the exit
- * status of a failure. The scenes and budgets of memory.csv, in their order: */
+ * status of a failure. The scenes of a CSV's "scene" column (memory.csv's, bench.csv's)
+ * and the budgets of memory.csv, in their order: */
 int report_memory_measure(const char *dir, int runs);
 void report_memory(FILE *f, const rcsv *mem);
-size_t report_memory_scenes(const rcsv *c, const char **names, size_t max);
+size_t report_scenes_of(const rcsv *c, const char **names, size_t max);
 size_t report_memory_budgets(const rcsv *c, const char *scene, double *budgets, size_t max);
 
 /* What the page says about Cortex-M4 firmware, per method: its code, its whole

@@ -254,8 +254,8 @@ static size_t methods_of(const rcsv *c, const char *scene, const char **names, s
     return n;
 }
 
-/* The scenes of memory.csv, in order; their budgets likewise. */
-size_t report_memory_scenes(const rcsv *c, const char **names, size_t max)
+/* The scenes of a CSV's "scene" column (memory.csv's, bench.csv's), in order. */
+size_t report_scenes_of(const rcsv *c, const char **names, size_t max)
 {
     size_t n = 0;
     for (size_t r = 0; r < c->rows; r++) {
@@ -307,7 +307,7 @@ void report_memory(FILE *f, const rcsv *mem)
                "(the table says what it would need). Every setting measured is in "
                "<code>memory.csv</code>.</p>\n");
     const char *scenes[8];
-    size_t nsc = report_memory_scenes(mem, scenes, 8);
+    size_t nsc = report_scenes_of(mem, scenes, 8);
     for (size_t s = 0; s < nsc; s++) {
         enum { MAXM = 16 };
         static double xs[MAXM][NBUDGET * 2], ys[MAXM][NBUDGET * 2];

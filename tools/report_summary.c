@@ -77,19 +77,6 @@ static void head_row(FILE *f, const char *first)
     fprintf(f, "</tr>\n");
 }
 
-/* The scenes of a CSV's "scene" column, in order. */
-static size_t scenes_of(const rcsv *c, const char **names, size_t max)
-{
-    size_t n = 0;
-    for (size_t r = 0; r < c->rows; r++) {
-        const char *s = rcsv_get(c, r, "scene");
-        size_t k = 0;
-        while (k < n && strcmp(names[k], s)) k++;
-        if (k == n && n < max) names[n++] = s;
-    }
-    return n;
-}
-
 static void chips(FILE *f, const rcross *x)
 {
     rchip ch[32];
@@ -153,7 +140,7 @@ void report_summary(FILE *f, const rcsv *bench, const rcsv *mem, const rcross *x
                "budget, and the most accurate setting that fits at all. Each cell links to the "
                "chart it was read from.</p>\n");
     const char *scenes[16];
-    size_t ns = mem ? report_memory_scenes(mem, scenes, 16) : 0;
+    size_t ns = mem ? report_scenes_of(mem, scenes, 16) : 0;
     if (ns) {
         fprintf(f, "<h3>All the memory you have (scene, frame and method arenas)</h3>\n<div class=\"cards\">\n");
         for (size_t s = 0; s < ns; s++) {
@@ -187,7 +174,7 @@ void report_summary(FILE *f, const rcsv *bench, const rcsv *mem, const rcross *x
                    "budgets of all the arenas.)</p>\n");
     }
     chips(f, x);
-    ns = bench ? scenes_of(bench, scenes, 16) : 0;
+    ns = bench ? report_scenes_of(bench, scenes, 16) : 0;
     if (ns) {
         fprintf(f, "<h3>Per scene of the sweep, the method's own arena</h3>\n<p class=\"read\">The same "
                    "question on each scene of the sweep at its size, the budget counting the method's arena "
