@@ -32,9 +32,9 @@
 
 /* The release this header belongs to (`ombra --version` prints the string). */
 #define OMBRA_VERSION_MAJOR 0
-#define OMBRA_VERSION_MINOR 1
+#define OMBRA_VERSION_MINOR 2
 #define OMBRA_VERSION_PATCH 0
-#define OMBRA_VERSION_STRING "0.1.0"
+#define OMBRA_VERSION_STRING "0.2.0"
 
 #include <stddef.h>
 #include <stdint.h>
