@@ -146,7 +146,7 @@ static void measure(FILE *o, const struct mscene *ms, const om_method *m, const 
     for (int i = 0; i < na; i++)
         for (int j = 0; j < nb && n < MAXC; j++) {
             char setting[96];
-            snprintf(setting, sizeof setting, "%.31s%s%s%s%.31s%s%s", k->a ? k->a : "", k->a ? "=" : "",
+            snprintf(setting, sizeof setting, "%.31s%s%.15s%s%.31s%s%.15s", k->a ? k->a : "", k->a ? "=" : "",
                      k->a ? av[i] : "", k->b ? " " : "", k->b ? k->b : "", k->b ? "=" : "", k->b ? bv[j] : "");
             size_t need;
             memset(&c[n], 0, sizeof c[n]);

@@ -94,21 +94,28 @@ static void plain(char *buf, size_t n, double v)
     }
 }
 
+/* s after buf's text where the whole of it fits in n bytes (no format: gcc cannot bound
+ * a number's length through one and warns at -O3). */
+static void put_after(char *buf, size_t n, const char *s)
+{
+    const size_t l = strlen(buf), k = strlen(s);
+    if (l + k < n) memcpy(buf + l, s, k + 1);
+}
+
 void svg_format(char *buf, size_t n, double v, svg_unit u)
 {
-    char num[48];
     if (u == SVG_SHARE) {
-        plain(num, sizeof num, 100 * v);
-        snprintf(buf, n, "%s%%", num);
+        plain(buf, n, 100 * v);
+        put_after(buf, n, "%");
     } else if (u == SVG_MS) {
-        plain(num, sizeof num, v);
-        snprintf(buf, n, "%s ms", num);
+        plain(buf, n, v);
+        put_after(buf, n, " ms");
     } else if (u == SVG_BYTES) {
-        static const char *const units[] = {"B", "KiB", "MiB", "GiB"};
+        static const char *const units[] = {" B", " KiB", " MiB", " GiB"};
         int k = 0;
         while (fabs(v) >= 1024 && k < 3) { v /= 1024; k++; }
-        plain(num, sizeof num, v);
-        snprintf(buf, n, "%s %s", num, units[k]);
+        plain(buf, n, v);
+        put_after(buf, n, units[k]);
     } else {
         plain(buf, n, v);
     }

@@ -28,6 +28,7 @@ static void one_scene(const bscene *b, bool fine)
         double ob[3], bu[3], lo[3], ey[3], miss[3], to[3][N], tb[3][N], tl[3][N], te[3][N];
         const int series = fine ? 3 : 2;
         mrun last, lastsp;
+        memset(&lastsp, 0, sizeof lastsp);   /* read after the loop, which gcc -O1 cannot see runs */
         om_method_cfg c[3];
         for (int k = 0; k < 3; k++) {
             om_method_cfg_default(&c[k], om_method_find(names[k]));
