@@ -77,6 +77,34 @@ static void head_row(FILE *f, const char *first)
     fprintf(f, "</tr>\n");
 }
 
+/* One scene's table of c: a row a budget, a cell an accuracy need (cell), the scene
+ * named `label` in its caption with its size. total: the budgets count every arena
+ * (memory.csv's total_bytes), else the method's alone (bench.csv's bytes). */
+static void budget_table(FILE *f, const rcsv *c, const char *scene, const char *label, const double *budgets,
+                         size_t nb, const char *anchor, bool total)
+{
+    const char *w = "", *h = "";
+    for (size_t r = 0; r < c->rows; r++)
+        if (!strcmp(rcsv_get(c, r, "scene"), scene)) {
+            w = rcsv_get(c, r, "width");
+            h = rcsv_get(c, r, "height");
+            break;
+        }
+    fprintf(f, "<div class=\"scroll\"><table class=\"summary\">\n<caption>");
+    svg_escape(f, label);
+    fprintf(f, "%s at %sx%s</caption>\n", total ? " scene" : "", w, h);
+    head_row(f, total ? "memory" : "method arena");
+    for (size_t b = 0; b < nb; b++) {
+        char t[32];
+        svg_format(t, sizeof t, budgets[b], SVG_BYTES);
+        fprintf(f, "<tr><th>%s</th>", t);
+        for (int k = 0; k < NNEED; k++)
+            cell(f, c, scene, total ? "total_bytes" : "bytes", budgets[b], needs[k], anchor, total);
+        fprintf(f, "</tr>\n");
+    }
+    fprintf(f, "</table></div>\n");
+}
+
 static void chips(FILE *f, const rcross *x)
 {
     rchip ch[32];
@@ -146,27 +174,9 @@ void report_summary(FILE *f, const rcsv *bench, const rcsv *mem, const rcross *x
         for (size_t s = 0; s < ns; s++) {
             double budgets[16];
             size_t nb = report_memory_budgets(mem, scenes[s], budgets, 16);
-            const char *w = "", *h = "";
-            for (size_t r = 0; r < mem->rows; r++)
-                if (!strcmp(rcsv_get(mem, r, "scene"), scenes[s])) {
-                    w = rcsv_get(mem, r, "width");
-                    h = rcsv_get(mem, r, "height");
-                    break;
-                }
             char anchor[96];
             snprintf(anchor, sizeof anchor, "chart-memory-%s", scenes[s]);
-            fprintf(f, "<div class=\"scroll\"><table class=\"summary\">\n<caption>");
-            svg_escape(f, scenes[s]);
-            fprintf(f, " scene at %sx%s</caption>\n", w, h);
-            head_row(f, "memory");
-            for (size_t b = 0; b < nb; b++) {
-                char t[32];
-                svg_format(t, sizeof t, budgets[b], SVG_BYTES);
-                fprintf(f, "<tr><th>%s</th>", t);
-                for (int k = 0; k < NNEED; k++) cell(f, mem, scenes[s], "total_bytes", budgets[b], needs[k], anchor, true);
-                fprintf(f, "</tr>\n");
-            }
-            fprintf(f, "</table></div>\n");
+            budget_table(f, mem, scenes[s], scenes[s], budgets, nb, anchor, true);
         }
         fprintf(f, "</div>\n");
     } else {
@@ -183,25 +193,7 @@ void report_summary(FILE *f, const rcsv *bench, const rcsv *mem, const rcross *x
         for (size_t s = 0; s < ns; s++) {
             char anchor[300];
             report_chart_id(anchor, sizeof anchor, scenes[s], "bytes");
-            const char *w = "", *h = "";
-            for (size_t r = 0; r < bench->rows; r++)
-                if (!strcmp(rcsv_get(bench, r, "scene"), scenes[s])) {
-                    w = rcsv_get(bench, r, "width");
-                    h = rcsv_get(bench, r, "height");
-                    break;
-                }
-            fprintf(f, "<div class=\"scroll\"><table class=\"summary\">\n<caption>");
-            svg_escape(f, cli_base_name(scenes[s]));
-            fprintf(f, " at %sx%s</caption>\n", w, h);
-            head_row(f, "method arena");
-            for (size_t b = 0; b < NARENA; b++) {
-                char t[32];
-                svg_format(t, sizeof t, arena_budgets[b], SVG_BYTES);
-                fprintf(f, "<tr><th>%s</th>", t);
-                for (int k = 0; k < NNEED; k++) cell(f, bench, scenes[s], "bytes", arena_budgets[b], needs[k], anchor, false);
-                fprintf(f, "</tr>\n");
-            }
-            fprintf(f, "</table></div>\n");
+            budget_table(f, bench, scenes[s], cli_base_name(scenes[s]), arena_budgets, NARENA, anchor, false);
         }
         fprintf(f, "</div>\n");
     }
